@@ -1,0 +1,155 @@
+"""The ``mrgc`` command: a thin layer over the Python API.
+
+Exit codes (docs/errors.md): 0 ok; 1 no plan / infeasible / ``fmt --check`` found unformatted files;
+2 input error (bad file or bad command line); 3 time limit; 4 missing backend; 70 internal error;
+130 interrupted.  No input produces a Python traceback: unexpected exceptions are reported in one line
+with exit code 70.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from typing import Callable, Sequence
+
+from mrgc import __version__
+from mrgc.errors import Diagnostic, InputError, MrgcError
+
+EXIT_OK = 0
+EXIT_NO_PLAN = 1
+EXIT_INPUT = 2
+EXIT_TIME_LIMIT = 3
+EXIT_MISSING_BACKEND = 4
+EXIT_INTERNAL = 70
+EXIT_INTERRUPTED = 130
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse whose usage errors are one ``error[E000]`` line and exit code 2."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        self.print_usage(sys.stderr)
+        print(f"mrgc: error[E000]: {message}", file=sys.stderr)
+        raise SystemExit(EXIT_INPUT)
+
+
+def _report(exc: InputError) -> None:
+    print(exc.render(), file=sys.stderr)
+    n = len(exc.diagnostics)
+    if n > 1:
+        print(f"{n} errors", file=sys.stderr)
+
+
+# ---------------------------------------------------------------- commands
+def cmd_check(args: argparse.Namespace) -> int:
+    from mrgc.language.loader import parse_file
+
+    status = EXIT_OK
+    for path in args.files:
+        try:
+            mf = parse_file(path)
+        except InputError as exc:
+            _report(exc)
+            status = EXIT_INPUT
+            continue
+        parts = [f"{len(mf.domains)} domain{'s' * (len(mf.domains) != 1)}"]
+        for p in mf.problems:
+            kind = "symbolic" if p.symbolic else "geometric"
+            parts.append(
+                f"problem {p.name} ({kind}: {len(p.robots)} robots, {len(p.movable)} movable, "
+                f"{len(p.regions)} regions, {len(p.goal)} goals, {len(p.init)} facts)"
+            )
+        if not args.quiet:
+            print(f"{path}: ok: " + "; ".join(parts))
+    return status
+
+
+def cmd_fmt(args: argparse.Namespace) -> int:
+    from mrgc.language.loader import read_source
+    from mrgc.language.parser import parse_text
+    from mrgc.language.printer import format_source
+
+    if not (args.check or args.write) and len(args.files) != 1:
+        raise InputError([Diagnostic("E000", "fmt prints one file; use --check or --write for several")])
+    status = EXIT_OK
+    for path in args.files:
+        text, diag = read_source(path)
+        if diag is None:
+            assert text is not None
+            tree = parse_text(text, path)
+            if isinstance(tree, Diagnostic):
+                diag = tree
+        if diag is not None:
+            _report(InputError([diag], {path: text} if text is not None else {}))
+            status = EXIT_INPUT
+            continue
+        assert text is not None and not isinstance(tree, Diagnostic)
+        pretty = format_source(tree, text)
+        if args.check:
+            if pretty != text:
+                print(f"{path}: would reformat", file=sys.stderr)
+                status = status or EXIT_NO_PLAN
+        elif args.write:
+            if pretty != text:
+                tmp = path + ".mrgc-tmp"
+                with open(tmp, "w", encoding="utf-8") as fh:
+                    fh.write(pretty)
+                os.replace(tmp, path)
+                print(f"{path}: reformatted")
+        else:
+            sys.stdout.write(pretty)
+    return status
+
+
+# ---------------------------------------------------------------- wiring
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog="mrgc", description="Multi-robot geometric task-and-motion planning compiler and solver.")
+    parser.add_argument("--version", action="version", version=f"mrgc {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+
+    p = sub.add_parser("check", help="parse and check .mrg files, reporting every error at once")
+    p.add_argument("files", nargs="+", metavar="FILE")
+    p.add_argument("-q", "--quiet", action="store_true", help="print nothing for files that are fine")
+    p.set_defaults(func=cmd_check)
+
+    p = sub.add_parser("fmt", help="print a .mrg file in canonical form")
+    p.add_argument("files", nargs="+", metavar="FILE")
+    mode = p.add_mutually_exclusive_group()
+    mode.add_argument("--check", action="store_true", help="exit 1 if a file is not canonically formatted")
+    mode.add_argument("--write", action="store_true", help="rewrite files in place")
+    p.set_defaults(func=cmd_fmt)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the CLI; returns the exit code (the console script exits with it)."""
+    parser = build_parser()
+    try:
+        args = parser.parse_args(argv)
+        if not getattr(args, "func", None):
+            parser.print_help()
+            return EXIT_INPUT
+        func: Callable[[argparse.Namespace], int] = args.func
+        return func(args)
+    except SystemExit as exc:  # argparse --help / --version / usage errors
+        return exc.code if isinstance(exc.code, int) else EXIT_INPUT
+    except InputError as exc:
+        _report(exc)
+        return exc.exit_code
+    except MrgcError as exc:
+        print(f"mrgc: error: {exc}", file=sys.stderr)
+        return exc.exit_code
+    except KeyboardInterrupt:
+        print("mrgc: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except BrokenPipeError:
+        return EXIT_OK
+    except Exception as exc:  # noqa: BLE001 - the promise is: never a traceback
+        print(f"mrgc: internal error[E070]: {type(exc).__name__}: {exc} "
+              "(please report this with the input that caused it)", file=sys.stderr)
+        return EXIT_INTERNAL
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,1 @@
+"""Facts → collaborative manipulation task graph (CMTG) → SkeletonModel IR (see docs/architecture.md)."""

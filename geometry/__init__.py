@@ -1,0 +1,1 @@
+"""Geometry on pybullet, coal and OMPL: scenes, kinematics, collisions, motions, predicates."""

@@ -1,0 +1,227 @@
+"""The checked problem: what a ``.mrg`` file *means*, in typed frozen dataclasses.
+
+Every later layer (geometry, compiler, planner) reads these objects and nothing of the syntax tree.  Units
+are SI (metres); ``Pose.yaw`` is in degrees as written, ``Pose.yaw_rad`` in radians.  A problem is either
+*symbolic* (no geometry; its facts are stated in ``:init``) or *geometric* (shapes and poses; facts are
+computed by the geometry layer, or read from a completed ``:init`` written by ``mrgc facts``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Union
+
+from mrgc.errors import Span
+from mrgc.language.ast import NOWHERE
+
+# The six predicates of the paper: name -> sorts of the arguments, in order.
+PREDICATES: dict[str, tuple[str, ...]] = {
+    "in-region": ("movable", "region"),
+    "reachable-pick": ("movable", "grasp", "robot"),
+    "reachable-place": ("movable", "region", "grasp", "robot"),
+    "occludes-pick": ("movable", "movable", "grasp", "robot"),
+    "occludes-goal-place": ("movable", "movable", "region", "grasp", "robot"),
+    "enable-goal-handover": ("movable", "grasp", "grasp", "robot", "robot"),
+}
+
+#: requirement flags a domain may declare (informational; see docs/language.md)
+REQUIREMENTS: tuple[str, ...] = ("handover", "planar-base", "symbolic")
+
+BASE_TYPES: tuple[str, ...] = ("fixed", "planar")
+
+
+def _span() -> Span:
+    return field(default=NOWHERE, compare=False, repr=False)  # type: ignore[no-any-return]
+
+
+@dataclass(frozen=True)
+class Pose:
+    """A planar-yaw pose: position (x, y, z) in metres and rotation ``yaw`` about +z in degrees."""
+
+    x: float
+    y: float
+    z: float
+    yaw: float = 0.0
+
+    @property
+    def yaw_rad(self) -> float:
+        return math.radians(self.yaw)
+
+    @property
+    def position(self) -> tuple[float, float, float]:
+        return (self.x, self.y, self.z)
+
+
+@dataclass(frozen=True)
+class Box:
+    """An axis-aligned box (in its own frame) with full side lengths, centred on its pose."""
+
+    sx: float
+    sy: float
+    sz: float
+
+
+@dataclass(frozen=True)
+class Cylinder:
+    """A cylinder along its local z axis, centred on its pose."""
+
+    radius: float
+    height: float
+
+
+@dataclass(frozen=True)
+class Sphere:
+    """A sphere centred on its pose."""
+
+    radius: float
+
+
+@dataclass(frozen=True)
+class Mesh:
+    """A triangle mesh file (OBJ/STL), ``path`` resolved relative to the declaring file, scaled uniformly."""
+
+    path: str
+    scale: float = 1.0
+
+
+Shape = Union[Box, Cylinder, Sphere, Mesh]
+
+
+@dataclass(frozen=True)
+class RobotKind:
+    """A kind of robot: its URDF, base type, end-effector link and home configuration.
+
+    ``base`` is ``fixed`` (arm bolted to its base pose) or ``planar`` (x, y, yaw driven base).  A planar
+    kind may give a ``footprint`` shape and the ``carry`` pose of a held object relative to its base.
+    """
+
+    name: str
+    urdf: str | None = None
+    base: str = "fixed"
+    end_effector: str | None = None
+    home: tuple[float, ...] = ()
+    footprint: Shape | None = None
+    carry: Pose | None = None
+    reach: float | None = None
+    source: str = field(default="", compare=False)
+    span: Span = _span()
+
+
+@dataclass(frozen=True)
+class Domain:
+    """A domain: requirement flags, robot kinds and the grasp vocabulary shared by its problems."""
+
+    name: str
+    requirements: tuple[str, ...] = ()
+    robot_kinds: tuple[RobotKind, ...] = ()
+    grasps: tuple[str, ...] = ()
+    source: str = field(default="", compare=False)
+    span: Span = _span()
+
+    def kind(self, name: str) -> RobotKind:
+        return next(k for k in self.robot_kinds if k.name == name)
+
+
+@dataclass(frozen=True)
+class Robot:
+    """A robot of a problem; ``kind`` and ``base`` are None in symbolic problems."""
+
+    name: str
+    kind: str | None = None
+    base: Pose | None = None
+    span: Span = _span()
+
+
+@dataclass(frozen=True)
+class FixedObject:
+    """An obstacle that never moves (a table, a wall)."""
+
+    name: str
+    shape: Shape | None = None
+    pose: Pose | None = None
+    span: Span = _span()
+
+
+@dataclass(frozen=True)
+class Region:
+    """A region objects can be placed in; an object is in it iff the object lies entirely inside."""
+
+    name: str
+    shape: Shape | None = None
+    pose: Pose | None = None
+    span: Span = _span()
+
+
+@dataclass(frozen=True)
+class MovableObject:
+    """A movable object; ``grasps`` are the grasps robots may use on it (default: the whole vocabulary).
+
+    ``handover_points`` names the handover points it may be passed at (default: all of the problem's).
+    """
+
+    name: str
+    shape: Shape | None = None
+    pose: Pose | None = None
+    grasps: tuple[str, ...] = ()
+    handover_points: tuple[str, ...] = ()
+    span: Span = _span()
+
+
+@dataclass(frozen=True)
+class HandoverPoint:
+    """A predefined point in space where two robots may pass an object (``position`` None if symbolic)."""
+
+    name: str
+    position: tuple[float, float, float] | None = None
+    span: Span = _span()
+
+
+@dataclass(frozen=True, order=True)
+class Fact:
+    """A ground predicate instance, e.g. ``Fact("reachable-pick", ("o1", "top", "r1"))``."""
+
+    predicate: str
+    args: tuple[str, ...]
+
+    def __str__(self) -> str:
+        return f"({self.predicate} {' '.join(self.args)})"
+
+
+@dataclass(frozen=True)
+class Problem:
+    """A checked problem, with its domain resolved.
+
+    ``init`` holds the facts stated in the file (all of them for a symbolic problem; for a geometric one,
+    the facts cached by ``mrgc facts``, or none).  ``goal`` is the conjunction of ``in-region`` facts.
+    """
+
+    name: str
+    domain: Domain
+    robots: tuple[Robot, ...]
+    fixed: tuple[FixedObject, ...]
+    regions: tuple[Region, ...]
+    movable: tuple[MovableObject, ...]
+    handover_points: tuple[HandoverPoint, ...]
+    init: tuple[Fact, ...]
+    goal: tuple[Fact, ...]
+    symbolic: bool
+    source: str = field(default="", compare=False)
+    span: Span = _span()
+
+    @property
+    def goal_regions(self) -> dict[str, str]:
+        """Goal object name → its goal region."""
+        return {f.args[0]: f.args[1] for f in self.goal}
+
+    @property
+    def initial_regions(self) -> dict[str, str]:
+        """Object name → the region ``(in-region o r)`` in ``:init`` puts it in (where stated)."""
+        return {f.args[0]: f.args[1] for f in self.init if f.predicate == "in-region"}
+
+    def object(self, name: str) -> MovableObject:
+        return next(m for m in self.movable if m.name == name)
+
+    def grasps_of(self, name: str) -> tuple[str, ...]:
+        """The grasps robots may use on movable object ``name``."""
+        return self.object(name).grasps or self.domain.grasps

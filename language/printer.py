@@ -1,0 +1,226 @@
+"""The canonical printer behind ``mrgc fmt``: syntax tree (+ the file's comments) → canonical text.
+
+Layout rules (docs/language.md, "Canonical format"): two-space indentation; one section per line; a
+declaration section with properties puts one declaration per line; ``:init`` puts one atom per line; bare
+name lists fill lines up to :data:`WIDTH` columns; numbers print in their shortest exact form (``0.5``,
+``90``, ``1e-05``).  Comments are kept: a comment on its own line stays before the item that follows it, a
+comment after code stays at the end of that item's line.  Printing is idempotent, and for any tree
+``parse(print(tree)) == tree``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from mrgc.errors import Span
+from mrgc.language import ast
+
+WIDTH = 100
+
+
+@dataclass(frozen=True)
+class Comment:
+    """A ``;`` comment: where it starts, its text (with the ``;``), and whether code precedes it on its line."""
+
+    line: int
+    column: int
+    text: str
+    trailing: bool
+
+
+def comments_of(text: str) -> list[Comment]:
+    """Every comment of ``text`` in order (``;`` inside a string is not a comment)."""
+    out: list[Comment] = []
+    line, col, in_string, code_on_line = 1, 1, False, False
+    i, n = 0, len(text)
+    while i < n:
+        ch = text[i]
+        if in_string:
+            if ch == "\\":
+                i += 2
+                col += 2
+                continue
+            if ch == '"':
+                in_string = False
+            elif ch == "\n":  # unterminated string: the parser reports it
+                in_string = False
+        elif ch == '"':
+            in_string, code_on_line = True, True
+        elif ch == ";":
+            end = text.find("\n", i)
+            end = n if end < 0 else end
+            out.append(Comment(line, col, text[i:end].rstrip(), code_on_line))
+            col += end - i
+            i = end
+            continue
+        elif not ch.isspace():
+            code_on_line = True
+        if ch == "\n":
+            line, col, code_on_line = line + 1, 1, False
+        else:
+            col += 1
+        i += 1
+    return out
+
+
+def number(x: float) -> str:
+    """Shortest text that parses back to exactly ``x``."""
+    if x == 0:
+        return "0"
+    if x.is_integer() and abs(x) < 1e16:
+        return str(int(x))
+    return repr(x)
+
+
+def string(s: str) -> str:
+    body = s.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n").replace("\t", "\\t")
+    return f'"{body}"'
+
+
+def value(v: ast.Value | ast.Number | ast.Symbol | ast.String) -> str:
+    if isinstance(v, ast.Number):
+        return number(v.value)
+    if isinstance(v, ast.Symbol):
+        return v.name
+    if isinstance(v, ast.String):
+        return string(v.value)
+    return "(" + " ".join(value(i) for i in v.items) + ")"
+
+
+def prop(p: ast.Property) -> str:
+    return f":{p.key} {value(p.value)}"
+
+
+def decl(d: ast.Decl) -> str:
+    if d.bare and not d.props:
+        return d.name
+    return "(" + " ".join([d.name, *(prop(p) for p in d.props)]) + ")"
+
+
+def atom(a: ast.Atom) -> str:
+    return "(" + " ".join([a.predicate, *a.args]) + ")"
+
+
+class _Out:
+    """Accumulates output lines, placing pending comments before the items they precede."""
+
+    def __init__(self, comments: list[Comment]) -> None:
+        self.lines: list[str] = []
+        self.pending = list(comments)
+
+    def _flush_before(self, span: Span | None, indent: str) -> None:
+        if span is None or span.file == "<generated>":
+            return
+        while self.pending and (self.pending[0].line, self.pending[0].column) < (span.line, span.column):
+            c = self.pending.pop(0)
+            if c.trailing and self.lines:
+                self.lines[-1] += " " + c.text
+            else:
+                self.lines.append(indent + c.text)
+
+    def flush_until(self, line: int, indent: str) -> None:
+        """Emit comments that start before ``line`` (used at the end of a group)."""
+        self._flush_before(Span("", line, 1, line, 1), indent)
+
+    def emit(self, text: str, indent: str, span: Span | None = None) -> None:
+        self._flush_before(span, indent)
+        self.lines.append(indent + text)
+
+    def close(self) -> None:
+        self.lines[-1] += ")"
+
+    def rest(self) -> None:
+        for c in self.pending:
+            if c.trailing and self.lines:
+                self.lines[-1] += " " + c.text
+            else:
+                self.lines.append(c.text)
+        self.pending = []
+
+
+def format_source(tree: ast.SourceFile, text: str = "") -> str:
+    """The canonical text of ``tree``; pass the original ``text`` to keep its comments."""
+    out = _Out(comments_of(text) if text else [])
+    for i, d in enumerate(tree.definitions):
+        if i:
+            out.lines.append("")
+        head = "domain" if isinstance(d, ast.DomainDef) else "problem"
+        out.emit(f"(define ({head} {d.name})", "", d.span)
+        for sec in d.sections:
+            _section(out, sec)
+        if d.span.file != "<generated>":
+            out.flush_until(d.span.end_line, "  ")  # comments inside, before the closing line
+        out.close()
+        if d.span.file != "<generated>":
+            out.flush_until(d.span.end_line + 1, "")  # comments after the closing parenthesis
+    out.rest()
+    return "\n".join(out.lines) + "\n"
+
+
+def _section(out: _Out, sec: ast.DomainSection | ast.ProblemSection) -> None:
+    ind = "  "
+    if isinstance(sec, ast.Requirements):
+        out.emit("(" + " ".join([":requirements", *(":" + f for f in sec.flags)]) + ")", ind, sec.span)
+    elif isinstance(sec, ast.Grasps):
+        _fill(out, ":grasps", list(zip(sec.names, sec.name_spans or (sec.span,) * len(sec.names))), sec.span)
+    elif isinstance(sec, ast.Include):
+        out.emit(f"(:include {string(sec.path)})", ind, sec.span)
+    elif isinstance(sec, ast.DomainRef):
+        out.emit(f"(:domain {sec.name})", ind, sec.span)
+    elif isinstance(sec, ast.RobotKindDecl):
+        out.emit(f"(:robot-kind {sec.name}", ind, sec.span)
+        for p in sec.props:
+            out.emit(prop(p), ind * 2, p.span)
+        out.close()
+    elif isinstance(sec, ast.DeclSection):
+        if all(d.bare and not d.props for d in sec.decls):
+            _fill(out, ":" + sec.kind, [(d.name, d.span) for d in sec.decls], sec.span)
+        else:
+            out.emit(f"(:{sec.kind}", ind, sec.span)
+            for d in sec.decls:
+                out.emit(decl(d), ind * 2, d.span)
+            out.close()
+    elif isinstance(sec, ast.Init):
+        if not sec.atoms:
+            out.emit("(:init)", ind, sec.span)
+            return
+        out.emit("(:init", ind, sec.span)
+        for a in sec.atoms:
+            out.emit(atom(a), ind * 2, a.span)
+        out.close()
+    elif isinstance(sec, ast.Goal):
+        _goal(out, sec)
+
+
+def _goal(out: _Out, sec: ast.Goal) -> None:
+    ind = "  "
+    if not sec.conjunction:
+        out.emit(f"(:goal {atom(sec.atoms[0])})", ind, sec.span)
+        return
+    one_line = "(:goal (and" + "".join(" " + atom(a) for a in sec.atoms) + "))"
+    s = sec.span
+    commented = s.file != "<generated>" and any(
+        (s.line, s.column) < (c.line, c.column) < (s.end_line, s.end_column) for c in out.pending
+    )
+    if len(ind + one_line) <= WIDTH and not commented:
+        out.emit(one_line, ind, sec.span)
+        return
+    out.emit("(:goal (and", ind, sec.span)
+    for a in sec.atoms:
+        out.emit(atom(a), ind * 3, a.span)
+    out.close()
+    out.close()
+
+
+def _fill(out: _Out, head: str, names: list[tuple[str, Span]], span: Span) -> None:
+    """``(head a b c ...)`` filled to WIDTH; a comment before a name starts a new line."""
+    ind, cont = "  ", "    "
+    out.emit("(" + head, ind, span)
+    for name, nspan in names:
+        has_comment = bool(out.pending) and nspan.file != "<generated>" and \
+            (out.pending[0].line, out.pending[0].column) < (nspan.line, nspan.column)
+        if has_comment or len(out.lines[-1]) + 1 + len(name) > WIDTH:
+            out.emit(name, cont, nspan)
+        else:
+            out.lines[-1] += " " + name
+    out.close()

@@ -1,0 +1,205 @@
+"""Reading ``:key value`` properties into typed values, with one diagnostic per problem found.
+
+Which properties each declaration accepts is data (:data:`SCHEMAS`); the readers turn a syntax value into a
+pose, a shape, a vector, a name list ... or report E251/E252/E253/E250/E256 and return ``None``.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from typing import Callable, Optional
+
+from mrgc.errors import Diagnostic, Span
+from mrgc.language import ast
+from mrgc.language.model import BASE_TYPES, Box, Cylinder, Mesh, Pose, Shape, Sphere
+from mrgc.language.suggest import did_you_mean
+
+#: declaration kind -> property name -> value type
+SCHEMAS: dict[str, dict[str, str]] = {
+    "robot-kind": {
+        "urdf": "string",
+        "base": "base-type",
+        "end-effector": "string",
+        "home": "vector",
+        "footprint": "shape",
+        "carry": "pose",
+        "reach": "length",
+    },
+    "robots": {"kind": "name", "base": "pose"},
+    "fixed": {"shape": "shape", "pose": "pose"},
+    "regions": {"shape": "shape", "pose": "pose"},
+    "movable": {"shape": "shape", "pose": "pose", "grasps": "names", "handover": "names"},
+    "handover-points": {"position": "point"},
+}
+
+#: the properties that make a declaration geometric
+GEOMETRIC_PROPS = frozenset({"shape", "pose", "base", "position"})
+
+#: shape name -> the names of its dimensions
+SHAPE_ARGS: dict[str, tuple[str, ...]] = {
+    "box": ("x size", "y size", "z size"),
+    "cylinder": ("radius", "height"),
+    "sphere": ("radius",),
+    "mesh": ("path", "scale"),
+}
+
+
+class PropReader:
+    """Reads properties of one file, appending diagnostics to ``diags``."""
+
+    def __init__(self, diags: list[Diagnostic], file: str) -> None:
+        self.diags = diags
+        self.file = file
+
+    def err(self, code: str, message: str, span: Span) -> None:
+        self.diags.append(Diagnostic(code, message, span))
+
+    # ------------------------------------------------------------ property tables
+    def table(self, kind: str, what: str, props: tuple[ast.Property, ...]) -> dict[str, ast.Property]:
+        """Index ``props`` by key, reporting duplicate (E202) and unknown (E254) keys."""
+        schema = SCHEMAS[kind]
+        out: dict[str, ast.Property] = {}
+        for prop in props:
+            if prop.key not in schema:
+                hint = did_you_mean(prop.key, schema) or f" (allowed: {', '.join(':' + k for k in schema)})"
+                self.err("E254", f"unknown property ':{prop.key}' for {what}{hint}", prop.span)
+            elif prop.key in out:
+                self.err("E202", f"property ':{prop.key}' given twice for {what}", prop.span)
+            else:
+                out[prop.key] = prop
+        return out
+
+    def read(self, kind: str, prop: ast.Property) -> object:
+        """The typed value of ``prop`` by its schema type, or None after reporting why not."""
+        reader: Callable[[ast.Value, str], object] = getattr(self, "_" + SCHEMAS[kind][prop.key].replace("-", "_"))
+        return reader(prop.value, f"':{prop.key}'")
+
+    # ------------------------------------------------------------ value readers
+    def _number(self, value: ast.Value, what: str) -> Optional[float]:
+        if not isinstance(value, ast.Number):
+            self.err("E253", f"{what} must be a number, not {_kind_of(value)}", value.span)
+            return None
+        if not math.isfinite(value.value):
+            self.err("E251", f"{what} is not a finite number", value.span)
+            return None
+        return value.value
+
+    def _length(self, value: ast.Value, what: str) -> Optional[float]:
+        x = self._number(value, what)
+        if x is not None and x <= 0:
+            self.err("E250", f"{what} must be positive, got {_fmt(x)}", value.span)
+            return None
+        return x
+
+    def _numbers(self, value: ast.Value, what: str, length: int | None) -> Optional[tuple[float, ...]]:
+        if not isinstance(value, ast.ListValue):
+            self.err("E253", f"{what} must be a list of numbers like (0 0 0), not {_kind_of(value)}", value.span)
+            return None
+        out: list[float] = []
+        ok = True
+        for item in value.items:
+            x = self._number(item, f"{what} entry")
+            ok = ok and x is not None
+            out.append(x if x is not None else 0.0)
+        if length is not None and len(out) != length:
+            self.err("E252", f"{what} needs {length} numbers, got {len(out)}", value.span)
+            return None
+        if length is None and not out:
+            self.err("E252", f"{what} needs at least one number", value.span)
+            return None
+        return tuple(out) if ok else None
+
+    def _vector(self, value: ast.Value, what: str) -> Optional[tuple[float, ...]]:
+        return self._numbers(value, what, None)
+
+    def _point(self, value: ast.Value, what: str) -> Optional[tuple[float, float, float]]:
+        v = self._numbers(value, what + " (x y z)", 3)
+        return (v[0], v[1], v[2]) if v is not None else None
+
+    def _pose(self, value: ast.Value, what: str) -> Optional[Pose]:
+        v = self._numbers(value, what + " (x y z yaw)", 4)
+        return Pose(*v) if v is not None else None
+
+    def _name(self, value: ast.Value, what: str) -> Optional[str]:
+        if not isinstance(value, ast.Symbol):
+            self.err("E253", f"{what} must be a name, not {_kind_of(value)}", value.span)
+            return None
+        return value.name
+
+    def _names(self, value: ast.Value, what: str) -> Optional[tuple[tuple[str, Span], ...]]:
+        if isinstance(value, ast.Symbol):
+            return ((value.name, value.span),)
+        if not isinstance(value, ast.ListValue):
+            self.err("E253", f"{what} must be a list of names like (a b), not {_kind_of(value)}", value.span)
+            return None
+        out = []
+        for item in value.items:
+            if not isinstance(item, ast.Symbol):
+                self.err("E253", f"{what} entries must be names, not {_kind_of(item)}", item.span)
+                return None
+            out.append((item.name, item.span))
+        return tuple(out)
+
+    def _string(self, value: ast.Value, what: str) -> Optional[str]:
+        if not isinstance(value, ast.String):
+            self.err("E253", f'{what} must be a string like "path", not {_kind_of(value)}', value.span)
+            return None
+        return value.value
+
+    def _base_type(self, value: ast.Value, what: str) -> Optional[str]:
+        name = self._name(value, what)
+        if name is not None and name not in BASE_TYPES:
+            hint = did_you_mean(name, BASE_TYPES) or f" (use {' or '.join(BASE_TYPES)})"
+            self.err("E257", f"unknown base type '{name}'{hint}", value.span)
+            return None
+        return name
+
+    def _shape(self, value: ast.Value, what: str) -> Optional[Shape]:
+        if not isinstance(value, ast.ListValue) or not value.items or not isinstance(value.items[0], ast.Symbol):
+            self.err("E253", f"{what} must be a shape like (box 0.1 0.1 0.1), not {_kind_of(value)}", value.span)
+            return None
+        head, args = value.items[0], value.items[1:]
+        if head.name not in SHAPE_ARGS:
+            hint = did_you_mean(head.name, SHAPE_ARGS) or f" (use {', '.join(SHAPE_ARGS)})"
+            self.err("E256", f"unknown shape '{head.name}'{hint}", head.span)
+            return None
+        names = SHAPE_ARGS[head.name]
+        if head.name == "mesh":
+            return self._mesh(value, args)
+        if len(args) != len(names):
+            self.err("E252", f"a {head.name} needs {len(names)} numbers ({', '.join(names)}), got {len(args)}", value.span)
+            return None
+        dims = [self._length(a, f"{head.name} {n}") for a, n in zip(args, names)]
+        if any(d is None for d in dims):
+            return None
+        cls = {"box": Box, "cylinder": Cylinder, "sphere": Sphere}[head.name]
+        return cls(*dims)  # type: ignore[arg-type]
+
+    def _mesh(self, value: ast.ListValue, args: tuple[ast.Number | ast.Symbol | ast.String, ...]) -> Optional[Mesh]:
+        if not 1 <= len(args) <= 2 or not isinstance(args[0], ast.String):
+            self.err("E253", 'a mesh is written (mesh "file.obj") or (mesh "file.obj" scale)', value.span)
+            return None
+        scale = self._length(args[1], "mesh scale") if len(args) == 2 else 1.0
+        if scale is None:
+            return None
+        path = args[0].value
+        full = path if os.path.isabs(path) else os.path.join(os.path.dirname(self.file), path)
+        if not os.path.isfile(full):
+            self.err("E258", f"mesh file '{path}' not found (looked for {full})", args[0].span)
+            return None
+        return Mesh(os.path.normpath(full), scale)
+
+
+def _kind_of(value: ast.Value | ast.Number | ast.Symbol | ast.String) -> str:
+    if isinstance(value, ast.Number):
+        return f"the number {_fmt(value.value)}"
+    if isinstance(value, ast.Symbol):
+        return f"the name '{value.name}'"
+    if isinstance(value, ast.String):
+        return "a string"
+    return "a list"
+
+
+def _fmt(x: float) -> str:
+    return str(int(x)) if x.is_integer() and abs(x) < 1e15 else repr(x)

@@ -326,6 +326,7 @@ class Checker:
     def _initial_regions(self, init: list[Fact], init_sec: ast.Init | None, movable: list[MovableObject],
                          geometric: bool) -> None:
         where: dict[str, list[str]] = {}
+        attempted = {a.args[0] for a in (init_sec.atoms if init_sec else ()) if a.predicate == "in-region" and a.args}
         for f in init:
             if f.predicate == "in-region":
                 where.setdefault(f.args[0], []).append(f.args[1])
@@ -334,7 +335,7 @@ class Checker:
             if len(regions) > 1:
                 span = init_sec.span if init_sec is not None else m.span
                 self.err("E228", f"'{m.name}' is initially in several regions ({', '.join(regions)})", span)
-            elif not regions and not geometric:
+            elif not regions and not geometric and m.name not in attempted:
                 self.err("E228", f"'{m.name}' has no initial region: add (in-region {m.name} REGION) to :init", m.span)
 
 

@@ -60,3 +60,66 @@ CODES: dict[str, str] = {
     "E261": "symbolic problem mixes in geometry",
     "E262": "geometric declaration lacks its shape or pose",
 }
+
+#: codes the CLI itself uses (not produced by the front end)
+CLI_CODES: dict[str, str] = {
+    "E000": "bad command line",
+    "E070": "internal error",
+}
+
+#: what each code means and how to fix it (docs/errors.md is generated from this and the golden files)
+HELP: dict[str, str] = {
+    "E000": "The command line is wrong (unknown option, missing argument). `mrgc COMMAND --help` shows usage.",
+    "E070": "A bug in mrgc. The message names the Python exception; please report it with the input.",
+    "E001": "The file does not exist, is a folder, or cannot be read.",
+    "E002": "Files above the size limit (8 MiB) are refused before parsing, so a huge input cannot stall mrgc.",
+    "E003": "The file holds bytes that are not UTF-8 text, or a NUL byte: probably not a `.mrg` file.",
+    "E004": "The file holds no `(define ...)` form (it is empty or only comments).",
+    "E100": "A character or word that cannot start any token here, or a string with no closing quote.",
+    "E101": "A token where the grammar expects something else; the message lists what may come here.",
+    "E102": "The file ends inside a form: usually a missing `)`.",
+    "E103": "A section keyword that does not exist at this place; the message suggests the closest one.",
+    "E200": "Two declarations share a name. Robots, fixed and movable objects, regions and handover points "
+    "share one namespace per problem; grasps and robot kinds one per domain.",
+    "E201": "A section such as `:goal`, `:init` or `:robots` appears twice in one definition.",
+    "E202": "A declaration gives the same `:property` twice.",
+    "E210": "A fact names a robot the problem does not declare.",
+    "E211": "A fact or goal names a movable object the problem does not declare.",
+    "E212": "A fact or goal names a region the problem does not declare.",
+    "E213": "A grasp that is not in the domain's `(:grasps ...)` vocabulary.",
+    "E214": "A robot's `:kind` that the domain does not define with `(:robot-kind ...)`.",
+    "E215": "A movable object's `:handover` list names a handover point the problem does not declare.",
+    "E216": "A declared name used where another sort belongs, e.g. a robot in a movable object's place.",
+    "E220": "A predicate other than the six of the language.",
+    "E221": "A predicate with too few or too many arguments; the message gives its signature.",
+    "E222": "A goal asks to move a fixed object, which can never move.",
+    "E223": "Goals are conjunctions of `(in-region OBJECT REGION)` literals only.",
+    "E224": "Two goals ask for the same object in two different regions.",
+    "E225": "`(:goal (and))` asks for nothing.",
+    "E226": "A problem without `(:goal ...)`.",
+    "E227": "A fact uses a grasp the object's `:grasps` list does not allow.",
+    "E228": "In a symbolic problem every movable object needs exactly one `(in-region OBJECT REGION)` in "
+    "`:init`; in any problem at most one.",
+    "E230": "A problem names no domain, or a domain that is not in the file, in `domain.mrg` beside it, "
+    "or in its includes; also used when a file does not hold the problem asked for.",
+    "E231": "The domain's name is defined in more than one place at the same lookup level.",
+    "E232": "Files that include each other in a loop.",
+    "E233": "An include path that resolves outside the folder of the file being checked.",
+    "E234": "An include path that names no file.",
+    "E235": "A requirement flag that mrgc does not know.",
+    "E250": "Sizes (box sides, radii, heights, reach, mesh scale) must be positive.",
+    "E251": "A number that overflows to infinity (such as `1e999`).",
+    "E252": "A pose needs 4 numbers (x y z yaw), a position 3, a shape its own count.",
+    "E253": "A property value of the wrong type, e.g. a name where a quoted path belongs.",
+    "E254": "A `:property` the declaration does not take; the message suggests the closest or lists them.",
+    "E255": "A required property is missing (a fixed-base robot kind needs `:urdf` and `:end-effector`, "
+    "a planar one `:footprint`).",
+    "E256": "Shapes are `box`, `cylinder`, `sphere` and `mesh`.",
+    "E257": "A robot kind's `:base` is `fixed` or `planar`.",
+    "E258": "A mesh file that does not exist (paths are relative to the declaring file).",
+    "E260": "In a geometric problem every robot needs a `:kind` from the domain.",
+    "E261": "A problem whose movable objects have no shapes is symbolic; it may not give shapes, poses, "
+    "robot bases or handover positions to anything.",
+    "E262": "A problem whose movable objects have shapes is geometric; then every object and region needs "
+    "`:shape` and `:pose`, every robot `:base`, every handover point `:position`.",
+}

@@ -85,6 +85,15 @@ def _byte_span(data: bytes, offset: int, path: str) -> Span:
     return Span(path, line, col, line, col + 1)
 
 
+def shown(path: str) -> str:
+    """``path`` as diagnostics show it: relative to the working folder when inside it."""
+    try:
+        rel = os.path.relpath(path)
+    except ValueError:  # another drive (Windows)
+        return path
+    return path if rel.startswith("..") else rel
+
+
 class _Loader:
     """Parses a root file and everything it includes, once each, and resolves domains."""
 
@@ -146,17 +155,17 @@ class _Loader:
             real = os.path.realpath(target)
             if os.path.commonpath([self.root_dir, real]) != self.root_dir:
                 self.diags.append(Diagnostic("E233", f"include '{inc.path}' leaves the folder tree of "
-                                             f"{self.root_dir}", inc.span))
+                                             f"{shown(self.root_dir)}", inc.span))
                 continue
             if real in stack or real == key:
                 chain = " -> ".join(os.path.basename(s) for s in (*stack, real))
                 self.diags.append(Diagnostic("E232", f"include cycle: {chain}", inc.span))
                 continue
             if not os.path.isfile(real):
-                self.diags.append(Diagnostic("E234", f"included file '{inc.path}' not found (looked for {target})",
+                self.diags.append(Diagnostic("E234", f"included file '{inc.path}' not found (looked for {shown(target)})",
                                              inc.span))
                 continue
-            sub = self.parse(target)
+            sub = self.parse(shown(target))
             if real not in out:
                 out.append(real)
             if sub is not None:
@@ -173,7 +182,7 @@ class _Loader:
         levels: list[list[Domain]] = []
         beside = os.path.join(self.dir_of(path), DOMAIN_FILE)
         if os.path.isfile(beside) and os.path.realpath(beside) != os.path.realpath(path):
-            btree = self.parse(beside)
+            btree = self.parse(shown(beside))
             if btree is not None:
                 bkey = os.path.realpath(beside)
                 found = [d for d in self.domains.get(bkey, []) if d.name == ref.name]
@@ -183,7 +192,7 @@ class _Loader:
         levels.append(self._in_files(self.follow_includes(path, tree, (key,)), ref.name))
         for found in levels:
             if len(found) > 1:
-                where = ", ".join(f"{d.source}:{d.span.line}" for d in found)
+                where = ", ".join(str(d.span) for d in found)
                 self.diags.append(Diagnostic("E231", f"domain '{ref.name}' is defined in several places ({where})",
                                              ref.span))
                 return None

@@ -1,0 +1,82 @@
+"""The check and fmt commands end to end (through cli.main, and once through the installed script)."""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from mrgc import __version__, cli
+
+GOOD = """(define (domain abstract) (:grasps top side))
+(define (problem tiny)  (:domain abstract)
+  (:robots r1) (:movable o1) (:regions start goal)   ; one object
+  (:init (in-region o1 start) (reachable-pick o1 top r1) (reachable-place o1 goal top r1))
+  (:goal (in-region o1 goal)))
+"""
+
+
+@pytest.fixture()
+def good(tmp_path: Path) -> Path:
+    path = tmp_path / "tiny.mrg"
+    path.write_text(GOOD, encoding="utf-8")
+    return path
+
+
+def test_check_ok(good: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert cli.main(["check", str(good)]) == 0
+    out = capsys.readouterr().out
+    assert "ok" in out and "problem tiny (symbolic: 1 robots, 1 movable" in out
+
+
+def test_check_reports_every_file(good: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    bad = tmp_path / "bad.mrg"
+    bad.write_text(GOOD.replace("(reachable-pick o1 top r1)", "(reachable-pick o1 top r9)"), encoding="utf-8")
+    assert cli.main(["check", str(bad), str(good)]) == 2
+    cap = capsys.readouterr()
+    assert "error[E210]: undeclared robot 'r9' (did you mean 'r1'?)" in cap.err
+    assert str(good) in cap.out
+
+
+def test_fmt_prints_canonical_text(good: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert cli.main(["fmt", str(good)]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("(define (domain abstract)\n  (:grasps top side))\n\n(define (problem tiny)\n")
+    assert "(:regions start goal) ; one object" in out
+
+
+def test_fmt_check_and_write(good: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert cli.main(["fmt", "--check", str(good)]) == 1
+    assert "would reformat" in capsys.readouterr().err
+    assert cli.main(["fmt", "--write", str(good)]) == 0
+    assert cli.main(["fmt", "--check", str(good)]) == 0
+    text = good.read_text(encoding="utf-8")
+    assert "; one object" in text
+    assert cli.main(["check", str(good)]) == 0
+
+
+def test_fmt_of_a_broken_file_is_an_input_error(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    bad = tmp_path / "bad.mrg"
+    bad.write_text("(define (domain d) (:grasps top)", encoding="utf-8")
+    assert cli.main(["fmt", "--check", str(bad)]) == 2
+    assert "error[E102]" in capsys.readouterr().err
+
+
+def test_fmt_needs_a_mode_for_several_files(good: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert cli.main(["fmt", str(good), str(good)]) == 2
+    assert "error[E000]" in capsys.readouterr().err
+
+
+def test_no_command_prints_help(capsys: pytest.CaptureFixture[str]) -> None:
+    assert cli.main([]) == 2
+    assert "usage: mrgc" in capsys.readouterr().out
+
+
+def test_installed_script(good: Path) -> None:
+    exe = shutil.which("mrgc") or str(Path(__file__).resolve().parent.parent / ".venv" / "bin" / "mrgc")
+    version = subprocess.run([exe, "--version"], capture_output=True, text=True)
+    assert version.returncode == 0 and version.stdout.strip() == f"mrgc {__version__}"
+    res = subprocess.run([exe, "check", str(good)], capture_output=True, text=True)
+    assert res.returncode == 0, res.stderr

@@ -1,0 +1,76 @@
+"""Golden diagnostics: every error code has an input that triggers it and the exact text mrgc prints.
+
+Set MRGC_UPDATE_GOLDEN=1 to rewrite the .out files after an intended change of wording.
+"""
+
+from __future__ import annotations
+
+import os
+import runpy
+from pathlib import Path
+
+import pytest
+
+from mrgc import cli
+from mrgc.language.codes import CODES
+from mrgc.language.loader import MAX_BYTES
+
+ROOT = Path(__file__).resolve().parent.parent
+GOLDEN = ROOT / "tests" / "golden" / "errors"
+CASES = sorted(p.stem for p in GOLDEN.glob("E*.mrg"))
+
+
+def test_every_code_has_a_golden_file() -> None:
+    special = {"E001", "E002"}  # made on the fly below: a missing file, an oversized one
+    assert sorted(set(CODES) - special) == CASES
+
+
+@pytest.mark.parametrize("code", CASES)
+def test_golden_diagnostics(code: str, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(ROOT)
+    rel = f"tests/golden/errors/{code}.mrg"
+    assert cli.main(["check", rel]) == 2
+    err = capsys.readouterr().err
+    codes = {line.split("error[", 1)[1][:4] for line in err.splitlines() if "error[" in line}
+    assert codes == {code}, f"{rel} should trigger exactly {code}, got {sorted(codes)}"
+    first = err.splitlines()[0]
+    assert first.count(":") >= 3 and f"error[{code}]" in first
+    out = GOLDEN / f"{code}.out"
+    if os.environ.get("MRGC_UPDATE_GOLDEN"):
+        out.write_text(err, encoding="utf-8")
+    assert err == out.read_text(encoding="utf-8")
+
+
+def test_missing_file_e001(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    assert cli.main(["check", str(tmp_path / "nope.mrg")]) == 2
+    assert "error[E001]: cannot read" in capsys.readouterr().err
+
+
+def test_oversized_file_e002(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    big = tmp_path / "huge.mrg"
+    big.write_bytes(b"; padding\n" * (MAX_BYTES // 10 + 1))
+    assert cli.main(["check", str(big)]) == 2
+    assert "error[E002]" in capsys.readouterr().err
+
+
+def test_usage_error_e000(capsys: pytest.CaptureFixture[str]) -> None:
+    assert cli.main(["check", "--frobnicate", "x.mrg"]) == 2
+    assert "error[E000]" in capsys.readouterr().err
+
+
+def test_internal_errors_are_one_line(capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch,
+                                      tmp_path: Path) -> None:
+    def boom(path: str) -> None:
+        raise KeyError("x")
+
+    monkeypatch.setattr("mrgc.language.loader.parse_file", boom)
+    assert cli.main(["check", str(tmp_path / "a.mrg")]) == 70
+    err = capsys.readouterr().err
+    assert err.startswith("mrgc: internal error[E070]: KeyError") and "Traceback" not in err
+
+
+def test_errors_doc_is_current(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(ROOT)
+    monkeypatch.setattr("sys.argv", ["build_errors_doc.py", "--check"])
+    result = runpy.run_path(str(ROOT / "docs" / "build_errors_doc.py"), run_name="not_main")
+    assert result["main"]() == 0

@@ -1,0 +1,116 @@
+"""The package's shape: what is packaged, who may import whom, and which heavy libraries load when."""
+
+from __future__ import annotations
+
+import ast
+import subprocess
+import sys
+import tomllib
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+SKIP_DIRS = {".venv", ".git", "tests", "docs", "benchmarks", "build", "dist", "domains", ".hypothesis"}
+
+#: DESIGN.md section 3: layer -> layers it may import (besides itself)
+MAY_IMPORT: dict[str, set[str]] = {
+    "errors": set(),
+    "language": {"errors"},
+    "compiler": {"errors", "language"},
+    "backends": {"errors", "language", "compiler"},
+    "geometry": {"errors", "language"},
+    "planner": {"errors", "language", "compiler", "backends", "geometry"},
+    "cli": {"*"},
+    "__init__": {"*"},
+}
+
+#: heavy library -> the one module allowed to import it (filled in as backends/geometry modules land)
+HEAVY = {
+    "highspy": "backends/highs.py",
+    "z3": "backends/z3opt.py",
+    "pysmt": "backends/pysmt_opt.py",
+    "ortools": "backends/cpsat.py",
+    "coal": "geometry/collision.py",
+    "pybullet": "geometry/kinematics.py",
+    "pybullet_data": "geometry/kinematics.py",
+    "ompl": "geometry/motion.py",
+}
+
+
+def code_files() -> list[Path]:
+    out = []
+    for path in ROOT.rglob("*.py"):
+        rel = path.relative_to(ROOT)
+        if rel.parts[0] in SKIP_DIRS or rel.parts[0].startswith("."):
+            continue
+        out.append(path)
+    return sorted(out)
+
+
+def layer(rel: Path) -> str:
+    return rel.parts[0] if len(rel.parts) > 1 else rel.stem
+
+
+def imports(path: Path) -> list[tuple[str, bool]]:
+    """(module, at top level?) for every import in the file."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    top = set(map(id, tree.body))
+    out = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            out += [(a.name, id(node) in top) for a in node.names]
+        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            out.append((node.module, id(node) in top))
+    return out
+
+
+def test_every_code_folder_is_packaged() -> None:
+    config = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
+    packages = set(config["tool"]["setuptools"]["packages"])
+    found = {"mrgc"} | {
+        "mrgc." + ".".join(p.parent.relative_to(ROOT).parts)
+        for p in ROOT.rglob("__init__.py")
+        if p.parent != ROOT and p.relative_to(ROOT).parts[0] not in SKIP_DIRS
+    }
+    assert found == packages
+
+
+def test_the_user_layout_exists() -> None:
+    for name in ["pyproject.toml", "language", "compiler", "backends", "geometry", "planner", "domains",
+                 "benchmarks", "tests", "docs", "README.md", "py.typed"]:
+        assert (ROOT / name).exists(), name
+    assert not (ROOT / "tests" / "__init__.py").exists()
+
+
+@pytest.mark.parametrize("path", code_files(), ids=lambda p: str(p.relative_to(ROOT)))
+def test_import_rules(path: Path) -> None:
+    rel = path.relative_to(ROOT)
+    me = layer(rel)
+    allowed = MAY_IMPORT[me]
+    for module, _ in imports(path):
+        parts = module.split(".")
+        if parts[0] == "mrgc":
+            if len(parts) == 1:
+                assert me in {"cli", "__init__"} or module == "mrgc", f"{rel} imports the mrgc root"
+                continue
+            target = parts[1]
+            assert target != "cli" or me == "__init__", f"{rel} imports the CLI"
+            assert "*" in allowed or target == me or target in allowed, f"{rel} ({me}) may not import {module}"
+        if parts[0] in HEAVY:
+            assert str(rel) == HEAVY[parts[0]], f"{rel} imports {parts[0]}; only {HEAVY[parts[0]]} may"
+
+
+@pytest.mark.parametrize("path", code_files(), ids=lambda p: str(p.relative_to(ROOT)))
+def test_heavy_libraries_are_imported_lazily(path: Path) -> None:
+    rel = path.relative_to(ROOT)
+    for module, top_level in imports(path):
+        if module.split(".")[0] in HEAVY:
+            assert not top_level, f"{rel} imports {module} at module level"
+
+
+def test_importing_mrgc_loads_no_heavy_library() -> None:
+    code = ("import sys, mrgc, mrgc.cli, mrgc.language; "
+            "print(sorted(m for m in %r if m in sys.modules))" % sorted(HEAVY))
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]"

@@ -1,0 +1,36 @@
+"""The README's Quick start is the contract with a new user and with CI."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def quick_start() -> list[str]:
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    section = text.split("## Quick start", 1)[1]
+    blocks = re.findall(r"```[a-z]*\n(.*?)```", section.split("\n## ", 1)[0], re.S)
+    assert len(blocks) == 1, "Quick start must hold exactly one fenced block"
+    return [line for line in blocks[0].splitlines() if line.strip()]
+
+
+def test_quick_start_has_two_one_line_commands() -> None:
+    commands = quick_start()
+    assert len(commands) == 2
+    assert all(c.startswith("python3 -m venv .venv && ") for c in commands)
+    assert "pytest" in commands[1] and "[test]" in commands[1]
+
+
+def test_ci_runs_exactly_the_readme_test_command() -> None:
+    script = (ROOT / ".ci" / "run").read_text(encoding="utf-8")
+    lines = [ln for ln in script.splitlines() if ln.strip() and not ln.startswith("#")]
+    assert quick_start()[1] in lines
+    assert lines[-1] == quick_start()[1]
+
+
+def test_quick_start_paths_exist() -> None:
+    first = quick_start()[0]
+    for path in re.findall(r"domains/[\w/*.-]+", first):
+        assert list(ROOT.glob(path)), path

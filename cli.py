@@ -11,10 +11,13 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-from typing import Callable, Sequence
+from typing import TYPE_CHECKING, Callable, Sequence
 
 from mrgc import __version__
 from mrgc.errors import Diagnostic, InputError, MrgcError
+
+if TYPE_CHECKING:
+    from mrgc.language.model import Problem
 
 EXIT_OK = 0
 EXIT_NO_PLAN = 1
@@ -102,6 +105,63 @@ def cmd_fmt(args: argparse.Namespace) -> int:
     return status
 
 
+def _load_problem(path: str, name: str | None) -> "Problem":
+    from mrgc.language.loader import parse_file
+
+    return parse_file(path).problem(name)
+
+
+def cmd_compile(args: argparse.Namespace) -> int:
+    import json
+
+    from mrgc.planner.skeletons import compile_problem, export_model
+
+    problem = _load_problem(args.file, args.problem)
+    if args.skeletons < 1:
+        raise InputError([Diagnostic("E000", "--skeletons must be at least 1")])
+    result = compile_problem(problem, backend=args.backend, encoding=args.encoding, skeletons=args.skeletons,
+                             max_makespan=args.max_makespan, time_limit=args.time_limit, seed=args.seed)
+    if args.emit:
+        horizon = result.skeletons[0].makespan if result.skeletons else None
+        export_model(problem, args.emit, backend=args.backend, encoding=args.encoding, horizon=horizon)
+    if args.format == "json":
+        print(json.dumps(result.to_json(), indent=2))
+    else:
+        n = len(result.skeletons)
+        print(f"problem {result.problem}: backend {result.backend}, encoding {result.encoding}: "
+              f"{result.status}, {n} skeleton{'s' * (n != 1)} "
+              f"({result.stats.get('objects', 0)} objects, {result.stats.get('actions', 0)} actions in the task graph, "
+              f"{result.stats.get('total_seconds', 0):.3f} s)")
+        for i, sk in enumerate(result.skeletons, 1):
+            print(f"skeleton {i}: makespan {sk.makespan}, moves {len(sk.moved)} ({' '.join(sk.moved)})")
+            for line in sk.describe():
+                print("  " + line)
+        for reason in result.reasons:
+            print(f"  reason: {reason}")
+        if args.emit:
+            print(f"model written to {args.emit}")
+    if result.skeletons:
+        return EXIT_OK
+    return {"infeasible": EXIT_NO_PLAN, "time limit": EXIT_TIME_LIMIT}.get(result.status, EXIT_INTERNAL)
+
+
+def cmd_backends(args: argparse.Namespace) -> int:
+    import json
+
+    from mrgc.backends.registry import describe, feature_table
+
+    rows = describe()
+    if args.format == "json":
+        print(json.dumps(rows, indent=2))
+        return EXIT_OK
+    for r in rows:
+        state = f"installed ({r['library']} {r['version']})" if r["installed"] else f"missing: pip install {r['library']}"
+        print(f"{r['name']:6} {r['title']}: {state}; encodings: {', '.join(r['encodings'])}")
+    print()
+    print(feature_table())
+    return EXIT_OK
+
+
 # ---------------------------------------------------------------- wiring
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="mrgc", description="Multi-robot geometric task-and-motion planning compiler and solver.")
@@ -119,6 +179,25 @@ def build_parser() -> argparse.ArgumentParser:
     mode.add_argument("--check", action="store_true", help="exit 1 if a file is not canonically formatted")
     mode.add_argument("--write", action="store_true", help="rewrite files in place")
     p.set_defaults(func=cmd_fmt)
+
+    p = sub.add_parser("compile", help="build the task graph and generate task skeletons with a solver backend")
+    p.add_argument("file", metavar="FILE")
+    p.add_argument("--problem", help="which problem of the file (default: its only one)")
+    p.add_argument("--backend", default="cpsat", help="mip | smt | pysmt | cpsat (default cpsat; see mrgc backends)")
+    p.add_argument("--encoding", default="time-of-move",
+                   help="paper | disaggregated | time-of-move (default time-of-move)")
+    p.add_argument("--skeletons", type=int, default=1, metavar="K", help="how many skeletons (default 1)")
+    p.add_argument("--max-makespan", type=int, default=None, metavar="T",
+                   help="horizon limit (default: the number of objects in the task graph)")
+    p.add_argument("--time-limit", type=float, default=None, metavar="S", help="seconds for the whole search")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--emit", metavar="PATH", help="also write the model: .lp/.mps (mip), .smt2 (smt), .pbtxt (cpsat)")
+    p.add_argument("--format", choices=["text", "json"], default="text")
+    p.set_defaults(func=cmd_compile)
+
+    p = sub.add_parser("backends", help="list solver backends: installed?, versions, encodings, features")
+    p.add_argument("--format", choices=["text", "json"], default="text")
+    p.set_defaults(func=cmd_backends)
     return parser
 
 

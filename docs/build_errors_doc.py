@@ -52,6 +52,18 @@ SPECIAL = {
              "mrgc: error[E000]: unrecognized arguments: --frobnicate"),
     "E070": ("(any input that trips a bug)", "mrgc: internal error[E070]: KeyError: 'x' "
              "(please report this with the input that caused it)"),
+    "E300": ("mrgc compile domains/symbolic/chain-3.mrg --backend mip --emit model.smt2",
+             "error[E300]: backend 'mip' cannot write .smt2 files (it writes: .lp, .mps)"),
+    "E301": ("mrgc compile domains/symbolic/chain-3.mrg --backend cplex",
+             "error[E301]: unknown backend 'cplex' (installed: mip, smt, pysmt, cpsat)"),
+    "E302": ("mrgc compile x.mrg --backend my-plugin --encoding paper",
+             "error[E302]: backend 'my-plugin' does not support encoding 'paper'"),
+    "E303": ("mrgc compile domains/symbolic/chain-3.mrg --encoding bigm",
+             "error[E303]: unknown encoding 'bigm' (choose from paper, disaggregated, time-of-move)"),
+    "E310": ("mrgc compile domains/packaging/pa5-s0.mrg",
+             "domains/packaging/pa5-s0.mrg:2:3: error[E310]: problem 'pa5-s0' is geometric and its :init "
+             "holds no geometric facts; compute them first with `mrgc facts FILE -o FILE.facts.mrg` and "
+             "compile that file"),
     "E001": ("mrgc check no-such.mrg", "error[E001]: cannot read 'no-such.mrg': No such file or directory"),
     "E002": ("mrgc check huge.mrg   # a file over 8 MiB",
              "huge.mrg:1:1: error[E002]: 'huge.mrg' is 9437184 bytes; the limit is 8388608 bytes"),

@@ -65,12 +65,23 @@ CODES: dict[str, str] = {
 CLI_CODES: dict[str, str] = {
     "E000": "bad command line",
     "E070": "internal error",
+    "E300": "backend cannot export this format",
+    "E301": "unknown backend",
+    "E302": "backend does not support the encoding",
+    "E303": "unknown encoding",
+    "E310": "geometric problem without facts",
 }
 
 #: what each code means and how to fix it (docs/errors.md is generated from this and the golden files)
 HELP: dict[str, str] = {
     "E000": "The command line is wrong (unknown option, missing argument). `mrgc COMMAND --help` shows usage.",
     "E070": "A bug in mrgc. The message names the Python exception; please report it with the input.",
+    "E300": "`--emit` names a file type the backend does not write (mip: .lp .mps; smt: .smt2; cpsat: "
+    ".pbtxt). The message is followed by the backend × feature table.",
+    "E301": "`--backend` names no registered backend; `mrgc backends` lists them.",
+    "E302": "The backend cannot run the chosen encoding.",
+    "E303": "`--encoding` is one of `paper`, `disaggregated`, `time-of-move`.",
+    "E310": "A geometric problem must have its facts computed (`mrgc facts`) before `mrgc compile`.",
     "E001": "The file does not exist, is a folder, or cannot be read.",
     "E002": "Files above the size limit (8 MiB) are refused before parsing, so a huge input cannot stall mrgc.",
     "E003": "The file holds bytes that are not UTF-8 text, or a NUL byte: probably not a `.mrg` file.",

@@ -10,6 +10,7 @@ comment after code stays at the end of that item's line.  Printing is idempotent
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from mrgc.errors import Span
@@ -64,7 +65,9 @@ def comments_of(text: str) -> list[Comment]:
 
 
 def number(x: float) -> str:
-    """Shortest text that parses back to exactly ``x``."""
+    """Shortest text that parses back to exactly ``x`` (overflowed literals print as ``1e999``)."""
+    if math.isinf(x):
+        return "1e999" if x > 0 else "-1e999"
     if x == 0:
         return "0"
     if x.is_integer() and abs(x) < 1e16:
@@ -102,59 +105,89 @@ def atom(a: ast.Atom) -> str:
 
 
 class _Out:
-    """Accumulates output lines, placing pending comments before the items they precede."""
+    """Accumulates output lines, placing pending comments before the items they precede.
 
-    def __init__(self, comments: list[Comment]) -> None:
-        self.lines: list[str] = []
+    Each line is kept as [code, comment] so a closing parenthesis can be put after the code and before a
+    trailing comment.  A blank line in the source before an item or an own-line comment is kept (runs of
+    blank lines become one).
+    """
+
+    def __init__(self, comments: list[Comment], text: str) -> None:
+        self.lines: list[list[str]] = []
         self.pending = list(comments)
+        self.blank = {i for i, ln in enumerate(text.split("\n"), 1) if not ln.strip()} if text else set()
+        self.last_line = 0  # source line of the last thing emitted
 
-    def _flush_before(self, span: Span | None, indent: str) -> None:
+    def _gap(self, line: int) -> None:
+        """Keep one blank line if the source has one between the last emitted thing and ``line``."""
+        if self.lines and self.lines[-1] != ["", ""] and any(n in self.blank for n in range(self.last_line + 1, line)):
+            self.lines.append(["", ""])
+
+    def _comment(self, c: Comment, indent: str) -> None:
+        if c.trailing and self.lines and self.lines[-1][0].strip() and not self.lines[-1][1]:
+            self.lines[-1][1] = c.text
+        else:
+            self._gap(c.line)
+            self.lines.append([indent, c.text])
+        self.last_line = c.line
+
+    def flush_before(self, span: Span | None, indent: str) -> None:
         if span is None or span.file == "<generated>":
             return
         while self.pending and (self.pending[0].line, self.pending[0].column) < (span.line, span.column):
-            c = self.pending.pop(0)
-            if c.trailing and self.lines:
-                self.lines[-1] += " " + c.text
-            else:
-                self.lines.append(indent + c.text)
+            self._comment(self.pending.pop(0), indent)
 
     def flush_until(self, line: int, indent: str) -> None:
         """Emit comments that start before ``line`` (used at the end of a group)."""
-        self._flush_before(Span("", line, 1, line, 1), indent)
+        self.flush_before(Span("", line, 1, line, 1), indent)
 
-    def emit(self, text: str, indent: str, span: Span | None = None) -> None:
-        self._flush_before(span, indent)
-        self.lines.append(indent + text)
+    def emit(self, text: str, indent: str, span: Span | None = None, header: bool = False) -> None:
+        """A line of code; ``header`` marks the opening line of a group whose items follow."""
+        self.flush_before(span, indent)
+        if span is not None and span.file != "<generated>":
+            self._gap(span.line)
+            self.last_line = span.line if header else span.end_line
+        self.lines.append([indent + text, ""])
 
-    def close(self) -> None:
-        self.lines[-1] += ")"
+    def append(self, text: str) -> None:
+        """Continue the last code line (filled name lists)."""
+        self.lines[-1][0] += text
+
+    def close(self, indent: str) -> None:
+        """Close the innermost group: after the last code, or on its own line after an own-line comment."""
+        last = self.lines[-1]
+        if last[0].strip():
+            last[0] += ")"
+        else:
+            self.lines.append([indent + ")", ""])
 
     def rest(self) -> None:
         for c in self.pending:
-            if c.trailing and self.lines:
-                self.lines[-1] += " " + c.text
-            else:
-                self.lines.append(c.text)
+            self._comment(c, "")
         self.pending = []
+
+    def text(self) -> str:
+        return "\n".join((code + " " + com) if code.strip() and com else (code + com) for code, com in self.lines)
 
 
 def format_source(tree: ast.SourceFile, text: str = "") -> str:
     """The canonical text of ``tree``; pass the original ``text`` to keep its comments."""
-    out = _Out(comments_of(text) if text else [])
+    out = _Out(comments_of(text) if text else [], text)
     for i, d in enumerate(tree.definitions):
         if i:
-            out.lines.append("")
+            out.lines.append(["", ""])
         head = "domain" if isinstance(d, ast.DomainDef) else "problem"
-        out.emit(f"(define ({head} {d.name})", "", d.span)
+        out.emit(f"(define ({head} {d.name})", "", d.span, header=True)
         for sec in d.sections:
             _section(out, sec)
         if d.span.file != "<generated>":
             out.flush_until(d.span.end_line, "  ")  # comments inside, before the closing line
-        out.close()
+            out.flush_before(Span("", d.span.end_line, d.span.end_column - 1, 0, 0), "  ")
+        out.close("")
         if d.span.file != "<generated>":
             out.flush_until(d.span.end_line + 1, "")  # comments after the closing parenthesis
     out.rest()
-    return "\n".join(out.lines) + "\n"
+    return out.text() + "\n"
 
 
 def _section(out: _Out, sec: ast.DomainSection | ast.ProblemSection) -> None:
@@ -168,26 +201,26 @@ def _section(out: _Out, sec: ast.DomainSection | ast.ProblemSection) -> None:
     elif isinstance(sec, ast.DomainRef):
         out.emit(f"(:domain {sec.name})", ind, sec.span)
     elif isinstance(sec, ast.RobotKindDecl):
-        out.emit(f"(:robot-kind {sec.name}", ind, sec.span)
+        out.emit(f"(:robot-kind {sec.name}", ind, sec.span, header=True)
         for p in sec.props:
             out.emit(prop(p), ind * 2, p.span)
-        out.close()
+        _close_group(out, sec.span, ind * 2, ind)
     elif isinstance(sec, ast.DeclSection):
         if all(d.bare and not d.props for d in sec.decls):
             _fill(out, ":" + sec.kind, [(d.name, d.span) for d in sec.decls], sec.span)
         else:
-            out.emit(f"(:{sec.kind}", ind, sec.span)
+            out.emit(f"(:{sec.kind}", ind, sec.span, header=True)
             for d in sec.decls:
                 out.emit(decl(d), ind * 2, d.span)
-            out.close()
+            _close_group(out, sec.span, ind * 2, ind)
     elif isinstance(sec, ast.Init):
         if not sec.atoms:
             out.emit("(:init)", ind, sec.span)
             return
-        out.emit("(:init", ind, sec.span)
+        out.emit("(:init", ind, sec.span, header=True)
         for a in sec.atoms:
             out.emit(atom(a), ind * 2, a.span)
-        out.close()
+        _close_group(out, sec.span, ind * 2, ind)
     elif isinstance(sec, ast.Goal):
         _goal(out, sec)
 
@@ -205,22 +238,31 @@ def _goal(out: _Out, sec: ast.Goal) -> None:
     if len(ind + one_line) <= WIDTH and not commented:
         out.emit(one_line, ind, sec.span)
         return
-    out.emit("(:goal (and", ind, sec.span)
+    out.emit("(:goal (and", ind, sec.span, header=True)
     for a in sec.atoms:
         out.emit(atom(a), ind * 3, a.span)
-    out.close()
-    out.close()
+    _close_group(out, sec.span, ind * 3, ind)
+    out.close(ind)
 
 
 def _fill(out: _Out, head: str, names: list[tuple[str, Span]], span: Span) -> None:
     """``(head a b c ...)`` filled to WIDTH; a comment before a name starts a new line."""
     ind, cont = "  ", "    "
-    out.emit("(" + head, ind, span)
+    out.emit("(" + head, ind, span, header=True)
     for name, nspan in names:
         has_comment = bool(out.pending) and nspan.file != "<generated>" and \
             (out.pending[0].line, out.pending[0].column) < (nspan.line, nspan.column)
-        if has_comment or len(out.lines[-1]) + 1 + len(name) > WIDTH:
+        if has_comment or out.lines[-1][1] or len(out.lines[-1][0]) + 1 + len(name) > WIDTH:
             out.emit(name, cont, nspan)
         else:
-            out.lines[-1] += " " + name
-    out.close()
+            out.append(" " + name)
+            if nspan.file != "<generated>":
+                out.last_line = nspan.end_line
+    _close_group(out, span, cont, ind)
+
+
+def _close_group(out: _Out, span: Span, inner: str, indent: str) -> None:
+    """Emit the comments before the group's closing parenthesis, then close it."""
+    if span.file != "<generated>":
+        out.flush_before(Span("", span.end_line, span.end_column - 1, 0, 0), inner)
+    out.close(indent)

@@ -1,0 +1,110 @@
+"""The backend base class: capabilities as data, checks in the public methods, work in private hooks."""
+
+from __future__ import annotations
+
+import os
+import time
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
+from typing import ClassVar, Sequence
+
+from mrgc.compiler.encodings import ENCODINGS
+from mrgc.compiler.ir import Feature, Row, SkeletonModel, Solution, Status
+from mrgc.compiler.lowering import lower
+from mrgc.errors import Diagnostic, InputError
+
+
+@dataclass(frozen=True)
+class BackendInfo:
+    """What a backend is and can do, readable without importing its solver library.
+
+    ``features`` are the optional model features it translates natively (the others are lowered to rows);
+    ``exports`` the file extensions ``export`` writes; ``module`` / ``distribution`` the import name and the
+    pip name of its library.
+    """
+
+    name: str
+    title: str
+    module: str
+    distribution: str
+    features: frozenset[Feature]
+    exports: tuple[str, ...] = ()
+    encodings: tuple[str, ...] = tuple(ENCODINGS)
+    install: str = ""
+
+    @property
+    def pip(self) -> str:
+        return self.install or self.distribution
+
+
+class Backend(ABC):
+    """A solver behind the :class:`~mrgc.compiler.ir.Solver` protocol.
+
+    ``load`` lowers the model to the features in ``info.features``; ``solve`` never raises for
+    infeasibility, time-outs or solver failures (they are statuses) and self-checks every solution it
+    returns against the lowered model.
+    """
+
+    info: ClassVar[BackendInfo]
+
+    def __init__(self, seed: int = 0, threads: int = 1) -> None:
+        self.seed = seed
+        self.threads = threads
+        self.model: SkeletonModel | None = None
+
+    @property
+    def name(self) -> str:
+        return self.info.name
+
+    def load(self, model: SkeletonModel) -> None:
+        self.model = lower(model, self.info.features)
+        self._load(self.model)
+
+    def add_rows(self, rows: Sequence[Row]) -> None:
+        if self.model is None:
+            raise RuntimeError("add_rows before load")
+        self.model.rows.extend(rows)
+        self._add_rows(rows)
+
+    def solve(self, time_limit: float | None = None) -> Solution:
+        if self.model is None:
+            raise RuntimeError("solve before load")
+        t0 = time.perf_counter()
+        try:
+            sol = self._solve(time_limit)
+        except Exception as exc:  # noqa: BLE001 - a failing solver is an outcome, not a crash
+            return Solution(Status.ERROR, message=f"{self.name}: {type(exc).__name__}: {exc}",
+                            seconds=time.perf_counter() - t0)
+        seconds = time.perf_counter() - t0
+        if sol.status in (Status.OPTIMAL, Status.FEASIBLE):
+            bad = self.model.violated(sol.values)
+            if bad:
+                return Solution(Status.ERROR, message=f"{self.name} returned a solution violating {bad[:3]}",
+                                seconds=seconds)
+            objective = tuple(self.model.evaluate(o, sol.values) for o in self.model.objectives)
+            return Solution(sol.status, sol.values, objective, seconds, sol.message)
+        return Solution(sol.status, (), (), seconds, sol.message)
+
+    def export(self, path: str) -> None:
+        if self.model is None:
+            raise RuntimeError("export before load")
+        ext = os.path.splitext(path)[1].lstrip(".").lower()
+        if ext not in self.info.exports:
+            from mrgc.backends.registry import feature_table
+
+            raise InputError([Diagnostic("E300", f"backend '{self.name}' cannot write .{ext} files "
+                                         f"(it writes: {', '.join('.' + e for e in self.info.exports) or 'none'})",
+                                         notes=tuple(feature_table().splitlines()))])
+        self._export(path)
+
+    @abstractmethod
+    def _load(self, model: SkeletonModel) -> None: ...
+
+    @abstractmethod
+    def _add_rows(self, rows: Sequence[Row]) -> None: ...
+
+    @abstractmethod
+    def _solve(self, time_limit: float | None) -> Solution: ...
+
+    def _export(self, path: str) -> None:  # pragma: no cover - backends with exports override
+        raise NotImplementedError

@@ -1,0 +1,121 @@
+"""``mip``: the skeleton model as a MIP solved by HiGHS (highspy).  The only module importing highspy.
+
+HiGHS has no indicator constraints, so conditional rows arrive as big-M rows (see compiler/lowering.py).
+Column and row names are the IR's readable names made LP-safe, so ``--emit model.lp`` is readable and
+deterministic.  highspy is pinned to 1.12.0: 1.15 cannot share a process with ortools 9.15.
+"""
+
+from __future__ import annotations
+
+import re
+from typing import Any, Sequence
+
+from mrgc.backends.base import Backend, BackendInfo
+from mrgc.compiler.ir import Row, SkeletonModel, Solution, Status
+from mrgc.errors import MissingBackendError
+
+INF = float("inf")
+
+
+def _highspy() -> Any:
+    try:
+        import highspy
+    except ImportError as exc:  # pragma: no cover - installed by default
+        raise MissingBackendError(f"backend 'mip' needs highspy: pip install 'highspy==1.12.0' ({exc})") from None
+    return highspy
+
+
+def lp_names(names: Sequence[str]) -> list[str]:
+    """LP-format-safe, unique versions of ``names`` (``-`` → ``_``, ``+`` → ``p``, other symbols → ``_``)."""
+    out, seen = [], set()
+    for n in names:
+        safe = re.sub(r"[^A-Za-z0-9_.]", "_", n.replace("+", "p").replace("@", "_t")).strip("_") or "v"
+        if safe[0].isdigit() or safe[0] == ".":
+            safe = "v" + safe
+        base, k = safe, 1
+        while safe in seen:
+            k += 1
+            safe = f"{base}_{k}"
+        seen.add(safe)
+        out.append(safe)
+    return out
+
+
+class HighsBackend(Backend):
+    info = BackendInfo(
+        name="mip",
+        title="HiGHS MIP (highspy)",
+        module="highspy",
+        distribution="highspy",
+        features=frozenset(),
+        exports=("lp", "mps"),
+        install="highspy==1.12.0",
+    )
+
+    def _load(self, model: SkeletonModel) -> None:
+        import numpy as np
+
+        hs = _highspy()
+        h = hs.Highs()
+        h.setOptionValue("output_flag", False)
+        h.setOptionValue("random_seed", int(self.seed))
+        h.setOptionValue("threads", int(self.threads))
+        h.setOptionValue("mip_rel_gap", 0.0)
+        n = len(model.vars)
+        h.addVars(n, np.array([v.lb for v in model.vars], dtype=np.float64),
+                  np.array([v.ub for v in model.vars], dtype=np.float64))
+        if n:
+            h.changeColsIntegrality(n, np.arange(n, dtype=np.int32),
+                                    np.full(n, int(hs.HighsVarType.kInteger), dtype=np.uint8))
+        cost = np.zeros(n)
+        for v, c in (model.objectives[0] if model.objectives else ()):
+            cost[v] += c
+        h.changeColsCost(n, np.arange(n, dtype=np.int32), cost)
+        for i, name in enumerate(lp_names([v.name for v in model.vars])):
+            h.passColName(i, name)
+        self.h, self.rows = h, 0
+        self._add_rows(model.rows)
+
+    def _add_rows(self, rows: Sequence[Row]) -> None:
+        import numpy as np
+
+        if not rows:
+            return
+        lower = np.array([-INF if r.lo is None else r.lo for r in rows], dtype=np.float64)
+        upper = np.array([INF if r.hi is None else r.hi for r in rows], dtype=np.float64)
+        starts, index, value = [], [], []
+        for r in rows:
+            starts.append(len(index))
+            for v, c in r.terms:
+                index.append(v)
+                value.append(c)
+        self.h.addRows(len(rows), lower, upper, len(index), np.array(starts, dtype=np.int32),
+                       np.array(index, dtype=np.int32), np.array(value, dtype=np.float64))
+        names = lp_names([f"{r.name or 'row'}#{self.rows + k}" for k, r in enumerate(rows)])
+        for k, name in enumerate(names):
+            self.h.passRowName(self.rows + k, name)
+        self.rows += len(rows)
+
+    def _solve(self, time_limit: float | None) -> Solution:
+        hs = _highspy()
+        self.h.setOptionValue("time_limit", float(time_limit) if time_limit is not None else INF)
+        self.h.run()
+        status = self.h.getModelStatus()
+        S = hs.HighsModelStatus
+        if status == S.kModelEmpty:
+            return Solution(Status.OPTIMAL, ())
+        if status == S.kOptimal:
+            values = tuple(int(round(x)) for x in self.h.getSolution().col_value)
+            return Solution(Status.OPTIMAL, values)
+        if status in (S.kInfeasible, S.kUnboundedOrInfeasible):
+            return Solution(Status.INFEASIBLE)
+        if status in (S.kTimeLimit, S.kInterrupt, S.kIterationLimit, S.kSolutionLimit):
+            info = self.h.getInfo()
+            if info.primal_solution_status == 2:  # a feasible incumbent exists
+                values = tuple(int(round(x)) for x in self.h.getSolution().col_value)
+                return Solution(Status.FEASIBLE, values, message="time limit")
+            return Solution(Status.TIME_LIMIT, message="time limit")
+        return Solution(Status.ERROR, message=f"HiGHS: {self.h.modelStatusToString(status)}")
+
+    def _export(self, path: str) -> None:
+        self.h.writeModel(path)

@@ -1,0 +1,90 @@
+"""The explicit registry of backends: lazy ``"module:Class"`` strings plus the ``mrgc.backends`` entry points.
+
+Looking a backend up imports only its mrgc module (cheap: solver libraries are imported inside it, lazily).
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.metadata
+import importlib.util
+from typing import Any
+
+from mrgc.backends.base import Backend, BackendInfo
+from mrgc.compiler.ir import Feature
+from mrgc.errors import Diagnostic, InputError
+
+BACKENDS: dict[str, str] = {
+    "mip": "mrgc.backends.highs:HighsBackend",
+    "smt": "mrgc.backends.z3opt:Z3Backend",
+    "pysmt": "mrgc.backends.pysmt_opt:PysmtBackend",
+    "cpsat": "mrgc.backends.cpsat:CpSatBackend",
+}
+
+ENTRY_POINT_GROUP = "mrgc.backends"
+
+
+def _all() -> dict[str, str]:
+    out = dict(BACKENDS)
+    for ep in importlib.metadata.entry_points(group=ENTRY_POINT_GROUP):
+        out.setdefault(ep.name, ep.value)
+    return out
+
+
+def names() -> list[str]:
+    return list(_all())
+
+
+def backend_class(name: str) -> type[Backend]:
+    """The backend class registered as ``name`` (InputError E301 naming the choices otherwise)."""
+    table = _all()
+    if name not in table:
+        from mrgc.language.suggest import did_you_mean
+
+        raise InputError([Diagnostic("E301", f"unknown backend '{name}'{did_you_mean(name, table)} "
+                                     f"(installed: {', '.join(table)})")])
+    module, _, cls = table[name].partition(":")
+    found: Any = getattr(importlib.import_module(module), cls)
+    return found  # type: ignore[no-any-return]
+
+
+def installed(info: BackendInfo) -> bool:
+    return importlib.util.find_spec(info.module) is not None
+
+
+def version(info: BackendInfo) -> str:
+    try:
+        return importlib.metadata.version(info.distribution)
+    except importlib.metadata.PackageNotFoundError:
+        return "-"
+
+
+def describe() -> list[dict[str, Any]]:
+    """One record per backend: name, installed?, library version, native features, encodings, exports."""
+    rows = []
+    for name in names():
+        info = backend_class(name).info
+        rows.append({
+            "name": name,
+            "title": info.title,
+            "installed": installed(info),
+            "library": info.distribution,
+            "version": version(info),
+            "features": sorted(f.value for f in info.features),
+            "encodings": list(info.encodings),
+            "exports": list(info.exports),
+        })
+    return rows
+
+
+def feature_table() -> str:
+    """A backend × feature table (native = translated by the solver, lowered = rewritten to rows)."""
+    feats = [f for f in Feature]
+    header = ["backend", *[f.value for f in feats], "exports"]
+    lines = [header]
+    for name in names():
+        info = backend_class(name).info
+        lines.append([name, *["native" if f in info.features else "lowered" for f in feats],
+                      " ".join("." + e for e in info.exports) or "-"])
+    widths = [max(len(r[i]) for r in lines) for i in range(len(header))]
+    return "\n".join("  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in lines)

@@ -1,0 +1,104 @@
+"""``smt``: the skeleton model in z3's Optimize (an OMT solver).  The only module importing z3.
+
+Bools are z3 Bools; integers are bounded z3 Ints; a row is a linear (in)equality; a conditional row is
+``Implies(And(literals), row)``; at-most-one is ``AtMost``; a lexicographic objective is z3's native
+``lex`` priority.  ``--emit model.smt2`` writes ``Optimize.sexpr()``: SMT-LIB2 with z3's ``(minimize)``
+extension.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Sequence
+
+from mrgc.backends.base import Backend, BackendInfo
+from mrgc.compiler.ir import Feature, Row, SkeletonModel, Solution, Status, Terms
+from mrgc.errors import MissingBackendError
+
+
+def _z3() -> Any:
+    try:
+        import z3
+    except ImportError as exc:  # pragma: no cover - installed by default
+        raise MissingBackendError(f"backend 'smt' needs z3: pip install z3-solver ({exc})") from None
+    return z3
+
+
+class Z3Backend(Backend):
+    info = BackendInfo(
+        name="smt",
+        title="z3 Optimize (OMT)",
+        module="z3",
+        distribution="z3-solver",
+        features=frozenset({Feature.CONDITIONAL, Feature.AT_MOST_ONE, Feature.LEXICOGRAPHIC}),
+        exports=("smt2",),
+    )
+
+    def _load(self, model: SkeletonModel) -> None:
+        z3 = _z3()
+        self.ctx = z3.Context()
+        opt = z3.Optimize(ctx=self.ctx)
+        opt.set(priority="lex")
+        opt.set("random_seed", int(self.seed))
+        self.x = []
+        for v in model.vars:
+            if v.is_bool:
+                self.x.append(z3.Bool(v.name, self.ctx))
+            else:
+                var = z3.Int(v.name, self.ctx)
+                opt.add(var >= v.lb, var <= v.ub)
+                self.x.append(var)
+        self.is_bool = [v.is_bool for v in model.vars]
+        for row in model.rows:
+            opt.add(*self._row(row))
+        for cr in model.cond_rows:
+            lits = [self.x[v] if val else z3.Not(self.x[v]) for v, val in cr.when]
+            cond = lits[0] if len(lits) == 1 else z3.And(*lits)
+            opt.add(z3.Implies(cond, z3.And(*self._row(cr.row))))
+        for amo in model.at_most_one:
+            opt.add(z3.AtMost(*[self.x[v] for v in amo.vars], 1))
+        self.objectives = [opt.minimize(self._sum(terms)) for terms in model.objectives]
+        self.opt = opt
+
+    def _sum(self, terms: Terms) -> Any:
+        z3 = _z3()
+        parts = [z3.If(self.x[v], z3.IntVal(c, self.ctx), z3.IntVal(0, self.ctx)) if self.is_bool[v]
+                 else self.x[v] * c for v, c in terms]
+        return z3.Sum(parts) if parts else z3.IntVal(0, self.ctx)
+
+    def _row(self, row: Row) -> list[Any]:
+        e = self._sum(row.terms)
+        out = []
+        if row.lo is not None and row.hi is not None and row.lo == row.hi:
+            return [e == row.lo]
+        if row.lo is not None:
+            out.append(e >= row.lo)
+        if row.hi is not None:
+            out.append(e <= row.hi)
+        return out or [_z3().BoolVal(True, self.ctx)]
+
+    def _add_rows(self, rows: Sequence[Row]) -> None:
+        for row in rows:
+            self.opt.add(*self._row(row))
+
+    def _solve(self, time_limit: float | None) -> Solution:
+        z3 = _z3()
+        self.opt.set("timeout", int(time_limit * 1000) if time_limit is not None else 4294967295)
+        res = self.opt.check()
+        if res == z3.unsat:
+            return Solution(Status.INFEASIBLE)
+        if res == z3.unknown:
+            reason = self.opt.reason_unknown()
+            if "timeout" in reason or "canceled" in reason:
+                return Solution(Status.TIME_LIMIT, message=reason)
+            return Solution(Status.ERROR, message=f"z3: {reason}")
+        m = self.opt.model()
+        values = tuple(
+            (1 if z3.is_true(m.eval(x, model_completion=True)) else 0) if b
+            else m.eval(x, model_completion=True).as_long()
+            for x, b in zip(self.x, self.is_bool)
+        )
+        return Solution(Status.OPTIMAL, values)
+
+    def _export(self, path: str) -> None:
+        with open(path, "w", encoding="utf-8") as fh:
+            fh.write(self.opt.sexpr())

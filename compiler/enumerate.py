@@ -1,0 +1,106 @@
+"""Skeleton enumeration: distinct skeletons in (makespan, moved objects) order, resumable.
+
+"Distinct" means a different *set of actions*: after each skeleton a cut excludes its action set at every
+horizon (a cut on the schedule would only exclude one ordering of the same plan).  For horizon-loop
+encodings the horizon grows T = T0, T0+1, ... up to the limit, carrying the cuts into each new model; a
+model of horizon T yields skeletons with exactly T non-empty steps, cheapest first.  For time-of-move one
+model covers every makespan up to the limit.  ``next(k)`` returns the next k skeletons and keeps the solver,
+the horizon and the cuts, so asking again continues where it stopped.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Callable
+
+from mrgc.compiler.diagnose import prune
+from mrgc.compiler.encodings.base import Encoded, Encoding
+from mrgc.compiler.ir import Row, Solver, Status
+from mrgc.compiler.skeleton import Skeleton
+from mrgc.compiler.task_graph import TaskGraph
+
+
+# Why ``next`` stopped: outcomes are values, not exceptions.
+ENOUGH = "enough"  # k skeletons found (more may exist)
+EXHAUSTED = "exhausted"  # every skeleton within the horizon limit has been returned
+TIME_LIMIT = "time limit"
+ERROR = "error"
+
+
+@dataclass
+class Batch:
+    """What one call of :meth:`SkeletonGenerator.next` produced."""
+
+    skeletons: list[Skeleton]
+    outcome: str
+    message: str = ""
+    stats: dict[str, float] = field(default_factory=dict)
+
+
+class SkeletonGenerator:
+    """Enumerates the skeletons of ``graph`` with ``encoding``, solving with solvers from ``make_solver``."""
+
+    def __init__(self, graph: TaskGraph, encoding: Encoding, make_solver: Callable[[], Solver],
+                 max_makespan: int | None = None) -> None:
+        self.graph = prune(graph)
+        self.encoding = encoding
+        self.make_solver = make_solver
+        self.limit = max_makespan if max_makespan is not None else max(1, len(graph.objects))
+        robots = max(1, len(graph.robots))
+        self.horizon = max(1, math.ceil(len(graph.must_move) / robots))  # each step moves <= |R| objects
+        self.found: list[frozenset[int]] = []
+        self.solver: Solver | None = None
+        self.encoded: Encoded | None = None
+        self.done = not graph.must_move
+        self.stats: dict[str, float] = {"solves": 0, "solve_seconds": 0.0, "build_seconds": 0.0, "models": 0}
+
+    def _cuts(self, enc: Encoded) -> list[Row]:
+        return [enc.cut(s, name=f"cut{i}") for i, s in enumerate(self.found)]
+
+    def _load(self) -> None:
+        t0 = time.perf_counter()
+        self.encoded = self.encoding.build(self.graph, self.horizon if self.encoding.horizon_loop else self.limit)
+        self.solver = self.make_solver()
+        self.solver.load(self.encoded.model)
+        cuts = self._cuts(self.encoded)
+        if cuts:
+            self.solver.add_rows(cuts)
+        self.stats["build_seconds"] += time.perf_counter() - t0
+        self.stats["models"] += 1
+
+    def next(self, k: int, time_limit: float | None = None) -> Batch:
+        """Up to ``k`` further skeletons, in (makespan, moved) order."""
+        deadline = None if time_limit is None else time.perf_counter() + time_limit
+        out: list[Skeleton] = []
+        while len(out) < k:
+            if self.done or self.horizon > self.limit:
+                self.done = True
+                return Batch(out, EXHAUSTED, stats=dict(self.stats))
+            if self.solver is None:
+                self._load()
+            assert self.solver is not None and self.encoded is not None
+            left = None if deadline is None else deadline - time.perf_counter()
+            if left is not None and left <= 0:
+                return Batch(out, TIME_LIMIT, stats=dict(self.stats))
+            sol = self.solver.solve(left)
+            self.stats["solves"] += 1
+            self.stats["solve_seconds"] += sol.seconds
+            if sol.status == Status.OPTIMAL:
+                skel = self.encoded.decode(sol.values)
+                chosen = frozenset(i for i, v in enumerate(self.encoded.select) if sol.values[v])
+                self.found.append(chosen)
+                self.solver.add_rows([self.encoded.cut(chosen, name=f"cut{len(self.found) - 1}")])
+                out.append(skel)
+            elif sol.status == Status.INFEASIBLE:
+                if not self.encoding.horizon_loop:
+                    self.done = True
+                    continue
+                self.horizon += 1
+                self.solver = None
+            elif sol.status in (Status.TIME_LIMIT, Status.FEASIBLE):
+                return Batch(out, TIME_LIMIT, sol.message, stats=dict(self.stats))
+            else:
+                return Batch(out, ERROR, sol.message, stats=dict(self.stats))
+        return Batch(out, ENOUGH, stats=dict(self.stats))

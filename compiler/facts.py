@@ -1,0 +1,85 @@
+"""The geometric facts a task graph is built from, indexed for Alg. 1 of the paper.
+
+Facts are plain data: the ``:init`` of a symbolic problem (or of a problem completed by ``mrgc facts``),
+or facts the planner passes in from the geometry layer.  The compiler never computes geometry.
+"""
+
+from __future__ import annotations
+
+from collections import defaultdict
+from dataclasses import dataclass, field
+from typing import Iterable
+
+from mrgc.language.model import Fact, Problem
+
+
+@dataclass(frozen=True)
+class FactBase:
+    """The facts of one problem, indexed the way Alg. 1 asks for them.
+
+    ``goal`` maps each goal object to its goal region; ``region`` each object to its current region;
+    ``robots`` and ``objects`` keep the problem's declaration order, which fixes every later ordering.
+    """
+
+    robots: tuple[str, ...]
+    objects: tuple[str, ...]
+    grasps: dict[str, tuple[str, ...]]
+    goal: dict[str, str]
+    region: dict[str, str]
+    reachable_pick: frozenset[tuple[str, str, str]] = frozenset()  # (M, g, R)
+    reachable_place: frozenset[tuple[str, str, str, str]] = frozenset()  # (M, Re, g, R)
+    handover: frozenset[tuple[str, str, str, str, str]] = frozenset()  # (M, g1, g2, R1, R2)
+    occludes_pick: dict[tuple[str, str, str], tuple[str, ...]] = field(default_factory=dict)  # (M2, g, R) -> M1s
+    occludes_place: dict[tuple[str, str, str, str], tuple[str, ...]] = field(default_factory=dict)  # (M2, Re, g, R)
+
+    @classmethod
+    def from_problem(cls, problem: Problem, facts: Iterable[Fact] | None = None) -> "FactBase":
+        """Index ``facts`` (default: the problem's ``:init``) for ``problem``'s robots, objects and goal."""
+        return cls.from_facts(
+            robots=[r.name for r in problem.robots],
+            objects=[m.name for m in problem.movable],
+            grasps={m.name: problem.grasps_of(m.name) for m in problem.movable},
+            goal=problem.goal_regions,
+            facts=problem.init if facts is None else facts,
+        )
+
+    @classmethod
+    def from_facts(cls, robots: Iterable[str], objects: Iterable[str], grasps: dict[str, tuple[str, ...]],
+                   goal: dict[str, str], facts: Iterable[Fact]) -> "FactBase":
+        region: dict[str, str] = {}
+        pick: set[tuple[str, str, str]] = set()
+        place: set[tuple[str, str, str, str]] = set()
+        hand: set[tuple[str, str, str, str, str]] = set()
+        occ_pick: dict[tuple[str, str, str], list[str]] = defaultdict(list)
+        occ_place: dict[tuple[str, str, str, str], list[str]] = defaultdict(list)
+        for f in facts:
+            a = f.args
+            if f.predicate == "in-region":
+                region.setdefault(a[0], a[1])
+            elif f.predicate == "reachable-pick":
+                pick.add((a[0], a[1], a[2]))
+            elif f.predicate == "reachable-place":
+                place.add((a[0], a[1], a[2], a[3]))
+            elif f.predicate == "enable-goal-handover":
+                hand.add((a[0], a[1], a[2], a[3], a[4]))
+            elif f.predicate == "occludes-pick":
+                if a[0] != a[1] and a[0] not in occ_pick[(a[1], a[2], a[3])]:
+                    occ_pick[(a[1], a[2], a[3])].append(a[0])
+            elif f.predicate == "occludes-goal-place":
+                if a[0] != a[1] and a[0] not in occ_place[(a[1], a[2], a[3], a[4])]:
+                    occ_place[(a[1], a[2], a[3], a[4])].append(a[0])
+        objects = tuple(objects)
+        order = {o: i for i, o in enumerate(objects)}
+        rank = lambda o: (order.get(o, len(order)), o)  # noqa: E731 - undeclared objects last, by name
+        return cls(
+            robots=tuple(robots),
+            objects=tuple(objects),
+            grasps=dict(grasps),
+            goal=dict(goal),
+            region=region,
+            reachable_pick=frozenset(pick),
+            reachable_place=frozenset(place),
+            handover=frozenset(hand),
+            occludes_pick={k: tuple(sorted(v, key=rank)) for k, v in occ_pick.items()},
+            occludes_place={k: tuple(sorted(v, key=rank)) for k, v in occ_place.items()},
+        )

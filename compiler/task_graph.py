@@ -1,0 +1,157 @@
+"""The collaborative manipulation task graph (CMTG): Alg. 1 of the paper.
+
+Object nodes are the objects that must or may move; action nodes are partially grounded pick-and-place
+actions (object, target region, pick robot, place robot, pick grasp, place grasp); block-pick and
+block-place edges say which objects obstruct an action.  A goal object's target region is its goal region,
+any other object's its current region (it is only moved out of the way).  Handover actions exist only for
+goal objects.  Objects already moved (the grounded suffix during search) get no node: each object moves at
+most once, and an action obstructed by such an object is dropped, because that object is still in place
+when the action runs (the suffix runs later).
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass
+from functools import cached_property
+from typing import Iterable
+
+from mrgc.compiler.facts import FactBase
+
+
+@dataclass(frozen=True)
+class Action:
+    """A partially grounded pick-and-place action; a handover when the two robots differ."""
+
+    obj: str
+    region: str
+    pick_robot: str
+    place_robot: str
+    pick_grasp: str
+    place_grasp: str
+
+    @property
+    def robots(self) -> tuple[str, ...]:
+        """The robots the action occupies for its whole step (one, or two for a handover)."""
+        if self.pick_robot == self.place_robot:
+            return (self.pick_robot,)
+        return (self.pick_robot, self.place_robot)
+
+    @property
+    def handover(self) -> bool:
+        return self.pick_robot != self.place_robot
+
+    def __str__(self) -> str:
+        who = self.pick_robot if not self.handover else f"{self.pick_robot}->{self.place_robot}"
+        grasp = self.pick_grasp if not self.handover else f"{self.pick_grasp}->{self.place_grasp}"
+        return f"{who} moves {self.obj} to {self.region} ({grasp})"
+
+
+@dataclass(frozen=True)
+class TaskGraph:
+    """A CMTG.  ``actions[i]`` is action node i; edges refer to actions by index.
+
+    ``must_move`` is M* (objects the skeleton has to move); ``objects`` are all object nodes in the order
+    they were added.  ``block_pick[i]`` / ``block_place[i]`` are the objects obstructing action i.
+    """
+
+    robots: tuple[str, ...]
+    objects: tuple[str, ...]
+    must_move: tuple[str, ...]
+    goal: dict[str, str]
+    actions: tuple[Action, ...]
+    block_pick: tuple[tuple[str, ...], ...]
+    block_place: tuple[tuple[str, ...], ...]
+
+    @cached_property
+    def _by_object(self) -> dict[str, list[int]]:
+        out: dict[str, list[int]] = {o: [] for o in self.objects}
+        for i, a in enumerate(self.actions):
+            out.setdefault(a.obj, []).append(i)
+        return out
+
+    def actions_of(self, obj: str) -> list[int]:
+        """Indices of the actions that move ``obj``."""
+        return self._by_object.get(obj, [])
+
+    def blockers(self, i: int) -> tuple[str, ...]:
+        """Objects obstructing action i (pick first, then place), without repeats."""
+        return tuple(dict.fromkeys(self.block_pick[i] + self.block_place[i]))
+
+    @cached_property
+    def _blocks(self) -> dict[str, list[int]]:
+        out: dict[str, list[int]] = {o: [] for o in self.objects}
+        for i in range(len(self.actions)):
+            for o in self.blockers(i):
+                out.setdefault(o, []).append(i)
+        return out
+
+    def blocked_by(self, obj: str) -> list[int]:
+        """Indices of the actions ``obj`` obstructs (the block edges into ``obj``)."""
+        return self._blocks.get(obj, [])
+
+
+def build_task_graph(facts: FactBase, must_move: Iterable[str], moved: Iterable[str] = ()) -> TaskGraph:
+    """Alg. 1 (AddObject) applied to every object of ``must_move``, skipping objects in ``moved``.
+
+    The recursion of the paper is run with a work queue, so graphs of thousands of objects cannot overflow
+    the Python stack; the resulting graph is the same.
+    """
+    done = set(moved)
+    must = tuple(dict.fromkeys(m for m in must_move if m not in done))
+    nodes: dict[str, None] = {}
+    actions: list[Action] = []
+    block_pick: list[tuple[str, ...]] = []
+    block_place: list[tuple[str, ...]] = []
+    queue = deque(must)
+    while queue:
+        obj = queue.popleft()
+        if obj in nodes or obj in done:
+            continue
+        nodes[obj] = None
+        for act in _actions_for(facts, obj):
+            pick_obs = facts.occludes_pick.get((obj, act.pick_grasp, act.pick_robot), ())
+            place_obs: tuple[str, ...] = ()
+            if obj in facts.goal:
+                place_obs = facts.occludes_place.get((obj, act.region, act.place_grasp, act.place_robot), ())
+            if any(o in done for o in pick_obs + place_obs):
+                continue  # obstructed by an object that moves only later: never executable now
+            actions.append(act)
+            block_pick.append(pick_obs)
+            block_place.append(place_obs)
+            queue.extend(o for o in pick_obs + place_obs if o not in nodes)
+    return TaskGraph(
+        robots=facts.robots,
+        objects=tuple(nodes),
+        must_move=must,
+        goal={o: r for o, r in facts.goal.items() if o in nodes},
+        actions=tuple(actions),
+        block_pick=tuple(block_pick),
+        block_place=tuple(block_place),
+    )
+
+
+def _actions_for(facts: FactBase, obj: str) -> list[Action]:
+    """Lines 5-20 of Alg. 1: the direct and handover actions moving ``obj`` to its target region."""
+    is_goal = obj in facts.goal
+    region = facts.goal[obj] if is_goal else facts.region.get(obj)
+    if region is None:
+        return []  # an object with no known region cannot be put back anywhere
+    grasps = facts.grasps.get(obj, ())
+    out: list[Action] = []
+    for r_pick in facts.robots:
+        for g_pick in grasps:
+            if (obj, g_pick, r_pick) not in facts.reachable_pick:
+                continue
+            if (obj, region, g_pick, r_pick) in facts.reachable_place:
+                out.append(Action(obj, region, r_pick, r_pick, g_pick, g_pick))
+            if not is_goal:
+                continue
+            for r_place in facts.robots:
+                if r_place == r_pick:
+                    continue
+                for g_place in grasps:
+                    if (obj, g_pick, g_place, r_pick, r_place) in facts.handover and \
+                            (obj, region, g_place, r_place) in facts.reachable_place:
+                        out.append(Action(obj, region, r_pick, r_place, g_pick, g_place))
+    return out

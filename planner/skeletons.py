@@ -1,0 +1,137 @@
+"""Skeleton generation wired to a backend: facts → task graph → encoding → solver → skeletons.
+
+This is what ``mrgc compile`` runs, and what the planner calls whenever grounding needs new skeletons
+(for other objects M*, with the grounded suffix's objects excluded).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Any, Iterable
+
+from mrgc.backends.registry import backend_class
+from mrgc.compiler.diagnose import explain_infeasible
+from mrgc.compiler.encodings import get_encoding
+from mrgc.compiler.enumerate import ERROR, EXHAUSTED, TIME_LIMIT, Batch, SkeletonGenerator
+from mrgc.compiler.facts import FactBase
+from mrgc.compiler.skeleton import Skeleton
+from mrgc.compiler.task_graph import TaskGraph, build_task_graph
+from mrgc.errors import Diagnostic, InputError
+from mrgc.language.model import Fact, Problem
+
+DEFAULT_BACKEND = "cpsat"
+DEFAULT_ENCODING = "time-of-move"
+
+
+@dataclass
+class CompileResult:
+    """The outcome of compiling a problem: a status and the skeletons in (makespan, moved) order.
+
+    ``status`` is ``optimal`` (the skeletons asked for, or every one that exists, in proven order),
+    ``infeasible`` (no skeleton within the horizon limit), ``time limit`` or ``error``.
+    """
+
+    problem: str
+    backend: str
+    encoding: str
+    status: str
+    skeletons: list[Skeleton]
+    reasons: list[str] = field(default_factory=list)
+    stats: dict[str, Any] = field(default_factory=dict)
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "problem": self.problem,
+            "backend": self.backend,
+            "encoding": self.encoding,
+            "status": self.status,
+            "skeletons": [s.to_json() for s in self.skeletons],
+            "reasons": list(self.reasons),
+            "stats": self.stats,
+        }
+
+
+def must_move(problem: Problem, facts: Iterable[Fact] | None = None) -> list[str]:
+    """M* at the start: the goal objects not already in their goal region."""
+    where = {f.args[0]: f.args[1] for f in (problem.init if facts is None else facts) if f.predicate == "in-region"}
+    return [o for o, r in problem.goal_regions.items() if where.get(o) != r]
+
+
+def require_facts(problem: Problem) -> None:
+    """A geometric problem needs its facts (``mrgc facts``) before it can be compiled."""
+    if problem.symbolic or any(f.predicate != "in-region" for f in problem.init):
+        return
+    raise InputError([Diagnostic(
+        "E310", f"problem '{problem.name}' is geometric and its :init holds no geometric facts; "
+        "compute them first with `mrgc facts FILE -o FILE.facts.mrg` and compile that file",
+        problem.span)])
+
+
+class SkeletonSource:
+    """Skeletons for one (M*, already moved) request, from a chosen backend and encoding; resumable."""
+
+    def __init__(self, facts: FactBase, must: Iterable[str], moved: Iterable[str] = (), backend: str = DEFAULT_BACKEND,
+                 encoding: str = DEFAULT_ENCODING, max_makespan: int | None = None, seed: int = 0) -> None:
+        cls = backend_class(backend)
+        self.backend, self.encoding = backend, encoding
+        if encoding not in cls.info.encodings:
+            raise InputError([Diagnostic("E302", f"backend '{backend}' does not support encoding '{encoding}'")])
+        try:
+            enc = get_encoding(encoding)
+        except ValueError as exc:
+            raise InputError([Diagnostic("E303", str(exc))]) from None
+        t0 = time.perf_counter()
+        self.graph: TaskGraph = build_task_graph(facts, must, moved)
+        self.reasons = explain_infeasible(self.graph, facts)
+        self.graph_seconds = time.perf_counter() - t0
+        self.generator = SkeletonGenerator(self.graph, enc, lambda: cls(seed=seed), max_makespan)
+        if self.reasons:
+            self.generator.done = True
+
+    def next(self, k: int, time_limit: float | None = None) -> Batch:
+        return self.generator.next(k, time_limit)
+
+
+def compile_problem(problem: Problem, backend: str = DEFAULT_BACKEND, encoding: str = DEFAULT_ENCODING,
+                    skeletons: int = 1, max_makespan: int | None = None, time_limit: float | None = None,
+                    facts: Iterable[Fact] | None = None, seed: int = 0) -> CompileResult:
+    """The first ``skeletons`` skeletons of ``problem`` (facts default to its ``:init``)."""
+    require_facts(problem)
+    fact_list = list(problem.init if facts is None else facts)
+    base = FactBase.from_problem(problem, fact_list)
+    source = SkeletonSource(base, must_move(problem, fact_list), (), backend, encoding, max_makespan, seed)
+    t0 = time.perf_counter()
+    batch = source.next(skeletons, time_limit)
+    stats: dict[str, Any] = {
+        "objects": len(source.graph.objects),
+        "actions": len(source.graph.actions),
+        "must_move": list(source.graph.must_move),
+        "graph_seconds": round(source.graph_seconds, 6),
+        "total_seconds": round(time.perf_counter() - t0 + source.graph_seconds, 6),
+        **{k: (round(v, 6) if isinstance(v, float) else v) for k, v in batch.stats.items()},
+    }
+    if batch.outcome == ERROR:
+        status = "error"
+    elif batch.outcome == TIME_LIMIT:
+        status = "time limit"
+    elif not batch.skeletons and batch.outcome == EXHAUSTED:
+        status = "infeasible"
+    else:
+        status = "optimal"
+    reasons = list(source.reasons) or ([batch.message] if batch.message else [])
+    return CompileResult(problem.name, backend, encoding, status, batch.skeletons, reasons, stats)
+
+
+def export_model(problem: Problem, path: str, backend: str = DEFAULT_BACKEND, encoding: str = DEFAULT_ENCODING,
+                 horizon: int | None = None, facts: Iterable[Fact] | None = None) -> None:
+    """Write the skeleton model (horizon ``horizon``; default the first one searched) to ``path``."""
+    require_facts(problem)
+    fact_list = list(problem.init if facts is None else facts)
+    base = FactBase.from_problem(problem, fact_list)
+    source = SkeletonSource(base, must_move(problem, fact_list), (), backend, encoding)
+    gen = source.generator
+    enc = gen.encoding.build(gen.graph, horizon or (gen.horizon if gen.encoding.horizon_loop else gen.limit))
+    solver = backend_class(backend)()
+    solver.load(enc.model)
+    solver.export(path)

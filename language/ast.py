@@ -80,6 +80,7 @@ class Requirements:
     """``(:requirements :handover ...)``; flags written without their colon."""
 
     flags: tuple[str, ...]
+    flag_spans: tuple[Span, ...] = field(default=(), compare=False, repr=False)
     span: Span = _span()
 
 

@@ -81,10 +81,10 @@ class Checker:
         reqs: tuple[str, ...] = ()
         if "requirements" in secs:
             req: ast.Requirements = secs["requirements"]
-            for flag in req.flags:
+            for flag, span in zip(req.flags, req.flag_spans or (req.span,) * len(req.flags)):
                 if flag not in REQUIREMENTS:
                     hint = did_you_mean(flag, REQUIREMENTS) or f" (known: {', '.join(':' + r for r in REQUIREMENTS)})"
-                    self.err("E235", f"unknown requirement ':{flag}'{hint}", req.span)
+                    self.err("E235", f"unknown requirement ':{flag}'{hint}", span)
             reqs = tuple(dict.fromkeys(f for f in req.flags if f in REQUIREMENTS))
         grasps: tuple[str, ...] = ()
         if "grasps" in secs:
@@ -289,6 +289,9 @@ class Checker:
             fact = self._atom(atom, sort_of, grasps)
             if fact is None:
                 continue
+            if _self_referential(fact):
+                self.err("E229", f"'{fact.predicate}' relates {_self_referential(fact)} to itself", atom.span)
+                continue
             for obj, grasp in _grasp_uses(fact):
                 if grasp not in obj_grasps.get(obj, {grasp}):
                     self.err("E227", f"grasp '{grasp}' is not among the grasps of '{obj}' "
@@ -337,6 +340,16 @@ class Checker:
                 self.err("E228", f"'{m.name}' is initially in several regions ({', '.join(regions)})", span)
             elif not regions and not geometric and m.name not in attempted:
                 self.err("E228", f"'{m.name}' has no initial region: add (in-region {m.name} REGION) to :init", m.span)
+
+
+def _self_referential(fact: Fact) -> str:
+    """What a fact wrongly relates to itself: an object occluding itself, a handover to the same robot."""
+    a = fact.args
+    if fact.predicate in ("occludes-pick", "occludes-goal-place") and a[0] == a[1]:
+        return f"object '{a[0]}'"
+    if fact.predicate == "enable-goal-handover" and a[3] == a[4]:
+        return f"robot '{a[3]}'"
+    return ""
 
 
 def _grasp_uses(fact: Fact) -> list[tuple[str, str]]:

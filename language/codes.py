@@ -38,6 +38,7 @@ CODES: dict[str, str] = {
     "E226": "missing goal",
     "E227": "grasp not allowed for this object",
     "E228": "initial region missing or ambiguous",
+    "E229": "fact relates a thing to itself",
     # domains and includes
     "E230": "missing domain",
     "E231": "ambiguous domain",
@@ -111,6 +112,7 @@ HELP: dict[str, str] = {
     "E227": "A fact uses a grasp the object's `:grasps` list does not allow.",
     "E228": "In a symbolic problem every movable object needs exactly one `(in-region OBJECT REGION)` in "
     "`:init`; in any problem at most one.",
+    "E229": "An object that occludes itself, or a handover from a robot to itself.",
     "E230": "A problem names no domain, or a domain that is not in the file, in `domain.mrg` beside it, "
     "or in its includes; also used when a file does not hold the problem asked for.",
     "E231": "The domain's name is defined in more than one place at the same lookup level.",

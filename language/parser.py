@@ -103,7 +103,7 @@ class _ToAst(Transformer[Token, Any]):
     # ------------------------------------------------------------ domain sections
     def requirements(self, children: list[Any]) -> ast.Requirements:
         span, flags = self._parts(children)
-        return ast.Requirements(tuple(str(t)[1:] for t in flags), span)
+        return ast.Requirements(tuple(str(t)[1:] for t in flags), tuple(self._tspan(t) for t in flags), span)
 
     def robot_kind(self, children: list[Any]) -> ast.RobotKindDecl:
         span, (name, *props) = self._parts(children)

@@ -133,6 +133,9 @@ class PropReader:
         if not isinstance(value, ast.ListValue):
             self.err("E253", f"{what} must be a list of names like (a b), not {_kind_of(value)}", value.span)
             return None
+        if not value.items:
+            self.err("E253", f"{what} must list at least one name (leave it out to allow them all)", value.span)
+            return None
         out = []
         for item in value.items:
             if not isinstance(item, ast.Symbol):

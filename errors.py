@@ -48,25 +48,25 @@ class Diagnostic:
         where = f"{self.span}: " if self.span is not None else ""
         return f"{where}{self.severity}[{self.code}]: {self.message}"
 
-    def render(self, source: str | None = None) -> str:
-        """The headline, then (when ``source`` holds the file's text) the source line with a caret."""
+    def render(self, source: str | Sequence[str] | None = None) -> str:
+        """The headline, then (when ``source`` holds the file's text or lines) the source line with a caret."""
         lines = [self.headline()]
         if self.span is not None and source is not None:
-            lines.extend(_snippet(source, self.span))
+            lines.extend(_snippet(source.split("\n") if isinstance(source, str) else source, self.span))
         lines.extend(f"  = note: {n}" for n in self.notes)
         return "\n".join(lines)
 
 
-def _snippet(source: str, span: Span) -> list[str]:
-    text_lines = source.split("\n")
+def _snippet(text_lines: Sequence[str], span: Span) -> list[str]:
     if not 1 <= span.line <= len(text_lines):
         return []
-    text = text_lines[span.line - 1].rstrip("\r").expandtabs(1)
+    text = text_lines[span.line - 1]
     if len(text) > 200:  # keep the caret line readable on generated one-line files
         start = max(0, span.column - 80)
-        text = ("..." if start else "") + text[start : start + 160]
+        text = ("..." if start else "") + text[start : start + 160].rstrip("\r").replace("\t", " ")
         col = span.column - start + (3 if start else 0)
     else:
+        text = text.rstrip("\r").replace("\t", " ")
         col = span.column
     width = span.end_column - span.column if span.end_line == span.line else len(text) - col + 1
     width = max(1, min(width, len(text) - col + 2))
@@ -99,8 +99,17 @@ class InputError(MrgcError):
         self.sources: dict[str, str] = dict(sources or {})
 
     def render(self) -> str:
-        """Every diagnostic with its snippet, in file order."""
-        return "\n".join(d.render(self.sources.get(d.span.file) if d.span else None) for d in self.diagnostics)
+        """Every diagnostic with its snippet, in file order (each file is split into lines once)."""
+        split: dict[str, list[str]] = {}
+        out = []
+        for d in self.diagnostics:
+            lines = None
+            if d.span is not None and d.span.file in self.sources:
+                if d.span.file not in split:
+                    split[d.span.file] = self.sources[d.span.file].split("\n")
+                lines = split[d.span.file]
+            out.append(d.render(lines))
+        return "\n".join(out)
 
 
 class MissingBackendError(MrgcError):

@@ -155,12 +155,13 @@ class Checker:
         for d in decls["regions"]:
             v = self._decl_values("regions", "region", d)
             regions.append(Region(d.name, v.get("shape"), v.get("pose"), d.span))
-        point_names = {d.name for d in decls["handover-points"]}
+        point_names = [d.name for d in decls["handover-points"]]
         for d in decls["movable"]:
             v = self._decl_values("movable", "movable object", d)
             own = self._name_list(v.get("grasps"), grasps, "grasp", f"domain '{domain.name}'")
-            via = self._name_list(v.get("handover"), point_names, "handover-point", "this problem")
-            movable.append(MovableObject(d.name, v.get("shape"), v.get("pose"), own or domain.grasps, via, d.span))
+            via = self._name_list(v.get("handover"), set(point_names), "handover-point", "this problem")
+            movable.append(MovableObject(d.name, v.get("shape"), v.get("pose"), own or domain.grasps,
+                                         via or tuple(dict.fromkeys(point_names)), d.span))
         for d in decls["handover-points"]:
             v = self._decl_values("handover-points", "handover point", d)
             points.append(HandoverPoint(d.name, v.get("position"), d.span))

@@ -152,7 +152,11 @@ class _Loader:
         base = self.dir_of(path)
         for inc in _includes(tree):
             target = os.path.normpath(os.path.join(base, inc.path))
-            real = os.path.realpath(target)
+            try:
+                real = os.path.realpath(target)
+            except (OSError, ValueError) as exc:  # e.g. a NUL character in the path
+                self.diags.append(Diagnostic("E234", f"include path {inc.path!r} is not usable: {exc}", inc.span))
+                continue
             if os.path.commonpath([self.root_dir, real]) != self.root_dir:
                 self.diags.append(Diagnostic("E233", f"include '{inc.path}' leaves the folder tree of "
                                              f"{shown(self.root_dir)}", inc.span))

@@ -155,9 +155,9 @@ class Region:
 
 @dataclass(frozen=True)
 class MovableObject:
-    """A movable object; ``grasps`` are the grasps robots may use on it (default: the whole vocabulary).
-
-    ``handover_points`` names the handover points it may be passed at (default: all of the problem's).
+    """A movable object; ``grasps`` are the grasps robots may use on it (the whole vocabulary unless its
+    ``:grasps`` narrows it); ``handover_points`` the handover points it may be passed at (all of the
+    problem's unless its ``:handover`` narrows them).
     """
 
     name: str

@@ -201,11 +201,8 @@ def test_strings_round_trip_exactly(s: str) -> None:
 
 
 def test_huge_number_written_1e999_keeps_its_meaning_through_fmt() -> None:
-    """``1e999`` parses as Number(inf); fmt must not turn it into the *name* ``inf``.
-
-    BUG: printer.number() prints repr(inf) == 'inf', which re-parses as Symbol('inf'), so `mrgc fmt` changes
-    the meaning of the file (the E251 "non-finite number" error becomes E253 "wrong type").
-    """
+    """``1e999`` parses as Number(inf); fmt must not turn it into the *name* ``inf`` (which would change the
+    file's E251 "non-finite number" into E253 "wrong type").  Regression test: printing repr(inf) was a bug."""
     text = "(define (problem p)\n  (:robots\n    (r :x 1e999 :y -1e999)))\n"
     tree = parsed(text)
     assert tree.definitions[0].sections[0].decls[0].props[0].value == ast.Number(math.inf)
@@ -219,12 +216,15 @@ comment_bodies = st.text(alphabet=st.characters(blacklist_characters="\n", black
 
 @st.composite
 def commented(draw: st.DrawFn) -> tuple[ast.SourceFile, str, list[str]]:
-    """A canonical file with random comments inserted on their own lines and at line ends."""
+    """A canonical file with random comments inserted on their own lines and at line ends (and a few blank
+    lines, which the printer keeps)."""
     tree = draw(source_files)
     lines = format_source(tree).split("\n")[:-1]
     out: list[str] = []
     comments: list[str] = []
     for i, line in enumerate([*lines, None]):
+        if draw(st.integers(0, 9)) == 0:
+            out.append("")
         for _ in range(draw(st.integers(0, 2))):  # own-line comments before this line
             c = draw(comment_bodies)
             comments.append(c)
@@ -271,8 +271,8 @@ def test_comments_survive_formatting(case: tuple[ast.SourceFile, str, list[str]]
     ],
 )
 def test_comments_in_non_canonical_places(text: str) -> None:
-    """fmt keeps each comment and never comments out code (BUG: a comment alone on the line before a
-    definition's closing ')' swallows the ')': '  ; trailing comment)')."""
+    """fmt keeps each comment and never comments out code.  Regression test: a comment alone on the line
+    before a definition's closing ')' used to swallow the ')' ('  ; trailing comment)')."""
     tree = parsed(text)
     out = format_source(tree, text)
     _assert_comments_kept(text, out, [c.text for c in comments_of(text)])

@@ -124,6 +124,7 @@ class Checker:
             footprint=vals.get("footprint"),  # type: ignore[arg-type]
             carry=vals.get("carry"),  # type: ignore[arg-type]
             reach=vals.get("reach"),  # type: ignore[arg-type]
+            tcp=vals.get("tcp"),  # type: ignore[arg-type]
             source=self.file,
             span=k.span,
         )

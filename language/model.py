@@ -94,6 +94,8 @@ class RobotKind:
 
     ``base`` is ``fixed`` (arm bolted to its base pose) or ``planar`` (x, y, yaw driven base).  A planar
     kind may give a ``footprint`` shape and the ``carry`` pose of a held object relative to its base.
+    ``tcp`` is the tool centre point (between the fingertips) relative to the end-effector link, ``reach``
+    an upper bound on the distance from the base at which the arm can place its tool centre point.
     """
 
     name: str
@@ -104,6 +106,7 @@ class RobotKind:
     footprint: Shape | None = None
     carry: Pose | None = None
     reach: float | None = None
+    tcp: Pose | None = None
     source: str = field(default="", compare=False)
     span: Span = _span()
 

@@ -25,6 +25,7 @@ SCHEMAS: dict[str, dict[str, str]] = {
         "footprint": "shape",
         "carry": "pose",
         "reach": "length",
+        "tcp": "pose",
     },
     "robots": {"kind": "name", "base": "pose"},
     "fixed": {"shape": "shape", "pose": "pose"},

@@ -1,0 +1,135 @@
+"""The scene of a geometric problem as plain, picklable data: what is where, in world coordinates.
+
+A :class:`SceneSpec` is built once from a checked geometric :class:`~mrgc.language.model.Problem`; worker
+processes rebuild their own collision worlds and robot models from it (one pybullet client per process).
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from mrgc.errors import Diagnostic, InputError
+from mrgc.geometry.transforms import from_pose
+from mrgc.language.model import Box, Cylinder, Mesh, Problem, RobotKind, Shape, Sphere
+
+
+@dataclass(frozen=True)
+class Body:
+    """A rigid body or region: its shape and its pose (4×4, world frame)."""
+
+    name: str
+    shape: Shape
+    pose: np.ndarray = field(compare=False)
+
+
+@dataclass(frozen=True)
+class RobotSpec:
+    """A robot: its kind, its base pose (4×4, world frame) and the folder its kind's URDF is relative to."""
+
+    name: str
+    kind: RobotKind
+    base: np.ndarray = field(compare=False)
+    base_dir: str = ""
+
+
+@dataclass(frozen=True)
+class SceneSpec:
+    """Everything geometric about a problem, in the order the problem declares it."""
+
+    problem: str
+    robots: tuple[RobotSpec, ...]
+    fixed: tuple[Body, ...]
+    movable: tuple[Body, ...]
+    regions: tuple[Body, ...]
+    handover_points: dict[str, np.ndarray]
+    grasps: dict[str, tuple[str, ...]]
+    handover_of: dict[str, tuple[str, ...]]
+    goal: dict[str, str]
+
+    def body(self, name: str) -> Body:
+        for b in (*self.movable, *self.fixed, *self.regions):
+            if b.name == name:
+                return b
+        raise KeyError(name)
+
+    def robot(self, name: str) -> RobotSpec:
+        return next(r for r in self.robots if r.name == name)
+
+
+def scene_from_problem(problem: Problem) -> SceneSpec:
+    """The scene of a geometric problem (InputError E401 for a symbolic one)."""
+    if problem.symbolic:
+        raise InputError([Diagnostic("E401", f"problem '{problem.name}' is symbolic: it has no geometry",
+                                     problem.span)])
+    kinds = {k.name: k for k in problem.domain.robot_kinds}
+    robots = []
+    for r in problem.robots:
+        assert r.kind is not None and r.base is not None  # guaranteed by the checks of a geometric problem
+        kind = kinds[r.kind]
+        robots.append(RobotSpec(r.name, kind, from_pose(r.base), os.path.dirname(os.path.abspath(kind.source))))
+    return SceneSpec(
+        problem=problem.name,
+        robots=tuple(robots),
+        fixed=tuple(Body(o.name, o.shape, from_pose(o.pose)) for o in problem.fixed if o.shape and o.pose),
+        movable=tuple(Body(o.name, o.shape, from_pose(o.pose)) for o in problem.movable if o.shape and o.pose),
+        regions=tuple(Body(o.name, o.shape, from_pose(o.pose)) for o in problem.regions if o.shape and o.pose),
+        handover_points={h.name: np.array(h.position) for h in problem.handover_points if h.position},
+        grasps={m.name: problem.grasps_of(m.name) for m in problem.movable},
+        handover_of={m.name: m.handover_points for m in problem.movable},
+        goal=problem.goal_regions,
+    )
+
+
+def half_extents(shape: Shape) -> np.ndarray:
+    """Half sizes of the shape's bounding box in its own frame."""
+    if isinstance(shape, Box):
+        return np.array([shape.sx, shape.sy, shape.sz]) / 2
+    if isinstance(shape, Cylinder):
+        return np.array([shape.radius, shape.radius, shape.height / 2])
+    if isinstance(shape, Sphere):
+        return np.full(3, shape.radius)
+    return mesh_half_extents(shape)
+
+
+def mesh_half_extents(mesh: Mesh) -> np.ndarray:
+    pts = mesh_vertices(mesh)
+    return np.abs(pts).max(axis=0)
+
+
+def mesh_vertices(mesh: Mesh) -> np.ndarray:
+    """The vertices of an OBJ mesh file (``v x y z`` lines), scaled."""
+    pts = []
+    with open(mesh.path, encoding="utf-8", errors="replace") as fh:
+        for line in fh:
+            if line.startswith("v "):
+                x, y, z = line.split()[1:4]
+                pts.append((float(x), float(y), float(z)))
+    return np.array(pts) * mesh.scale if pts else np.zeros((1, 3))
+
+
+def outline(shape: Shape) -> np.ndarray:
+    """Points whose convex hull contains the shape (its bounding-box corners; a mesh's own vertices)."""
+    if isinstance(shape, Mesh):
+        return mesh_vertices(shape)
+    h = half_extents(shape)
+    signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=float)
+    return signs * h
+
+
+def inside(region: Body, shape: Shape, pose: np.ndarray, tol: float = 1e-6) -> bool:
+    """``in-region``: the object (of ``shape`` at ``pose``) lies entirely inside the region's box.
+
+    Cylinders and spheres are tested by their bounding boxes, which makes the test conservative (an
+    object reported inside is inside).  A region must be a box.
+    """
+    if not isinstance(region.shape, Box):
+        return False
+    pts = outline(shape)
+    world = pts @ pose[:3, :3].T + pose[:3, 3]
+    inv = np.linalg.inv(region.pose)
+    local = world @ inv[:3, :3].T + inv[:3, 3]
+    half = half_extents(region.shape) + tol
+    return bool(np.all(np.abs(local) <= half))

@@ -53,7 +53,8 @@ class SkeletonGenerator:
         self.found: list[frozenset[int]] = []
         self.solver: Solver | None = None
         self.encoded: Encoded | None = None
-        self.done = not graph.must_move
+        self.done = False
+        self.trivial = not graph.must_move  # nothing to move: the empty skeleton is the one plan
         self.stats: dict[str, float] = {"solves": 0, "solve_seconds": 0.0, "build_seconds": 0.0, "models": 0}
 
     def _cuts(self, enc: Encoded) -> list[Row]:
@@ -74,6 +75,9 @@ class SkeletonGenerator:
         """Up to ``k`` further skeletons, in (makespan, moved) order."""
         deadline = None if time_limit is None else time.perf_counter() + time_limit
         out: list[Skeleton] = []
+        if self.trivial and not self.done:
+            self.done = True
+            return Batch([Skeleton(())] if k > 0 else [], EXHAUSTED, stats=dict(self.stats))
         while len(out) < k:
             if self.done or self.horizon > self.limit:
                 self.done = True

@@ -1,0 +1,158 @@
+"""RRTConnect through OMPL: a point through a gap in a wall, SE(2) around a wall, outcomes, determinism."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from mrgc.geometry.motion import MotionResult, MotionStatus, plan_joint_path, plan_se2_path
+
+LOWER, UPPER = [0.0, 0.0], [1.0, 1.0]
+
+
+def wall_with_gap(q: np.ndarray) -> bool:
+    """The unit square with a wall at 0.45 <= x <= 0.55, open only for 0.45 < y < 0.55."""
+    x, y = q
+    return not (0.45 <= x <= 0.55 and not 0.45 < y < 0.55)
+
+
+def check_path(result: MotionResult, start, goal, is_valid, step: float, yaw: bool = False) -> None:
+    assert result.status is MotionStatus.SOLVED and result.solved
+    path = np.array(result.path)
+    assert np.allclose(path[0], start) and np.allclose(path[-1], goal)
+    assert all(is_valid(q) for q in path)
+    d = np.diff(path, axis=0)
+    if yaw:
+        d[:, 2] = (d[:, 2] + math.pi) % (2 * math.pi) - math.pi
+        assert np.max(np.linalg.norm(d[:, :2], axis=1)) <= step + 1e-9
+    else:
+        assert np.max(np.linalg.norm(d, axis=1)) <= step + 1e-9
+
+
+def test_point_through_the_gap() -> None:
+    result = plan_joint_path(LOWER, UPPER, [0.1, 0.1], [0.9, 0.9], wall_with_gap, time_limit=2.0, seed=1,
+                             resolution=0.01)
+    check_path(result, [0.1, 0.1], [0.9, 0.9], wall_with_gap, 0.01)
+    # it really went through the gap
+    crossing = [q for q in result.path if 0.45 <= q[0] <= 0.55]
+    assert crossing and all(0.45 < q[1] < 0.55 for q in crossing)
+
+
+def test_every_checked_state_is_returned() -> None:
+    calls: list[np.ndarray] = []
+
+    def valid(q: np.ndarray) -> bool:
+        calls.append(q)
+        return wall_with_gap(q)
+
+    result = plan_joint_path(LOWER, UPPER, [0.1, 0.1], [0.9, 0.9], valid, time_limit=2.0, seed=3,
+                             resolution=0.02)
+    assert result.solved
+    assert all(isinstance(q, np.ndarray) and q.shape == (2,) for q in calls)
+    checked = {tuple(np.round(q, 12)) for q in calls}
+    assert all(tuple(np.round(q, 12)) in checked for q in result.path)
+
+
+def test_invalid_start_and_goal() -> None:
+    r = plan_joint_path(LOWER, UPPER, [0.5, 0.1], [0.9, 0.9], wall_with_gap, time_limit=0.5)
+    assert r.status is MotionStatus.INVALID_START and r.path == []
+    r = plan_joint_path(LOWER, UPPER, [0.1, 0.1], [0.5, 0.9], wall_with_gap, time_limit=0.5)
+    assert r.status is MotionStatus.INVALID_GOAL
+    r = plan_joint_path(LOWER, UPPER, [1.5, 0.1], [0.9, 0.9], wall_with_gap, time_limit=0.5)
+    assert r.status is MotionStatus.INVALID_START
+
+
+def test_enclosed_goal_is_no_path_within_the_time_limit() -> None:
+    def boxed_in(q: np.ndarray) -> bool:  # a closed ring 0.1 thick around the goal at (0.8, 0.8)
+        d = np.max(np.abs(q - 0.8))
+        return not 0.1 <= d <= 0.2
+
+    r = plan_joint_path(LOWER, UPPER, [0.1, 0.1], [0.8, 0.8], boxed_in, time_limit=0.3, seed=0)
+    assert r.status is MotionStatus.NO_PATH and r.path == [] and not r.solved
+    assert r.planning_time < 2.0
+
+
+def test_misuse_raises() -> None:
+    with pytest.raises(ValueError):
+        plan_joint_path([0, 0], [1, 1], [0.1], [0.9, 0.9], wall_with_gap)
+    with pytest.raises(ValueError):
+        plan_joint_path([0, 0], [1, 1], [0.1, 0.1], [0.9, 0.9], wall_with_gap, resolution=0)
+
+
+def test_exceptions_in_the_validity_test_propagate() -> None:
+    def broken(q: np.ndarray) -> bool:
+        if 0.4 < q[0] < 0.6:  # start and goal are fine: it raises inside OMPL's solve
+            raise RuntimeError("bug in the checker")
+        return True
+
+    with pytest.raises(RuntimeError, match="bug in the checker"):
+        plan_joint_path(LOWER, UPPER, [0.1, 0.1], [0.9, 0.9], broken, time_limit=1.0)
+
+
+def test_same_seed_same_path_and_other_seed_other_path() -> None:
+    def run(seed: int) -> list[np.ndarray]:
+        r = plan_joint_path(LOWER, UPPER, [0.1, 0.1], [0.9, 0.9], wall_with_gap, time_limit=2.0, seed=seed)
+        assert r.solved
+        return r.path
+
+    a, b, c = run(7), run(7), run(8)
+    assert len(a) == len(b) and all(np.array_equal(p, q) for p, q in zip(a, b))
+    assert len(a) != len(c) or not all(np.array_equal(p, q) for p, q in zip(a, c))
+    # seed 0 is deterministic too (OMPL itself ignores a zero seed)
+    z1, z2 = run(0), run(0)
+    assert len(z1) == len(z2) and all(np.array_equal(p, q) for p, q in zip(z1, z2))
+
+
+def test_seven_joints() -> None:
+    lo, hi = -np.pi * np.ones(7), np.pi * np.ones(7)
+
+    def valid(q: np.ndarray) -> bool:  # a slab in joint 0 with a window where joint 1 is near 0
+        return not (abs(q[0]) < 0.2 and abs(q[1]) > 0.3)
+
+    start, goal = np.full(7, -2.0), np.full(7, 2.0)
+    r = plan_joint_path(lo, hi, start, goal, valid, time_limit=5.0, seed=2, resolution=0.05)
+    check_path(r, start, goal, valid, 0.05)
+    simple = plan_joint_path(lo, hi, start, goal, valid, time_limit=5.0, seed=2, resolution=0.05, simplify=True)
+    check_path(simple, start, goal, valid, 0.05)
+
+
+# -------------------------------------------------------------------------------------- SE(2)
+
+BOUNDS = (0.0, 4.0, 0.0, 4.0)
+
+
+def base_valid(p: np.ndarray) -> bool:
+    """A 0.6 × 0.2 robot (corners tested) in the 4 × 4 square with a wall at x = 2 open only for y > 3."""
+    x, y, yaw = p
+    c, s = math.cos(yaw), math.sin(yaw)
+    for dx, dy in ((0.3, 0.1), (0.3, -0.1), (-0.3, 0.1), (-0.3, -0.1), (0, 0)):
+        px, py = x + c * dx - s * dy, y + s * dx + c * dy
+        if not (0 <= px <= 4 and 0 <= py <= 4):
+            return False
+        if 1.9 <= px <= 2.1 and py <= 3.0:
+            return False
+    return True
+
+
+def test_se2_around_a_wall() -> None:
+    start, goal = (1.0, 1.0, 0.0), (3.0, 1.0, math.pi / 2)
+    r = plan_se2_path(BOUNDS, start, goal, base_valid, time_limit=5.0, seed=0, resolution=0.02)
+    check_path(r, start, goal, base_valid, 0.02, yaw=True)
+    assert max(q[1] for q in r.path) > 3.0  # it went round the end of the wall
+    assert all(-math.pi <= q[2] < math.pi for q in r.path)
+    yaw_steps = np.abs((np.diff([q[2] for q in r.path]) + math.pi) % (2 * math.pi) - math.pi)
+    assert yaw_steps.max() <= 0.05 + 1e-9
+
+
+def test_se2_outcomes_and_determinism() -> None:
+    assert plan_se2_path(BOUNDS, (2.0, 1.0, 0.0), (3, 1, 0), base_valid).status is MotionStatus.INVALID_START
+    assert plan_se2_path(BOUNDS, (1.0, 1.0, 0.0), (2, 1, 0), base_valid).status is MotionStatus.INVALID_GOAL
+    assert plan_se2_path(BOUNDS, (1.0, 1.0, 0.0), (9, 1, 0), base_valid).status is MotionStatus.INVALID_GOAL
+    a = plan_se2_path(BOUNDS, (1.0, 1.0, 0.0), (3.0, 1.0, 3.0), base_valid, time_limit=5.0, seed=4)
+    b = plan_se2_path(BOUNDS, (1.0, 1.0, 0.0), (3.0, 1.0, 3.0), base_valid, time_limit=5.0, seed=4)
+    assert a.solved and len(a.path) == len(b.path) and all(np.array_equal(p, q) for p, q in zip(a.path, b.path))
+    # a yaw beyond π is taken modulo 2π
+    c = plan_se2_path(BOUNDS, (1.0, 1.0, 2 * math.pi), (1.5, 1.0, 0.0), base_valid, time_limit=2.0)
+    assert c.solved and abs(c.path[0][2]) < 1e-9

@@ -62,7 +62,7 @@ class SceneSpec:
 def scene_from_problem(problem: Problem) -> SceneSpec:
     """The scene of a geometric problem (InputError E401 for a symbolic one)."""
     if problem.symbolic:
-        raise InputError([Diagnostic("E401", f"problem '{problem.name}' is symbolic: it has no geometry",
+        raise InputError([Diagnostic("E402", f"problem '{problem.name}' is symbolic: it has no geometry",
                                      problem.span)])
     kinds = {k.name: k for k in problem.domain.robot_kinds}
     robots = []

@@ -1,0 +1,644 @@
+"""Robot models: a URDF read once into plain, picklable kinematic and collision data.
+
+A :class:`RobotModel` holds everything the rest of the geometry layer needs about a robot without touching
+pybullet again: the chain of movable joints from the base link to the end-effector link, every link with
+its collision geometry (mesh vertices read from the files), and the fixed transforms of links hanging off
+the chain (a Panda's hand and fingers).  Forward kinematics (:mod:`mrgc.geometry.fk`) and inverse
+kinematics (:mod:`mrgc.geometry.ik`) are numpy on this data.
+
+The URDF's joints and collisions are read with the standard library's XML parser (pybullet reports joint
+frames relative to centres of mass, with their rotations inverted); pybullet loads every URDF too, as a
+validity check and as the reference.  This is the only module that imports pybullet, lazily, in one
+DIRECT client per process; pybullet's own forward and inverse kinematics (:func:`pybullet_fk`,
+:func:`pybullet_ik`) are here for tests and benchmarks.
+
+Frames: a link's frame is its URDF link frame (pybullet's ``worldLinkFrame``, not its centre of mass); a
+movable joint's frame is its child link's frame.  Off-chain movable joints (the Panda's fingers) are frozen
+at :attr:`Link.frozen_value`: a prismatic one at its upper limit (gripper open), a revolute one at 0
+clamped into its limits.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import functools
+import math
+import os
+import struct
+import sys
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from typing import Any, Iterator, Sequence
+
+import numpy as np
+
+from mrgc.errors import Diagnostic, InputError, Span
+from mrgc.geometry import transforms as tf
+from mrgc.language.model import RobotKind
+
+#: code of "robot URDF not found or unreadable" and of "end-effector link not in the URDF"
+E_URDF = "E400"
+E_LINK = "E401"
+
+
+# ----------------------------------------------------------------------------------------------- data
+
+@dataclass(frozen=True, eq=False)
+class Collision:
+    """One collision shape of a link.
+
+    ``kind`` is ``mesh``, ``box``, ``sphere``, ``cylinder``, ``capsule`` or ``plane``; ``origin`` maps the
+    shape's frame to its link's frame.  ``size``: box full side lengths (sx, sy, sz); sphere (radius,);
+    cylinder and capsule (radius, length along z); mesh its scale (sx, sy, sz).  ``vertices`` (V, 3) are in
+    the shape frame, scaled (for primitives, points on the surface: a box's 8 corners, 16-gons for round
+    shapes); ``faces`` (F, 3) index triangles of a mesh (empty for primitives).
+    """
+
+    kind: str
+    origin: np.ndarray
+    size: tuple[float, ...]
+    mesh_path: str | None
+    vertices: np.ndarray
+    faces: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
+class Link:
+    """A link and the joint that attaches it to its parent link.
+
+    ``origin`` maps the joint frame at joint value 0 (= this link's frame) into the parent link's frame;
+    ``axis`` is the unit joint axis in the joint frame.  ``joint_kind`` is ``base`` (the root, ``parent``
+    -1), ``fixed``, ``revolute`` or ``prismatic``.  ``chain_index`` is the joint's position in the
+    configuration vector, or -1 when the joint is not on the base→end-effector chain; such a movable joint
+    is frozen at ``frozen_value``.  ``points`` (P, 3) are all collision vertices in the link frame.
+    """
+
+    name: str
+    index: int
+    parent: int
+    joint: str | None
+    joint_kind: str
+    origin: np.ndarray
+    axis: np.ndarray
+    chain_index: int
+    frozen_value: float
+    collisions: tuple[Collision, ...]
+    points: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
+class Joint:
+    """A movable joint of the chain.  ``origin``: parent link frame → joint frame at 0 (the URDF origin);
+    ``pre``: frame of the previous chain joint (or the base link) → this joint's frame at 0, folding in any
+    fixed joints between them.  ``link`` is the index of the child link in :attr:`RobotModel.links`."""
+
+    name: str
+    kind: str
+    axis: np.ndarray
+    origin: np.ndarray
+    pre: np.ndarray
+    lower: float
+    upper: float
+    max_velocity: float
+    link: int
+    continuous: bool = False
+
+
+@dataclass(frozen=True, eq=False)
+class RobotModel:
+    """A robot read from a URDF: chain, links, limits, end effector and a reach bound; plain data.
+
+    ``key`` identifies the model across processes (resolved URDF path and end-effector link).  Links are in
+    topological order (a parent before its children), ``links[0]`` is the base link.  ``ee_offset`` maps
+    the end-effector link's frame into the frame of the last chain joint.  ``shoulder`` (base frame) and
+    ``reach`` bound the workspace: every end-effector position lies within ``reach`` of ``shoulder``.
+    """
+
+    key: str
+    urdf: str
+    name: str
+    end_effector: str
+    links: tuple[Link, ...]
+    joints: tuple[Joint, ...]
+    ee_link: int
+    ee_offset: np.ndarray
+    lower: np.ndarray
+    upper: np.ndarray
+    max_velocity: np.ndarray
+    shoulder: np.ndarray
+    reach: float
+
+    @property
+    def dof(self) -> int:
+        return len(self.joints)
+
+    @property
+    def link_names(self) -> tuple[str, ...]:
+        return tuple(link.name for link in self.links)
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        return tuple(j.name for j in self.joints)
+
+    def link_index(self, name: str) -> int:
+        for link in self.links:
+            if link.name == name:
+                return link.index
+        raise KeyError(name)
+
+    def clamp(self, q: np.ndarray) -> np.ndarray:
+        """``q`` clipped into the joint limits."""
+        return np.clip(q, self.lower, self.upper)
+
+    def within_limits(self, q: np.ndarray, eps: float = 1e-9) -> np.ndarray:
+        """Whether each configuration of ``q`` (..., dof) respects the limits."""
+        q = np.asarray(q)
+        return np.all((q >= self.lower - eps) & (q <= self.upper + eps), axis=-1)
+
+    def __repr__(self) -> str:
+        return f"RobotModel({self.name!r}, ee={self.end_effector!r}, dof={self.dof}, links={len(self.links)})"
+
+
+# ------------------------------------------------------------------------------------ pybullet client
+
+_CLIENT: dict[str, Any] = {}
+
+
+@contextlib.contextmanager
+def _quiet_stdout() -> Iterator[None]:
+    """Silence C-level writes to fds 1 and 2 (pybullet's build-time banner, which goes to stdout or stderr
+    depending on the build, and its loader warnings) so JSON on stdout and diagnostics stay clean."""
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (AttributeError, ValueError):
+            pass
+    saved: list[tuple[int, int]] = []
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+    except OSError:  # pragma: no cover
+        yield
+        return
+    try:
+        for fd in (1, 2):
+            try:
+                saved.append((fd, os.dup(fd)))
+            except OSError:  # that fd is closed: nothing to protect
+                continue
+            os.dup2(devnull, fd)
+        yield
+    finally:
+        _c_fflush()
+        for fd, copy in saved:
+            os.dup2(copy, fd)
+            os.close(copy)
+        os.close(devnull)
+
+
+def _c_fflush() -> None:
+    """Flush C stdio buffers: printf output buffered while fd 1 was redirected must go to /dev/null."""
+    try:
+        import ctypes
+
+        ctypes.CDLL(None).fflush(None)
+    except (OSError, AttributeError):  # pragma: no cover - non-POSIX
+        pass
+
+
+def _pb() -> tuple[Any, int]:
+    """The pybullet module and this process's DIRECT client (created on first use, again after fork)."""
+    if _CLIENT.get("pid") != os.getpid():
+        with _quiet_stdout():
+            import pybullet
+
+            cid = pybullet.connect(pybullet.DIRECT)
+        _CLIENT.clear()
+        _CLIENT.update(pid=os.getpid(), pb=pybullet, cid=cid, bodies={})
+    return _CLIENT["pb"], _CLIENT["cid"]
+
+
+def _data_path() -> str:
+    with _quiet_stdout():
+        import pybullet_data
+    return str(pybullet_data.getDataPath())
+
+
+def _body(urdf: str) -> int:
+    """The body id of the resolved URDF in the client, loaded once (fixed base, identity base pose)."""
+    pb, cid = _pb()
+    bodies: dict[str, int] = _CLIENT["bodies"]
+    if urdf not in bodies:
+        with _quiet_stdout():
+            bodies[urdf] = pb.loadURDF(urdf, useFixedBase=True, physicsClientId=cid)
+    return bodies[urdf]
+
+
+# ----------------------------------------------------------------------------------------- loading
+
+def resolve_urdf(urdf: str, base_dir: str, span: Span | None = None) -> str:
+    """The absolute path of ``urdf``: relative to ``base_dir`` (the .mrg file's folder) if it exists
+    there, else relative to pybullet_data; :class:`~mrgc.errors.InputError` E400 when neither exists."""
+    candidates = [urdf] if os.path.isabs(urdf) else [os.path.join(base_dir, urdf), os.path.join(_data_path(), urdf)]
+    for c in candidates:
+        if os.path.isfile(c):
+            return os.path.realpath(c)
+    looked = " or ".join(repr(c) for c in candidates)
+    raise InputError([Diagnostic(E_URDF, f"robot URDF {urdf!r} not found (looked for {looked})", span)])
+
+
+def load_robot_model(urdf: str, base_dir: str, end_effector: str, *, span: Span | None = None) -> RobotModel:
+    """Read the robot of ``urdf`` (resolved by :func:`resolve_urdf`) with ``end_effector`` as its tool link.
+
+    Raises :class:`~mrgc.errors.InputError` with E400 when the URDF is missing, malformed or refused by
+    pybullet, E401 when it has no link named ``end_effector``.  Cached per (resolved path, end effector).
+    """
+    path = resolve_urdf(urdf, base_dir, span)
+    try:
+        names = _parse_urdf(path).order
+    except (ET.ParseError, ValueError, KeyError) as exc:
+        raise InputError([Diagnostic(E_URDF, f"robot URDF {path!r} is malformed: {exc}", span)]) from None
+    pb, _ = _pb()
+    try:
+        _body(path)  # pybullet must accept the file too: it is the reference and loads it for checks
+    except pb.error as exc:
+        raise InputError([Diagnostic(E_URDF, f"pybullet cannot load robot URDF {path!r}: {exc}", span)]) from None
+    if end_effector not in names:
+        raise InputError([Diagnostic(
+            E_LINK, f"end-effector link {end_effector!r} is not a link of {path!r} (links: {', '.join(names)})",
+            span)])
+    try:
+        return _build_model(path, end_effector)
+    except ValueError as exc:
+        raise InputError([Diagnostic(E_URDF, f"robot URDF {path!r}: {exc}", span)]) from None
+
+
+def model_for_kind(kind: RobotKind, base_dir: str) -> RobotModel:
+    """The model of a robot kind of a geometric domain (``base_dir``: folder of the file declaring it)."""
+    if kind.urdf is None or kind.end_effector is None:
+        what = ":urdf" if kind.urdf is None else ":end-effector"
+        raise InputError([Diagnostic(E_URDF, f"robot kind {kind.name!r} has no {what}", kind.span)])
+    return load_robot_model(kind.urdf, base_dir, kind.end_effector, span=kind.span)
+
+
+# The URDF itself is read with the standard library rather than through pybullet's getJointInfo, whose
+# parentFrameOrn is expressed in the parent's centre-of-mass frame and comes back with the rotation inverted
+# (bullet3 issues #3253, #4231); pybullet still loads every file, as the reference and as a validity check.
+
+@dataclass(frozen=True)
+class _UrdfJoint:
+    name: str
+    kind: str
+    parent: str
+    child: str
+    origin: np.ndarray
+    axis: np.ndarray
+    lower: float
+    upper: float
+    velocity: float
+
+
+@dataclass(frozen=True)
+class _Urdf:
+    name: str
+    order: tuple[str, ...]  # links, root first, parents before children
+    joint_of: dict[str, _UrdfJoint]  # child link -> the joint attaching it
+    links: dict[str, ET.Element]
+
+
+def _vec(text: str | None, default: tuple[float, ...]) -> tuple[float, ...]:
+    if text is None:
+        return default
+    vals = tuple(float(x) for x in text.split())
+    if len(vals) != len(default):
+        raise ValueError(f"expected {len(default)} numbers, got {text!r}")
+    return vals
+
+
+def _origin(el: ET.Element | None) -> np.ndarray:
+    if el is None:
+        return np.eye(4)
+    return tf.from_xyz_rpy(_vec(el.get("xyz"), (0.0, 0.0, 0.0)), _vec(el.get("rpy"), (0.0, 0.0, 0.0)))
+
+
+@functools.lru_cache(maxsize=None)
+def _parse_urdf(path: str) -> _Urdf:
+    root = ET.parse(path).getroot()
+    links = {el.attrib["name"]: el for el in root.findall("link")}
+    joint_of: dict[str, _UrdfJoint] = {}
+    children: dict[str, list[str]] = {}
+    for el in root.findall("joint"):
+        kind = el.attrib["type"]
+        parent, child = el.find("parent"), el.find("child")
+        if parent is None or child is None:
+            raise ValueError(f"joint {el.get('name')!r} lacks its parent or child")
+        axis = np.array(_vec(el.find("axis").get("xyz") if el.find("axis") is not None else None, (1.0, 0.0, 0.0)))
+        lim = el.find("limit")
+        lo = float(lim.get("lower", 0.0)) if lim is not None else 0.0
+        hi = float(lim.get("upper", 0.0)) if lim is not None else 0.0
+        vel = float(lim.get("velocity", 0.0)) if lim is not None else 0.0
+        if kind == "continuous" or (kind == "revolute" and lo >= hi):
+            lo, hi = -math.pi, math.pi
+        j = _UrdfJoint(el.attrib["name"], kind, parent.attrib["link"], child.attrib["link"], _origin(el.find("origin")),
+                       axis / np.linalg.norm(axis) if np.linalg.norm(axis) > 0 else axis, lo, hi, vel)
+        joint_of[j.child] = j
+        children.setdefault(j.parent, []).append(j.child)
+    roots = [name for name in links if name not in joint_of]
+    if len(roots) != 1:
+        raise ValueError(f"expected one root link, found {roots}")
+    order: list[str] = []
+    stack = [roots[0]]
+    while stack:  # depth first, children in document order
+        name = stack.pop()
+        order.append(name)
+        stack.extend(reversed(children.get(name, [])))
+    return _Urdf(root.get("name", ""), tuple(order), joint_of, links)
+
+
+@functools.lru_cache(maxsize=None)
+def _build_model(path: str, end_effector: str) -> RobotModel:
+    urdf = _parse_urdf(path)
+    index = {name: i for i, name in enumerate(urdf.order)}
+    ee = index[end_effector]
+    chain_names: list[str] = []
+    k_name = end_effector
+    while k_name in urdf.joint_of:
+        j = urdf.joint_of[k_name]
+        if j.kind in ("revolute", "continuous", "prismatic"):
+            chain_names.append(k_name)
+        elif j.kind != "fixed":
+            raise ValueError(f"joint {j.name!r} between the base and {end_effector!r} is {j.kind}, "
+                             f"not revolute, continuous, prismatic or fixed")
+        k_name = j.parent
+    chain_names.reverse()
+
+    links: list[Link] = []
+    for k, name in enumerate(urdf.order):
+        j = urdf.joint_of.get(name)
+        if j is None:
+            kind, origin, axis, parent, jname, lo, hi = "base", np.eye(4), np.zeros(3), -1, None, 0.0, 0.0
+        else:
+            kind = {"continuous": "revolute"}.get(j.kind, j.kind)
+            if kind not in ("revolute", "prismatic"):
+                kind = "fixed"  # off-chain floating/planar joints are frozen at zero
+            origin, axis, parent, jname, lo, hi = j.origin, j.axis, index[j.parent], j.name, j.lower, j.upper
+        chain_index = chain_names.index(name) if name in chain_names else -1
+        frozen = 0.0
+        if chain_index < 0 and kind == "prismatic":
+            frozen = hi  # a gripper finger: open
+        elif chain_index < 0 and kind == "revolute":
+            frozen = float(min(max(0.0, lo), hi))
+        collisions = tuple(_collisions(urdf.links[name], path))
+        pts = [(c.origin[:3, :3] @ c.vertices.T).T + c.origin[:3, 3] for c in collisions if len(c.vertices)]
+        links.append(Link(
+            name=name, index=k, parent=parent, joint=jname, joint_kind=kind, origin=_ro(origin), axis=_ro(axis),
+            chain_index=chain_index, frozen_value=frozen, collisions=collisions,
+            points=_ro(np.concatenate(pts) if pts else np.zeros((0, 3)))))
+
+    joints: list[Joint] = []
+    prev = 0  # frame of the previous chain joint (its child link) or the base link
+    for name in chain_names:
+        k = index[name]
+        j = urdf.joint_of[name]
+        pre = _fixed_between(links, prev, links[k].parent) @ links[k].origin
+        joints.append(Joint(name=j.name, kind=links[k].joint_kind, axis=links[k].axis, origin=links[k].origin,
+                            pre=_ro(pre), lower=j.lower, upper=j.upper, max_velocity=j.velocity, link=k,
+                            continuous=j.kind == "continuous"))
+        prev = k
+    ee_offset = _fixed_between(links, prev, ee)
+    shoulder, reach = _reach_bound(joints, ee_offset)
+    return RobotModel(
+        key=f"{path}#{end_effector}", urdf=path, name=urdf.name, end_effector=end_effector, links=tuple(links),
+        joints=tuple(joints), ee_link=ee, ee_offset=_ro(ee_offset),
+        lower=_ro(np.array([j.lower for j in joints])), upper=_ro(np.array([j.upper for j in joints])),
+        max_velocity=_ro(np.array([j.max_velocity for j in joints])), shoulder=_ro(shoulder), reach=reach)
+
+
+def _fixed_between(links: list[Link], ancestor: int, k: int) -> np.ndarray:
+    """Transform from link ``ancestor``'s frame to link ``k``'s, through fixed joints only."""
+    t = np.eye(4)
+    while k != ancestor:
+        t = links[k].origin @ t
+        k = links[k].parent
+    return t
+
+
+def _reach_bound(joints: list[Joint], ee_offset: np.ndarray) -> tuple[np.ndarray, float]:
+    """A point fixed in the base frame and a radius around it that contains every end-effector position.
+
+    The shoulder is the first chain joint's origin (a revolute joint's origin lies on its axis, so it does
+    not move); the radius sums the lengths of the translations after it (triangle inequality) plus the
+    travel of prismatic joints.
+    """
+    if not joints:
+        return ee_offset[:3, 3].copy(), 0.0
+    shoulder = joints[0].pre[:3, 3].copy()
+    reach = sum(float(np.linalg.norm(j.pre[:3, 3])) for j in joints[1:]) + float(np.linalg.norm(ee_offset[:3, 3]))
+    reach += sum(max(abs(j.lower), abs(j.upper)) for j in joints if j.kind == "prismatic")
+    return shoulder, reach
+
+
+def _ro(a: np.ndarray) -> np.ndarray:
+    a = np.array(a, dtype=float)
+    a.setflags(write=False)
+    return a
+
+
+# ------------------------------------------------------------------------------ collision geometry
+
+def _collisions(link: ET.Element, urdf: str) -> Iterator[Collision]:
+    for col in link.findall("collision"):
+        geom = col.find("geometry")
+        shape = geom[0] if geom is not None and len(geom) else None
+        if shape is None:
+            continue
+        origin = _ro(_origin(col.find("origin")))
+        faces = np.zeros((0, 3), dtype=np.int64)
+        mesh_path = None
+        if shape.tag == "mesh":
+            size = _vec(shape.get("scale"), (1.0, 1.0, 1.0))
+            mesh_path = _mesh_path(shape.get("filename", ""), urdf)
+            verts, faces = read_mesh(mesh_path) if mesh_path else (np.zeros((0, 3)), faces)
+            verts = verts * np.asarray(size)
+        elif shape.tag == "box":
+            size = _vec(shape.get("size"), (0.0, 0.0, 0.0))
+            verts = np.array([[x, y, z] for x in (-.5, .5) for y in (-.5, .5) for z in (-.5, .5)]) * size
+        elif shape.tag == "sphere":
+            size = (float(shape.get("radius", 0.0)),)
+            verts = _sphere_points(size[0])
+        elif shape.tag in ("cylinder", "capsule"):
+            size = (float(shape.get("radius", 0.0)), float(shape.get("length", 0.0)))
+            verts = _ring_points(size[0], size[1], capsule=shape.tag == "capsule")
+        else:  # planes and unknown shapes carry no points
+            size, verts = (), np.zeros((0, 3))
+        faces.setflags(write=False)
+        yield Collision(kind=shape.tag, origin=origin, size=tuple(size), mesh_path=mesh_path, vertices=_ro(verts),
+                        faces=faces)
+
+
+def _mesh_path(filename: str, urdf: str) -> str | None:
+    """A mesh file named in a URDF: ``package://`` and ``file://`` stripped, relative to the URDF's folder
+    (also without the package name), as pybullet resolves it; None when no file is there."""
+    here = os.path.dirname(urdf)
+    rel = filename
+    for prefix in ("package://", "file://"):
+        if rel.startswith(prefix):
+            rel = rel[len(prefix):]
+    for cand in (rel, os.path.join(here, rel), os.path.join(here, rel.split("/", 1)[-1]),
+                 os.path.join(here, os.pardir, rel)):
+        if rel and os.path.isfile(cand):
+            return os.path.realpath(cand)
+    return None
+
+
+def _ring_points(radius: float, length: float, capsule: bool, segments: int = 16) -> np.ndarray:
+    a = np.linspace(0.0, 2 * math.pi, segments, endpoint=False)
+    ring = np.stack([radius * np.cos(a), radius * np.sin(a)], axis=1)
+    pts = [np.column_stack([ring, np.full(segments, z)]) for z in (-length / 2, length / 2)]
+    if capsule:
+        pts.append(np.array([[0.0, 0.0, -length / 2 - radius], [0.0, 0.0, length / 2 + radius]]))
+    return np.concatenate(pts)
+
+
+def _sphere_points(radius: float) -> np.ndarray:
+    d = np.array([[x, y, z] for x in (-1, 0, 1) for y in (-1, 0, 1) for z in (-1, 0, 1) if (x, y, z) != (0, 0, 0)],
+                 dtype=float)
+    return radius * d / np.linalg.norm(d, axis=1, keepdims=True)
+
+
+@functools.lru_cache(maxsize=256)
+def read_mesh(path: str) -> tuple[np.ndarray, np.ndarray]:
+    """Vertices (V, 3) and triangles (F, 3) of an OBJ (``v``/``f`` lines) or STL file, unscaled."""
+    if path.lower().endswith(".stl"):
+        return _read_stl(path)
+    verts: list[list[float]] = []
+    faces: list[tuple[int, int, int]] = []
+    with open(path, encoding="utf-8", errors="replace") as fh:
+        for line in fh:
+            if line.startswith("v "):
+                verts.append([float(x) for x in line.split()[1:4]])
+            elif line.startswith("f "):
+                idx = [int(tok.split("/")[0]) for tok in line.split()[1:]]
+                idx = [i - 1 if i > 0 else len(verts) + i for i in idx]
+                faces.extend((idx[0], idx[i], idx[i + 1]) for i in range(1, len(idx) - 1))
+    v = np.array(verts, dtype=float).reshape(-1, 3)
+    f = np.array(faces, dtype=np.int64).reshape(-1, 3)
+    v.setflags(write=False)
+    f.setflags(write=False)
+    return v, f
+
+
+def _read_stl(path: str) -> tuple[np.ndarray, np.ndarray]:
+    with open(path, "rb") as fh:
+        data = fh.read()
+    if len(data) >= 84:
+        (count,) = struct.unpack_from("<I", data, 80)
+        if 84 + 50 * count == len(data):
+            rec = np.frombuffer(data, dtype=np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")]),
+                                count=count, offset=84)
+            tri = rec["v"].astype(float).reshape(-1, 3)
+            return tri, np.arange(len(tri)).reshape(-1, 3)
+    tri = np.array([[float(x) for x in line.split()[1:4]] for line in data.decode(errors="replace").splitlines()
+                    if line.strip().startswith("vertex")]).reshape(-1, 3)
+    return tri, np.arange(len(tri) - len(tri) % 3).reshape(-1, 3)
+
+
+# ------------------------------------------------------------------------------ pybullet references
+
+def _pose(pos: Sequence[float], orn: Sequence[float]) -> np.ndarray:
+    quat = np.asarray(orn, dtype=float)
+    return tf.from_quaternion(pos, quat / np.linalg.norm(quat))  # pybullet's are single precision
+
+
+def _pb_links(model: RobotModel) -> tuple[int, dict[str, int], list[tuple[int, Link]]]:
+    """The model's body, link name → pybullet link index (base -1), and its movable joints in pybullet
+    order with our link (pybullet's IK takes and returns one value per movable joint, in that order)."""
+    pb, cid = _pb()
+    body = _body(model.urdf)
+    key = ("links", model.key)
+    if key not in _CLIENT:
+        by_name = {pb.getBodyInfo(body, physicsClientId=cid)[0].decode(): -1}
+        movable = []
+        for j in range(pb.getNumJoints(body, physicsClientId=cid)):
+            info = pb.getJointInfo(body, j, physicsClientId=cid)
+            by_name[info[12].decode()] = j
+            if info[2] != pb.JOINT_FIXED:
+                movable.append((j, model.links[model.link_index(info[12].decode())]))
+        _CLIENT[key] = (by_name, movable)
+    by_name, movable = _CLIENT[key]
+    return body, by_name, movable
+
+
+def _set_state(model: RobotModel, q: np.ndarray, base: np.ndarray | None) -> tuple[Any, int, int]:
+    pb, cid = _pb()
+    body, _, movable = _pb_links(model)
+    base_t = np.eye(4) if base is None else np.asarray(base, dtype=float)
+    # resetBasePositionAndOrientation places the base's centre of mass, not its URDF frame
+    com = base_t @ _pose(*pb.getDynamicsInfo(body, -1, physicsClientId=cid)[3:5])
+    pos, orn = tf.to_quaternion(com)
+    pb.resetBasePositionAndOrientation(body, pos, orn, physicsClientId=cid)
+    for j, link in movable:
+        v = q[link.chain_index] if link.chain_index >= 0 else link.frozen_value
+        pb.resetJointState(body, j, float(v), physicsClientId=cid)
+    return pb, cid, body
+
+
+def pybullet_fk(model: RobotModel, q: Sequence[float], base: np.ndarray | None = None) -> dict[str, np.ndarray]:
+    """pybullet's forward kinematics (reference): link name → 4×4 URDF link frame in the world, with the
+    base link's frame at ``base`` (identity when None); off-chain joints at their frozen values.
+
+    pybullet reports link frames in single precision (errors up to about 1e-7 m).
+    """
+    pb, cid, body = _set_state(model, np.asarray(q, dtype=float), base)
+    _, by_name, _ = _pb_links(model)
+    out = {}
+    bpos, born = pb.getBasePositionAndOrientation(body, physicsClientId=cid)
+    inertial = _pose(*pb.getDynamicsInfo(body, -1, physicsClientId=cid)[3:5])
+    names = [n for n in model.link_names if by_name[n] >= 0]
+    states = pb.getLinkStates(body, [by_name[n] for n in names], computeForwardKinematics=True, physicsClientId=cid)
+    out[model.links[0].name] = _pose(bpos, born) @ tf.inverse(inertial)
+    for name, st in zip(names, states):
+        out[name] = _pose(st[4], st[5])  # worldLinkFramePosition/Orientation, not the centre of mass
+    return out
+
+
+def pybullet_ik(model: RobotModel, target: np.ndarray, seed: int, q_init: Sequence[float] | None = None,
+                restarts: int = 8, tol_pos: float = 1e-4, tol_rot: float = 1e-3, max_iters: int = 200,
+                null_space: bool = False) -> Any:
+    """pybullet's ``calculateInverseKinematics`` with random restarts drawn like
+    :func:`mrgc.geometry.ik.solve_ik`'s, for comparison; ``target`` in the base frame.  A restart counts
+    when its result meets the tolerances within the joint limits.  Returns an
+    :class:`mrgc.geometry.ik.IKResult`.
+
+    ``null_space`` selects pybullet's variant that takes joint limits and rest poses; on the Panda it
+    rarely gets within 1e-4 m (0 of 100 reachable poses here), so the plain damped least squares is the
+    default.
+    """
+    from mrgc.geometry.fk import ee_pose
+    from mrgc.geometry.ik import IKResult, IKStatus, pose_error, restart_configurations
+
+    target = np.asarray(target, dtype=float)
+    pb, cid = _pb()
+    body, by_name, movable = _pb_links(model)
+    ll = [lk.frozen_value if lk.chain_index < 0 else model.lower[lk.chain_index] for _, lk in movable]
+    ul = [lk.frozen_value if lk.chain_index < 0 else model.upper[lk.chain_index] for _, lk in movable]
+    jr = [max(u - lo, 1e-6) for lo, u in zip(ll, ul)]
+    pos, orn = tf.to_quaternion(target)
+    best = (math.inf, math.inf)
+    starts = restart_configurations(model, seed, restarts, q_init)
+    for r, q0 in enumerate(starts):
+        _set_state(model, q0, None)
+        kw: dict[str, Any] = {}
+        if null_space:
+            rest = [float(q0[lk.chain_index]) if lk.chain_index >= 0 else lk.frozen_value for _, lk in movable]
+            kw = dict(lowerLimits=ll, upperLimits=ul, jointRanges=jr, restPoses=rest)
+        sol = pb.calculateInverseKinematics(body, by_name[model.end_effector], pos, orn, maxNumIterations=max_iters,
+                                            residualThreshold=1e-8, physicsClientId=cid, **kw)
+        q = np.zeros(model.dof)
+        for (_, lk), v in zip(movable, sol):
+            if lk.chain_index >= 0:
+                q[lk.chain_index] = v
+        pe, re = (float(e) for e in pose_error(ee_pose(model, q), target))
+        best = min(best, (pe, re), key=sum)
+        if pe <= tol_pos and re <= tol_rot and bool(model.within_limits(q)):
+            return IKResult(IKStatus.SOLVED, q, pe, re, r + 1)
+    return IKResult(IKStatus.NO_CONVERGENCE, None, best[0], best[1], len(starts))

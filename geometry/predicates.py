@@ -1,0 +1,303 @@
+"""Phase 1 of the paper: the geometric facts of a scene, in IK mode (the packaging domain).
+
+For every robot R (in parallel, one process per robot when there are cores to spare):
+
+- ``reachable-pick M g R``: inverse kinematics puts the tool at M's grasp g and at the pre-grasp pose,
+  both configurations collision-free with respect to the fixed objects (M itself is ignored);
+- ``reachable-place M Re g R``: the same for a placement of M inside Re (tried in order from the region's
+  centre outwards; M at the placement must not hit a fixed object), for Re = M's goal region and M's
+  current region;
+- ``occludes-pick M1 M g R``: M1 is hit by R's links along the approach (pre-grasp → grasp, sampled) for
+  the pick configuration chosen collision-free with respect to the movable objects if possible;
+- ``occludes-goal-place M1 M Re g R`` (goal pairs only): M1 is hit by R's links or by M along the
+  approach to the placement, or by M at the placement, the placement chosen free of movables if possible;
+- ``enable-goal-handover M g1 g2 R1 R2`` (goal objects): at some handover point of M, R1 holding M with
+  g1 and R2 holding it with g2 are both collision-free with respect to the fixed objects and to each other.
+
+and ``in-region M Re`` from the initial poses.  Everything is deterministic for a seed.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+import zlib
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass, field
+from multiprocessing import get_context
+
+import numpy as np
+
+from mrgc.geometry.arm import Arm
+from mrgc.geometry.collision import CollisionWorld
+from mrgc.geometry.grasps import grasp_transform, known, pregrasp_transform
+from mrgc.geometry.ik import solve_ik_many
+from mrgc.geometry.scene import SceneSpec, half_extents, inside
+from mrgc.geometry.transforms import translation
+from mrgc.language.model import Box, Fact
+
+APPROACH_SAMPLES = 5  # configurations sampled from pre-grasp to grasp for the swept volume
+LIFT = 1e-3  # placements float this much above the region floor (touching counts as colliding)
+PLACEMENT_GRID = 3  # placements tried per region: a GRID × GRID lattice, centre first
+IK_SEEDS = 3  # IK solutions tried per target when looking for one free of movable objects
+IK_ITERS = 100  # Levenberg-Marquardt iterations per solve (reachable targets converge in far fewer)
+
+
+@dataclass
+class RobotFacts:
+    """What one robot's worker found: facts, handover configurations and counters."""
+
+    facts: list[Fact] = field(default_factory=list)
+    handover: dict[tuple[str, str, str], np.ndarray] = field(default_factory=dict)  # (M, point, g) -> q
+    ik_solves: int = 0
+    collision_checks: int = 0
+
+
+@dataclass
+class FactsResult:
+    """All facts of a scene (sorted, deterministic) and statistics."""
+
+    facts: list[Fact]
+    stats: dict[str, float]
+
+
+def seed_for(*parts: str, seed: int = 0) -> int:
+    """A stable per-query seed (Python's hash() is salted per process)."""
+    return (zlib.crc32("|".join(parts).encode()) + seed) % (2**31)
+
+
+def scene_world(scene: SceneSpec) -> CollisionWorld:
+    """Fixed objects in group ``fixed``, movable objects (at their initial poses) in group ``movable``."""
+    world = CollisionWorld()
+    for b in scene.fixed:
+        world.add(b.name, b.shape, b.pose, "fixed")
+    for b in scene.movable:
+        world.add(b.name, b.shape, b.pose, "movable")
+    return world
+
+
+class RobotEvaluator:
+    """Computes one robot's facts of a scene."""
+
+    def __init__(self, scene: SceneSpec, robot: str, seed: int = 0) -> None:
+        self.scene = scene
+        self.arm = Arm(scene.robot(robot))
+        self.world = scene_world(scene)
+        self.seed = seed
+        self.out = RobotFacts()
+        self.current = {m.name: r.name for m in scene.movable for r in scene.regions if inside(r, m.shape, m.pose)}
+
+    # ------------------------------------------------------------ primitives
+    def _ik(self, tool_poses: list[np.ndarray], key: str, q_init: np.ndarray | None = None,
+            attempt: int = 0, restarts: int = 8) -> list[np.ndarray | None]:
+        """IK for many tool poses in one batch (``q_init``: one start for all, or one per pose)."""
+        if not tool_poses:
+            return []
+        targets = np.stack([self.arm.ee_target(t) for t in tool_poses])
+        self.out.ik_solves += len(targets)
+        start = self.arm.home if q_init is None else q_init
+        res = solve_ik_many(self.arm.model, targets, seed_for(self.arm.name, key, str(attempt), seed=self.seed),
+                            q_init=start, restarts=restarts, max_iters=IK_ITERS)
+        return [r.q if r.solved else None for r in res]
+
+    def _free(self, qs: np.ndarray, ignore: tuple[str, ...], against: str = "fixed") -> bool:
+        shapes, _ = self.arm.probes
+        self.out.collision_checks += 1
+        return not self.world.batch_collides(shapes, self.arm.link_transforms(qs), against=against, ignore=ignore)
+
+    def _swept_hits(self, qs: np.ndarray, ignore: tuple[str, ...]) -> set[str]:
+        shapes, _ = self.arm.probes
+        self.out.collision_checks += 1
+        return self.world.batch_hits(shapes, self.arm.link_transforms(qs), against="movable", ignore=ignore)
+
+    @staticmethod
+    def _approach(q_pre: np.ndarray, q: np.ndarray) -> np.ndarray:
+        s = np.linspace(0.0, 1.0, APPROACH_SAMPLES)[:, None]
+        return q_pre[None] * (1 - s) + q[None] * s
+
+    def _object_hits(self, obj: str, shape: object, g_t: np.ndarray, path: np.ndarray, pose: np.ndarray) -> set[str]:
+        """Movable objects hit by the held object along the approach and at its placement."""
+        obj_poses = self.arm.tool_world(path) @ np.linalg.inv(g_t)
+        probes = [(shape, p) for p in obj_poses] + [(shape, pose)]
+        return self.world.probe_hits(probes, against="movable", ignore=(obj,))
+
+    def _solve(self, queries: list[tuple[str, str, np.ndarray, bool, str]],
+               want_free: bool) -> dict[int, tuple[np.ndarray, set[str]]]:
+        """Batched grasp + pre-grasp IK and collision checks for (object, grasp, object pose, held, key)
+        queries; the approach path and the movable objects it hits for each query that is reachable.
+
+        Queries with no answer are retried with other IK seeds (other solution branches), and so are those
+        whose approach hits movable objects when ``want_free`` (the paper's "collision-free, if possible");
+        the first clean answer wins, else the first answer.
+        """
+        found: dict[int, tuple[np.ndarray, set[str]]] = {}
+        todo = list(range(len(queries)))
+        for attempt in range(IK_SEEDS):
+            if not todo:
+                break
+            g_ts = [grasp_transform(queries[i][1], self.scene.body(queries[i][0]).shape) for i in todo]
+            qs = self._ik([queries[i][2] @ g for i, g in zip(todo, g_ts)], "grasp", attempt=attempt)
+            ok = [(i, g, q) for i, g, q in zip(todo, g_ts, qs) if q is not None and not (
+                queries[i][3] and self.world.probe_collides([(self.scene.body(queries[i][0]).shape, queries[i][2])],
+                                                            against="fixed"))]
+            pres = self._ik([queries[i][2] @ pregrasp_transform(g) for i, g, _ in ok], "pre", attempt=attempt,
+                            q_init=np.stack([q for _, _, q in ok]) if ok else None, restarts=2)
+            for (i, g, q), q_pre in zip(ok, pres):
+                if q_pre is None:
+                    continue
+                obj, _, pose, held, _ = queries[i]
+                path = self._approach(q_pre, q)
+                if not self._free(path, (obj,)):
+                    continue
+                hits = self._swept_hits(path, (obj,))
+                if held:
+                    hits |= self._object_hits(obj, self.scene.body(obj).shape, g, path, pose)
+                if i not in found or (found[i][1] and not hits):
+                    found[i] = (path, hits)
+            # try other IK solutions for queries with no answer yet, or (if asked) one that hits movables
+            todo = [i for i in todo if i not in found or (want_free and found[i][1])]
+        return found
+
+    def placements(self, obj: str, region: str) -> list[np.ndarray]:
+        """Candidate poses of ``obj`` resting inside ``region``: a lattice, centre first."""
+        body, reg = self.scene.body(obj), self.scene.body(region)
+        if not isinstance(reg.shape, Box):
+            return []
+        h_o, h_r = half_extents(body.shape), half_extents(reg.shape)
+        room = h_r[:2] - h_o[:2]
+        if np.any(room < 0) or h_o[2] > h_r[2]:
+            return []
+        ticks = np.linspace(-1, 1, PLACEMENT_GRID) if PLACEMENT_GRID > 1 else np.zeros(1)
+        offsets = sorted(((float(a), float(b)) for a in ticks for b in ticks), key=lambda ab: (ab[0] ** 2 + ab[1] ** 2, ab))
+        out = []
+        for a, b in offsets:
+            pose = reg.pose @ translation(a * room[0] * 0.9, b * room[1] * 0.9, -h_r[2] + h_o[2] + LIFT)
+            if inside(reg, body.shape, pose):
+                out.append(pose)
+        return out
+
+    # ------------------------------------------------------------ the predicates of one robot
+    def run(self) -> RobotFacts:
+        r, scene = self.arm.name, self.scene
+        near = {m.name: self.arm.in_reach(m.pose[:3, 3], margin=0.3) for m in scene.movable}
+        picks = [(m.name, g, m.pose, False, "pick") for m in scene.movable if near[m.name]
+                 for g in scene.grasps[m.name] if known(g)]
+        for i, (path, hits) in sorted(self._solve(picks, want_free=True).items()):
+            obj, g = picks[i][0], picks[i][1]
+            self.out.facts.append(Fact("reachable-pick", (obj, g, r)))
+            self.out.facts.extend(Fact("occludes-pick", (o, obj, g, r)) for o in sorted(hits))
+        # placements: round k tries the k-th candidate pose of every (object, region, grasp) not yet placed
+        triples = []
+        for m in scene.movable:
+            for region in sorted({scene.goal.get(m.name), self.current.get(m.name)} - {None}):  # type: ignore[type-var]
+                poses = [p for p in self.placements(m.name, region) if self.arm.in_reach(p[:3, 3], margin=0.3)]
+                triples.extend((m.name, region, g, poses) for g in scene.grasps[m.name] if known(g) and poses)
+        placed: dict[int, set[str]] = {}
+        for k in range(PLACEMENT_GRID * PLACEMENT_GRID):
+            open_ = [i for i, t in enumerate(triples) if k < len(t[3]) and (i not in placed or placed[i])
+                     and (i not in placed or scene.goal.get(t[0]) == t[1])]
+            if not open_:
+                break
+            queries = [(triples[i][0], triples[i][2], triples[i][3][k], True, "place") for i in open_]
+            for j, (path, hits) in self._solve(queries, want_free=False).items():
+                i = open_[j]
+                if i not in placed or (placed[i] and not hits):
+                    placed[i] = hits
+        for i in sorted(placed):
+            obj, region, g, _ = triples[i]
+            self.out.facts.append(Fact("reachable-place", (obj, region, g, r)))
+            if scene.goal.get(obj) == region:
+                self.out.facts.extend(Fact("occludes-goal-place", (o, obj, region, g, r)) for o in sorted(placed[i]))
+        self._handover_configs()
+        return self.out
+
+    def _handover_configs(self) -> None:
+        keys, tools = [], []
+        for obj in self.scene.goal:
+            body = self.scene.body(obj)
+            for point in self.scene.handover_of.get(obj, ()):
+                if point not in self.scene.handover_points:
+                    continue
+                pose = translation(*self.scene.handover_points[point])
+                if not self.arm.in_reach(pose[:3, 3], margin=0.3):
+                    continue
+                for g in self.scene.grasps[obj]:
+                    if known(g):
+                        keys.append((obj, point, g))
+                        tools.append(pose @ grasp_transform(g, body.shape))
+        for key, q in zip(keys, self._ik(tools, "handover")):
+            if q is not None and self._free(q[None], (key[0],)):
+                self.out.handover[key] = q
+
+
+def _robot_worker(args: tuple[SceneSpec, str, int]) -> RobotFacts:
+    scene, robot, seed = args
+    return RobotEvaluator(scene, robot, seed).run()
+
+
+def compute_facts(scene: SceneSpec, seed: int = 0, workers: int | None = None) -> FactsResult:
+    """Every fact of ``scene`` (see the module docstring); ``workers`` processes (default: one per robot,
+    at most the number of cores; 1 runs everything in this process)."""
+    t0 = time.perf_counter()
+    robots = [r.name for r in scene.robots]
+    n = workers if workers is not None else min(len(robots), os.cpu_count() or 1)
+    jobs = [(scene, r, seed) for r in robots]
+    if n > 1 and len(robots) > 1:
+        with ProcessPoolExecutor(max_workers=n, mp_context=get_context("fork")) as pool:
+            per_robot = list(pool.map(_robot_worker, jobs))
+    else:
+        per_robot = [_robot_worker(j) for j in jobs]
+    t_robots = time.perf_counter() - t0
+    facts: set[Fact] = set()
+    for rf in per_robot:
+        facts.update(rf.facts)
+    facts.update(_handovers(scene, dict(zip(robots, per_robot))))
+    for m in scene.movable:
+        for reg in scene.regions:
+            if inside(reg, m.shape, m.pose):
+                facts.add(Fact("in-region", (m.name, reg.name)))
+    order = {"in-region": 0, "reachable-pick": 1, "reachable-place": 2, "occludes-pick": 3,
+             "occludes-goal-place": 4, "enable-goal-handover": 5}
+    stats = {
+        "seconds": time.perf_counter() - t0,
+        "robot_seconds": t_robots,
+        "workers": n,
+        "ik_solves": sum(rf.ik_solves for rf in per_robot),
+        "collision_checks": sum(rf.collision_checks for rf in per_robot),
+        "facts": len(facts),
+    }
+    return FactsResult(sorted(facts, key=lambda f: (order[f.predicate], f.args)), stats)
+
+
+def _handovers(scene: SceneSpec, per_robot: dict[str, RobotFacts]) -> set[Fact]:
+    """``enable-goal-handover`` from the robots' handover configurations, checking robot–robot collisions."""
+    out: set[Fact] = set()
+    arms: dict[str, Arm] = {}
+    for obj in scene.goal:
+        for r1 in per_robot:
+            for r2 in per_robot:
+                if r1 == r2:
+                    continue
+                for (o1, point, g1), q1 in per_robot[r1].handover.items():
+                    if o1 != obj:
+                        continue
+                    for (o2, point2, g2), q2 in per_robot[r2].handover.items():
+                        if o2 != obj or point2 != point:
+                            continue
+                        fact = Fact("enable-goal-handover", (obj, g1, g2, r1, r2))
+                        if fact in out:
+                            continue
+                        a1 = arms.setdefault(r1, Arm(scene.robot(r1)))
+                        a2 = arms.setdefault(r2, Arm(scene.robot(r2)))
+                        if not _arms_collide(a1, q1, a2, q2):
+                            out.add(fact)
+    return out
+
+
+def _arms_collide(a1: Arm, q1: np.ndarray, a2: Arm, q2: np.ndarray) -> bool:
+    world = CollisionWorld()
+    shapes2, _ = a2.probes
+    for i, (shape, t) in enumerate(zip(shapes2, a2.link_transforms(q2))):
+        world.add(f"{a2.name}#{i}", shape, t, "robot")
+    shapes1, _ = a1.probes
+    return world.batch_collides(shapes1, a1.link_transforms(q1), against="robot")

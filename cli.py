@@ -38,6 +38,13 @@ class _Parser(argparse.ArgumentParser):
 
 
 def _report(exc: InputError) -> None:
+    for d in exc.diagnostics:  # errors raised past the loader (geometry) carry no source text: read it
+        if d.span is not None and d.span.file not in exc.sources and os.path.isfile(d.span.file):
+            try:
+                with open(d.span.file, encoding="utf-8") as fh:
+                    exc.sources[d.span.file] = fh.read()
+            except (OSError, UnicodeDecodeError):
+                pass
     print(exc.render(), file=sys.stderr)
     n = len(exc.diagnostics)
     if n > 1:
@@ -145,6 +152,34 @@ def cmd_compile(args: argparse.Namespace) -> int:
     return {"infeasible": EXIT_NO_PLAN, "time limit": EXIT_TIME_LIMIT}.get(result.status, EXIT_INTERNAL)
 
 
+def cmd_facts(args: argparse.Namespace) -> int:
+    import json
+
+    from mrgc.language.edit import facts_document
+    from mrgc.language.loader import parse_file
+    from mrgc.planner.phase1 import compute_problem_facts
+
+    mf = parse_file(args.file)
+    problem = mf.problem(args.problem)
+    result = compute_problem_facts(problem, seed=args.seed, workers=args.workers)
+    header = (f"facts of problem {problem.name} computed by mrgc {__version__} (seed {args.seed}) from "
+              f"{os.path.basename(args.file)}: {len(result.facts)} facts in {result.stats['seconds']:.2f} s")
+    text = facts_document(mf.syntax, problem.name, problem.domain.name, problem.domain.source, result.facts,
+                          args.file, args.output, header)
+    if args.output:
+        tmp = args.output + ".mrgc-tmp"
+        with open(tmp, "w", encoding="utf-8") as fh:
+            fh.write(text)
+        os.replace(tmp, args.output)
+        print(f"{args.output}: {len(result.facts)} facts ({result.stats['seconds']:.2f} s, "
+              f"{int(result.stats['ik_solves'])} IK solves, {int(result.stats['workers'])} workers)")
+        if args.stats:
+            print(json.dumps(result.stats, indent=2))
+    else:
+        sys.stdout.write(text)
+    return EXIT_OK
+
+
 def cmd_backends(args: argparse.Namespace) -> int:
     import json
 
@@ -179,6 +214,15 @@ def build_parser() -> argparse.ArgumentParser:
     mode.add_argument("--check", action="store_true", help="exit 1 if a file is not canonically formatted")
     mode.add_argument("--write", action="store_true", help="rewrite files in place")
     p.set_defaults(func=cmd_fmt)
+
+    p = sub.add_parser("facts", help="phase 1: compute the geometric facts of a problem and write it with :init completed")
+    p.add_argument("file", metavar="FILE")
+    p.add_argument("-o", "--output", metavar="OUT", help="write here (default: standard output)")
+    p.add_argument("--problem", help="which problem of the file (default: its only one)")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--workers", type=int, default=None, help="processes (default: one per robot, at most one per core)")
+    p.add_argument("--stats", action="store_true", help="also print timing statistics as JSON")
+    p.set_defaults(func=cmd_facts)
 
     p = sub.add_parser("compile", help="build the task graph and generate task skeletons with a solver backend")
     p.add_argument("file", metavar="FILE")

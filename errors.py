@@ -84,6 +84,17 @@ class MrgcError(Exception):
         super().__init__(message)
         self.diagnostics: tuple[Diagnostic, ...] = tuple(diagnostics)
 
+    def __reduce__(self) -> tuple[object, ...]:
+        # picklable across processes (worker pools) whatever the subclass's constructor takes
+        return (_rebuild, (type(self), self.args, self.__dict__))
+
+
+def _rebuild(cls: type, args: tuple[object, ...], state: dict[str, object]) -> "MrgcError":
+    err = Exception.__new__(cls)
+    err.args = args
+    err.__dict__.update(state)
+    return err  # type: ignore[no-any-return]
+
 
 class InputError(MrgcError):
     """The user's input (a file or the command line) is wrong; carries every diagnostic found."""

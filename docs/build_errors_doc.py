@@ -60,10 +60,15 @@ SPECIAL = {
              "error[E302]: backend 'my-plugin' does not support encoding 'paper'"),
     "E303": ("mrgc compile domains/symbolic/chain-3.mrg --encoding bigm",
              "error[E303]: unknown encoding 'bigm' (choose from paper, disaggregated, time-of-move)"),
-    "E310": ("mrgc compile domains/packaging/pa5-s0.mrg",
-             "domains/packaging/pa5-s0.mrg:2:3: error[E310]: problem 'pa5-s0' is geometric and its :init "
-             "holds no geometric facts; compute them first with `mrgc facts FILE -o FILE.facts.mrg` and "
-             "compile that file"),
+    "E400": ("mrgc facts bad-urdf.mrg",
+             "bad-urdf.mrg:5:3: error[E400]: robot URDF 'robots/arm.urdf' not found (looked for "
+             "'/home/me/robots/arm.urdf' or '.../site-packages/pybullet_data/robots/arm.urdf')"),
+    "E401": ("mrgc facts bad-ee.mrg",
+             "bad-ee.mrg:5:3: error[E401]: end-effector link 'hand' is not a link of '.../franka_panda/panda.urdf' "
+             "(links: panda_link0, panda_link1, ..., panda_hand, panda_leftfinger, panda_rightfinger, "
+             "panda_grasptarget)"),
+    "E402": ("mrgc facts domains/symbolic/chain-3.mrg",
+             "domains/symbolic/chain-3.mrg:25:3: error[E402]: problem 'chain-3' is symbolic: it has no geometry"),
     "E001": ("mrgc check no-such.mrg", "error[E001]: cannot read 'no-such.mrg': No such file or directory"),
     "E002": ("mrgc check huge.mrg   # a file over 8 MiB",
              "huge.mrg:1:1: error[E002]: 'huge.mrg' is 9437184 bytes; the limit is 8388608 bytes"),

@@ -32,6 +32,7 @@ from mrgc.geometry.arm import Arm
 from mrgc.geometry.collision import CollisionWorld
 from mrgc.geometry.grasps import grasp_transform, known, pregrasp_transform
 from mrgc.geometry.ik import solve_ik_many
+from mrgc.geometry.kinematics import model_for_kind
 from mrgc.geometry.scene import SceneSpec, half_extents, inside
 from mrgc.geometry.transforms import translation
 from mrgc.language.model import Box, Fact
@@ -242,6 +243,8 @@ def compute_facts(scene: SceneSpec, seed: int = 0, workers: int | None = None) -
     robots = [r.name for r in scene.robots]
     n = workers if workers is not None else min(len(robots), os.cpu_count() or 1)
     jobs = [(scene, r, seed) for r in robots]
+    for spec in scene.robots:  # load every robot model here: errors surface once, and forked workers share them
+        model_for_kind(spec.kind, spec.base_dir)
     if n > 1 and len(robots) > 1:
         with ProcessPoolExecutor(max_workers=n, mp_context=get_context("fork")) as pool:
             per_robot = list(pool.map(_robot_worker, jobs))

@@ -70,7 +70,9 @@ CLI_CODES: dict[str, str] = {
     "E301": "unknown backend",
     "E302": "backend does not support the encoding",
     "E303": "unknown encoding",
-    "E310": "geometric problem without facts",
+    "E400": "robot URDF not found or unreadable",
+    "E401": "end-effector link not in the URDF",
+    "E402": "geometry asked of a symbolic problem",
 }
 
 #: what each code means and how to fix it (docs/errors.md is generated from this and the golden files)
@@ -82,7 +84,10 @@ HELP: dict[str, str] = {
     "E301": "`--backend` names no registered backend; `mrgc backends` lists them.",
     "E302": "The backend cannot run the chosen encoding.",
     "E303": "`--encoding` is one of `paper`, `disaggregated`, `time-of-move`.",
-    "E310": "A geometric problem must have its facts computed (`mrgc facts`) before `mrgc compile`.",
+    "E400": "A robot kind's `:urdf` names no readable URDF (looked up beside the .mrg file, then in "
+    "pybullet_data), or pybullet refuses the file.",
+    "E401": "A robot kind's `:end-effector` is not a link of its URDF; the message lists the links.",
+    "E402": "`mrgc facts` (or another geometric command) was run on a symbolic problem, which has no geometry.",
     "E001": "The file does not exist, is a folder, or cannot be read.",
     "E002": "Files above the size limit (8 MiB) are refused before parsing, so a huge input cannot stall mrgc.",
     "E003": "The file holds bytes that are not UTF-8 text, or a NUL byte: probably not a `.mrg` file.",

@@ -1,6 +1,7 @@
 """Skeleton generation wired to a backend: facts → task graph → encoding → solver → skeletons.
 
-This is what ``mrgc compile`` runs, and what the planner calls whenever grounding needs new skeletons
+A geometric problem without cached facts gets them from phase 1 (the geometry layer) first.  This is what
+``mrgc compile`` runs, and what the planner calls whenever grounding needs new skeletons
 (for other objects M*, with the grounded suffix's objects excluded).
 """
 
@@ -58,14 +59,21 @@ def must_move(problem: Problem, facts: Iterable[Fact] | None = None) -> list[str
     return [o for o, r in problem.goal_regions.items() if where.get(o) != r]
 
 
-def require_facts(problem: Problem) -> None:
-    """A geometric problem needs its facts (``mrgc facts``) before it can be compiled."""
-    if problem.symbolic or any(f.predicate != "in-region" for f in problem.init):
-        return
-    raise InputError([Diagnostic(
-        "E310", f"problem '{problem.name}' is geometric and its :init holds no geometric facts; "
-        "compute them first with `mrgc facts FILE -o FILE.facts.mrg` and compile that file",
-        problem.span)])
+def needs_facts(problem: Problem) -> bool:
+    """A geometric problem whose ``:init`` holds no geometric facts (phase 1 has not been run or cached)."""
+    return not problem.symbolic and all(f.predicate == "in-region" for f in problem.init)
+
+
+def problem_facts(problem: Problem, facts: Iterable[Fact] | None = None, seed: int = 0) -> tuple[list[Fact], float]:
+    """The facts to compile with: given ones, the file's ``:init``, or phase 1 run now (and its seconds)."""
+    if facts is not None:
+        return list(facts), 0.0
+    if needs_facts(problem):
+        from mrgc.planner.phase1 import compute_problem_facts
+
+        result = compute_problem_facts(problem, seed=seed)
+        return list(result.facts), float(result.stats["seconds"])
+    return list(problem.init), 0.0
 
 
 class SkeletonSource:
@@ -97,8 +105,7 @@ def compile_problem(problem: Problem, backend: str = DEFAULT_BACKEND, encoding: 
                     skeletons: int = 1, max_makespan: int | None = None, time_limit: float | None = None,
                     facts: Iterable[Fact] | None = None, seed: int = 0) -> CompileResult:
     """The first ``skeletons`` skeletons of ``problem`` (facts default to its ``:init``)."""
-    require_facts(problem)
-    fact_list = list(problem.init if facts is None else facts)
+    fact_list, facts_seconds = problem_facts(problem, facts, seed)
     base = FactBase.from_problem(problem, fact_list)
     source = SkeletonSource(base, must_move(problem, fact_list), (), backend, encoding, max_makespan, seed)
     t0 = time.perf_counter()
@@ -107,6 +114,8 @@ def compile_problem(problem: Problem, backend: str = DEFAULT_BACKEND, encoding: 
         "objects": len(source.graph.objects),
         "actions": len(source.graph.actions),
         "must_move": list(source.graph.must_move),
+        "facts": len(fact_list),
+        "facts_seconds": round(facts_seconds, 6),
         "graph_seconds": round(source.graph_seconds, 6),
         "total_seconds": round(time.perf_counter() - t0 + source.graph_seconds, 6),
         **{k: (round(v, 6) if isinstance(v, float) else v) for k, v in batch.stats.items()},
@@ -126,8 +135,7 @@ def compile_problem(problem: Problem, backend: str = DEFAULT_BACKEND, encoding: 
 def export_model(problem: Problem, path: str, backend: str = DEFAULT_BACKEND, encoding: str = DEFAULT_ENCODING,
                  horizon: int | None = None, facts: Iterable[Fact] | None = None) -> None:
     """Write the skeleton model (horizon ``horizon``; default the first one searched) to ``path``."""
-    require_facts(problem)
-    fact_list = list(problem.init if facts is None else facts)
+    fact_list, _ = problem_facts(problem, facts)
     base = FactBase.from_problem(problem, fact_list)
     source = SkeletonSource(base, must_move(problem, fact_list), (), backend, encoding)
     gen = source.generator

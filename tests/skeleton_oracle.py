@@ -1,0 +1,317 @@
+"""An independent reference for task skeletons, written only from the model's definitions.
+
+It shares no code with ``mrgc.compiler``: ``Action`` and ``TaskGraph`` are used as plain input data (their
+fields), nothing else.  Test files load this module by path (tests/ is not a package):
+
+    spec = importlib.util.spec_from_file_location("skeleton_oracle", Path(__file__).with_name("skeleton_oracle.py"))
+
+The definitions (DESIGN.md section 5, the paper's "Key Component 1"):
+
+- each action moves exactly one object; every object moves at most once; every object of M* moves;
+- a pick obstacle of a selected action moves at a strictly earlier step, a place obstacle at the same step
+  or earlier; every obstacle of a selected action moves;
+- an object outside M* moves only if it obstructs a selected action;
+- a robot does at most one action per step, and a handover occupies both of its robots;
+- no step is empty;
+- skeletons are ranked by (makespan, number of moved objects); two skeletons are distinct when their sets
+  of actions differ, and an action set's makespan is the smallest one any valid schedule of it has.
+
+Contents: :func:`check_skeleton` (violations of one skeleton), :func:`min_makespan` and
+:func:`feasible_action_sets` / :func:`oracle_keys` (brute force over action sets), and
+:func:`reference_task_graph` (Alg. 1 of the paper on raw fact tuples, returned as a ``TaskGraph``).
+"""
+
+from __future__ import annotations
+
+from typing import Any, Iterable, Mapping, Sequence
+
+from mrgc.compiler.task_graph import Action, TaskGraph
+
+
+# ------------------------------------------------------------------ helpers on the graph's data
+def _obstacles(graph: TaskGraph) -> dict[Action, tuple[frozenset[str], frozenset[str]]]:
+    """action -> (pick obstacles, place obstacles), straight from the graph's edge lists."""
+    out: dict[Action, tuple[frozenset[str], frozenset[str]]] = {}
+    for i, a in enumerate(graph.actions):
+        pick, place = out.get(a, (frozenset(), frozenset()))
+        out[a] = (pick | frozenset(graph.block_pick[i]), place | frozenset(graph.block_place[i]))
+    return out
+
+
+def _robots(a: Action) -> set[str]:
+    return {a.pick_robot, a.place_robot}
+
+
+def _steps(skeleton: Any) -> list[tuple[Action, ...]]:
+    steps = skeleton.steps if hasattr(skeleton, "steps") else skeleton
+    return [tuple(s) for s in steps]
+
+
+# ------------------------------------------------------------------ (a) checking one skeleton
+def check_skeleton(graph: TaskGraph, skeleton: Any) -> list[str]:
+    """Every way ``skeleton`` (an object with ``.steps``, or a list of steps) breaks the definitions."""
+    steps = _steps(skeleton)
+    obstacles = _obstacles(graph)
+    bad: list[str] = []
+    step_of: dict[str, int] = {}
+    placed: list[tuple[int, Action]] = []
+    for t, step in enumerate(steps, 1):
+        if not step:
+            bad.append(f"step {t} is empty")
+        busy: dict[str, Action] = {}
+        for a in step:
+            placed.append((t, a))
+            if a not in obstacles:
+                bad.append(f"step {t}: '{a}' is not an action of the task graph")
+            if a.obj in step_of:
+                bad.append(f"{a.obj} is moved twice (steps {step_of[a.obj]} and {t})")
+            else:
+                step_of[a.obj] = t
+            for r in sorted(_robots(a)):
+                if r in busy:
+                    bad.append(f"step {t}: robot {r} does two actions ('{busy[r]}' and '{a}')")
+                else:
+                    busy[r] = a
+    for o in graph.must_move:
+        if o not in step_of:
+            bad.append(f"{o} is in M* but is not moved")
+    obstructing: set[str] = set()
+    for t, a in placed:
+        pick, place = obstacles.get(a, (frozenset(), frozenset()))
+        obstructing |= pick | place
+        for o in sorted(pick):
+            if o not in step_of:
+                bad.append(f"pick obstacle {o} of '{a}' (step {t}) is never moved")
+            elif not step_of[o] < t:
+                bad.append(f"pick obstacle {o} of '{a}' (step {t}) moves at step {step_of[o]}, not strictly earlier")
+        for o in sorted(place):
+            if o not in step_of:
+                bad.append(f"place obstacle {o} of '{a}' (step {t}) is never moved")
+            elif not step_of[o] <= t:
+                bad.append(f"place obstacle {o} of '{a}' (step {t}) moves later, at step {step_of[o]}")
+    must = set(graph.must_move)
+    for o, t in step_of.items():
+        if o not in must and o not in obstructing:
+            bad.append(f"{o} is not in M* and obstructs no selected action, but is moved (step {t})")
+    return bad
+
+
+# ------------------------------------------------------------------ (b) brute force
+def _valid_selection(graph: TaskGraph, actions: Iterable[Action],
+                     obstacles: Mapping[Action, tuple[frozenset[str], frozenset[str]]]) -> bool:
+    """The schedule-free rules: one action per object, M* moved, obstacles moved, no needless move."""
+    acts = list(actions)
+    moved = [a.obj for a in acts]
+    if len(moved) != len(set(moved)) or any(a not in obstacles for a in acts):
+        return False
+    moved_set = set(moved)
+    needed: set[str] = set()
+    for a in acts:
+        needed |= obstacles[a][0] | obstacles[a][1]
+    if not set(graph.must_move) <= moved_set or not needed <= moved_set:
+        return False
+    return moved_set <= needed | set(graph.must_move)
+
+
+def min_makespan(graph: TaskGraph, actions: Iterable[Action]) -> int | None:
+    """The smallest number of steps of a valid schedule of exactly ``actions`` (None: no schedule).
+
+    Tries makespan m = 1, 2, ... and assigns every action a step in 1..m by backtracking; the first m
+    that works leaves no step empty (an empty step could be squeezed out, giving a smaller m).
+    """
+    obstacles = _obstacles(graph)
+    acts = sorted(set(actions), key=lambda a: (a.obj, str(a)))
+    if not _valid_selection(graph, acts, obstacles):
+        return None
+    if not acts:
+        return 0
+    by_obj = {a.obj: a for a in acts}
+    # pairwise relations: (i, j, kind) meaning step[i] < step[j] ('<'), step[i] <= step[j] ('<='),
+    # or step[i] != step[j] ('!=', a shared robot)
+    rel: list[list[tuple[int, str]]] = [[] for _ in acts]  # rel[j]: constraints against earlier i < j
+    index = {a: k for k, a in enumerate(acts)}
+    for a in acts:
+        pick, place = obstacles[a]
+        for o in pick:
+            b = by_obj[o]
+            _relate(rel, index[b], index[a], "<")
+        for o in place - pick:
+            b = by_obj[o]
+            _relate(rel, index[b], index[a], "<=")
+    for i, a in enumerate(acts):
+        for j in range(i + 1, len(acts)):
+            if _robots(a) & _robots(acts[j]):
+                _relate(rel, i, j, "!=")
+    for m in range(1, len(acts) + 1):
+        if _assign(rel, [0] * len(acts), 0, m):
+            return m
+    return None
+
+
+def _relate(rel: list[list[tuple[int, str]]], i: int, j: int, kind: str) -> None:
+    """Record ``step[i] kind step[j]`` under the later of the two indices."""
+    if i < j:
+        rel[j].append((i, kind))
+    elif i > j:
+        flipped = {"<": ">", "<=": ">=", "!=": "!="}[kind]
+        rel[i].append((j, flipped))
+    else:  # an action obstructed by its own object: impossible for "<", trivial for "<="
+        rel[i].append((i, kind))
+
+
+def _assign(rel: list[list[tuple[int, str]]], step: list[int], k: int, m: int) -> bool:
+    if k == len(step):
+        return True
+    for s in range(1, m + 1):
+        step[k] = s
+        ok = True
+        for i, kind in rel[k]:
+            # constraint "step[i] kind step[k]" (i < k) or, for i == k, "step[k] kind step[k]"
+            x, y = step[i], s
+            if (kind == "<" and not x < y) or (kind == "<=" and not x <= y) or (kind == ">" and not x > y) \
+                    or (kind == ">=" and not x >= y) or (kind == "!=" and not x != y):
+                ok = False
+                break
+        if ok and _assign(rel, step, k + 1, m):
+            return True
+    step[k] = 0
+    return False
+
+
+def feasible_action_sets(graph: TaskGraph) -> dict[frozenset[Action], int]:
+    """Every action set that has a valid schedule, with its minimum makespan.
+
+    Search over subsets: each object of the graph is either not moved or moved by one of its actions
+    (objects of M* must move).  Partial selections are cut as soon as an obstacle of a chosen action is
+    decided "not moved"; the remaining rules are checked on the complete selection.
+    """
+    obstacles = _obstacles(graph)
+    objects = list(dict.fromkeys(list(graph.objects) + [a.obj for a in graph.actions]))
+    options: dict[str, list[Action]] = {o: [] for o in objects}
+    for a in obstacles:
+        options[a.obj].append(a)
+    must = set(graph.must_move)
+    out: dict[frozenset[Action], int] = {}
+    choice: dict[str, Action | None] = {}
+
+    def blockers(a: Action) -> frozenset[str]:
+        return obstacles[a][0] | obstacles[a][1]
+
+    def consistent(o: str) -> bool:
+        a = choice[o]
+        if a is not None:
+            for b in blockers(a):
+                if b in choice and choice[b] is None:
+                    return False
+                if b not in options:
+                    return False
+        else:
+            for other, c in choice.items():
+                if c is not None and o in blockers(c):
+                    return False
+        return True
+
+    def dfs(k: int) -> None:
+        if k == len(objects):
+            selected = frozenset(a for a in choice.values() if a is not None)
+            m = min_makespan(graph, selected)
+            if m is not None:
+                out[selected] = m
+            return
+        o = objects[k]
+        alternatives: list[Action | None] = list(options[o])
+        if o not in must:
+            alternatives.insert(0, None)
+        for a in alternatives:
+            choice[o] = a
+            if consistent(o):
+                dfs(k + 1)
+            del choice[o]
+
+    dfs(0)
+    return out
+
+
+def oracle_keys(graph: TaskGraph) -> list[tuple[int, int]]:
+    """The sorted (makespan, moved objects) keys of every feasible action set: the exact key sequence a
+    correct enumeration of distinct skeletons produces."""
+    return sorted((m, len(s)) for s, m in feasible_action_sets(graph).items())
+
+
+# ------------------------------------------------------------------ Alg. 1 on raw facts
+def reference_task_graph(robots: Sequence[str], grasps: Mapping[str, Sequence[str]], goal: Mapping[str, str],
+                         region: Mapping[str, str], facts: Iterable[tuple[str, ...]],
+                         must_move: Sequence[str]) -> TaskGraph:
+    """Alg. 1 (AddObject for every object of M*) on fact tuples ``(predicate, arg, ...)``.
+
+    Target region: the goal region of a goal object, else the object's current region.  Direct actions need
+    ReachablePick and ReachablePlace(target) with the same robot and grasp; handovers (goal objects only)
+    need ReachablePick(g1, R1), EnableGoalHandover(g1, g2, R1, R2) with R1 != R2 and
+    ReachablePlace(target, g2, R2).  Pick obstacles: OccludesPick(Mj, M, g_pick, R_pick); place obstacles
+    (goal objects only): OccludesGoalPlace(Mj, M, target, g_place, R_place).  Obstacles join the graph
+    recursively.  Edges and actions are compared as sets by the tests, so order is not meaningful here.
+    """
+    facts = {tuple(f) for f in facts}
+    pick = {f[1:] for f in facts if f[0] == "reachable-pick"}
+    place = {f[1:] for f in facts if f[0] == "reachable-place"}
+    hand = {f[1:] for f in facts if f[0] == "enable-goal-handover"}
+    occ_pick = {f[1:] for f in facts if f[0] == "occludes-pick" and f[1] != f[2]}
+    occ_place = {f[1:] for f in facts if f[0] == "occludes-goal-place" and f[1] != f[2]}
+    movable = sorted({f[1] for f in facts if f[0] == "in-region"} | set(goal) | set(must_move))
+    nodes: list[str] = []
+    actions: list[Action] = []
+    bp: list[tuple[str, ...]] = []
+    bl: list[tuple[str, ...]] = []
+
+    def add_object(m: str) -> None:
+        if m in nodes:
+            return
+        nodes.append(m)
+        target = goal.get(m, region.get(m))
+        if target is None:
+            return
+        for r1 in robots:
+            for g1 in grasps.get(m, ()):
+                if (m, g1, r1) not in pick:
+                    continue
+                found = []
+                if (m, target, g1, r1) in place:
+                    found.append(Action(m, target, r1, r1, g1, g1))
+                if m in goal:
+                    for r2 in robots:
+                        if r2 == r1:
+                            continue
+                        for g2 in grasps.get(m, ()):
+                            if (m, g1, g2, r1, r2) in hand and (m, target, g2, r2) in place:
+                                found.append(Action(m, target, r1, r2, g1, g2))
+                for a in found:
+                    actions.append(a)
+                    p = tuple(mj for mj in movable if (mj, m, a.pick_grasp, a.pick_robot) in occ_pick)
+                    q = tuple(mj for mj in movable if m in goal
+                              and (mj, m, target, a.place_grasp, a.place_robot) in occ_place)
+                    bp.append(p)
+                    bl.append(q)
+                    for mj in p + q:
+                        add_object(mj)
+
+    for m in must_move:
+        add_object(m)
+    return TaskGraph(
+        robots=tuple(robots),
+        objects=tuple(nodes),
+        must_move=tuple(must_move),
+        goal={o: r for o, r in goal.items() if o in nodes},
+        actions=tuple(actions),
+        block_pick=tuple(bp),
+        block_place=tuple(bl),
+    )
+
+
+def graph_signature(graph: TaskGraph) -> tuple[frozenset[str], frozenset[str], frozenset[tuple[Action, frozenset[str], frozenset[str]]]]:
+    """(objects, M*, {(action, pick obstacles, place obstacles)}): a graph up to the order of its lists."""
+    return (
+        frozenset(graph.objects),
+        frozenset(graph.must_move),
+        frozenset((a, frozenset(graph.block_pick[i]), frozenset(graph.block_place[i]))
+                  for i, a in enumerate(graph.actions)),
+    )

@@ -1,0 +1,245 @@
+"""Skeleton generation against an independent brute-force oracle (tests/skeleton_oracle.py).
+
+Random small symbolic problems (2-3 robots, 2-5 objects, 2-3 regions, grasps top/side, random reachability,
+occlusion and handover facts, 1-2 goal objects) are written as .mrg text and parsed.  For every backend x
+encoding the first K skeleton keys (makespan, moved) must equal the oracle's, every skeleton must satisfy
+the model's definitions, and the action sets of one run must be pairwise distinct.  The oracle itself is
+checked first on hand-broken skeletons, so a vacuous oracle cannot make the property pass.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+from pathlib import Path
+from typing import Any
+
+import pytest
+from hypothesis import HealthCheck, event, given, settings
+from hypothesis import strategies as st
+
+from mrgc import cli, parse_file, parse_string
+from mrgc.compiler.facts import FactBase
+from mrgc.compiler.task_graph import Action, build_task_graph
+from mrgc.language.model import Problem
+from mrgc.planner.skeletons import compile_problem, must_move
+
+
+def _load_oracle() -> Any:
+    name = "skeleton_oracle"
+    if name not in sys.modules:
+        spec = importlib.util.spec_from_file_location(name, Path(__file__).with_name("skeleton_oracle.py"))
+        assert spec is not None and spec.loader is not None
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[name] = module
+        spec.loader.exec_module(module)
+    return sys.modules[name]
+
+
+oracle = _load_oracle()
+
+BACKENDS = ["mip", "smt", "pysmt", "cpsat"]
+ENCODINGS = ["paper", "disaggregated", "time-of-move"]
+K = 4
+GRASPS = ("top", "side")
+SYMBOLIC = Path(__file__).resolve().parent.parent / "domains" / "symbolic"
+
+DOMAIN = "(define (domain abstract) (:requirements :handover :symbolic) (:grasps top side))\n"
+
+
+# ---------------------------------------------------------------- problem generation
+@st.composite
+def problems(draw: Any) -> str:
+    """The text of a random small symbolic problem (with its domain)."""
+    robots = [f"r{i}" for i in range(1, draw(st.integers(2, 3)) + 1)]
+    objects = [f"o{i}" for i in range(1, draw(st.integers(2, 5)) + 1)]
+    regions = ["ra", "rb", "rc"][: draw(st.integers(2, 3))]
+    region = {o: draw(st.sampled_from(regions)) for o in objects}
+    goal_objs = draw(st.lists(st.sampled_from(objects), min_size=1, max_size=2, unique=True))
+    goal: dict[str, str] = {}
+    for k, o in enumerate(goal_objs):
+        # the first goal is never already satisfied (so M* is not empty); the second may be, which puts a
+        # goal object outside M* (it then moves only as an obstacle, back into its goal region)
+        choices = [r for r in regions if r != region[o]] if k == 0 else regions
+        goal[o] = draw(st.sampled_from(choices))
+    target = {o: goal.get(o, region[o]) for o in objects}
+
+    density = draw(st.sampled_from([35, 50, 70]))  # percent of the reachability facts that hold
+
+    def some(candidates: list[tuple[str, ...]], dense: bool, cap: int = 4) -> list[tuple[str, ...]]:
+        if not candidates:
+            return []
+        if dense:
+            flags = draw(st.lists(st.integers(0, 99), min_size=len(candidates), max_size=len(candidates)))
+            return [c for c, f in zip(candidates, flags) if f < density]
+        return sorted(draw(st.sets(st.sampled_from(candidates), max_size=cap)))
+
+    facts: list[tuple[str, ...]] = [("in-region", o, region[o]) for o in objects]
+    facts += [("reachable-pick", *c) for c in some([(o, g, r) for o in objects for g in GRASPS for r in robots], True)]
+    facts += [("reachable-place", *c)
+              for c in some([(o, target[o], g, r) for o in objects for g in GRASPS for r in robots], True)]
+    facts += [("reachable-place", *c)  # decoys: places in regions that are nobody's target
+              for c in some([(o, re, g, r) for o in objects for re in regions if re != target[o]
+                             for g in GRASPS for r in robots], False, 2)]
+    facts += [("occludes-pick", *c)
+              for c in some([(m1, m2, g, r) for m1 in objects for m2 in objects if m1 != m2
+                             for g in GRASPS for r in robots], False, 8)]
+    facts += [("occludes-goal-place", *c)
+              for c in some([(m1, m2, goal[m2], g, r) for m1 in objects for m2 in goal if m1 != m2
+                             for g in GRASPS for r in robots], False, 4)]
+    facts += [("enable-goal-handover", *c)
+              for c in some([(m, g1, g2, r1, r2) for m in objects for g1 in GRASPS for g2 in GRASPS
+                             for r1 in robots for r2 in robots if r1 != r2], False, 6)]
+    init = "\n    ".join(f"({' '.join(f)})" for f in dict.fromkeys(facts))
+    goals = " ".join(f"(in-region {o} {r})" for o, r in goal.items())
+    return (DOMAIN + "(define (problem random)\n  (:domain abstract)\n"
+            f"  (:robots {' '.join(robots)})\n  (:movable {' '.join(objects)})\n  (:regions {' '.join(regions)})\n"
+            f"  (:init\n    {init})\n  (:goal (and {goals})))\n")
+
+
+def reference_graph(problem: Problem) -> Any:
+    """Alg. 1 by the oracle, from the problem's raw facts (no mrgc.compiler code)."""
+    facts = [(f.predicate, *f.args) for f in problem.init]
+    region = {f.args[0]: f.args[1] for f in problem.init if f.predicate == "in-region"}
+    must = [o for o, r in problem.goal_regions.items() if region.get(o) != r]
+    return oracle.reference_task_graph([r.name for r in problem.robots],
+                                       {m.name: tuple(GRASPS) for m in problem.movable},
+                                       problem.goal_regions, region, facts, must)
+
+
+# ---------------------------------------------------------------- the property
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@given(problems())
+def test_every_backend_and_encoding_matches_the_brute_force_oracle(text: str) -> None:
+    problem = parse_string(text).problem()
+    ref = reference_graph(problem)
+    graph = build_task_graph(FactBase.from_problem(problem), must_move(problem))
+    assert oracle.graph_signature(graph) == oracle.graph_signature(ref), "Alg. 1 differs from the reference"
+
+    sets = oracle.feasible_action_sets(ref)
+    expected = sorted((m, len(s)) for s, m in sets.items())[:K]
+    event(f"{min(len(sets), K)}{'+' if len(sets) > K else ''} feasible action sets")
+    event(f"first makespan {expected[0][0] if expected else '-'}, {len(ref.actions) // 5 * 5}+ actions")
+    runs: dict[tuple[str, str], list[tuple[int, int]]] = {}
+    problems_found: list[str] = []
+    for backend in BACKENDS:
+        for encoding in ENCODINGS:
+            res = compile_problem(problem, backend=backend, encoding=encoding, skeletons=K)
+            keys = [s.key for s in res.skeletons]
+            runs[(backend, encoding)] = keys
+            where = f"{backend}/{encoding}"
+            want_status = "optimal" if sets else "infeasible"
+            if res.status != want_status:
+                problems_found.append(f"{where}: status {res.status!r}, expected {want_status!r} ({res.reasons})")
+            if keys != expected:
+                problems_found.append(f"{where}: keys {keys}, oracle {expected}")
+            seen: set[frozenset[Action]] = set()
+            for sk in res.skeletons:
+                bad = oracle.check_skeleton(ref, sk)
+                if bad:
+                    problems_found.append(f"{where}: skeleton {sk.describe()} violates {bad}")
+                if sk.actions in seen:
+                    problems_found.append(f"{where}: action set returned twice: {sk.describe()}")
+                seen.add(sk.actions)
+                if sets.get(sk.actions) != sk.makespan:
+                    problems_found.append(f"{where}: {sk.describe()} has makespan {sk.makespan}, the oracle's "
+                                          f"minimum for that action set is {sets.get(sk.actions)}")
+    assert len(set(map(tuple, runs.values()))) == 1 or problems_found, runs
+    assert not problems_found, "\n".join(problems_found) + "\n\nproblem:\n" + text
+
+
+# ---------------------------------------------------------------- the oracle is not vacuous
+def _chain3() -> tuple[Any, dict[str, Action]]:
+    problem = parse_file(str(SYMBOLIC / "chain-3.mrg")).problem()
+    graph = reference_graph(problem)
+    named = {
+        "A1": Action("o1", "goal", "r1", "r1", "top", "top"),
+        "A2": Action("o1", "goal", "r2", "r2", "side", "side"),
+        "A3": Action("o1", "goal", "r1", "r2", "top", "side"),
+        "B": Action("o2", "start", "r1", "r1", "top", "top"),
+        "C": Action("o3", "start", "r2", "r2", "side", "side"),
+    }
+    assert set(graph.actions) == set(named.values())
+    return graph, named
+
+
+def test_oracle_on_chain3_lists_exactly_the_documented_action_sets() -> None:
+    graph, a = _chain3()
+    assert oracle.feasible_action_sets(graph) == {
+        frozenset({a["A2"]}): 1,
+        frozenset({a["B"], a["A3"]}): 2,
+        frozenset({a["B"], a["C"], a["A1"]}): 2,
+    }
+    assert oracle.oracle_keys(graph) == [(1, 1), (2, 2), (2, 3)]
+    assert oracle.min_makespan(graph, [a["A1"]]) is None  # its obstacles are not moved
+    assert oracle.min_makespan(graph, [a["A2"], a["B"]]) is None  # o2 moved without need
+
+
+def test_oracle_accepts_valid_and_flags_each_kind_of_violation() -> None:
+    graph, a = _chain3()
+    A1, A2, A3, B, C = a["A1"], a["A2"], a["A3"], a["B"], a["C"]
+    assert oracle.check_skeleton(graph, [[A2]]) == []
+    assert oracle.check_skeleton(graph, [[B, C], [A1]]) == []
+    assert oracle.check_skeleton(graph, [[B], [A1, C]]) == []  # a place obstacle may share the step
+    assert oracle.check_skeleton(graph, [[B], [A3]]) == []
+
+    def flagged(steps: list[list[Action]], needle: str) -> None:
+        bad = oracle.check_skeleton(graph, steps)
+        assert any(needle in b for b in bad), (steps, bad)
+
+    flagged([[B, C, A1]], "not strictly earlier")  # pick obstacle in the same step (also: r1 twice)
+    flagged([[B], [A1], [C]], "moves later")  # place obstacle after the action
+    flagged([[B], [], [A3]], "empty")
+    flagged([[B, A3]], "robot r1 does two actions")  # the handover also occupies r1
+    flagged([[C], [A3, B]], "robot r1")
+    flagged([[B], [A2]], "obstructs no selected action")
+    flagged([[B]], "in M* but is not moved")
+    flagged([[A2], [A1]], "moved twice")
+    flagged([[C], [A1]], "never moved")
+    flagged([[Action("o1", "goal", "r2", "r2", "top", "top")]], "not an action of the task graph")
+
+
+def test_min_makespan_respects_handover_robots_and_strict_pick_order() -> None:
+    text = (DOMAIN + """(define (problem p) (:domain abstract)
+      (:robots r1 r2 r3) (:movable o1 o2 o3) (:regions ra rb)
+      (:init (in-region o1 ra) (in-region o2 ra) (in-region o3 ra)
+        (reachable-pick o1 top r1) (enable-goal-handover o1 top side r1 r2) (reachable-place o1 rb side r2)
+        (reachable-pick o2 top r2) (reachable-place o2 rb top r2)
+        (reachable-pick o3 top r3) (reachable-place o3 rb top r3) (occludes-pick o2 o3 top r3))
+      (:goal (and (in-region o1 rb) (in-region o2 rb) (in-region o3 rb))))""")
+    graph = reference_graph(parse_string(text).problem())
+    # o2 before o3 (strict); the o1 handover shares r2 with o2: o1 | o2 | o3 or o2 | o1+o3 -> 2 steps
+    assert oracle.oracle_keys(graph) == [(2, 3)]
+
+
+# ---------------------------------------------------------------- a goal that already holds
+ALREADY_DONE = DOMAIN + """(define (problem done) (:domain abstract)
+  (:robots r1 r2) (:movable o1 o2) (:regions ra rb)
+  (:init (in-region o1 rb) (in-region o2 ra) (reachable-pick o1 top r1) (reachable-place o1 rb top r1))
+  (:goal (in-region o1 rb)))
+"""
+
+
+def test_oracle_says_a_satisfied_goal_needs_the_empty_skeleton() -> None:
+    graph = reference_graph(parse_string(ALREADY_DONE).problem())
+    assert graph.must_move == ()
+    assert oracle.oracle_keys(graph) == [(0, 0)]
+
+
+def test_a_satisfied_goal_is_not_infeasible() -> None:
+    """M* is empty: the empty skeleton (makespan 0, nothing moved) is a plan, so 'infeasible' is wrong."""
+    problem = parse_string(ALREADY_DONE).problem()
+    outcome = {}
+    for backend in BACKENDS:
+        for encoding in ENCODINGS:
+            res = compile_problem(problem, backend=backend, encoding=encoding)
+            outcome[(backend, encoding)] = (res.status, [s.key for s in res.skeletons])
+    assert all(status == "optimal" and set(keys) <= {(0, 0)} for status, keys in outcome.values()), outcome
+
+
+def test_cli_compile_of_a_satisfied_goal_exits_0(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    path = tmp_path / "done.mrg"
+    path.write_text(ALREADY_DONE, encoding="utf-8")
+    code = cli.main(["compile", str(path)])
+    out = capsys.readouterr().out
+    assert code == 0, out

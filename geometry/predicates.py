@@ -127,8 +127,9 @@ class RobotEvaluator:
         """Batched grasp + pre-grasp IK and collision checks for (object, grasp, object pose, held, key)
         queries; the approach path and the movable objects it hits for each query that is reachable.
 
-        Queries with no answer are retried with other IK seeds (other solution branches), and so are those
-        whose approach hits movable objects when ``want_free`` (the paper's "collision-free, if possible");
+        Queries whose IK solution collides with a fixed object (or has no pre-grasp) are retried with other
+        IK seeds (other solution branches), and so are those whose approach hits movable objects when
+        ``want_free`` (the paper's "collision-free, if possible");
         the first clean answer wins, else the first answer.
         """
         found: dict[int, tuple[np.ndarray, set[str]]] = {}
@@ -138,6 +139,7 @@ class RobotEvaluator:
                 break
             g_ts = [grasp_transform(queries[i][1], self.scene.body(queries[i][0]).shape) for i in todo]
             qs = self._ik([queries[i][2] @ g for i, g in zip(todo, g_ts)], "grasp", attempt=attempt)
+            unsolvable = {i for i, q in zip(todo, qs) if q is None}  # IK with restarts failed: no retry
             ok = [(i, g, q) for i, g, q in zip(todo, g_ts, qs) if q is not None and not (
                 queries[i][3] and self.world.probe_collides([(self.scene.body(queries[i][0]).shape, queries[i][2])],
                                                             against="fixed"))]
@@ -156,7 +158,7 @@ class RobotEvaluator:
                 if i not in found or (found[i][1] and not hits):
                     found[i] = (path, hits)
             # try other IK solutions for queries with no answer yet, or (if asked) one that hits movables
-            todo = [i for i in todo if i not in found or (want_free and found[i][1])]
+            todo = [i for i in todo if i not in unsolvable and (i not in found or (want_free and found[i][1]))]
         return found
 
     def placements(self, obj: str, region: str) -> list[np.ndarray]:

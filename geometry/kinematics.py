@@ -601,6 +601,27 @@ def pybullet_fk(model: RobotModel, q: Sequence[float], base: np.ndarray | None =
     return out
 
 
+def pybullet_box_distance(model: RobotModel, q: Sequence[float], base: np.ndarray | None, size: Sequence[float],
+                          pose: np.ndarray, skip_links: Sequence[str] = ()) -> float:
+    """Reference signed distance (negative: penetration) between the robot's links at ``q`` and a box of full
+    side lengths ``size`` at ``pose``, from pybullet's own collision engine (``getClosestPoints``), the
+    second engine the tests compare coal against.  Links named in ``skip_links`` are left out."""
+    pb, cid, body = _set_state(model, np.asarray(q, dtype=float), base)
+    _, by_name, _ = _pb_links(model)
+    shape = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=[float(v) / 2 for v in size], physicsClientId=cid)
+    pos, orn = tf.to_quaternion(np.asarray(pose, dtype=float))
+    box = pb.createMultiBody(baseMass=0, baseCollisionShapeIndex=shape, basePosition=pos, baseOrientation=orn,
+                             physicsClientId=cid)
+    # the box body stays (pybullet refuses to remove it in DIRECT mode); only the robot's distance to it is read
+    best = float("inf")
+    for name, index in by_name.items():
+        if name in skip_links:
+            continue
+        for pt in pb.getClosestPoints(body, box, 1.0, linkIndexA=index, physicsClientId=cid):
+            best = min(best, float(pt[8]))
+    return best
+
+
 def pybullet_ik(model: RobotModel, target: np.ndarray, seed: int, q_init: Sequence[float] | None = None,
                 restarts: int = 8, tol_pos: float = 1e-4, tol_rot: float = 1e-3, max_iters: int = 200,
                 null_space: bool = False) -> Any:

@@ -12,6 +12,10 @@ from __future__ import annotations
 import os
 import random
 
+from mrgc.errors import Diagnostic
+from mrgc.language.parser import parse_text
+from mrgc.language.printer import format_source
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 
 ARMS = {
@@ -68,8 +72,11 @@ def main() -> None:
     # seeds chosen so that every instance has a plan (seed 0 of pa18-4arms gives an object no arm can
     # bring to its bin); the shipped files are exactly what this writes
     for name, n, arms, seed in [("pa5", 5, 2, 0), ("pa10", 10, 2, 0), ("pa18-4arms", 18, 4, 2)]:
+        text = problem(name, n, arms, seed)
+        tree = parse_text(text, name)
+        assert not isinstance(tree, Diagnostic), tree
         with open(os.path.join(HERE, f"{name}.mrg"), "w", encoding="utf-8") as fh:
-            fh.write(problem(name, n, arms, seed))
+            fh.write(format_source(tree, text))  # canonical, as `mrgc fmt` would write it
 
 
 if __name__ == "__main__":

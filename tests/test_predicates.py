@@ -1,0 +1,155 @@
+"""Phase 1: the geometric predicates on small scenes with known answers, a golden fact list, and the
+agreement of the two collision engines (coal for the planner, pybullet for reference)."""
+
+from __future__ import annotations
+
+import os
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from mrgc import cli, parse_file
+from mrgc.geometry.collision import CollisionWorld, ConvexHull, collision_shape
+from mrgc.geometry.fk import fk_world
+from mrgc.geometry.kinematics import load_robot_model, pybullet_box_distance
+from mrgc.geometry.predicates import compute_facts
+from mrgc.geometry.scene import scene_from_problem
+from mrgc.geometry.transforms import rot_z, translation
+from mrgc.language.model import Box, Fact
+from mrgc.planner.skeletons import compile_problem
+
+ROOT = Path(__file__).resolve().parent.parent
+PACKAGING = ROOT / "domains" / "packaging"
+
+SCENE = """
+(define (problem tiny)
+  (:domain packaging)
+  (:robots
+    (r1 :kind panda :base (0 -0.7 0 90))
+    (r2 :kind panda :base (0 0.7 0 -90)))
+  (:fixed
+    (table :shape (box 3.4 3.4 0.05) :pose (0 0 -0.025 0)))
+  (:regions
+    (start :shape (box 0.3 0.3 0.3) :pose (0 -0.25 0.15 0))
+    (far :shape (box 0.3 0.3 0.3) :pose (1.5 0 0.15 0))
+    (bin-a :shape (box 0.2 0.2 0.3) :pose (0.35 -0.35 0.15 0)))
+  (:movable
+    (o1 :shape (box 0.05 0.05 0.12) :pose (0 -0.25 0.06 0))
+    (o2 :shape (box 0.05 0.05 0.12) :pose (0.07 -0.25 0.06 0))
+    (lone :shape (box 0.05 0.05 0.12) :pose (1.5 0 0.06 0)))
+  (:handover-points
+    (h1 :position (0 0 0.4))
+    (h-far :position (0 2.5 0.4)))
+  (:goal (and (in-region o1 bin-a) (in-region lone bin-a))))
+"""
+
+
+@pytest.fixture(scope="module")
+def tiny_facts(tmp_path_factory: pytest.TempPathFactory) -> set[Fact]:
+    folder = tmp_path_factory.mktemp("tiny")
+    shutil.copy(PACKAGING / "domain.mrg", folder / "domain.mrg")
+    (folder / "tiny.mrg").write_text(SCENE, encoding="utf-8")
+    problem = parse_file(folder / "tiny.mrg").problem()
+    return set(compute_facts(scene_from_problem(problem), workers=1).facts)
+
+
+def facts_of(facts: set[Fact], predicate: str, **where: str) -> set[tuple[str, ...]]:
+    names = {"reachable-pick": ("obj", "grasp", "robot"), "reachable-place": ("obj", "region", "grasp", "robot"),
+             "occludes-pick": ("blocker", "obj", "grasp", "robot"),
+             "enable-goal-handover": ("obj", "g1", "g2", "r1", "r2"), "in-region": ("obj", "region")}[predicate]
+    return {f.args for f in facts if f.predicate == predicate
+            and all(f.args[names.index(k)] == v for k, v in where.items())}
+
+
+def test_an_object_out_of_reach_has_no_pick(tiny_facts: set[Fact]) -> None:
+    assert facts_of(tiny_facts, "reachable-pick", obj="lone") == set()
+    assert facts_of(tiny_facts, "in-region", obj="lone") == {("lone", "far")}
+    assert facts_of(tiny_facts, "reachable-pick", obj="o1", robot="r1")  # the near one is reachable
+
+
+def test_a_neighbour_blocks_the_grasp_that_passes_through_it(tiny_facts: set[Fact]) -> None:
+    # o2 stands 7 cm on o1's +x side: approaching o1 from +x goes through o2, from -x does not
+    assert ("o2", "o1", "side-x+", "r1") in facts_of(tiny_facts, "occludes-pick")
+    assert ("o2", "o1", "side-x-", "r1") not in facts_of(tiny_facts, "occludes-pick")
+    assert ("o1", "o2", "side-x-", "r1") in facts_of(tiny_facts, "occludes-pick")
+
+
+def test_a_bin_only_one_arm_reaches(tiny_facts: set[Fact]) -> None:
+    placers = {args[3] for args in facts_of(tiny_facts, "reachable-place", obj="o1", region="bin-a")}
+    assert placers == {"r1"}
+
+
+def test_two_arms_meet_only_at_a_reachable_handover_point(tiny_facts: set[Fact]) -> None:
+    handovers = facts_of(tiny_facts, "enable-goal-handover", obj="o1")
+    assert handovers and all({a[3], a[4]} == {"r1", "r2"} for a in handovers)
+    assert facts_of(tiny_facts, "enable-goal-handover", obj="o2") == set()  # not a goal object
+
+
+def test_facts_are_deterministic_and_independent_of_the_worker_count() -> None:
+    problem = parse_file(PACKAGING / "pa3-handover.mrg").problem()
+    scene = scene_from_problem(problem)
+    one = compute_facts(scene, seed=3, workers=1).facts
+    two = compute_facts(scene, seed=3, workers=2).facts
+    assert one == two
+
+
+def test_golden_facts_of_a_hand_made_scene() -> None:
+    problem = parse_file(PACKAGING / "pa3-handover.mrg").problem()
+    facts = compute_facts(scene_from_problem(problem), workers=1).facts
+    text = "".join(f"{f}\n" for f in facts)
+    golden = ROOT / "tests" / "golden" / "facts" / "pa3-handover.facts"
+    if os.environ.get("MRGC_UPDATE_GOLDEN"):
+        golden.write_text(text, encoding="utf-8")
+    assert text == golden.read_text(encoding="utf-8")
+
+
+def test_mrgc_facts_writes_a_file_that_compiles(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "pa3.facts.mrg"  # another folder: the domain comes along
+    assert cli.main(["facts", str(PACKAGING / "pa3-handover.mrg"), "-o", str(out)]) == 0
+    assert "facts" in capsys.readouterr().out
+    mf = parse_file(out)
+    problem = mf.problem()
+    assert mf.domains and problem.init and any(f.predicate == "enable-goal-handover" for f in problem.init)
+    result = compile_problem(problem)
+    assert result.status == "optimal"
+    first = result.skeletons[0]
+    assert first.makespan == 1 and first.moved == ("o1",) and first.steps[0][0].handover
+    assert cli.main(["fmt", "--check", str(out)]) == 0
+
+
+def test_geometric_problems_compile_directly() -> None:
+    problem = parse_file(PACKAGING / "pa3-place-obstacle.mrg").problem()
+    result = compile_problem(problem, skeletons=2)
+    assert result.status == "optimal" and result.stats["facts"] > 0
+    assert [s.key for s in result.skeletons][0] == (2, 2)
+
+
+def test_facts_of_a_symbolic_problem_is_an_input_error(capsys: pytest.CaptureFixture[str]) -> None:
+    assert cli.main(["facts", str(ROOT / "domains" / "symbolic" / "chain-3.mrg")]) == 2
+    assert "error[E402]" in capsys.readouterr().err
+
+
+PANDA = load_robot_model("franka_panda/panda.urdf", str(PACKAGING), "panda_hand")
+LINKS = [link for link in PANDA.links if link.index != 0 and len(link.points) >= 4]
+SHAPES = [collision_shape(ConvexHull(np.asarray(link.points, dtype=float))) for link in LINKS]
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.floats(0, 1), min_size=PANDA.dof, max_size=PANDA.dof),
+       st.tuples(st.floats(-0.6, 0.6), st.floats(-0.6, 0.6), st.floats(0.0, 0.9)),
+       st.tuples(st.floats(0.03, 0.3), st.floats(0.03, 0.3), st.floats(0.03, 0.3)),
+       st.floats(-3.14, 3.14))
+def test_coal_and_pybullet_agree_on_robot_box_collisions(u: list[float], xyz: tuple[float, float, float],
+                                                         size: tuple[float, float, float], yaw: float) -> None:
+    q = PANDA.lower + np.array(u) * (PANDA.upper - PANDA.lower)
+    pose = translation(*xyz) @ rot_z(yaw)
+    reference = pybullet_box_distance(PANDA, q, None, size, pose, skip_links=(PANDA.links[0].name,))
+    world = CollisionWorld()
+    world.add("box", Box(*size), pose, "fixed")
+    ours = world.batch_collides(SHAPES, fk_world(PANDA, q, np.eye(4))[[link.index for link in LINKS]], against="fixed")
+    if abs(reference) > 0.005:  # both engines use convex hulls of the same meshes; skip grazing contacts
+        assert ours == (reference < 0), f"coal says {ours}, pybullet distance {reference:.4f} m"

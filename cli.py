@@ -138,7 +138,9 @@ def cmd_compile(args: argparse.Namespace) -> int:
         print(f"problem {result.problem}: backend {result.backend}, encoding {result.encoding}: "
               f"{result.status}, {n} skeleton{'s' * (n != 1)} "
               f"({result.stats.get('objects', 0)} objects, {result.stats.get('actions', 0)} actions in the task graph, "
-              f"{result.stats.get('total_seconds', 0):.3f} s)")
+              f"{result.stats.get('total_seconds', 0):.3f} s"
+              + (f"; phase 1: {result.stats['facts']} facts in {result.stats['facts_seconds']:.2f} s"
+                 if result.stats.get("facts_seconds") else "") + ")")
         for i, sk in enumerate(result.skeletons, 1):
             print(f"skeleton {i}: makespan {sk.makespan}, moves {len(sk.moved)} ({' '.join(sk.moved)})")
             for line in sk.describe():

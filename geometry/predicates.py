@@ -1,4 +1,5 @@
-"""Phase 1 of the paper: the geometric facts of a scene, in IK mode (the packaging domain).
+"""Phase 1 of the paper: the geometric facts of a scene.  Fixed-base arms use IK mode (the packaging
+domain, below); planar mobile robots use path mode (geometry/path_predicates.py, the box-moving domain).
 
 For every robot R (in parallel, one process per robot when there are cores to spare):
 
@@ -235,6 +236,10 @@ class RobotEvaluator:
 
 def _robot_worker(args: tuple[SceneSpec, str, int]) -> RobotFacts:
     scene, robot, seed = args
+    if scene.robot(robot).kind.base == "planar":  # path mode (box-moving)
+        from mrgc.geometry.path_predicates import PlanarEvaluator  # imports this module: import here
+
+        return PlanarEvaluator(scene, robot, seed).run()
     return RobotEvaluator(scene, robot, seed).run()
 
 
@@ -245,8 +250,9 @@ def compute_facts(scene: SceneSpec, seed: int = 0, workers: int | None = None) -
     robots = [r.name for r in scene.robots]
     n = workers if workers is not None else min(len(robots), os.cpu_count() or 1)
     jobs = [(scene, r, seed) for r in robots]
-    for spec in scene.robots:  # load every robot model here: errors surface once, and forked workers share them
-        model_for_kind(spec.kind, spec.base_dir)
+    for spec in scene.robots:  # load every arm model here: errors surface once, and forked workers share them
+        if spec.kind.base != "planar":
+            model_for_kind(spec.kind, spec.base_dir)
     if n > 1 and len(robots) > 1:
         with ProcessPoolExecutor(max_workers=n, mp_context=get_context("fork")) as pool:
             per_robot = list(pool.map(_robot_worker, jobs))

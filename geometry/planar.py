@@ -1,0 +1,284 @@
+"""Planar mobile manipulators (the box-moving domain): a footprint driven over the floor in SE(2).
+
+The model (docs/geometry.md, "Planar robots"):
+
+- **Base frame.**  A planar robot's base pose is ``(x, y, yaw)`` on the floor (z = 0, yaw about +z,
+  radians in code, degrees in ``.mrg``); +x of the base frame is the robot's *front*.  The ``:base`` pose
+  of a robot in a problem is its start (home) pose; its z is ignored.
+- **Footprint.**  The robot's body is its kind's ``:footprint`` shape (usually a box), centred over the base
+  origin and standing on the floor: its frame is the base frame lifted by the shape's half height plus
+  :data:`LIFT` (so a footprint never touches a floor slab; touching counts as colliding).
+- **Grasps.**  A planar robot grasps an object from one of its *side* faces: grasp ``side-x+`` means the
+  robot stands on the object's +x side facing it (facing the object's -x direction), and so on for
+  ``side-x-``, ``side-y+``, ``side-y-``.  ``top`` (and any grasp name this layer does not know) is not
+  available to planar robots: it yields no fact.
+- **Pick base pose.**  To pick object M with grasp g the robot stands facing M's g face with its front at
+  :data:`CLEARANCE` from that face: the base origin is at distance
+  ``d = footprint half length (x) + CLEARANCE + M's half extent along the face normal`` from M's centre,
+  along the face normal, yawed to face M.  The footprint at the pick pose therefore never touches M.
+- **Carrying.**  After the pick, M rides at the kind's ``:carry`` pose relative to the base frame (the pose
+  of M's own frame, i.e. its centre), turned so that the grasped face still faces the robot:
+  ``carry @ Rz(face yaw of g)`` (``side-x-``: 0°, ``side-y-``: -90°, ``side-x+``: 180°, ``side-y+``: 90°).
+  Without ``:carry`` the object rides on top of the footprint (centred, :data:`LIFT` above it).  The
+  change from "M on the floor in front of the robot" to "M at the carry pose" is instantaneous (not swept),
+  but M at the carry pose must be free of fixed objects at the pick base pose.
+- **Place base pose.**  Placing M at a pose P with grasp g is the pick geometry in reverse: the robot stands
+  at the pick base pose it would use to pick M from P.  Candidate placements inside a region are a lattice
+  (centre first) × four yaws (M's current yaw + 0°, 90°, 180°, 270°); a placement rests on the region's
+  floor, :data:`LIFT` above it.
+- **Bounds.**  Base paths stay within the axis-aligned bounding box of every fixed object, movable object,
+  region and robot start, grown by the footprint's circumradius plus 0.1 m.
+
+Other robots are not obstacles here (they are at home between steps; simultaneous motions are the
+grounding's business).  Nothing in this module plans: :mod:`mrgc.geometry.path_predicates` does.
+"""
+
+from __future__ import annotations
+
+import math
+from functools import cached_property
+
+import numpy as np
+
+from mrgc.geometry.collision import CollisionShape, collision_shape
+from mrgc.geometry.scene import Body, RobotSpec, SceneSpec, half_extents, inside, outline
+from mrgc.geometry.transforms import from_pose, rot_z, translation
+from mrgc.language.model import Box, Cylinder, Shape
+
+#: gap between the robot's front and the face of the object it picks or places (m)
+CLEARANCE = 0.05
+#: footprints and placements float this much above the floor (touching counts as colliding) (m)
+LIFT = 1e-3
+#: placements tried per region: a GRID × GRID lattice, centre first (each at four yaws)
+PLACEMENT_GRID = 5
+#: placement yaws tried, relative to the object's current yaw (degrees)
+PLACEMENT_YAWS = (0.0, 90.0, 180.0, 270.0)
+
+#: grasp -> (outward normal of the grasped face in the object frame, yaw of the object in the base frame
+#: while carried, degrees): the grasped face always faces the robot (the base's -x)
+PLANAR_GRASPS: dict[str, tuple[tuple[float, float], float]] = {
+    "side-x+": ((1.0, 0.0), 180.0),
+    "side-x-": ((-1.0, 0.0), 0.0),
+    "side-y+": ((0.0, 1.0), 90.0),
+    "side-y-": ((0.0, -1.0), -90.0),
+}
+
+
+def planar_grasp(grasp: str) -> bool:
+    """Can a planar robot use ``grasp`` (a side grasp)?"""
+    return grasp in PLANAR_GRASPS
+
+
+def is_planar(spec: RobotSpec) -> bool:
+    return spec.kind.base == "planar"
+
+
+def se2(x: float, y: float, yaw: float) -> np.ndarray:
+    """The 4×4 transform of a base pose (yaw in radians)."""
+    t = rot_z(yaw)
+    t[0, 3], t[1, 3] = x, y
+    return t
+
+
+def to_se2(t: np.ndarray) -> np.ndarray:
+    """``(x, y, yaw)`` of a 4×4 transform projected onto the floor (yaw in [-π, π))."""
+    yaw = math.atan2(t[1, 0], t[0, 0])
+    return np.array([t[0, 3], t[1, 3], (yaw + math.pi) % (2 * math.pi) - math.pi])
+
+
+class PlanarRobot:
+    """A planar mobile robot of a scene: footprint, grasp geometry and carried-object poses."""
+
+    def __init__(self, spec: RobotSpec) -> None:
+        if spec.kind.footprint is None:
+            raise ValueError(f"robot '{spec.name}' has a planar base but no footprint")
+        self.spec = spec
+        self.name = spec.name
+        self.footprint: Shape = spec.kind.footprint
+        self.half = half_extents(self.footprint)
+        self.shape: CollisionShape = collision_shape(self.footprint)
+        #: the footprint's frame relative to the base frame
+        self.lift = translation(0.0, 0.0, float(self.half[2]) + LIFT)
+        self.start = to_se2(spec.base)
+
+    @cached_property
+    def radius(self) -> float:
+        """Circumradius of the footprint in the floor plane (m)."""
+        return float(np.hypot(self.half[0], self.half[1]))
+
+    # ------------------------------------------------------------------------------------ geometry
+    def body_transform(self, q: np.ndarray) -> np.ndarray:
+        """World transform of the footprint at base pose ``q`` = (x, y, yaw)."""
+        return se2(q[0], q[1], q[2]) @ self.lift
+
+    def carry_transform(self, shape: Shape, grasp: str) -> np.ndarray:
+        """Pose of a carried object (of ``shape``, held with ``grasp``) relative to the base frame."""
+        face_yaw = math.radians(PLANAR_GRASPS[grasp][1])
+        carry = self.spec.kind.carry
+        if carry is not None:
+            return from_pose(carry) @ rot_z(face_yaw)
+        h = half_extents(shape)
+        return translation(0.0, 0.0, 2 * float(self.half[2]) + 2 * LIFT + float(h[2])) @ rot_z(face_yaw)
+
+    def probe(self, q: np.ndarray, carried: tuple[CollisionShape, np.ndarray] | None = None
+              ) -> list[tuple[CollisionShape, np.ndarray]]:
+        """Collision probe of the robot at ``q`` (and of the object it carries, given its carry transform)."""
+        base = se2(q[0], q[1], q[2])
+        out = [(self.shape, base @ self.lift)]
+        if carried is not None:
+            out.append((carried[0], base @ carried[1]))
+        return out
+
+    def standoff(self, shape: Shape, grasp: str) -> float:
+        """Distance from an object's centre to the base origin when grasping it with ``grasp``."""
+        normal = np.abs(np.array(PLANAR_GRASPS[grasp][0]))
+        return float(self.half[0]) + CLEARANCE + float(normal @ half_extents(shape)[:2])
+
+    def grasp_base(self, pose: np.ndarray, shape: Shape, grasp: str) -> np.ndarray:
+        """The base pose ``(x, y, yaw)`` from which the robot picks (or places) an object at ``pose``."""
+        nx, ny = PLANAR_GRASPS[grasp][0]
+        r = pose[:2, :2]
+        n = r @ np.array([nx, ny])
+        n = n / max(float(np.linalg.norm(n)), 1e-12)
+        d = self.standoff(shape, grasp)
+        x, y = float(pose[0, 3] + d * n[0]), float(pose[1, 3] + d * n[1])
+        yaw = math.atan2(-n[1], -n[0])
+        return np.array([x, y, (yaw + math.pi) % (2 * math.pi) - math.pi])
+
+
+def scene_bounds(scene: SceneSpec, margin: float) -> tuple[float, float, float, float]:
+    """``(xmin, xmax, ymin, ymax)`` of everything in the scene (and the robots' starts), grown by ``margin``."""
+    pts = [b.pose[:3, 3] for b in (*scene.fixed, *scene.movable, *scene.regions)]
+    for b in (*scene.fixed, *scene.movable, *scene.regions):
+        pts.extend(outline(b.shape) @ b.pose[:3, :3].T + b.pose[:3, 3])
+    pts.extend(r.base[:3, 3] for r in scene.robots)
+    xy = np.array(pts)[:, :2]
+    lo, hi = xy.min(axis=0) - margin, xy.max(axis=0) + margin
+    return float(lo[0]), float(hi[0]), float(lo[1]), float(hi[1])
+
+
+def placements(obj: Body, region: Body, grid: int = PLACEMENT_GRID) -> list[np.ndarray]:
+    """Candidate poses of ``obj`` resting inside box ``region``: a lattice (centre first) × four yaws.
+
+    The object's yaw is its current yaw plus each of :data:`PLACEMENT_YAWS`; the lattice spans the room the
+    object's (rotated) bounding box leaves in the region; every returned pose passes :func:`inside`.
+    """
+    if not isinstance(region.shape, Box):
+        return []
+    h_o, h_r = half_extents(obj.shape), half_extents(region.shape)
+    if h_o[2] * 2 + LIFT > h_r[2] * 2:
+        return []
+    ticks = np.linspace(-1, 1, grid) if grid > 1 else np.zeros(1)
+    offsets = sorted(((float(a), float(b)) for a in ticks for b in ticks),
+                     key=lambda ab: (ab[0] ** 2 + ab[1] ** 2, ab))
+    obj_yaw = math.atan2(obj.pose[1, 0], obj.pose[0, 0])
+    reg_yaw = math.atan2(region.pose[1, 0], region.pose[0, 0])
+    out = []
+    for a, b in offsets:
+        for dyaw in PLACEMENT_YAWS:
+            rel = obj_yaw - reg_yaw + math.radians(dyaw)  # the object's yaw in the region frame
+            c, s = abs(math.cos(rel)), abs(math.sin(rel))
+            ex, ey = c * h_o[0] + s * h_o[1], s * h_o[0] + c * h_o[1]  # its bounding box in the region frame
+            room = (h_r[0] - ex, h_r[1] - ey)
+            if room[0] < 0 or room[1] < 0:
+                continue
+            local = translation(a * room[0] * 0.95, b * room[1] * 0.95, -h_r[2] + h_o[2] + LIFT) @ rot_z(rel)
+            pose = region.pose @ local
+            if inside(region, obj.shape, pose):
+                out.append(pose)
+    return out
+
+
+class DiscGrid:
+    """A necessary condition for base paths, on a grid: can the footprint's *inscribed disc* get through?
+
+    Every valid base pose keeps the disc (radius ``r``, the footprint's inscribed radius, extruded over the
+    footprint's height) clear of every obstacle, so a base path exists only if the disc's centre can move
+    from start to goal among the obstacles grown by ``r``.  Cells of side ``cell`` are free when their
+    centre has clearance ``≥ r - cell·√2/2 - slack``, ``slack`` being half the path's checking resolution
+    (the planner checks states, not the segments between them); free cells are 8-connected.  So a start
+    and goal in different components of the free cells have no path the planner could return, and the
+    planner need not be run.  Obstacles counted are the vertical prisms (boxes turned about z only,
+    cylinders along z) whose height range overlaps the footprint's; other shapes are left out, which
+    keeps the test conservative.  Without a box or vertical-cylinder footprint the grid says "maybe" always.
+    """
+
+    def __init__(self, robot: PlanarRobot, scene: SceneSpec, bounds: tuple[float, float, float, float],
+                 cell: float = 0.05, slack: float = 0.025) -> None:
+        self.bounds = bounds
+        self.cell = cell
+        xmin, xmax, ymin, ymax = bounds
+        self.nx = max(1, int(math.ceil((xmax - xmin) / cell)))
+        self.ny = max(1, int(math.ceil((ymax - ymin) / cell)))
+        xs = xmin + (np.arange(self.nx) + 0.5) * cell
+        ys = ymin + (np.arange(self.ny) + 0.5) * cell
+        self.centres = np.stack(np.meshgrid(xs, ys, indexing="ij"), axis=-1)  # (nx, ny, 2)
+        fp = robot.footprint
+        self.enabled = isinstance(fp, (Box, Cylinder))
+        self.threshold = float(min(robot.half[0], robot.half[1])) - cell * math.sqrt(2) / 2 - slack
+        self.z_range = (LIFT, LIFT + 2 * float(robot.half[2]))
+        self.bodies = {b.name: b for b in (*scene.fixed, *scene.movable)}
+        self._masks: dict[str, np.ndarray | None] = {}
+        self._reached: dict[frozenset[str], list[np.ndarray]] = {}
+
+    def _mask(self, name: str) -> np.ndarray | None:
+        """Cells whose centre is too close to object ``name`` (None: the object is not counted)."""
+        if name in self._masks:
+            return self._masks[name]
+        body = self.bodies[name]
+        t, shape, mask = body.pose, body.shape, None
+        h = half_extents(shape)
+        lo, hi = t[2, 3] - h[2], t[2, 3] + h[2]
+        vertical = abs(t[2, 2] - 1.0) < 1e-9
+        overlaps = lo < self.z_range[1] - 1e-9 and hi > self.z_range[0] + 1e-9
+        if vertical and overlaps and isinstance(shape, (Box, Cylinder)):
+            d = self.centres - t[:2, 3]
+            if isinstance(shape, Box):
+                local = d @ t[:2, :2]  # into the box frame (rows of R^T)
+                out = np.maximum(np.abs(local) - h[:2], 0.0)
+                dist = np.hypot(out[..., 0], out[..., 1])
+            else:
+                dist = np.maximum(np.hypot(d[..., 0], d[..., 1]) - shape.radius, 0.0)
+            mask = dist < self.threshold
+        self._masks[name] = mask
+        return mask
+
+    def _cell(self, q: np.ndarray) -> tuple[int, int]:
+        i = int((q[0] - self.bounds[0]) / self.cell)
+        j = int((q[1] - self.bounds[2]) / self.cell)
+        return min(max(i, 0), self.nx - 1), min(max(j, 0), self.ny - 1)
+
+    def connected(self, start: np.ndarray, goal: np.ndarray, obstacles: frozenset[str]) -> bool:
+        """False only if no base path from ``start`` to ``goal`` avoids ``obstacles`` (object names)."""
+        if not self.enabled or self.threshold <= 0:
+            return True
+        s, g = self._cell(start), self._cell(goal)
+        for reached in self._reached.get(obstacles, ()):
+            if reached[s]:
+                return bool(reached[g])
+        blocked = np.zeros((self.nx, self.ny), dtype=bool)
+        for name in obstacles:
+            m = self._mask(name)
+            if m is not None:
+                blocked |= m
+        if blocked[s]:
+            return False
+        reached = self._flood(~blocked, s)
+        self._reached.setdefault(obstacles, []).append(reached)
+        return bool(reached[g])
+
+    @staticmethod
+    def _flood(free: np.ndarray, start: tuple[int, int]) -> np.ndarray:
+        """The 8-connected component of ``free`` holding ``start``."""
+        reached = np.zeros_like(free)
+        reached[start] = True
+        while True:
+            grown = reached.copy()
+            grown[1:, :] |= reached[:-1, :]
+            grown[:-1, :] |= reached[1:, :]
+            grown[:, 1:] |= grown[:, :-1].copy()
+            grown[:, :-1] |= grown[:, 1:].copy()
+            grown &= free
+            if np.array_equal(grown, reached):
+                return reached
+            reached = grown

@@ -1,0 +1,97 @@
+"""The grounding API the planner uses: placements, approach configurations, handovers, paths, volumes."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from mrgc import parse_file
+from mrgc.geometry.grounding import Grounder, Status
+from mrgc.geometry.planar import to_se2
+from mrgc.geometry.scene import inside, scene_from_problem
+from mrgc.geometry.transforms import translation
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+@pytest.fixture()
+def pa3() -> Grounder:
+    problem = parse_file(ROOT / "domains" / "packaging" / "pa3-handover.mrg").problem()
+    return Grounder(scene_from_problem(problem), seed=0)
+
+
+def test_placement_lies_inside_the_region_and_avoids_objects(pa3: Grounder) -> None:
+    ans = pa3.placement("o2", "start", avoid=["o1", "o3"])
+    assert ans.ok and ans.pose is not None
+    assert inside(pa3.scene.body("start"), pa3.scene.body("o2").shape, ans.pose)
+    volume = [(pa3.shape("o2"), ans.pose)]
+    assert pa3.hits(volume, among=["o1", "o3"]) == set()
+
+
+def test_placement_avoids_a_swept_volume(pa3: Grounder) -> None:
+    # a wall of volume over the whole start region except nothing: no placement can be found
+    region = pa3.scene.body("start")
+    volume = [(pa3.shape("o1"), region.pose @ translation(x, y, -0.09)) for x in np.linspace(-0.15, 0.15, 7)
+              for y in np.linspace(-0.15, 0.15, 7)]
+    assert pa3.placement("o2", "start", volume=volume, samples=40).status is Status.NO_PLACEMENT
+    assert pa3.placement("o2", "start", volume=volume[:1], samples=40).ok
+
+
+def test_pick_reports_the_objects_in_the_way(pa3: Grounder) -> None:
+    blocked = pa3.pick("r1", "o1", "side-x+", avoid=["o2", "o3"])
+    assert blocked.status is Status.COLLISION and "o2" in blocked.blockers
+    free = pa3.pick("r1", "o1", "top", avoid=["o2", "o3"])
+    assert free.ok and free.configs is not None and free.configs.shape == (5, 7)
+    assert pa3.arm("r1").model.within_limits(free.configs).all()
+    # the last configuration puts the tool at the grasp
+    tool = pa3.arm("r1").tool_world(free.configs[-1])
+    assert np.linalg.norm(tool[:3, 3] - (pa3.poses["o1"][:3, 3] + [0, 0, 0.04])) < 1e-3
+    assert pa3.pick("r2", "o1", "top").status is Status.NO_IK  # out of r2's reach
+
+
+def test_moving_an_object_clears_the_way(pa3: Grounder) -> None:
+    assert not pa3.pick("r1", "o1", "side-x+", avoid=["o2"]).ok
+    pa3.move("o2", pa3.poses["o2"] @ translation(0, 0.45, 0))  # far to the other side of the table
+    assert pa3.pick("r1", "o1", "side-x+", avoid=["o2"]).ok
+
+
+def test_handover_and_place(pa3: Grounder) -> None:
+    hand = pa3.handover("o1", "h1", "r1", "top", "r2", "side-x+")
+    assert hand.ok and hand.configs is not None and hand.configs.shape == (2, 7)
+    target = pa3.placement("o1", "bin-b")
+    assert target.ok and target.pose is not None
+    assert pa3.place("r2", "o1", "top", target.pose).ok
+    assert pa3.place("r1", "o1", "top", target.pose).status is Status.NO_IK
+
+
+def test_arm_path_and_its_volume(pa3: Grounder) -> None:
+    arm = pa3.arm("r1")
+    pick = pa3.pick("r1", "o1", "top")
+    assert pick.ok and pick.configs is not None
+    path = pa3.arm_path("r1", arm.home, pick.configs[0], time_limit=2.0)
+    assert path.ok and np.allclose(path.path[0], arm.home) and np.allclose(path.path[-1], pick.configs[0])
+    volume = pa3.arm_volume("r1", np.array(path.path))
+    assert pa3.hits(volume, among="fixed") == set()
+    held = pa3.arm_volume("r1", pick.configs[-1:], holding=("o1", "top"))
+    assert len(held) == len(pa3.arm("r1").probes[0]) + 1
+
+
+def test_base_path_for_a_planar_robot() -> None:
+    problem = parse_file(ROOT / "domains" / "box-moving" / "bo-doorway.mrg").problem()
+    g = Grounder(scene_from_problem(problem), seed=0)
+    robot = problem.robots[0].name
+    assert g.is_planar(robot)
+    start = to_se2(g.scene.robot(robot).base)
+    goal = start + np.array([0.3, 0.0, 0.0])
+    res = g.base_path(robot, start, goal, time_limit=1.0)
+    assert res.ok and np.allclose(res.path[-1], goal, atol=1e-6)
+    assert g.hits(g.base_volume(robot, res.path), among="fixed") == set()
+
+
+def test_same_queries_same_answers() -> None:
+    problem = parse_file(ROOT / "domains" / "packaging" / "pa3-handover.mrg").problem()
+    a = Grounder(scene_from_problem(problem), seed=4).placement("o2", "start", avoid=["o1", "o3"])
+    b = Grounder(scene_from_problem(problem), seed=4).placement("o2", "start", avoid=["o1", "o3"])
+    assert a.pose is not None and b.pose is not None and np.array_equal(a.pose, b.pose)

@@ -102,8 +102,9 @@ class HighsBackend(Backend):
         self.h.run()
         status = self.h.getModelStatus()
         S = hs.HighsModelStatus
-        if status == S.kModelEmpty:
-            return Solution(Status.OPTIMAL, ())
+        if status == S.kModelEmpty:  # no variables: only constant rows, which hold or not
+            assert self.model is not None
+            return Solution(Status.INFEASIBLE if self.model.violated(()) else Status.OPTIMAL, ())
         if status == S.kOptimal:
             values = tuple(int(round(x)) for x in self.h.getSolution().col_value)
             return Solution(Status.OPTIMAL, values)

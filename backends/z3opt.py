@@ -8,6 +8,8 @@ extension.
 
 from __future__ import annotations
 
+import math
+import threading
 from typing import Any, Sequence
 
 from mrgc.backends.base import Backend, BackendInfo
@@ -82,14 +84,25 @@ class Z3Backend(Backend):
 
     def _solve(self, time_limit: float | None) -> Solution:
         z3 = _z3()
-        self.opt.set("timeout", int(time_limit * 1000) if time_limit is not None else 4294967295)
-        res = self.opt.check()
+        # z3 reads a timeout of 0 as none, and Optimize sometimes overruns its own timeout: round up to
+        # 1 ms and back the limit with a watchdog that interrupts the context
+        self.opt.set("timeout", max(1, math.ceil(time_limit * 1000)) if time_limit is not None else 4294967295)
+        watchdog = None
+        if time_limit is not None:
+            watchdog = threading.Timer(time_limit + 0.05, self.ctx.interrupt)
+            watchdog.daemon = True
+            watchdog.start()
+        try:
+            res = self.opt.check()
+        finally:
+            if watchdog is not None:
+                watchdog.cancel()
         if res == z3.unsat:
             return Solution(Status.INFEASIBLE)
         if res == z3.unknown:
             reason = self.opt.reason_unknown()
-            if "timeout" in reason or "canceled" in reason:
-                return Solution(Status.TIME_LIMIT, message=reason)
+            if time_limit is not None or "timeout" in reason or "canceled" in reason:
+                return Solution(Status.TIME_LIMIT, message=reason or "time limit")
             return Solution(Status.ERROR, message=f"z3: {reason}")
         m = self.opt.model()
         values = tuple(

@@ -83,12 +83,12 @@ class SkeletonSource:
                  encoding: str = DEFAULT_ENCODING, max_makespan: int | None = None, seed: int = 0) -> None:
         cls = backend_class(backend)
         self.backend, self.encoding = backend, encoding
-        if encoding not in cls.info.encodings:
-            raise InputError([Diagnostic("E302", f"backend '{backend}' does not support encoding '{encoding}'")])
         try:
             enc = get_encoding(encoding)
         except ValueError as exc:
             raise InputError([Diagnostic("E303", str(exc))]) from None
+        if encoding not in cls.info.encodings:
+            raise InputError([Diagnostic("E302", f"backend '{backend}' does not support encoding '{encoding}'")])
         t0 = time.perf_counter()
         self.graph: TaskGraph = build_task_graph(facts, must, moved)
         self.reasons = explain_infeasible(self.graph, facts)

@@ -241,8 +241,12 @@ def oracle_keys(graph: TaskGraph) -> list[tuple[int, int]]:
 # ------------------------------------------------------------------ Alg. 1 on raw facts
 def reference_task_graph(robots: Sequence[str], grasps: Mapping[str, Sequence[str]], goal: Mapping[str, str],
                          region: Mapping[str, str], facts: Iterable[tuple[str, ...]],
-                         must_move: Sequence[str]) -> TaskGraph:
+                         must_move: Sequence[str], moved: Iterable[str] = ()) -> TaskGraph:
     """Alg. 1 (AddObject for every object of M*) on fact tuples ``(predicate, arg, ...)``.
+
+    ``moved`` are the objects of the already grounded suffix S' (they move later, once): they get no node
+    and are not in M*, and an action one of them obstructs is left out, since that object is still in
+    place when the action would run (the project's reading of the paper's "M excludes S'").
 
     Target region: the goal region of a goal object, else the object's current region.  Direct actions need
     ReachablePick and ReachablePlace(target) with the same robot and grasp; handovers (goal objects only)
@@ -257,14 +261,16 @@ def reference_task_graph(robots: Sequence[str], grasps: Mapping[str, Sequence[st
     hand = {f[1:] for f in facts if f[0] == "enable-goal-handover"}
     occ_pick = {f[1:] for f in facts if f[0] == "occludes-pick" and f[1] != f[2]}
     occ_place = {f[1:] for f in facts if f[0] == "occludes-goal-place" and f[1] != f[2]}
-    movable = sorted({f[1] for f in facts if f[0] == "in-region"} | set(goal) | set(must_move))
+    done = set(moved)
+    must_move = [m for m in dict.fromkeys(must_move) if m not in done]
+    movable = sorted({f[1] for f in facts if f[0] == "in-region"} | set(goal) | set(must_move) | done)
     nodes: list[str] = []
     actions: list[Action] = []
     bp: list[tuple[str, ...]] = []
     bl: list[tuple[str, ...]] = []
 
     def add_object(m: str) -> None:
-        if m in nodes:
+        if m in nodes or m in done:
             return
         nodes.append(m)
         target = goal.get(m, region.get(m))
@@ -285,10 +291,12 @@ def reference_task_graph(robots: Sequence[str], grasps: Mapping[str, Sequence[st
                             if (m, g1, g2, r1, r2) in hand and (m, target, g2, r2) in place:
                                 found.append(Action(m, target, r1, r2, g1, g2))
                 for a in found:
-                    actions.append(a)
                     p = tuple(mj for mj in movable if (mj, m, a.pick_grasp, a.pick_robot) in occ_pick)
                     q = tuple(mj for mj in movable if m in goal
                               and (mj, m, target, a.place_grasp, a.place_robot) in occ_place)
+                    if done & set(p + q):
+                        continue
+                    actions.append(a)
                     bp.append(p)
                     bl.append(q)
                     for mj in p + q:

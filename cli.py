@@ -182,6 +182,33 @@ def cmd_facts(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def cmd_plan(args: argparse.Namespace) -> int:
+    from mrgc.planner.plan import file_sha256
+    from mrgc.planner.search import plan_problem
+
+    problem = _load_problem(args.file, args.problem)
+    plan = plan_problem(problem, args.file, file_sha256(args.file), __version__, backend=args.backend,
+                        encoding=args.encoding, seed=args.seed, time_limit=args.time_limit, c=args.c,
+                        alpha=args.alpha, skeletons=args.skeletons, max_makespan=args.max_makespan)
+    text = plan.dumps()
+    if args.output:
+        tmp = args.output + ".mrgc-tmp"
+        with open(tmp, "w", encoding="utf-8") as fh:
+            fh.write(text)
+        os.replace(tmp, args.output)
+    else:
+        sys.stdout.write(text)
+    out = sys.stderr if not args.output else sys.stdout
+    for line in plan.summary():
+        print(line, file=out)
+    st = plan.stats
+    print(f"  {st.get('seconds', 0):.2f} s: facts {st.get('facts_seconds', 0):.2f} s, skeletons "
+          f"{st.get('skeleton_seconds', 0):.2f} s, grounding {st.get('grounding_seconds', 0):.2f} s; "
+          f"{st.get('skeletons', 0)} skeletons, {st.get('groundings', 0)} grounded, {st.get('nodes', 0)} nodes",
+          file=out)
+    return {"solved": EXIT_OK, "no plan": EXIT_NO_PLAN, "time limit": EXIT_TIME_LIMIT}[plan.status]
+
+
 def cmd_backends(args: argparse.Namespace) -> int:
     import json
 
@@ -240,6 +267,20 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--emit", metavar="PATH", help="also write the model: .lp/.mps (mip), .smt2 (smt), .pbtxt (cpsat)")
     p.add_argument("--format", choices=["text", "json"], default="text")
     p.set_defaults(func=cmd_compile)
+
+    p = sub.add_parser("plan", help="plan end to end: facts, skeletons, MCTS with reverse-search grounding")
+    p.add_argument("file", metavar="FILE")
+    p.add_argument("--problem", help="which problem of the file (default: its only one)")
+    p.add_argument("-o", "--output", metavar="PLAN", help="write the plan JSON here (default: standard output)")
+    p.add_argument("--backend", default="cpsat")
+    p.add_argument("--encoding", default="time-of-move")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--time-limit", type=float, default=60.0, metavar="S")
+    p.add_argument("--skeletons", type=int, default=5, metavar="K", help="skeletons per generator call (default 5)")
+    p.add_argument("--max-makespan", type=int, default=None, metavar="T")
+    p.add_argument("-c", type=float, default=1.0, help="PUCT exploration constant (default 1)")
+    p.add_argument("--alpha", type=float, default=1.0, help="reward weight of fewer moved objects (default 1)")
+    p.set_defaults(func=cmd_plan)
 
     p = sub.add_parser("backends", help="list solver backends: installed?, versions, encodings, features")
     p.add_argument("--format", choices=["text", "json"], default="text")

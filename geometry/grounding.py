@@ -29,7 +29,7 @@ from mrgc.geometry.collision import CollisionShape, CollisionWorld, collision_sh
 from mrgc.geometry.grasps import grasp_transform, known, pregrasp_transform
 from mrgc.geometry.ik import solve_ik_many
 from mrgc.geometry.motion import plan_joint_path, plan_se2_path
-from mrgc.geometry.planar import PlanarRobot, is_planar, scene_bounds
+from mrgc.geometry.planar import DiscGrid, PlanarRobot, is_planar, scene_bounds
 from mrgc.geometry.predicates import APPROACH_SAMPLES, LIFT, scene_world, seed_for
 from mrgc.geometry.scene import SceneSpec, half_extents, inside
 from mrgc.geometry.transforms import rot_z, translation
@@ -72,6 +72,7 @@ class Grounder:
         self.poses = {b.name: b.pose.copy() for b in scene.movable}
         self._arms: dict[str, Arm] = {}
         self._planar: dict[str, PlanarRobot] = {}
+        self._grids: dict[str, DiscGrid] = {}
         self.queries = 0
 
     # ------------------------------------------------------------ state
@@ -247,10 +248,16 @@ class Grounder:
         return Answer(Status.OK if res.solved else Status.NO_PATH, path=list(res.path))
 
     def base_path(self, robot: str, start: np.ndarray, goal: np.ndarray, holding: tuple[str, str] | None = None,
-                  avoid: Iterable[str] = (), time_limit: float = 0.5) -> Answer:
-        """An SE(2) path for a planar robot, free of fixed objects and ``avoid``."""
+                  avoid: Iterable[str] = (), time_limit: float = 0.25) -> Answer:
+        """An SE(2) path for a planar robot, free of fixed objects and ``avoid`` (objects at their initial
+        poses); hopeless queries are refused at once by an inscribed-disc grid test."""
         against = ("fixed", *[a for a in avoid if not holding or a != holding[0]])
         ignore = (holding[0],) if holding else ()
+        if robot not in self._grids:
+            self._grids[robot] = DiscGrid(self.planar(robot), self.scene, scene_bounds(self.scene, 0.5))
+        obstacles = frozenset([b.name for b in self.scene.fixed] + [a for a in against if a != "fixed"])
+        if not self._grids[robot].connected(np.asarray(start), np.asarray(goal), obstacles):
+            return Answer(Status.NO_PATH)  # not even the footprint's inscribed disc gets through
 
         def valid(q: np.ndarray) -> bool:
             self.queries += 1

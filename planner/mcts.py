@@ -1,0 +1,159 @@
+"""Monte-Carlo tree search over task skeletons, exactly as the paper's "Searching for task-and-motion plans".
+
+Nodes hold grounded suffixes S (D.S); edges hold task skeletons.  Selection follows the PUCT value
+``value/(visits+1) + c·prior·sqrt(node visits)/(visits+1)`` with ``prior = 1/|objects moved by the
+skeleton|``; expansion creates the edge's head node; evaluation grounds the skeleton given the node's suffix:
+failure → reward 0; a full plan S* → ``1 + α/|S*|``; a grounded suffix S' with objects M* → new skeletons for
+M* (the suffix's objects excluded) and reward ``|S'|/(|S'|+|S̄*|) + α/(objects(S') + objects(S̄*))`` in steps
+and objects, S̄* the new skeleton with the fewest steps (0 and a terminal node when there is none);
+backpropagation adds the reward to the selected edges and counts visits.  Grounding failures are memoised
+(suffix, skeleton actions) so known-infeasible branches are skipped.  Beyond the paper: a node whose
+skeletons are all used up asks its skeleton source for more instead of becoming terminal.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Callable
+
+from mrgc.compiler.skeleton import Skeleton
+from mrgc.planner.ground import GroundedStep, Grounding, Outcome, moved_objects
+
+# makes a skeleton source for (M*, moved objects): returns a callable giving the next k skeletons
+SourceFactory = Callable[[set[str], set[str]], Callable[[int], list[Skeleton]]]
+
+
+@dataclass
+class Edge:
+    skeleton: Skeleton
+    value: float = 0.0
+    visits: int = 0
+    child: "Node | None" = None
+    dead: bool = False
+
+    @property
+    def prior(self) -> float:
+        return 1.0 / max(1, len(self.skeleton.moved))
+
+
+@dataclass
+class Node:
+    suffix: list[GroundedStep]
+    more: Callable[[int], list[Skeleton]]
+    edges: list[Edge] = field(default_factory=list)
+    visits: int = 0
+    exhausted: bool = False  # the source has no more skeletons
+
+    def refill(self, k: int) -> None:
+        if self.exhausted:
+            return
+        new = self.more(k)
+        if not new:
+            self.exhausted = True
+        self.edges.extend(Edge(s) for s in new)
+
+    @property
+    def open_edges(self) -> list[Edge]:
+        return [e for e in self.edges if not e.dead]
+
+
+@dataclass
+class SearchResult:
+    steps: list[GroundedStep] | None
+    iterations: int
+    stats: dict[str, float]
+
+
+class MCTS:
+    """The search; ``ground(skeleton, suffix)`` evaluates, ``sources(M*, moved)`` makes skeleton sources."""
+
+    def __init__(self, ground: Callable[[Skeleton, list[GroundedStep]], Grounding], sources: SourceFactory,
+                 must_move: set[str], c: float = 1.0, alpha: float = 1.0, k: int = 5) -> None:
+        self.ground = ground
+        self.sources = sources
+        self.c, self.alpha, self.k = c, alpha, k
+        t0 = time.perf_counter()
+        self.root = Node([], sources(must_move, set()))
+        self.root.refill(k)
+        first_skeletons = time.perf_counter() - t0
+        self.memo: set[tuple[frozenset[tuple[str, ...]], frozenset[object]]] = set()
+        self.stats: dict[str, float] = {"groundings": 0, "grounding_seconds": 0.0, "skeleton_seconds": first_skeletons,
+                                        "skeletons": len(self.root.edges), "nodes": 1, "memo_hits": 0}
+
+    def q(self, node: Node, e: Edge) -> float:
+        return e.value / (e.visits + 1) + self.c * e.prior * math.sqrt(node.visits) / (e.visits + 1)
+
+    def run(self, deadline: float, max_iterations: int = 10_000) -> SearchResult:
+        for it in range(1, max_iterations + 1):
+            if time.perf_counter() >= deadline:
+                return SearchResult(None, it - 1, self.stats)
+            path: list[tuple[Node, Edge]] = []
+            node = self.root
+            reward = 0.0
+            while True:
+                if not node.open_edges:  # beyond the paper: ask for more skeletons before giving up
+                    t0 = time.perf_counter()
+                    before = len(node.edges)
+                    node.refill(self.k)
+                    self.stats["skeleton_seconds"] += time.perf_counter() - t0
+                    self.stats["skeletons"] += len(node.edges) - before
+                edges = node.open_edges
+                if not edges:
+                    if path:
+                        path[-1][1].dead = True  # nothing left below this edge
+                    break
+                edge = max(edges, key=lambda e: self.q(node, e))
+                path.append((node, edge))
+                if edge.child is None:
+                    done, reward = self._expand(node, edge)
+                    if done is not None:
+                        self._backprop(path, reward)
+                        return SearchResult(done, it, self.stats)
+                    break
+                node = edge.child
+            if not path:
+                return SearchResult(None, it, self.stats)  # the root ran out of skeletons: no plan
+            self._backprop(path, reward)
+        return SearchResult(None, max_iterations, self.stats)
+
+    def _expand(self, node: Node, edge: Edge) -> tuple[list[GroundedStep] | None, float]:
+        memo_key = (frozenset((a.object, a.region, a.pick_robot, a.place_robot) for s in node.suffix
+                              for a in s.actions), edge.skeleton.actions)
+        if memo_key in self.memo:
+            self.stats["memo_hits"] += 1
+            edge.dead = True
+            return None, 0.0
+        t0 = time.perf_counter()
+        result = self.ground(edge.skeleton, node.suffix)
+        self.stats["groundings"] += 1
+        self.stats["grounding_seconds"] += time.perf_counter() - t0
+        if result.outcome is Outcome.FAIL:
+            self.memo.add(memo_key)
+            edge.dead = True
+            return None, 0.0
+        if result.outcome is Outcome.SUCCESS:
+            plan = result.steps
+            return plan, 1.0 + self.alpha / max(1, len(moved_objects(plan)))
+        moved = moved_objects(result.steps)
+        t0 = time.perf_counter()
+        child = Node(result.steps, self.sources(result.must_move, moved))
+        child.refill(self.k)
+        self.stats["skeleton_seconds"] += time.perf_counter() - t0
+        self.stats["skeletons"] += len(child.edges)
+        self.stats["nodes"] += 1
+        edge.child = child
+        if not child.edges:
+            edge.dead = True
+            return None, 0.0
+        best = min(child.edges, key=lambda e: e.skeleton.key)
+        s_len, b_len = len(result.steps), best.skeleton.makespan
+        reward = s_len / (s_len + b_len) + self.alpha / (len(moved) + len(best.skeleton.moved))
+        return None, reward
+
+    def _backprop(self, path: list[tuple[Node, Edge]], reward: float) -> None:
+        for node, edge in path:
+            edge.value += reward
+            edge.visits += 1
+            node.visits += 1

@@ -1,0 +1,137 @@
+"""The planner end to end (mrgc plan) and the MCTS mechanics with a scripted grounder."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from mrgc import __version__, cli, parse_file
+from mrgc.compiler.skeleton import Skeleton
+from mrgc.compiler.task_graph import Action
+from mrgc.planner.ground import GroundedStep, Grounding, Outcome
+from mrgc.planner.mcts import MCTS
+from mrgc.planner.plan import PlannedAction, file_sha256
+from mrgc.planner.search import plan_problem
+
+ROOT = Path(__file__).resolve().parent.parent
+GEOMETRIC = sorted((ROOT / "domains" / "packaging").glob("pa*.mrg")) + sorted((ROOT / "domains" / "box-moving").glob("bo*.mrg"))
+
+
+def plan_of(path: Path, seed: int = 0, time_limit: float = 120.0):  # type: ignore[no-untyped-def]
+    return plan_problem(parse_file(path).problem(), str(path), file_sha256(str(path)), __version__, seed=seed,
+                        time_limit=time_limit)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("path", GEOMETRIC, ids=lambda p: p.name)
+def test_every_shipped_geometric_problem_gets_a_plan(path: Path) -> None:
+    plan = plan_of(path)
+    assert plan.status == "solved", plan.stats
+    problem = parse_file(path).problem()
+    moved = [a.object for step in plan.steps for a in step]
+    assert len(moved) == len(set(moved))  # each object at most once
+    last_region = {a.object: a.region for step in plan.steps for a in step}
+    for obj, region in problem.goal_regions.items():
+        assert last_region.get(obj, region) == region
+    for step in plan.steps:
+        robots = [r for a in step for r in a.robots()]
+        assert len(robots) == len(set(robots))  # one action per robot per step
+        for a in step:
+            assert a.place_pose is not None and "pick" in a.configs and "place" in a.configs
+            if a.kind == "handover":
+                assert a.handover_point and len(a.configs["handover"]) == 2
+
+
+def test_a_handover_plan_for_pa3(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    src = ROOT / "domains" / "packaging" / "pa3-handover.mrg"
+    out = tmp_path / "plan.json"
+    assert cli.main(["plan", str(src), "-o", str(out), "--seed", "1"]) == 0
+    assert "solved, makespan 1" in capsys.readouterr().out
+    data = json.loads(out.read_text(encoding="utf-8"))
+    assert data["schema"] == "mrgc-plan/1" and data["status"] == "solved" and data["makespan"] == 1
+    action = data["steps"][0]["actions"][0]
+    assert action["kind"] == "handover" and action["object"] == "o1" and action["region"] == "bin-b"
+    assert len(action["configs"]["pick"]) == 5 and len(action["configs"]["handover"]) == 2
+    assert len(action["place_pose"]) == 4 and data["problem_sha256"] == file_sha256(str(src))
+
+
+def test_same_seed_same_plan() -> None:
+    src = ROOT / "domains" / "packaging" / "pa10.mrg"
+    a, b = plan_of(src), plan_of(src)
+    strip = lambda p: {k: v for k, v in p.to_json().items() if k != "stats"}  # noqa: E731
+    assert strip(a) == strip(b)
+
+
+def test_symbolic_plans_are_the_best_skeleton(capsys: pytest.CaptureFixture[str]) -> None:
+    assert cli.main(["plan", str(ROOT / "domains" / "symbolic" / "medium.mrg")]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["symbolic"] and data["makespan"] == 3 and data["motion_cost"] == 7
+    assert cli.main(["plan", str(ROOT / "domains" / "symbolic" / "infeasible.mrg")]) == 1
+    assert json.loads(capsys.readouterr().out)["status"] == "no plan"
+
+
+# ------------------------------------------------------------------ MCTS mechanics, scripted grounding
+A1 = Action("o1", "goal", "r1", "r1", "top", "top")
+A2 = Action("o2", "start", "r1", "r1", "top", "top")
+SKEL_DIRECT = Skeleton(((A1,),))
+SKEL_CLEAR = Skeleton(((A2,), (A1,)))
+
+
+def step_of(action: Action) -> GroundedStep:
+    return GroundedStep([PlannedAction(action.obj, action.region, "r1", "r1", "top", "top")], [], (action.obj,))
+
+
+def test_mcts_follows_a_partial_grounding_to_a_plan() -> None:
+    calls: list[tuple[Skeleton, int]] = []
+
+    def ground(skel: Skeleton, suffix: list[GroundedStep]) -> Grounding:
+        calls.append((skel, len(suffix)))
+        if skel == SKEL_DIRECT and not suffix:  # o1 can be placed, but o2 is in the way of its pick
+            return Grounding(Outcome.PARTIAL, [step_of(A1)], {"o2"})
+        if skel == Skeleton(((A2,),)) and suffix:
+            return Grounding(Outcome.SUCCESS, [step_of(A2)] + suffix)
+        return Grounding(Outcome.FAIL)
+
+    def sources(need: set[str], moved: set[str]):  # type: ignore[no-untyped-def]
+        queue = [SKEL_DIRECT] if need == {"o1"} else [Skeleton(((A2,),))]
+        assert "o1" not in need or not moved
+
+        def more(k: int) -> list[Skeleton]:
+            out, queue[:] = queue[:k], queue[k:]
+            return out
+
+        return more
+
+    search = MCTS(ground, sources, {"o1"})
+    result = search.run(deadline=float("inf"))
+    assert result.steps is not None and [s.moved for s in result.steps] == [("o2",), ("o1",)]
+    assert calls == [(SKEL_DIRECT, 0), (Skeleton(((A2,),)), 1)]
+    assert search.stats["nodes"] == 2
+
+
+def test_mcts_memoises_failures_and_reports_no_plan() -> None:
+    def ground(skel: Skeleton, suffix: list[GroundedStep]) -> Grounding:
+        return Grounding(Outcome.FAIL)
+
+    def sources(need: set[str], moved: set[str]):  # type: ignore[no-untyped-def]
+        left = [SKEL_DIRECT, SKEL_CLEAR]
+
+        def more(k: int) -> list[Skeleton]:
+            out, left[:] = left[:k], left[k:]
+            return out
+
+        return more
+
+    search = MCTS(ground, sources, {"o1"}, k=1)
+    result = search.run(deadline=float("inf"))
+    assert result.steps is None and search.stats["groundings"] == 2  # each skeleton grounded once
+
+
+def test_puct_prefers_fewer_objects_at_first() -> None:
+    search = MCTS(lambda s, x: Grounding(Outcome.FAIL), lambda n, m: (lambda k: [SKEL_CLEAR, SKEL_DIRECT][:k]),
+                  {"o1"}, k=2)
+    search.root.visits = 1
+    q = {len(e.skeleton.moved): search.q(search.root, e) for e in search.root.edges}
+    assert q[1] == pytest.approx(1.0) and q[2] == pytest.approx(0.5)

@@ -132,7 +132,7 @@ class Grounder:
 
     # ------------------------------------------------------------ placements
     def placement(self, obj: str, region: str, avoid: Iterable[str] = (), volume: Volume | None = None,
-                  samples: int = 60, key: str = "") -> Answer:
+                  samples: int = 200, key: str = "") -> Answer:
         """A pose of ``obj`` entirely inside ``region`` that hits no fixed object, none of ``avoid`` (at their
         current poses) and nothing of ``volume``: random positions over the region floor and the four yaws."""
         body, reg = self.scene.body(obj), self.scene.body(region)
@@ -147,9 +147,17 @@ class Grounder:
                 vol_world.add(f"v{i}", shape, t, "volume")
         avoid = tuple(a for a in avoid if a != obj)
         shape = self.shape(obj)
-        for k in range(samples):
-            yaw = (np.pi / 2) * (k % 4)
-            x, y = rng.uniform(-1, 1, 2) * np.maximum(h_r[:2] - min(h_o[0], h_o[1]), 0)
+        # first the 3 × 3 lattice phase 1 uses (so a placement the facts relied on is tried first), then
+        # random positions and the four yaws
+        room = np.maximum(h_r[:2] - h_o[:2], 0) * 0.9
+        lattice = sorted(((a, b) for a in (-1.0, 0.0, 1.0) for b in (-1.0, 0.0, 1.0)),
+                         key=lambda ab: (ab[0] ** 2 + ab[1] ** 2, ab))
+        for k in range(len(lattice) + samples):
+            if k < len(lattice):
+                yaw, (x, y) = 0.0, (lattice[k][0] * room[0], lattice[k][1] * room[1])
+            else:
+                yaw = (np.pi / 2) * (k % 4)
+                x, y = rng.uniform(-1, 1, 2) * np.maximum(h_r[:2] - min(h_o[0], h_o[1]), 0)
             pose = reg.pose @ translation(x, y, -h_r[2] + h_o[2] + LIFT) @ rot_z(yaw)
             if not inside(reg, body.shape, pose):
                 continue
@@ -166,7 +174,7 @@ class Grounder:
 
     # ------------------------------------------------------------ arm configurations
     def _approach(self, robot: str, obj: str, grasp: str, pose: np.ndarray, key: str,
-                  avoid: Iterable[str], attempts: int = 3, approach: bool = True) -> Answer:
+                  avoid: Iterable[str], attempts: int = 8, approach: bool = True) -> Answer:
         if not known(grasp):
             return Answer(Status.NO_IK)
         arm = self.arm(robot)

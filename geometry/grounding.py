@@ -132,9 +132,10 @@ class Grounder:
 
     # ------------------------------------------------------------ placements
     def placement(self, obj: str, region: str, avoid: Iterable[str] = (), volume: Volume | None = None,
-                  samples: int = 200, key: str = "") -> Answer:
+                  samples: int = 200, key: str = "", skip: int = 0) -> Answer:
         """A pose of ``obj`` entirely inside ``region`` that hits no fixed object, none of ``avoid`` (at their
-        current poses) and nothing of ``volume``: random positions over the region floor and the four yaws."""
+        current poses) and nothing of ``volume``: phase 1's lattice first, then random positions and the four
+        yaws; ``skip`` passes over that many valid candidates (to get another one on a retry)."""
         body, reg = self.scene.body(obj), self.scene.body(region)
         if not isinstance(reg.shape, Box):
             return Answer(Status.NO_PLACEMENT)
@@ -168,6 +169,9 @@ class Grounder:
             if avoid and self.world.probe_collides(probe, against=avoid):
                 continue
             if vol_world is not None and vol_world.probe_collides(probe, against="volume"):
+                continue
+            if skip > 0:  # the caller wants a different placement than the ones it already tried
+                skip -= 1
                 continue
             return Answer(Status.OK, pose=pose)
         return Answer(Status.NO_PLACEMENT)

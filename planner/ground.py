@@ -139,7 +139,7 @@ class ReverseGrounder:
             vols[a.pick_robot] += g.arm_volume(a.pick_robot, answer.configs[:1], holding=(a.obj, a.pick_grasp))
             vols[a.place_robot] = g.arm_volume(a.place_robot, answer.configs[1:], holding=(a.obj, a.place_grasp))
         for k in range(PLACEMENT_TRIES):
-            spot = g.placement(a.obj, a.region, avoid=avoid, volume=v_fut, key=f"{key}:{k}")
+            spot = g.placement(a.obj, a.region, avoid=avoid, volume=v_fut, key=key, skip=k)
             if not spot.ok:
                 return None
             assert spot.pose is not None
@@ -168,7 +168,7 @@ class ReverseGrounder:
         if not to_pick.ok:
             return None
         for k in range(PLACEMENT_TRIES):
-            spot = g.placement(a.obj, a.region, avoid=avoid, volume=v_fut, key=f"{key}:{k}")
+            spot = g.placement(a.obj, a.region, avoid=avoid, volume=v_fut, key=key, skip=k)
             if not spot.ok:
                 return None
             assert spot.pose is not None

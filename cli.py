@@ -1,14 +1,15 @@
 """The ``mrgc`` command: a thin layer over the Python API.
 
-Exit codes (docs/errors.md): 0 ok; 1 no plan / infeasible / ``fmt --check`` found unformatted files;
-2 input error (bad file or bad command line); 3 time limit; 4 missing backend; 70 internal error;
-130 interrupted.  No input produces a Python traceback: unexpected exceptions are reported in one line
-with exit code 70.
+Exit codes (docs/errors.md): 0 ok; 1 no plan / infeasible / ``fmt --check`` found unformatted files /
+``validate`` found the plan invalid; 2 input error (bad file, bad plan file or bad command line); 3 time
+limit; 4 missing backend; 70 internal error; 130 interrupted.  No input produces a Python traceback:
+unexpected exceptions are reported in one line with exit code 70.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import sys
 from typing import TYPE_CHECKING, Callable, Sequence
@@ -182,14 +183,24 @@ def cmd_facts(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _progress(message: str) -> "contextlib.AbstractContextManager[object]":
+    """A rich spinner on a terminal (stderr), nothing otherwise (logs and pipes stay clean)."""
+    if not sys.stderr.isatty():
+        return contextlib.nullcontext()
+    from rich.console import Console
+
+    return Console(stderr=True).status(message)
+
+
 def cmd_plan(args: argparse.Namespace) -> int:
     from mrgc.planner.plan import file_sha256
     from mrgc.planner.search import plan_problem
 
     problem = _load_problem(args.file, args.problem)
-    plan = plan_problem(problem, args.file, file_sha256(args.file), __version__, backend=args.backend,
-                        encoding=args.encoding, seed=args.seed, time_limit=args.time_limit, c=args.c,
-                        alpha=args.alpha, skeletons=args.skeletons, max_makespan=args.max_makespan)
+    with _progress(f"planning {problem.name} (phase 1, then the tree search; at most {args.time_limit:g} s)"):
+        plan = plan_problem(problem, args.file, file_sha256(args.file), __version__, backend=args.backend,
+                            encoding=args.encoding, seed=args.seed, time_limit=args.time_limit, c=args.c,
+                            alpha=args.alpha, skeletons=args.skeletons, max_makespan=args.max_makespan)
     text = plan.dumps()
     if args.output:
         tmp = args.output + ".mrgc-tmp"
@@ -207,6 +218,26 @@ def cmd_plan(args: argparse.Namespace) -> int:
           f"{st.get('skeletons', 0)} skeletons, {st.get('groundings', 0)} grounded, {st.get('nodes', 0)} nodes",
           file=out)
     return {"solved": EXIT_OK, "no plan": EXIT_NO_PLAN, "time limit": EXIT_TIME_LIMIT}[plan.status]
+
+
+def cmd_validate(args: argparse.Namespace) -> int:
+    import json
+
+    from mrgc.language.loader import parse_file
+    from mrgc.planner.validate import load_plan, validate
+
+    mf = parse_file(args.file)
+    plan = load_plan(args.plan)
+    name = args.problem
+    if name is None and len(mf.problems) > 1 and any(p.name == plan["problem"] for p in mf.problems):
+        name = plan["problem"]  # a file of several problems: the one the plan names
+    report = validate(mf.problem(name), plan, args.file)
+    if args.format == "json":
+        print(json.dumps(report.to_json(), indent=2))
+    else:
+        for line in report.lines():
+            print(line)
+    return EXIT_OK if report.ok else EXIT_NO_PLAN
 
 
 def cmd_backends(args: argparse.Namespace) -> int:
@@ -281,6 +312,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-c", type=float, default=1.0, help="PUCT exploration constant (default 1)")
     p.add_argument("--alpha", type=float, default=1.0, help="reward weight of fewer moved objects (default 1)")
     p.set_defaults(func=cmd_plan)
+
+    p = sub.add_parser("validate", help="independently re-check a plan: replay it in pybullet, check every step")
+    p.add_argument("file", metavar="FILE", help="the problem file the plan was made for")
+    p.add_argument("plan", metavar="PLAN", help="the plan JSON (mrgc plan -o PLAN)")
+    p.add_argument("--problem", help="which problem of the file (default: the one the plan names, else its only one)")
+    p.add_argument("--format", choices=["text", "json"], default="text")
+    p.set_defaults(func=cmd_validate)
 
     p = sub.add_parser("backends", help="list solver backends: installed?, versions, encodings, features")
     p.add_argument("--format", choices=["text", "json"], default="text")

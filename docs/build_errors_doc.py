@@ -37,8 +37,8 @@ file, that mrgc prints exactly the `.out` text for it, and that this page is cur
 | code | meaning |
 | --- | --- |
 | 0 | success (`check`: every file is fine; `fmt --check`: every file is canonical) |
-| 1 | no plan / infeasible / no skeleton within the limits; `fmt --check`: some file would be reformatted |
-| 2 | input error: a bad `.mrg` file (any `E0xx`–`E2xx` code below) or a bad command line (`E000`) |
+| 1 | no plan / infeasible / no skeleton within the limits; `fmt --check`: some file would be reformatted; `validate`: the plan is invalid |
+| 2 | input error: a bad `.mrg` file (any `E0xx`–`E2xx` code below), a bad plan file (`E5xx`) or a bad command line (`E000`) |
 | 3 | time limit reached before an answer |
 | 4 | a needed backend (solver or geometry library) is not installed |
 | 70 | internal error (`E070`): a bug in mrgc |
@@ -69,6 +69,16 @@ SPECIAL = {
              "panda_grasptarget)"),
     "E402": ("mrgc facts domains/symbolic/chain-3.mrg",
              "domains/symbolic/chain-3.mrg:25:3: error[E402]: problem 'chain-3' is symbolic: it has no geometry"),
+    "E500": ("mrgc validate domains/packaging/pa5.mrg no-such.json",
+             "error[E500]: cannot read plan 'no-such.json': No such file or directory"),
+    "E501": ("mrgc validate domains/packaging/pa5.mrg truncated.json",
+             "truncated.json:76:21: error[E501]: plan is not JSON: it ends early (truncated?): Expecting ',' "
+             "delimiter\n 76 |         -2.675816509\n    |                     ^"),
+    "E502": ("mrgc validate domains/packaging/pa5.mrg plan.json",
+             "error[E502]: plan.json does not follow the plan schema mrgc-plan/1: plan.steps[0].actions[0] lacks "
+             "'pick_grasp'"),
+    "E503": ("mrgc validate domains/packaging/pa5.mrg old.json",
+             "error[E503]: old.json: schema 'mrgc-plan/0' is not supported (this mrgc reads 'mrgc-plan/1')"),
     "E001": ("mrgc check no-such.mrg", "error[E001]: cannot read 'no-such.mrg': No such file or directory"),
     "E002": ("mrgc check huge.mrg   # a file over 8 MiB",
              "huge.mrg:1:1: error[E002]: 'huge.mrg' is 9437184 bytes; the limit is 8388608 bytes"),

@@ -8,9 +8,9 @@ kinematics (:mod:`mrgc.geometry.ik`) are numpy on this data.
 
 The URDF's joints and collisions are read with the standard library's XML parser (pybullet reports joint
 frames relative to centres of mass, with their rotations inverted); pybullet loads every URDF too, as a
-validity check and as the reference.  This is the only module that imports pybullet, lazily, in one
-DIRECT client per process; pybullet's own forward and inverse kinematics (:func:`pybullet_fk`,
-:func:`pybullet_ik`) are here for tests and benchmarks.
+validity check and as the reference.  pybullet itself lives in :mod:`mrgc.geometry.bullet` (the only module
+that imports it); its forward and inverse kinematics and distance references (:func:`pybullet_fk`,
+:func:`pybullet_ik`, :func:`pybullet_box_distance`) are re-exported here for tests and benchmarks.
 
 Frames: a link's frame is its URDF link frame (pybullet's ``worldLinkFrame``, not its centre of mass); a
 movable joint's frame is its child link's frame.  Off-chain movable joints (the Panda's fingers) are frozen
@@ -20,21 +20,23 @@ clamped into its limits.
 
 from __future__ import annotations
 
-import contextlib
 import functools
 import math
 import os
 import struct
-import sys
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
-from typing import Any, Iterator, Sequence
+from typing import Iterator
 
 import numpy as np
 
 from mrgc.errors import Diagnostic, InputError, Span
 from mrgc.geometry import transforms as tf
+from mrgc.geometry.bullet import check_urdf, data_path, pybullet_box_distance, pybullet_fk, pybullet_ik
 from mrgc.language.model import RobotKind
+
+__all__ = ["E_LINK", "E_URDF", "Collision", "Joint", "Link", "RobotModel", "load_robot_model", "model_for_kind",
+           "pybullet_box_distance", "pybullet_fk", "pybullet_ik", "read_mesh", "resolve_urdf"]
 
 #: code of "robot URDF not found or unreadable" and of "end-effector link not in the URDF"
 E_URDF = "E400"
@@ -159,86 +161,12 @@ class RobotModel:
         return f"RobotModel({self.name!r}, ee={self.end_effector!r}, dof={self.dof}, links={len(self.links)})"
 
 
-# ------------------------------------------------------------------------------------ pybullet client
-
-_CLIENT: dict[str, Any] = {}
-
-
-@contextlib.contextmanager
-def _quiet_stdout() -> Iterator[None]:
-    """Silence C-level writes to fds 1 and 2 (pybullet's build-time banner, which goes to stdout or stderr
-    depending on the build, and its loader warnings) so JSON on stdout and diagnostics stay clean."""
-    for stream in (sys.stdout, sys.stderr):
-        try:
-            stream.flush()
-        except (AttributeError, ValueError):
-            pass
-    saved: list[tuple[int, int]] = []
-    try:
-        devnull = os.open(os.devnull, os.O_WRONLY)
-    except OSError:  # pragma: no cover
-        yield
-        return
-    try:
-        for fd in (1, 2):
-            try:
-                saved.append((fd, os.dup(fd)))
-            except OSError:  # that fd is closed: nothing to protect
-                continue
-            os.dup2(devnull, fd)
-        yield
-    finally:
-        _c_fflush()
-        for fd, copy in saved:
-            os.dup2(copy, fd)
-            os.close(copy)
-        os.close(devnull)
-
-
-def _c_fflush() -> None:
-    """Flush C stdio buffers: printf output buffered while fd 1 was redirected must go to /dev/null."""
-    try:
-        import ctypes
-
-        ctypes.CDLL(None).fflush(None)
-    except (OSError, AttributeError):  # pragma: no cover - non-POSIX
-        pass
-
-
-def _pb() -> tuple[Any, int]:
-    """The pybullet module and this process's DIRECT client (created on first use, again after fork)."""
-    if _CLIENT.get("pid") != os.getpid():
-        with _quiet_stdout():
-            import pybullet
-
-            cid = pybullet.connect(pybullet.DIRECT)
-        _CLIENT.clear()
-        _CLIENT.update(pid=os.getpid(), pb=pybullet, cid=cid, bodies={})
-    return _CLIENT["pb"], _CLIENT["cid"]
-
-
-def _data_path() -> str:
-    with _quiet_stdout():
-        import pybullet_data
-    return str(pybullet_data.getDataPath())
-
-
-def _body(urdf: str) -> int:
-    """The body id of the resolved URDF in the client, loaded once (fixed base, identity base pose)."""
-    pb, cid = _pb()
-    bodies: dict[str, int] = _CLIENT["bodies"]
-    if urdf not in bodies:
-        with _quiet_stdout():
-            bodies[urdf] = pb.loadURDF(urdf, useFixedBase=True, physicsClientId=cid)
-    return bodies[urdf]
-
-
 # ----------------------------------------------------------------------------------------- loading
 
 def resolve_urdf(urdf: str, base_dir: str, span: Span | None = None) -> str:
     """The absolute path of ``urdf``: relative to ``base_dir`` (the .mrg file's folder) if it exists
     there, else relative to pybullet_data; :class:`~mrgc.errors.InputError` E400 when neither exists."""
-    candidates = [urdf] if os.path.isabs(urdf) else [os.path.join(base_dir, urdf), os.path.join(_data_path(), urdf)]
+    candidates = [urdf] if os.path.isabs(urdf) else [os.path.join(base_dir, urdf), os.path.join(data_path(), urdf)]
     for c in candidates:
         if os.path.isfile(c):
             return os.path.realpath(c)
@@ -257,11 +185,9 @@ def load_robot_model(urdf: str, base_dir: str, end_effector: str, *, span: Span 
         names = _parse_urdf(path).order
     except (ET.ParseError, ValueError, KeyError) as exc:
         raise InputError([Diagnostic(E_URDF, f"robot URDF {path!r} is malformed: {exc}", span)]) from None
-    pb, _ = _pb()
-    try:
-        _body(path)  # pybullet must accept the file too: it is the reference and loads it for checks
-    except pb.error as exc:
-        raise InputError([Diagnostic(E_URDF, f"pybullet cannot load robot URDF {path!r}: {exc}", span)]) from None
+    refused = check_urdf(path)  # pybullet must accept the file too: it is the reference and replays plans
+    if refused is not None:
+        raise InputError([Diagnostic(E_URDF, f"pybullet cannot load robot URDF {path!r}: {refused}", span)])
     if end_effector not in names:
         raise InputError([Diagnostic(
             E_LINK, f"end-effector link {end_effector!r} is not a link of {path!r} (links: {', '.join(names)})",
@@ -540,126 +466,3 @@ def _read_stl(path: str) -> tuple[np.ndarray, np.ndarray]:
     tri = np.array([[float(x) for x in line.split()[1:4]] for line in data.decode(errors="replace").splitlines()
                     if line.strip().startswith("vertex")]).reshape(-1, 3)
     return tri, np.arange(len(tri) - len(tri) % 3).reshape(-1, 3)
-
-
-# ------------------------------------------------------------------------------ pybullet references
-
-def _pose(pos: Sequence[float], orn: Sequence[float]) -> np.ndarray:
-    quat = np.asarray(orn, dtype=float)
-    return tf.from_quaternion(pos, quat / np.linalg.norm(quat))  # pybullet's are single precision
-
-
-def _pb_links(model: RobotModel) -> tuple[int, dict[str, int], list[tuple[int, Link]]]:
-    """The model's body, link name → pybullet link index (base -1), and its movable joints in pybullet
-    order with our link (pybullet's IK takes and returns one value per movable joint, in that order)."""
-    pb, cid = _pb()
-    body = _body(model.urdf)
-    key = ("links", model.key)
-    if key not in _CLIENT:
-        by_name = {pb.getBodyInfo(body, physicsClientId=cid)[0].decode(): -1}
-        movable = []
-        for j in range(pb.getNumJoints(body, physicsClientId=cid)):
-            info = pb.getJointInfo(body, j, physicsClientId=cid)
-            by_name[info[12].decode()] = j
-            if info[2] != pb.JOINT_FIXED:
-                movable.append((j, model.links[model.link_index(info[12].decode())]))
-        _CLIENT[key] = (by_name, movable)
-    by_name, movable = _CLIENT[key]
-    return body, by_name, movable
-
-
-def _set_state(model: RobotModel, q: np.ndarray, base: np.ndarray | None) -> tuple[Any, int, int]:
-    pb, cid = _pb()
-    body, _, movable = _pb_links(model)
-    base_t = np.eye(4) if base is None else np.asarray(base, dtype=float)
-    # resetBasePositionAndOrientation places the base's centre of mass, not its URDF frame
-    com = base_t @ _pose(*pb.getDynamicsInfo(body, -1, physicsClientId=cid)[3:5])
-    pos, orn = tf.to_quaternion(com)
-    pb.resetBasePositionAndOrientation(body, pos, orn, physicsClientId=cid)
-    for j, link in movable:
-        v = q[link.chain_index] if link.chain_index >= 0 else link.frozen_value
-        pb.resetJointState(body, j, float(v), physicsClientId=cid)
-    return pb, cid, body
-
-
-def pybullet_fk(model: RobotModel, q: Sequence[float], base: np.ndarray | None = None) -> dict[str, np.ndarray]:
-    """pybullet's forward kinematics (reference): link name → 4×4 URDF link frame in the world, with the
-    base link's frame at ``base`` (identity when None); off-chain joints at their frozen values.
-
-    pybullet reports link frames in single precision (errors up to about 1e-7 m).
-    """
-    pb, cid, body = _set_state(model, np.asarray(q, dtype=float), base)
-    _, by_name, _ = _pb_links(model)
-    out = {}
-    bpos, born = pb.getBasePositionAndOrientation(body, physicsClientId=cid)
-    inertial = _pose(*pb.getDynamicsInfo(body, -1, physicsClientId=cid)[3:5])
-    names = [n for n in model.link_names if by_name[n] >= 0]
-    states = pb.getLinkStates(body, [by_name[n] for n in names], computeForwardKinematics=True, physicsClientId=cid)
-    out[model.links[0].name] = _pose(bpos, born) @ tf.inverse(inertial)
-    for name, st in zip(names, states):
-        out[name] = _pose(st[4], st[5])  # worldLinkFramePosition/Orientation, not the centre of mass
-    return out
-
-
-def pybullet_box_distance(model: RobotModel, q: Sequence[float], base: np.ndarray | None, size: Sequence[float],
-                          pose: np.ndarray, skip_links: Sequence[str] = ()) -> float:
-    """Reference signed distance (negative: penetration) between the robot's links at ``q`` and a box of full
-    side lengths ``size`` at ``pose``, from pybullet's own collision engine (``getClosestPoints``), the
-    second engine the tests compare coal against.  Links named in ``skip_links`` are left out."""
-    pb, cid, body = _set_state(model, np.asarray(q, dtype=float), base)
-    _, by_name, _ = _pb_links(model)
-    shape = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=[float(v) / 2 for v in size], physicsClientId=cid)
-    pos, orn = tf.to_quaternion(np.asarray(pose, dtype=float))
-    box = pb.createMultiBody(baseMass=0, baseCollisionShapeIndex=shape, basePosition=pos, baseOrientation=orn,
-                             physicsClientId=cid)
-    # the box body stays (pybullet refuses to remove it in DIRECT mode); only the robot's distance to it is read
-    best = float("inf")
-    for name, index in by_name.items():
-        if name in skip_links:
-            continue
-        for pt in pb.getClosestPoints(body, box, 1.0, linkIndexA=index, physicsClientId=cid):
-            best = min(best, float(pt[8]))
-    return best
-
-
-def pybullet_ik(model: RobotModel, target: np.ndarray, seed: int, q_init: Sequence[float] | None = None,
-                restarts: int = 8, tol_pos: float = 1e-4, tol_rot: float = 1e-3, max_iters: int = 200,
-                null_space: bool = False) -> Any:
-    """pybullet's ``calculateInverseKinematics`` with random restarts drawn like
-    :func:`mrgc.geometry.ik.solve_ik`'s, for comparison; ``target`` in the base frame.  A restart counts
-    when its result meets the tolerances within the joint limits.  Returns an
-    :class:`mrgc.geometry.ik.IKResult`.
-
-    ``null_space`` selects pybullet's variant that takes joint limits and rest poses; on the Panda it
-    rarely gets within 1e-4 m (0 of 100 reachable poses here), so the plain damped least squares is the
-    default.
-    """
-    from mrgc.geometry.fk import ee_pose
-    from mrgc.geometry.ik import IKResult, IKStatus, pose_error, restart_configurations
-
-    target = np.asarray(target, dtype=float)
-    pb, cid = _pb()
-    body, by_name, movable = _pb_links(model)
-    ll = [lk.frozen_value if lk.chain_index < 0 else model.lower[lk.chain_index] for _, lk in movable]
-    ul = [lk.frozen_value if lk.chain_index < 0 else model.upper[lk.chain_index] for _, lk in movable]
-    jr = [max(u - lo, 1e-6) for lo, u in zip(ll, ul)]
-    pos, orn = tf.to_quaternion(target)
-    best = (math.inf, math.inf)
-    starts = restart_configurations(model, seed, restarts, q_init)
-    for r, q0 in enumerate(starts):
-        _set_state(model, q0, None)
-        kw: dict[str, Any] = {}
-        if null_space:
-            rest = [float(q0[lk.chain_index]) if lk.chain_index >= 0 else lk.frozen_value for _, lk in movable]
-            kw = dict(lowerLimits=ll, upperLimits=ul, jointRanges=jr, restPoses=rest)
-        sol = pb.calculateInverseKinematics(body, by_name[model.end_effector], pos, orn, maxNumIterations=max_iters,
-                                            residualThreshold=1e-8, physicsClientId=cid, **kw)
-        q = np.zeros(model.dof)
-        for (_, lk), v in zip(movable, sol):
-            if lk.chain_index >= 0:
-                q[lk.chain_index] = v
-        pe, re = (float(e) for e in pose_error(ee_pose(model, q), target))
-        best = min(best, (pe, re), key=sum)
-        if pe <= tol_pos and re <= tol_rot and bool(model.within_limits(q)):
-            return IKResult(IKStatus.SOLVED, q, pe, re, r + 1)
-    return IKResult(IKStatus.NO_CONVERGENCE, None, best[0], best[1], len(starts))

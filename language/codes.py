@@ -73,6 +73,10 @@ CLI_CODES: dict[str, str] = {
     "E400": "robot URDF not found or unreadable",
     "E401": "end-effector link not in the URDF",
     "E402": "geometry asked of a symbolic problem",
+    "E500": "plan file cannot be read",
+    "E501": "plan file is not JSON",
+    "E502": "plan does not follow the plan schema",
+    "E503": "unsupported plan schema version",
 }
 
 #: what each code means and how to fix it (docs/errors.md is generated from this and the golden files)
@@ -88,6 +92,14 @@ HELP: dict[str, str] = {
     "pybullet_data), or pybullet refuses the file.",
     "E401": "A robot kind's `:end-effector` is not a link of its URDF; the message lists the links.",
     "E402": "`mrgc facts` (or another geometric command) was run on a symbolic problem, which has no geometry.",
+    "E500": "`mrgc validate FILE PLAN`: the plan file does not exist, is a folder, is not UTF-8 text or cannot "
+    "be read.",
+    "E501": "The plan file is not JSON (empty, truncated, or not a plan at all); the message gives the line and "
+    "column where reading stopped.",
+    "E502": "The plan is JSON but does not follow `docs/plan.schema.json` (`mrgc-plan/1`): a required field is "
+    "missing, has the wrong type, or holds an unknown value; the message names the first such field.",
+    "E503": "The plan's `schema` names another plan format version than the one this mrgc reads "
+    "(`mrgc-plan/1`); plan again, or validate with the mrgc that wrote it.",
     "E001": "The file does not exist, is a folder, or cannot be read.",
     "E002": "Files above the size limit (8 MiB) are refused before parsing, so a huge input cannot stall mrgc.",
     "E003": "The file holds bytes that are not UTF-8 text, or a NUL byte: probably not a `.mrg` file.",

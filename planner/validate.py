@@ -112,12 +112,33 @@ def load_plan(path: str) -> dict[str, Any]:
         plan = json.loads(text, parse_constant=_no_constant)
     except json.JSONDecodeError as exc:
         span = Span(path, exc.lineno, exc.colno, exc.lineno, exc.colno + 1)
-        what = "it is empty" if not text.strip() else exc.msg
+        what = ("it is empty" if not text.strip() else
+                f"it ends early (truncated?): {exc.msg}" if _ends_early(text) else exc.msg)
         raise InputError([Diagnostic(E_JSON, f"plan is not JSON: {what}", span)], {path: text}) from None
     except ValueError as exc:
         raise InputError([Diagnostic(E_JSON, f"plan is not JSON: {exc}")]) from None
     check_schema(plan, path)
     return plan  # type: ignore[no-any-return]
+
+
+def _ends_early(text: str) -> bool:
+    """Whether the text stops inside a string or with brackets still open (a cut-off file)."""
+    depth, in_string, escape = 0, False, False
+    for ch in text:
+        if in_string:
+            if escape:
+                escape = False
+            elif ch == "\\":
+                escape = True
+            elif ch == '"':
+                in_string = False
+        elif ch == '"':
+            in_string = True
+        elif ch in "[{":
+            depth += 1
+        elif ch in "]}":
+            depth -= 1
+    return in_string or depth > 0
 
 
 def _no_constant(name: str) -> Any:
@@ -146,6 +167,8 @@ def schema_errors(plan: Any) -> list[str]:
     return out
 
 
+_ARTICLE = {"object": "an object", "array": "an array", "string": "a string", "integer": "an integer",
+            "number": "a finite number", "boolean": "true or false"}
 _TYPES = {"object": dict, "array": list, "string": str, "boolean": bool, "null": type(None)}
 
 
@@ -174,7 +197,7 @@ def _check(value: Any, schema: dict[str, Any], root: dict[str, Any], path: str, 
     if "type" in schema:
         types = schema["type"] if isinstance(schema["type"], list) else [schema["type"]]
         if not any(_type_ok(value, t) for t in types):
-            out.append(f"{path} should be {' or '.join(types)}, not {_show(value)}")
+            out.append(f"{path} should be {' or '.join(_ARTICLE.get(t, t) for t in types)}, not {_show(value)}")
             return
     if "const" in schema and value != schema["const"]:
         out.append(f"{path} should be {_show(schema['const'])}, not {_show(value)}")
@@ -210,7 +233,10 @@ def _check(value: Any, schema: dict[str, Any], root: dict[str, Any], path: str, 
 # ------------------------------------------------------------------------------------------ validating
 def validate(problem: Problem, plan: dict[str, Any], problem_path: str | None = None) -> ValidationReport:
     """Check ``plan`` (a parsed plan JSON) against ``problem``, read from ``problem_path`` (whose sha256
-    must match the plan's; None skips that comparison).  InputError when ``plan`` breaks the schema."""
+    must match the plan's; None skips that comparison).  ``plan`` may also be a :class:`~mrgc.planner.plan.Plan`.
+    InputError when ``plan`` breaks the schema."""
+    if not isinstance(plan, dict) and hasattr(plan, "to_json"):
+        plan = json.loads(json.dumps(plan.to_json()))
     check_schema(plan)
     out: list[Violation] = []
     steps: list[list[dict[str, Any]]] = [s["actions"] for s in plan["steps"]]
@@ -226,8 +252,8 @@ def validate(problem: Problem, plan: dict[str, Any], problem_path: str | None = 
         _symbolic(problem, steps, usable, out)
         final = dict(problem.initial_regions)
         for step in steps:
-            for i, a in enumerate(step):
-                if (id(a) in usable):
+            for a in step:
+                if id(a) in usable:
                     final[a["object"]] = a["region"]
         for obj, region in sorted(problem.goal_regions.items()):
             if final.get(obj) != region:
@@ -378,8 +404,9 @@ def _symbolic(problem: Problem, steps: list[list[dict[str, Any]]], usable: set[i
                     when = moved_at.get(args[0])
                     if when is None or when > t:
                         state = "never moves" if when is None else f"moves at step {when}"
-                        out.append(Violation(t, o, "place-obstacle", f"{args[0]} blocks {r2} placing {o} in {re_} "
-                                                                     f"with {g2} and {state}; it must move by step {t}"))
+                        out.append(Violation(t, o, "place-obstacle",
+                                             f"{args[0]} blocks {r2} placing {o} in {re_} with {g2} and {state}; "
+                                             f"it must move by step {t}"))
 
 
 def _describe(a: dict[str, Any]) -> str:

@@ -32,8 +32,8 @@ HEAVY = {
     "pysmt": "backends/pysmt_opt.py",
     "ortools": "backends/cpsat.py",
     "coal": "geometry/collision.py",
-    "pybullet": "geometry/kinematics.py",
-    "pybullet_data": "geometry/kinematics.py",
+    "pybullet": "geometry/bullet.py",
+    "pybullet_data": "geometry/bullet.py",
     "ompl": "geometry/motion.py",
 }
 

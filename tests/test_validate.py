@@ -1,0 +1,562 @@
+"""The independent plan validator: valid plans pass; every kind of broken plan is rejected in one clear line.
+
+Geometric plans for pa3-handover are built here with the geometry layer's grounding service (tests may use
+it; the validator itself may not) and then mutated; symbolic plans for chain-3 are written by hand from
+the file's own comment (its three feasible action sets).
+"""
+
+from __future__ import annotations
+
+import ast
+import copy
+import json
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any, Callable
+
+import numpy as np
+import pytest
+
+from mrgc import cli
+from mrgc.errors import InputError
+from mrgc.geometry.grounding import Grounder
+from mrgc.geometry.ik import solve_ik_many
+from mrgc.geometry.grasps import grasp_transform
+from mrgc.geometry.scene import scene_from_problem
+from mrgc.geometry.transforms import translation
+from mrgc.language.loader import parse_file
+from mrgc.planner.plan import Plan, PlannedAction, file_sha256
+from mrgc.planner.validate import ValidationReport, load_plan, validate
+
+ROOT = Path(__file__).resolve().parent.parent
+PA3 = str(ROOT / "domains" / "packaging" / "pa3-handover.mrg")
+CHAIN3 = str(ROOT / "domains" / "symbolic" / "chain-3.mrg")
+
+
+def _l(a: Any) -> list[list[float]]:
+    return [[float(v) for v in row] for row in np.atleast_2d(a)]
+
+
+def _plan(problem: Any, path: str, steps: list[list[PlannedAction]], symbolic: bool = False) -> dict[str, Any]:
+    plan = Plan(problem.name, path, file_sha256(path), "0.1.0", "cpsat", "time-of-move", 0, "solved", steps,
+                symbolic=symbolic, stats={"robots": [r.name for r in problem.robots]})
+    return json.loads(plan.dumps())  # as a file holds it
+
+
+# ------------------------------------------------------------------------------------- pa3-handover
+@pytest.fixture(scope="module")
+def pa3() -> Any:
+    return parse_file(PA3).problem(None)
+
+
+@pytest.fixture(scope="module")
+def grounder(pa3: Any) -> Grounder:
+    return Grounder(scene_from_problem(pa3), seed=0)
+
+
+def _handover(g: Grounder, avoid: list[str]) -> PlannedAction:
+    """r1 picks o1 from the top, hands it to r2 at h1 (r2 grasps side-x+), r2 puts it into bin-b."""
+    pick = g.pick("r1", "o1", "top", avoid=avoid)
+    hand = g.handover("o1", "h1", "r1", "top", "r2", "side-x+", avoid=avoid)
+    spot = g.placement("o1", "bin-b", avoid=avoid)
+    assert pick.ok and hand.ok and spot.ok and spot.pose is not None
+    place = g.place("r2", "o1", "side-x+", spot.pose, avoid=avoid)
+    assert place.ok
+    return PlannedAction("o1", "bin-b", "r1", "r2", "top", "side-x+", place_pose=_l(spot.pose), handover_point="h1",
+                         configs={"pick": _l(pick.configs), "handover": _l(hand.configs), "place": _l(place.configs)})
+
+
+@pytest.fixture(scope="module")
+def one_step(pa3: Any) -> dict[str, Any]:
+    g = Grounder(scene_from_problem(pa3), seed=0)
+    return _plan(pa3, PA3, [[_handover(g, ["o2", "o3"])]])
+
+
+@pytest.fixture(scope="module")
+def two_steps(pa3: Any) -> dict[str, Any]:
+    """Step 1: r1 moves o2 within start (top); step 2: the handover of o1 into bin-b."""
+    g = Grounder(scene_from_problem(pa3), seed=0)
+    pick = g.pick("r1", "o2", "top", avoid=["o1", "o3"])
+    spot = g.placement("o2", "start", avoid=["o1", "o3"])
+    assert pick.ok and spot.ok and spot.pose is not None
+    place = g.place("r1", "o2", "top", spot.pose, avoid=["o1", "o3"])
+    assert place.ok
+    first = PlannedAction("o2", "start", "r1", "r1", "top", "top", place_pose=_l(spot.pose),
+                          configs={"pick": _l(pick.configs), "place": _l(place.configs)})
+    g.move("o2", spot.pose)
+    return _plan(pa3, PA3, [[first], [_handover(g, ["o2", "o3"])]])
+
+
+def _codes(report: ValidationReport) -> set[str]:
+    return {v.code for v in report.violations}
+
+
+def test_hand_built_plans_are_valid(pa3: Any, one_step: dict[str, Any], two_steps: dict[str, Any]) -> None:
+    for plan in (one_step, two_steps):
+        report = validate(pa3, plan, PA3)
+        assert report.ok, report.lines()
+        assert report.lines()[0].startswith("valid: plan for pa3-handover")
+        assert report.stats["configurations"] > 40 and report.stats["distance_queries"] > 100
+
+
+def _action(plan: dict[str, Any], step: int, k: int = 0) -> dict[str, Any]:
+    return plan["steps"][step - 1]["actions"][k]  # type: ignore[no-any-return]
+
+
+def _drop_last_step(p: dict[str, Any]) -> None:
+    p["steps"].pop()
+    p["makespan"] -= 1
+    p["motion_cost"] -= 1
+
+
+def _move_twice(p: dict[str, Any]) -> None:
+    p["steps"].append({"index": 3, "actions": [copy.deepcopy(_action(p, 1))], "waiting": ["r2"]})
+    p["makespan"], p["motion_cost"] = 3, 3
+
+
+def _nudge(p: dict[str, Any]) -> None:  # o2's placement pushed into its neighbour o1 (still inside start)
+    pose = _action(p, 1)["place_pose"]
+    pose[0][3], pose[1][3] = 0.03, -0.25
+
+
+def _swap_grasp(p: dict[str, Any]) -> None:
+    _action(p, 2)["pick_grasp"] = "side-x+"
+
+
+def _beyond_limits(p: dict[str, Any]) -> None:
+    _action(p, 1)["configs"]["pick"][2][3] = 0.5  # panda_joint4 lies in [-3.1416, 0]
+
+
+def _busy(p: dict[str, Any]) -> None:
+    p["steps"][1]["actions"].insert(0, p["steps"][0]["actions"].pop())
+    p["steps"].pop(0)
+    p["makespan"] = 1
+    for i, s in enumerate(p["steps"], 1):
+        s["index"] = i
+
+
+def _rename(p: dict[str, Any]) -> None:
+    _action(p, 1)["pick_robot"] = _action(p, 1)["place_robot"] = "r9"
+
+
+def _short_config(p: dict[str, Any]) -> None:
+    _action(p, 1)["configs"]["place"][0].pop()
+
+
+def _no_configs(p: dict[str, Any]) -> None:
+    del _action(p, 2)["configs"]["handover"]
+
+
+def _out_of_region(p: dict[str, Any]) -> None:
+    _action(p, 1)["region"] = "bin-a"
+
+
+def _handover_moved(p: dict[str, Any]) -> None:
+    _action(p, 2)["configs"]["handover"][1][0] += 0.2
+
+
+def _other_file(p: dict[str, Any]) -> None:
+    p["problem_sha256"] = "0" * 64
+
+
+def _other_problem(p: dict[str, Any]) -> None:
+    p["problem"] = "pa5"
+
+
+def _regrasp(p: dict[str, Any]) -> None:
+    _action(p, 1)["place_grasp"] = "side-x+"
+
+
+def _not_solved(p: dict[str, Any]) -> None:
+    p["status"], p["steps"], p["makespan"], p["motion_cost"] = "no plan", [], None, None
+
+
+MUTATIONS: dict[str, tuple[Callable[[dict[str, Any]], None], str, str]] = {
+    # name: (mutation, expected code, a fragment of its message)
+    "nudged into a neighbour": (_nudge, "collision-object-object", "o2 placed and o1 overlap by"),
+    "step removed": (_drop_last_step, "goal", "goal (in-region o1 bin-b) does not hold at the end"),
+    "object moved twice": (_move_twice, "moved-twice", "o2 is moved again (first at step 1)"),
+    "grasp swapped": (_swap_grasp, "grasp", "puts the tool 40.3 mm, 1.571 rad from grasp 'side-x+' of o1"),
+    "outside joint limits": (_beyond_limits, "joint-limits", "panda_joint4 = 0.5000 is outside [-3.1416, 0.0000]"),
+    "robot in two actions": (_busy, "robot-busy", "r1 is in two actions of the step"),
+    "unknown robot": (_rename, "unknown-name", "no robot 'r9'"),
+    "configuration too short": (_short_config, "config", "has 6 values; r1 has 7 joints"),
+    "handover configurations missing": (_no_configs, "missing", "no handover configurations"),
+    "placement outside its region": (_out_of_region, "outside-region", "is not entirely inside region bin-a"),
+    "taker away from the handover point": (_handover_moved, "handover", "from handover point h1"),
+    "problem file changed": (_other_file, "problem-changed", "the problem file changed since the plan was made"),
+    "plan of another problem": (_other_problem, "problem", "the plan is for problem 'pa5', not 'pa3-handover'"),
+    "regrasp in hand": (_regrasp, "action", "a robot cannot regrasp in hand"),
+    "no plan": (_not_solved, "status", "the plan's status is 'no plan'"),
+}
+
+
+@pytest.mark.parametrize("name", list(MUTATIONS))
+def test_mutated_plans_are_rejected(name: str, pa3: Any, two_steps: dict[str, Any]) -> None:
+    mutate, code, fragment = MUTATIONS[name]
+    plan = copy.deepcopy(two_steps)
+    mutate(plan)
+    report = validate(pa3, plan, PA3)
+    assert not report.ok
+    hits = [str(v) for v in report.violations if v.code == code]
+    assert any(fragment in h for h in hits), report.lines()
+    for line in report.lines():
+        assert "\n" not in line and "Traceback" not in line
+    assert report.lines()[-1].startswith("invalid: ")
+
+
+def test_a_pick_through_a_neighbour_is_a_robot_object_collision(pa3: Any, one_step: dict[str, Any],
+                                                               grounder: Grounder) -> None:
+    pick = grounder.pick("r1", "o1", "side-x+")  # avoiding nothing: the hand goes through o2
+    assert pick.ok
+    plan = copy.deepcopy(one_step)
+    _action(plan, 1)["configs"]["pick"] = _l(pick.configs)
+    report = validate(pa3, plan, PA3)
+    hits = [str(v) for v in report.violations if v.code == "collision-robot-object"]
+    assert any("pick: panda_hand of r1 (" in h and "of 5) and o2 overlap by" in h for h in hits), \
+        report.lines()
+
+
+def test_two_hands_at_one_handover_collide(pa3: Any, one_step: dict[str, Any], grounder: Grounder) -> None:
+    arm = grounder.arm("r2")
+    target = arm.ee_target(translation(0, 0, 0.4) @ grasp_transform("top", grounder.scene.body("o1").shape))
+    res = solve_ik_many(arm.model, target[None], 0, q_init=arm.home)[0]
+    assert res.solved
+    plan = copy.deepcopy(one_step)
+    a = _action(plan, 1)
+    a["place_grasp"] = "top"  # the taker also grasps from the top: the two hands meet
+    a["configs"]["handover"][1] = [float(v) for v in res.q]
+    report = validate(pa3, plan, PA3)
+    hits = [str(v) for v in report.violations if v.code == "collision-robot-robot"]
+    assert any(h.startswith("step 1: r1: handover: ") and "of r2 (at its handover (taker) configuration)" in h
+               for h in hits), report.lines()
+
+
+def test_paths_are_checked_and_must_connect(pa3: Any, one_step: dict[str, Any]) -> None:
+    plan = copy.deepcopy(one_step)
+    a = _action(plan, 1)
+    home = [0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785]
+    pre = a["configs"]["pick"][0]
+    a["paths"] = {"to-pick": [home, [(x + y) / 2 for x, y in zip(home, pre)], pre]}
+    assert validate(pa3, plan, PA3).ok
+    a["paths"]["to-pick"] = a["paths"]["to-pick"][:-1]
+    a["paths"]["fly"] = [home]
+    lines = validate(pa3, plan, PA3).lines()
+    assert any("path 'to-pick' (moving o1) ends" in x and "away from the first pick configuration" in x for x in lines)
+    assert any("unknown path 'fly'" in x for x in lines)
+
+
+# ------------------------------------------------------------------------------------- the CLI
+def test_cli_valid_and_invalid(tmp_path: Path, two_steps: dict[str, Any], capsys: pytest.CaptureFixture[str]) -> None:
+    good = tmp_path / "good.json"
+    good.write_text(json.dumps(two_steps), encoding="utf-8")
+    assert cli.main(["validate", PA3, str(good)]) == 0
+    assert capsys.readouterr().out.startswith("valid: plan for pa3-handover: 2 steps, 2 objects moved")
+    bad_plan = copy.deepcopy(two_steps)
+    _drop_last_step(bad_plan)
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(bad_plan), encoding="utf-8")
+    assert cli.main(["validate", PA3, str(bad)]) == 1
+    out = capsys.readouterr().out.splitlines()
+    assert out == ["o1: goal (in-region o1 bin-b) does not hold at the end: o1 is at (0.000, -0.250, 0.060), not "
+                   "entirely inside bin-b [goal]", "invalid: 1 violation"]
+    assert cli.main(["validate", PA3, str(bad), "--format", "json"]) == 1
+    data = json.loads(capsys.readouterr().out)
+    assert data["ok"] is False and data["violations"][0]["code"] == "goal"
+
+
+def _truncated(text: str) -> str:
+    return text[: len(text) // 2]
+
+
+def _edit(change: Callable[[dict[str, Any]], None]) -> Callable[[str], str]:
+    def make(text: str) -> str:
+        plan = json.loads(text)
+        change(plan)
+        return json.dumps(plan, indent=1)
+    return make
+
+
+def _del_grasp(p: dict[str, Any]) -> None:
+    del _action(p, 1)["pick_grasp"]
+
+
+def _set(key: str, value: Any) -> Callable[[dict[str, Any]], None]:
+    return lambda p: p.__setitem__(key, value)
+
+
+def _small_matrix(p: dict[str, Any]) -> None:
+    _action(p, 1)["place_pose"] = [[1.0, 0.0, 0.0]]
+
+
+def _unknown_kind(p: dict[str, Any]) -> None:
+    _action(p, 1)["kind"] = "throw"
+
+
+MALFORMED: dict[str, tuple[Callable[[str], str | bytes] | None, str, str]] = {
+    "truncated": (_truncated, "E501", "plan is not JSON: it ends early (truncated?)"),
+    "empty": (lambda t: "", "E501", "plan is not JSON: it is empty"),
+    "not JSON": (lambda t: "steps: [1, 2]\n", "E501", "plan is not JSON: Expecting value"),
+    "NaN": (lambda t: t.replace('"seed": 0', '"seed": NaN'), "E501", "NaN is not a JSON number"),
+    "binary": (lambda t: b"\x89PNG\r\n\x1a\n\x00\xff", "E500", "it is not UTF-8 text"),
+    "a list": (lambda t: "[1, 2]", "E502", "plan should be an object, not [1, 2]"),
+    "field missing": (_edit(_del_grasp), "E502", "plan.steps[0].actions[0] lacks 'pick_grasp'"),
+    "wrong type": (_edit(_set("seed", "zero")), "E502", "plan.seed should be an integer, not \"zero\""),
+    "unknown kind": (_edit(_unknown_kind), "E502", "plan.steps[0].actions[0].kind should be one of"),
+    "bad matrix": (_edit(_small_matrix), "E502", "plan.steps[0].actions[0].place_pose should hold 4 items, not 1"),
+    "wrong schema": (_edit(_set("schema", "mrgc-plan/7")), "E503",
+                     "schema 'mrgc-plan/7' is not supported (this mrgc reads 'mrgc-plan/1')"),
+    "missing file": (None, "E500", "No such file or directory"),
+}
+
+
+@pytest.mark.parametrize("name", list(MALFORMED))
+def test_malformed_plan_files_are_input_errors(name: str, tmp_path: Path, two_steps: dict[str, Any],
+                                               capsys: pytest.CaptureFixture[str]) -> None:
+    make, code, fragment = MALFORMED[name]
+    text = json.dumps(two_steps, indent=1)
+    path = tmp_path / "plan.json"
+    if make is not None:
+        data = make(text)
+        path.write_bytes(data if isinstance(data, bytes) else data.encode("utf-8"))
+    assert cli.main(["validate", PA3, str(path)]) == 2
+    cap = capsys.readouterr()
+    first = cap.err.splitlines()[0]
+    assert f"error[{code}]" in first and fragment in first, cap.err
+    assert "Traceback" not in cap.err and cap.out == ""
+    if make is not None and code != "E500":
+        with pytest.raises(InputError) as err:
+            load_plan(str(path))
+        assert err.value.diagnostics[0].code == code
+
+
+def test_validate_raises_on_a_schema_violation(pa3: Any, two_steps: dict[str, Any]) -> None:
+    plan = copy.deepcopy(two_steps)
+    del plan["steps"][0]["actions"][0]["object"]
+    with pytest.raises(InputError) as err:
+        validate(pa3, plan, PA3)
+    assert err.value.diagnostics[0].code == "E502"
+
+
+def test_the_installed_script_validates(tmp_path: Path, one_step: dict[str, Any]) -> None:
+    """End to end in a fresh process: nothing but the report on stdout, and coal (the planner's collision
+    engine) is never loaded: the validator's collisions are pybullet's alone."""
+    path = tmp_path / "plan.json"
+    path.write_text(json.dumps(one_step), encoding="utf-8")
+    code = ("import sys; from mrgc import cli; rc = cli.main(['validate', %r, %r]); "
+            "print('coal' in sys.modules, 'mrgc.geometry.grounding' in sys.modules, rc)" % (PA3, str(path)))
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=tmp_path)
+    lines = out.stdout.splitlines()
+    assert len(lines) == 2 and lines[0].startswith("valid: ") and lines[1] == "False False 0", out
+    assert out.stderr == ""
+
+
+def test_the_validator_imports_no_planner_search_or_grounding() -> None:
+    banned = {"mrgc.planner.ground", "mrgc.planner.mcts", "mrgc.planner.search", "mrgc.geometry.grounding",
+              "mrgc.geometry.predicates", "mrgc.geometry.path_predicates", "mrgc.geometry.collision",
+              "mrgc.geometry.motion", "mrgc.geometry.ik", "mrgc.geometry.fk", "mrgc.geometry.arm", "mrgc.compiler"}
+    for name in ("validate.py", "replay.py"):
+        tree = ast.parse((ROOT / "planner" / name).read_text(encoding="utf-8"))
+        for node in ast.walk(tree):
+            if isinstance(node, ast.ImportFrom) and node.module:
+                assert not any(node.module == b or node.module.startswith(b + ".") for b in banned), \
+                    f"planner/{name} imports {node.module}"
+
+
+# ------------------------------------------------------------------------------------- the replay scene
+def test_replay_scene_distances_and_kinematics(pa3: Any, grounder: Grounder, tmp_path: Path) -> None:
+    from mrgc.geometry.bullet import ReplayScene
+    from mrgc.geometry.fk import ee_pose
+    from mrgc.language.model import Box, Mesh
+
+    cube = tmp_path / "cube.obj"
+    corners = "".join(f"v {x} {y} {z}\n" for x in (-0.05, 0.05) for y in (-0.05, 0.05) for z in (-0.05, 0.05))
+    faces = ["1 2 4", "1 4 3", "5 7 8", "5 8 6", "1 5 6", "1 6 2", "3 4 8", "3 8 7", "1 3 7", "1 7 5", "2 6 8",
+             "2 8 4"]
+    cube.write_text(corners + "".join(f"f {f}\n" for f in faces), encoding="utf-8")
+    scene = grounder.scene
+    with ReplayScene(scene) as rs:
+        rs.add_object("mesh", Mesh(str(cube)), translation(2, 0, 0))
+        rs.add_object("box", Box(0.1, 0.1, 0.1), translation(2.13, 0, 0))
+        c = rs.closest("mesh", "box", 0.1)  # pybullet's 1 mm mesh margin is added back
+        assert c is not None and abs(c.distance - 0.03) < 1e-6
+        rs.set_pose("box", translation(2.09, 0, 0))
+        c = rs.closest("mesh", "box")
+        assert c is not None and abs(c.distance + 0.01) < 1e-6
+        arm = grounder.arm("r1")
+        q = np.array([0.3, 0.2, -0.1, -2.0, 0.1, 1.9, 0.4])
+        rs.set_config("r1", q)
+        assert np.abs(rs.ee_pose("r1") - arm.base @ ee_pose(arm.model, q)).max() < 1e-6
+        rs.set_config("r1", arm.home)
+        assert rs.closest("r1", "table") is None  # its base link stands on the table: ignored
+        assert rs.closest("r1", "r2", 10.0) is not None
+
+
+# ------------------------------------------------------------------------------------- symbolic: chain-3
+@pytest.fixture(scope="module")
+def chain3() -> Any:
+    return parse_file(CHAIN3).problem(None)
+
+
+def _act(obj: str, region: str, r1: str, g1: str, r2: str | None = None, g2: str | None = None) -> PlannedAction:
+    return PlannedAction(obj, region, r1, r2 or r1, g1, g2 or g1)
+
+
+A1 = ("o1", "goal", "r1", "top")
+A2 = ("o1", "goal", "r2", "side")
+A3 = ("o1", "goal", "r1", "top", "r2", "side")
+B = ("o2", "start", "r1", "top")
+C = ("o3", "start", "r2", "side")
+
+VALID_SYMBOLIC = {
+    "{A2}": [[A2]],
+    "{B, A3}": [[B], [A3]],
+    "{B, C, A1}": [[B, C], [A1]],
+    "{B, C, A1}, C beside A1": [[B], [C, A1]],
+}
+
+
+@pytest.mark.parametrize("name", list(VALID_SYMBOLIC))
+def test_symbolic_plans_of_chain3_are_valid(name: str, chain3: Any) -> None:
+    steps = [[_act(*a) for a in step] for step in VALID_SYMBOLIC[name]]
+    report = validate(chain3, _plan(chain3, CHAIN3, steps, symbolic=True), CHAIN3)
+    assert report.ok, report.lines()
+    assert report.stats["mode"] == "symbolic"
+
+
+INVALID_SYMBOLIC: dict[str, tuple[list[list[tuple[str, ...]]], str, str]] = {
+    "pick obstacle in the same step": ([[B, A1], [C]], "pick-obstacle",
+                                       "o2 blocks r1 picking o1 with top and moves at step 1; it must move at an "
+                                       "earlier step"),
+    "place obstacle later": ([[B], [A1], [C]], "place-obstacle",
+                             "o3 blocks r1 placing o1 in goal with top and moves at step 3; it must move by step 2"),
+    "place obstacle never moved": ([[B], [A1]], "place-obstacle", "o3 blocks r1 placing o1 in goal with top and "
+                                                                  "never moves"),
+    "handover before its pick obstacle": ([[A3], [B]], "pick-obstacle", "o2 blocks r1 picking o1 with top"),
+    "unsupported grasp": ([[("o1", "goal", "r1", "side")]], "unsupported",
+                          "no fact (reachable-pick o1 side r1) supports 'r1 moves o1 to goal (side)'"),
+    "unsupported handover": ([[("o1", "goal", "r2", "side", "r1", "top")]], "unsupported",
+                             "no fact (enable-goal-handover o1 side top r2 r1)"),
+    "obstacle to the goal": ([[("o2", "goal", "r1", "top")], [A2]], "region",
+                             "o2 goes to 'goal', but the model moves it only into 'start'"),
+    "goal missed": ([[B]], "goal", "goal (in-region o1 goal) does not hold at the end: o1 is in 'start'"),
+    "moved twice": ([[A2], [A2]], "moved-twice", "o1 is moved again (first at step 1)"),
+    "robot busy": ([[B, A3]], "robot-busy", "r1 is in two actions of the step (moving o2 and o1)"),
+}
+
+
+@pytest.mark.parametrize("name", list(INVALID_SYMBOLIC))
+def test_broken_symbolic_plans_are_rejected(name: str, chain3: Any) -> None:
+    spec, code, fragment = INVALID_SYMBOLIC[name]
+    steps = [[_act(*a) for a in step] for step in spec]
+    report = validate(chain3, _plan(chain3, CHAIN3, steps, symbolic=True), CHAIN3)
+    hits = [str(v) for v in report.violations if v.code == code]
+    assert any(fragment in h for h in hits), report.lines()
+
+
+def test_symbolic_cli(tmp_path: Path, chain3: Any, capsys: pytest.CaptureFixture[str]) -> None:
+    path = tmp_path / "plan.json"
+    path.write_text(json.dumps(_plan(chain3, CHAIN3, [[_act(*A2)]], symbolic=True)), encoding="utf-8")
+    assert cli.main(["validate", CHAIN3, str(path)]) == 0
+    assert capsys.readouterr().out == "valid: plan for chain-3: 1 steps, 1 objects moved (symbolic checks)\n"
+    # a geometric plan's file given for the wrong problem file: every mismatch is reported, nothing crashes
+    assert cli.main(["validate", PA3, str(path)]) == 1
+    out = capsys.readouterr().out
+    assert "the plan is for problem 'chain-3', not 'pa3-handover' [problem]" in out
+    assert "[plan-kind]" in out and "[unknown-name]" in out
+
+
+# ------------------------------------------------------------------------------------- planar robots
+ROOM = """(define (domain movers)
+  (:requirements :planar-base)
+  (:robot-kind mover :base planar :footprint (box 0.5 0.4 0.3) :carry (0.45 0 0.2 0))
+  (:grasps side-x+ side-x- side-y+ side-y-))
+(define (problem room)
+  (:domain movers)
+  (:robots (r1 :kind mover :base (-1 0 0 0)) (r2 :kind mover :base (-1 -1.5 0 0)))
+  (:fixed (wall :shape (box 0.1 1 0.5) :pose (0 1.2 0.25 0)))
+  (:regions (start :shape (box 1 1 0.5) :pose (0 0 0.25 0)) (goal :shape (box 1 1 0.5) :pose (1.5 0 0.25 0)))
+  (:movable (b :shape (box 0.3 0.3 0.3) :pose (0 0 0.15 0)))
+  (:goal (in-region b goal)))
+"""
+
+
+def _line(a: Any, b: Any, n: int = 5) -> list[list[float]]:
+    return _l(np.linspace(np.asarray(a, dtype=float), np.asarray(b, dtype=float), n))
+
+
+@pytest.fixture(scope="module")
+def room(tmp_path_factory: pytest.TempPathFactory) -> tuple[str, Any, dict[str, Any]]:
+    """r1 drives from (-1, 0) to the box's -x side, carries it east into the goal region, and drives back."""
+    path = tmp_path_factory.mktemp("room") / "room.mrg"
+    path.write_text(ROOM, encoding="utf-8")
+    problem = parse_file(str(path)).problem(None)
+    # the planar model (geometry/planar.py): facing the grasped face, the front 5 cm from it; the base origin
+    # 0.25 (half length) + 0.05 + 0.15 (half the box) = 0.45 m from the box's centre
+    q_pick, place = [-0.45, 0.0, 0.0], translation(1.7, 0.0, 0.151)
+    q_place = [1.25, 0.0, 0.0]
+    act = PlannedAction("b", "goal", "r1", "r1", "side-x-", "side-x-", place_pose=_l(place),
+                        configs={"pick": [q_pick], "place": [q_place]},
+                        paths={"to-pick": _line([-1, 0, 0], q_pick), "to-place": _line(q_pick, q_place, 20),
+                               "home": _line(q_place, [-1, 0, 0], 30)})
+    return str(path), problem, _plan(problem, str(path), [[act]])
+
+
+def test_a_planar_plan_is_valid_and_its_mutations_are_not(room: tuple[str, Any, dict[str, Any]]) -> None:
+    path, problem, plan = room
+    report = validate(problem, plan, path)
+    assert report.ok, report.lines()
+    bad = copy.deepcopy(plan)
+    a = _action(bad, 1)
+    a["configs"]["pick"] = [[-0.5, 0.0, 0.0]]  # 5 cm short of the box, where the to-pick path does not go
+    a["paths"]["home"] = _line([1.25, 0, 0], [0, 1.2, 0], 10) + _line([0, 1.2, 0], [-1, 0, 0], 10)  # through the wall
+    lines = validate(problem, bad, path).lines()
+    assert any("the last pick base pose of r1 is 50.0 mm, 0.000 rad from where grasp 'side-x-' of b puts it" in x
+               for x in lines), lines
+    assert any("[collision-robot-fixed]" in x and "footprint of r1 (" in x and "and wall overlap by" in x
+               for x in lines), lines
+    assert any("path 'to-pick' (moving b) ends 50.0 mm, 0.000 rad away from the first pick configuration" in x
+               for x in lines), lines
+    bad = copy.deepcopy(plan)
+    detour = [-1.3, -1.5, 0]  # carrying the box through r2, standing at home
+    _action(bad, 1)["paths"]["to-place"] = _line([-0.45, 0, 0], detour) + _line(detour, [1.25, 0, 0])
+    lines = validate(problem, bad, path).lines()
+    assert any("[collision-robot-robot]" in x and "footprint of r2 (at home)" in x for x in lines), lines
+    assert any("[collision-robot-object]" in x and "b held by r1" in x and "r2" in x for x in lines), lines
+
+
+def test_random_damage_never_crashes_the_validator(pa3: Any, two_steps: dict[str, Any]) -> None:
+    """Values swapped for others of the same JSON type (so the schema still holds): always a report."""
+    import random
+
+    rng = random.Random(0)
+    names = ["o1", "o2", "o3", "r1", "r2", "h1", "start", "bin-a", "bin-b", "table", "top", "side-y-", "", "zz"]
+    numbers = [0.0, -1.0, 1e6, -1e300, 3.2, 1e-12, 7]
+
+    def leaves(node: Any, path: tuple[Any, ...] = ()) -> list[tuple[Any, ...]]:
+        if isinstance(node, dict):
+            return [p for k, v in node.items() for p in leaves(v, path + (k,))]
+        if isinstance(node, list):
+            return [p for i, v in enumerate(node) for p in leaves(v, path + (i,))]
+        return [path]
+
+    steps_only = [p for p in leaves(two_steps) if p[0] == "steps" and p[-1] not in ("index",)]
+    for _ in range(25):
+        plan = copy.deepcopy(two_steps)
+        for path in rng.sample(steps_only, 3):
+            node = plan
+            for k in path[:-1]:
+                node = node[k]
+            old = node[path[-1]]
+            if isinstance(old, str):
+                node[path[-1]] = rng.choice(names)
+            elif isinstance(old, float):
+                node[path[-1]] = rng.choice(numbers)
+        try:
+            report = validate(pa3, plan, PA3)
+        except InputError as exc:  # e.g. a kind no longer in the schema's enum
+            assert exc.diagnostics[0].code == "E502"
+            continue
+        for line in report.lines():
+            assert "\n" not in line

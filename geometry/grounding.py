@@ -29,7 +29,7 @@ from mrgc.geometry.collision import CollisionShape, CollisionWorld, collision_sh
 from mrgc.geometry.grasps import grasp_transform, known, pregrasp_transform
 from mrgc.geometry.ik import solve_ik_many
 from mrgc.geometry.motion import plan_joint_path, plan_se2_path
-from mrgc.geometry.planar import DiscGrid, PlanarRobot, is_planar, scene_bounds
+from mrgc.geometry.planar import DiscGrid, PlanarRobot, is_planar, scene_bounds, to_se2
 from mrgc.geometry.predicates import APPROACH_SAMPLES, LIFT, scene_world, seed_for
 from mrgc.geometry.scene import SceneSpec, half_extents, inside
 from mrgc.geometry.transforms import rot_z, translation
@@ -73,6 +73,14 @@ class Grounder:
         self._arms: dict[str, Arm] = {}
         self._planar: dict[str, PlanarRobot] = {}
         self._grids: dict[str, DiscGrid] = {}
+        # planar robots wait at their start pose (as the validator assumes): obstacles for the others
+        self.parked: dict[str, str] = {}
+        for spec in scene.robots:
+            if is_planar(spec):
+                pr = self.planar(spec.name)
+                shape, pose = pr.probe(to_se2(spec.base))[0]
+                self.parked[spec.name] = f"@{spec.name}"
+                self.world.add(f"@{spec.name}", shape, pose, "robots")
         self.queries = 0
 
     # ------------------------------------------------------------ state
@@ -166,6 +174,8 @@ class Grounder:
             self.queries += 1
             if self.world.probe_collides(probe, against="fixed"):
                 continue
+            if self.parked and self.world.probe_collides(probe, against="robots"):
+                continue
             if avoid and self.world.probe_collides(probe, against=avoid):
                 continue
             if vol_world is not None and vol_world.probe_collides(probe, against="volume"):
@@ -178,7 +188,7 @@ class Grounder:
 
     # ------------------------------------------------------------ arm configurations
     def _approach(self, robot: str, obj: str, grasp: str, pose: np.ndarray, key: str,
-                  avoid: Iterable[str], attempts: int = 8, approach: bool = True) -> Answer:
+                  avoid: Iterable[str], attempts: int = 8, approach: bool = True, held: bool = False) -> Answer:
         if not known(grasp):
             return Answer(Status.NO_IK)
         arm = self.arm(robot)
@@ -202,9 +212,11 @@ class Grounder:
                 configs = pre.q[None] * (1 - s) + q.q[None] * s
             else:
                 configs = np.asarray(q.q)[None]
-            volume = self.arm_volume(robot, configs)
+            # checked on a 4× finer interpolation than the configurations kept (the validator's resolution),
+            # with the object in hand when placing
+            volume = self.arm_volume(robot, refine(configs), holding=(obj, grasp) if held else None)
             self.queries += 1
-            if self.world.probe_collides(volume, against="fixed", ignore=(obj,)):
+            if self.world.probe_collides(volume, against="fixed", ignore=() if held else (obj,)):
                 status = Status.COLLISION
                 continue
             hit = self.world.probe_hits(volume, against=avoid) if avoid else set()
@@ -222,7 +234,7 @@ class Grounder:
 
     def place(self, robot: str, obj: str, grasp: str, pose: np.ndarray, avoid: Iterable[str] = ()) -> Answer:
         """Approach configurations for ``robot`` holding ``obj`` with ``grasp`` to put it at ``pose``."""
-        return self._approach(robot, obj, grasp, pose, "place", avoid)
+        return self._approach(robot, obj, grasp, pose, "place", avoid, held=True)
 
     def handover(self, obj: str, point: str, giver: str, g1: str, taker: str, g2: str,
                  avoid: Iterable[str] = ()) -> Answer:
@@ -263,11 +275,13 @@ class Grounder:
                   avoid: Iterable[str] = (), time_limit: float = 0.25) -> Answer:
         """An SE(2) path for a planar robot, free of fixed objects and ``avoid`` (objects at their initial
         poses); hopeless queries are refused at once by an inscribed-disc grid test."""
-        against = ("fixed", *[a for a in avoid if not holding or a != holding[0]])
+        others = [name for r, name in self.parked.items() if r != robot]
+        against = ("fixed", *others, *[a for a in avoid if not holding or a != holding[0]])
         ignore = (holding[0],) if holding else ()
         if robot not in self._grids:
             self._grids[robot] = DiscGrid(self.planar(robot), self.scene, scene_bounds(self.scene, 0.5))
-        obstacles = frozenset([b.name for b in self.scene.fixed] + [a for a in against if a != "fixed"])
+        obstacles = frozenset([b.name for b in self.scene.fixed]
+                              + [a for a in against if a != "fixed" and not a.startswith("@")])
         if not self._grids[robot].connected(np.asarray(start), np.asarray(goal), obstacles):
             return Answer(Status.NO_PATH)  # not even the footprint's inscribed disc gets through
 
@@ -278,6 +292,15 @@ class Grounder:
         res = plan_se2_path(scene_bounds(self.scene, 0.5), tuple(start), tuple(goal), valid,  # type: ignore[arg-type]
                             time_limit=time_limit, seed=seed_for(robot, "base-path", seed=self.seed))
         return Answer(Status.OK if res.solved else Status.NO_PATH, path=list(res.path))
+
+
+def refine(configs: np.ndarray, sub: int = 4) -> np.ndarray:
+    """``configs`` with ``sub - 1`` evenly spaced configurations inserted between consecutive ones."""
+    if len(configs) < 2:
+        return configs
+    s = np.linspace(0.0, 1.0, sub + 1)[:-1, None]
+    pieces = [a[None] * (1 - s) + b[None] * s for a, b in zip(configs[:-1], configs[1:])]
+    return np.concatenate(pieces + [configs[-1:]])
 
 
 def _against(among: Iterable[str] | str) -> str | tuple[str, ...]:

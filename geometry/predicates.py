@@ -39,7 +39,8 @@ from mrgc.geometry.transforms import translation
 from mrgc.language.model import Box, Fact
 
 APPROACH_SAMPLES = 5  # configurations sampled from pre-grasp to grasp for the swept volume
-LIFT = 1e-3  # placements float this much above the region floor (touching counts as colliding)
+LIFT = 6e-3  # placements float this much above the region floor: touching counts as colliding, and the
+# object in hand dips a few mm below the straight line as the arm interpolates its approach in joint space
 PLACEMENT_GRID = 3  # placements tried per region: a GRID × GRID lattice, centre first
 IK_SEEDS = 3  # IK solutions tried per target when looking for one free of movable objects
 IK_ITERS = 100  # Levenberg-Marquardt iterations per solve (reachable targets converge in far fewer)
@@ -151,8 +152,13 @@ class RobotEvaluator:
                     continue
                 obj, _, pose, held, _ = queries[i]
                 path = self._approach(q_pre, q)
-                if not self._free(path, (obj,)):
+                if not self._free(_refine(path), (obj,)):
                     continue
+                if held:  # the object in hand, along the approach, must stay clear of fixed objects too
+                    shape = self.scene.body(obj).shape
+                    in_hand = self.arm.tool_world(_refine(path)) @ np.linalg.inv(g)
+                    if self.world.probe_collides([(shape, t) for t in in_hand], against="fixed"):
+                        continue
                 hits = self._swept_hits(path, (obj,))
                 if held:
                     hits |= self._object_hits(obj, self.scene.body(obj).shape, g, path, pose)
@@ -232,6 +238,14 @@ class RobotEvaluator:
         for key, q in zip(keys, self._ik(tools, "handover")):
             if q is not None and self._free(q[None], (key[0],)):
                 self.out.handover[key] = q
+
+
+def _refine(configs: np.ndarray, sub: int = 4) -> np.ndarray:
+    """Configurations with ``sub - 1`` more interpolated between consecutive ones (the validator's
+    resolution), so facts and grounding agree with what the validator checks."""
+    s = np.linspace(0.0, 1.0, sub + 1)[:-1, None]
+    return np.concatenate([a[None] * (1 - s) + b[None] * s for a, b in zip(configs[:-1], configs[1:])]
+                          + [configs[-1:]])
 
 
 def _robot_worker(args: tuple[SceneSpec, str, int]) -> RobotFacts:

@@ -20,7 +20,7 @@ import numpy as np
 from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action
 from mrgc.geometry.collision import CollisionWorld
-from mrgc.geometry.grounding import Answer, Grounder, Volume
+from mrgc.geometry.grounding import Answer, Grounder, Volume, refine
 from mrgc.geometry.planar import to_se2
 from mrgc.planner.plan import PlannedAction
 
@@ -85,7 +85,10 @@ class ReverseGrounder:
                 grounded.insert(0, relaxed)
                 steps = grounded + suffix
                 moved = {o for s in steps for o in s.moved}
-                blockers = self.g.hits([p for s in grounded for p in s.volume], among=sorted(out_objs))
+                # the grounded steps assumed the objects of the discarded earlier steps were out of the way:
+                # those are blockers too when the steps hit them, just like the never-moved ones
+                earlier = {a.obj for step in skeleton.steps[:t] for a in step}
+                blockers = self.g.hits([p for s in grounded for p in s.volume], among=sorted(out_objs | earlier))
                 must = {o for o in self.goal if o not in moved} | blockers
                 return Grounding(Outcome.PARTIAL, steps, must, reason=f"step {t + 1} needs {sorted(blockers)} moved")
             grounded.insert(0, strict)
@@ -125,7 +128,8 @@ class ReverseGrounder:
         pick = g.pick(a.pick_robot, a.obj, a.pick_grasp, avoid=avoid)
         if not pick.ok:
             return None
-        vols: dict[str, Volume] = {a.pick_robot: g.arm_volume(a.pick_robot, pick.configs)}  # type: ignore[arg-type]
+        # volumes on the validator's finer interpolation, so later placements keep clear between samples too
+        vols: dict[str, Volume] = {a.pick_robot: g.arm_volume(a.pick_robot, refine(pick.configs))}  # type: ignore[arg-type]
         planned = PlannedAction(a.obj, a.region, a.pick_robot, a.place_robot, a.pick_grasp, a.place_grasp)
         planned.configs["pick"] = _configs(pick.configs)
         if a.handover:
@@ -148,7 +152,7 @@ class ReverseGrounder:
                 planned.place_pose = _matrix(spot.pose)
                 planned.configs["place"] = _configs(place.configs)
                 # robots of later steps sweep V_fut at other times: only placements must stay out of it
-                vol = g.arm_volume(a.place_robot, place.configs, holding=(a.obj, a.place_grasp))  # type: ignore[arg-type]
+                vol = g.arm_volume(a.place_robot, refine(place.configs), holding=(a.obj, a.place_grasp))  # type: ignore[arg-type]
                 vols.setdefault(a.place_robot, []).extend(vol)
                 return planned, vols
         return None

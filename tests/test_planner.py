@@ -14,6 +14,7 @@ from mrgc.planner.ground import GroundedStep, Grounding, Outcome
 from mrgc.planner.mcts import MCTS
 from mrgc.planner.plan import PlannedAction, file_sha256
 from mrgc.planner.search import plan_problem
+from mrgc.planner.validate import validate
 
 ROOT = Path(__file__).resolve().parent.parent
 GEOMETRIC = sorted((ROOT / "domains" / "packaging").glob("pa*.mrg")) + sorted((ROOT / "domains" / "box-moving").glob("bo*.mrg"))
@@ -26,9 +27,11 @@ def plan_of(path: Path, seed: int = 0, time_limit: float = 120.0):  # type: igno
 
 @pytest.mark.slow
 @pytest.mark.parametrize("path", GEOMETRIC, ids=lambda p: p.name)
-def test_every_shipped_geometric_problem_gets_a_plan(path: Path) -> None:
+def test_every_shipped_geometric_problem_gets_a_plan_that_validates(path: Path) -> None:
     plan = plan_of(path)
     assert plan.status == "solved", plan.stats
+    report = validate(parse_file(path).problem(), plan.to_json(), str(path))
+    assert report.ok, [str(v) for v in report.violations]
     problem = parse_file(path).problem()
     moved = [a.object for step in plan.steps for a in step]
     assert len(moved) == len(set(moved))  # each object at most once

@@ -120,14 +120,14 @@ def main(argv: list[str] | None = None) -> None:
     # swept volume: 30 configurations of a 7-link chain
     links = make_links(7, rng)
     sweeps = [np.array([chain(7, np.random.default_rng(1000 * i + k)) for k in range(30)]) for i in range(batches)]
-    row(f"sweep of 30 configurations × 7 links: `batch_hits`",
+    row("sweep of 30 configurations × 7 links: `batch_hits`",
         lambda i: world.batch_hits(links, sweeps[i]), "")
 
     # colliding_with: which of the 20 objects does one object hit
     names = world.names("movable")
     row(f"`colliding_with` one object vs {args.boxes} objects + table",
         lambda i: world.colliding_with(names[i % len(names)]))
-    row(f"`colliding_with` one object vs movables, ignoring 3",
+    row("`colliding_with` one object vs movables, ignoring 3",
         lambda i: world.colliding_with(names[i % len(names)], against="movable", ignore=names[:3]))
 
     print(f"# Collision query costs\n\n`{' '.join([sys.executable.rsplit('/', 1)[-1], *sys.argv])}`  "

@@ -30,7 +30,7 @@ from mrgc.geometry.grasps import grasp_transform, known, pregrasp_transform
 from mrgc.geometry.ik import solve_ik_many
 from mrgc.geometry.motion import plan_joint_path, plan_se2_path
 from mrgc.geometry.planar import DiscGrid, PlanarRobot, is_planar, scene_bounds, to_se2
-from mrgc.geometry.predicates import APPROACH_SAMPLES, LIFT, scene_world, seed_for
+from mrgc.geometry.predicates import APPROACH_SAMPLES, LIFT, refine, scene_world, seed_for
 from mrgc.geometry.scene import SceneSpec, half_extents, inside
 from mrgc.geometry.transforms import rot_z, translation
 from mrgc.language.model import Box
@@ -292,15 +292,6 @@ class Grounder:
         res = plan_se2_path(scene_bounds(self.scene, 0.5), tuple(start), tuple(goal), valid,  # type: ignore[arg-type]
                             time_limit=time_limit, seed=seed_for(robot, "base-path", seed=self.seed))
         return Answer(Status.OK if res.solved else Status.NO_PATH, path=list(res.path))
-
-
-def refine(configs: np.ndarray, sub: int = 4) -> np.ndarray:
-    """``configs`` with ``sub - 1`` evenly spaced configurations inserted between consecutive ones."""
-    if len(configs) < 2:
-        return configs
-    s = np.linspace(0.0, 1.0, sub + 1)[:-1, None]
-    pieces = [a[None] * (1 - s) + b[None] * s for a, b in zip(configs[:-1], configs[1:])]
-    return np.concatenate(pieces + [configs[-1:]])
 
 
 def _against(among: Iterable[str] | str) -> str | tuple[str, ...]:

@@ -152,11 +152,11 @@ class RobotEvaluator:
                     continue
                 obj, _, pose, held, _ = queries[i]
                 path = self._approach(q_pre, q)
-                if not self._free(_refine(path), (obj,)):
+                if not self._free(refine(path), (obj,)):
                     continue
                 if held:  # the object in hand, along the approach, must stay clear of fixed objects too
                     shape = self.scene.body(obj).shape
-                    in_hand = self.arm.tool_world(_refine(path)) @ np.linalg.inv(g)
+                    in_hand = self.arm.tool_world(refine(path)) @ np.linalg.inv(g)
                     if self.world.probe_collides([(shape, t) for t in in_hand], against="fixed"):
                         continue
                 hits = self._swept_hits(path, (obj,))
@@ -240,9 +240,11 @@ class RobotEvaluator:
                 self.out.handover[key] = q
 
 
-def _refine(configs: np.ndarray, sub: int = 4) -> np.ndarray:
+def refine(configs: np.ndarray, sub: int = 4) -> np.ndarray:
     """Configurations with ``sub - 1`` more interpolated between consecutive ones (the validator's
     resolution), so facts and grounding agree with what the validator checks."""
+    if len(configs) < 2:
+        return configs
     s = np.linspace(0.0, 1.0, sub + 1)[:-1, None]
     return np.concatenate([a[None] * (1 - s) + b[None] * s for a, b in zip(configs[:-1], configs[1:])]
                           + [configs[-1:]])

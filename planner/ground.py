@@ -20,7 +20,8 @@ import numpy as np
 from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action
 from mrgc.geometry.collision import CollisionWorld
-from mrgc.geometry.grounding import Answer, Grounder, Volume, refine
+from mrgc.geometry.grounding import Answer, Grounder, Volume
+from mrgc.geometry.predicates import refine
 from mrgc.geometry.planar import to_se2
 from mrgc.planner.plan import PlannedAction
 

@@ -82,4 +82,5 @@ def prune(graph: TaskGraph) -> TaskGraph:
         actions=tuple(graph.actions[i] for i in keep),
         block_pick=tuple(graph.block_pick[i] for i in keep),
         block_place=tuple(graph.block_place[i] for i in keep),
+        single_handover_point=graph.single_handover_point,
     )

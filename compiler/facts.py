@@ -31,6 +31,8 @@ class FactBase:
     handover: frozenset[tuple[str, str, str, str, str]] = frozenset()  # (M, g1, g2, R1, R2)
     occludes_pick: dict[tuple[str, str, str], tuple[str, ...]] = field(default_factory=dict)  # (M2, g, R) -> M1s
     occludes_place: dict[tuple[str, str, str, str], tuple[str, ...]] = field(default_factory=dict)  # (M2, Re, g, R)
+    #: handovers that can happen at once (the number of handover points); None: no limit (symbolic)
+    handover_capacity: int | None = None
 
     @classmethod
     def from_problem(cls, problem: Problem, facts: Iterable[Fact] | None = None) -> "FactBase":
@@ -41,11 +43,12 @@ class FactBase:
             grasps={m.name: problem.grasps_of(m.name) for m in problem.movable},
             goal=problem.goal_regions,
             facts=problem.init if facts is None else facts,
+            handover_capacity=None if problem.symbolic else len(problem.handover_points),
         )
 
     @classmethod
     def from_facts(cls, robots: Iterable[str], objects: Iterable[str], grasps: dict[str, tuple[str, ...]],
-                   goal: dict[str, str], facts: Iterable[Fact]) -> "FactBase":
+                   goal: dict[str, str], facts: Iterable[Fact], handover_capacity: int | None = None) -> "FactBase":
         region: dict[str, str] = {}
         pick: set[tuple[str, str, str]] = set()
         place: set[tuple[str, str, str, str]] = set()
@@ -82,4 +85,5 @@ class FactBase:
             handover=frozenset(hand),
             occludes_pick={k: tuple(sorted(v, key=rank)) for k, v in occ_pick.items()},
             occludes_place={k: tuple(sorted(v, key=rank)) for k, v in occ_place.items()},
+            handover_capacity=handover_capacity,
         )

@@ -62,6 +62,9 @@ class TaskGraph:
     actions: tuple[Action, ...]
     block_pick: tuple[tuple[str, ...], ...]
     block_place: tuple[tuple[str, ...], ...]
+    #: the number of handover points when it is one: then at most one handover per step (beyond the paper:
+    #: two objects cannot be passed at the same point at once); None: no limit
+    single_handover_point: bool = False
 
     @cached_property
     def _by_object(self) -> dict[str, list[int]]:
@@ -128,6 +131,7 @@ def build_task_graph(facts: FactBase, must_move: Iterable[str], moved: Iterable[
         actions=tuple(actions),
         block_pick=tuple(block_pick),
         block_place=tuple(block_place),
+        single_handover_point=facts.handover_capacity == 1,
     )
 
 

@@ -102,24 +102,49 @@ class ReverseGrounder:
               key: str) -> GroundedStep | None:
         actions: list[PlannedAction] = []
         step_volume: Volume = []
-        robot_volumes: dict[str, Volume] = {}
+        motions: dict[str, dict[str, list[Volume]]] = {}  # robot -> phase -> volume at each sample
         for a in step:
             avoid_a = sorted((avoid | same) - {a.obj})
             planned = self._action(a, avoid_a, v_fut + step_volume, f"{key}:{a.obj}")
             if planned is None:
                 return None
             action, vols = planned
-            for robot, vol in vols.items():  # robots of one step must not collide with each other
-                for other, ovol in robot_volumes.items():
-                    if other != robot and _volumes_collide(vol, ovol):
+            mine = self._motions(action)
+            # robots of one step move at once: phase by phase (pick, handover, place; drives), samples paired
+            # by index as the validator replays them, they must not collide with each other
+            for robot, phases in mine.items():
+                for other, their in motions.items():
+                    if other != robot and _phases_collide(phases, their):
                         return None
-            for robot, vol in vols.items():
-                robot_volumes.setdefault(robot, []).extend(vol)
+            for robot, phases in mine.items():
+                motions.setdefault(robot, {}).update(phases)
+            for vol in vols.values():
                 step_volume.extend(vol)
             assert action.place_pose is not None
             step_volume.append((self.g.shape(a.obj), np.array(action.place_pose)))
             actions.append(action)
         return GroundedStep(actions, step_volume, tuple(a.obj for a in step))
+
+    def _motions(self, action: PlannedAction) -> dict[str, dict[str, list[Volume]]]:
+        """Each robot's volume at every sample of every phase of a planned action."""
+        g, obj = self.g, action.object
+        out: dict[str, dict[str, list[Volume]]] = {}
+        if g.is_planar(action.pick_robot):
+            held = {"to-pick": None, "to-place": (obj, action.pick_grasp), "home": None}
+            out[action.pick_robot] = {ph: [g.base_volume(action.pick_robot, [q], held[ph]) for q in np.array(path)]
+                                      for ph, path in action.paths.items()}
+            return out
+        out.setdefault(action.pick_robot, {})["pick"] = [
+            g.arm_volume(action.pick_robot, q[None]) for q in refine(np.array(action.configs["pick"]))]
+        if "handover" in action.configs:
+            giver, taker = np.array(action.configs["handover"])
+            out[action.pick_robot]["handover"] = [g.arm_volume(action.pick_robot, giver[None], (obj, action.pick_grasp))]
+            out.setdefault(action.place_robot, {})["handover"] = [
+                g.arm_volume(action.place_robot, taker[None], (obj, action.place_grasp))]
+        out.setdefault(action.place_robot, {})["place"] = [
+            g.arm_volume(action.place_robot, q[None], (obj, action.place_grasp))
+            for q in refine(np.array(action.configs["place"]))]
+        return out
 
     def _action(self, a: Action, avoid: list[str], v_fut: Volume,
                 key: str) -> tuple[PlannedAction, dict[str, Volume]] | None:
@@ -202,6 +227,19 @@ class ReverseGrounder:
             if ans.ok:
                 return point, ans
         return None
+
+
+def _phases_collide(mine: dict[str, list[Volume]], theirs: dict[str, list[Volume]]) -> bool:
+    """Do two robots collide in a phase both move in, their samples paired by index (resampled)?"""
+    for phase, samples in mine.items():
+        other = theirs.get(phase)
+        if not other:
+            continue
+        n = max(len(samples), len(other))
+        for i in range(n):
+            if _volumes_collide(samples[i * len(samples) // n], other[i * len(other) // n]):
+                return True
+    return False
 
 
 def _volumes_collide(a: Volume, b: Volume) -> bool:

@@ -53,6 +53,12 @@ class PaperEncoding(Encoding):
                 m.add([(X[a][t], 1) for a in acts] + [(X[a][t + 1], -1) for a in acts], hi=1,
                       name=f"c6[{r},{t + 1}]")
             m.add([(X[a][t], 1) for a in A] + [(X[a][t + 1], -1) for a in A], lo=1, name=f"c7[{t + 1}]")  # (7)
+        handovers = [a for a in A if graph.actions[a].handover]
+        if graph.single_handover_point and len(handovers) > 1:  # one handover point: one handover per step
+            m.add([(X[a][T - 1], 1) for a in handovers], hi=1, name="handover-point")
+            for t in range(T - 1):
+                m.add([(X[a][t], 1) for a in handovers] + [(X[a][t + 1], -1) for a in handovers], hi=1,
+                      name=f"handover-point[{t + 1}]")
         for o in graph.must_move:  # (8) M* is moved
             m.add([(X[a][0], 1) for a in of[o]], lo=1, hi=1, name=f"c8[{o}]")
         for a in A:  # (9) the obstacles of a selected action are moved

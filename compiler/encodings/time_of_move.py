@@ -62,6 +62,10 @@ class TimeOfMoveEncoding(Encoding):
                 tasks.append((busy, tau[o]))
             if len(tasks) > 1:
                 m.no_overlap.append(NoOverlap(tuple(tasks), name=f"robot[{r}]"))
+        handovers = [a for a in A if graph.actions[a].handover]
+        if graph.single_handover_point and len(handovers) > 1:  # one handover point: one handover per step
+            m.no_overlap.append(NoOverlap(tuple((y[a], tau[graph.actions[a].obj]) for a in handovers),
+                                          name="handover-point"))
         # redundant capacity rows (valid for every skeleton, they tighten the makespan bound): a robot
         # acts at most once per step, and all robots together at most |R| times per step
         for r in graph.robots:

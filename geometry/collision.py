@@ -353,12 +353,7 @@ class CollisionWorld:
         cb = self._first
         result, collide = cb.data.result, manager.collide
         for shape, t in shapes:
-            obj = (shape if type(shape) is CollisionShape else collision_shape(shape)).coal_object
-            t = np.asarray(t, dtype=float)
-            obj.setRotation(t[:3, :3])
-            obj.setTranslation(t[:3, 3])
-            obj.computeAABB()
-            collide(obj, cb)  # the manager re-initialises the callback (clears its result) first
+            collide(_posed(shape, t), cb)  # the manager re-initialises the callback (clears its result) first
             if result.isCollision():
                 return True
         return False
@@ -372,12 +367,7 @@ class CollisionWorld:
         cb = self._every
         result, collide = cb.data.result, manager.collide
         for shape, t in shapes:
-            obj = (shape if type(shape) is CollisionShape else collision_shape(shape)).coal_object
-            t = np.asarray(t, dtype=float)
-            obj.setRotation(t[:3, :3])
-            obj.setTranslation(t[:3, 3])
-            obj.computeAABB()
-            collide(obj, cb)
+            collide(_posed(shape, t), cb)
             if result.numContacts():
                 self._collect(result, hits)
         return hits
@@ -445,3 +435,14 @@ def _batch(shapes: Sequence[ShapeLike], transforms: np.ndarray) -> list[tuple[Co
         raise ValueError(f"transforms of shape {t.shape} do not match {len(links)} shapes")
     flat = t.reshape(-1, 4, 4)
     return list(zip(links * (len(flat) // max(1, len(links))), flat))
+
+
+def _posed(shape: ShapeLike, t: np.ndarray) -> Any:
+    """The shape's probe object moved to ``t`` (4×4), its bounding box refreshed (coal trap: without
+    ``computeAABB`` after a move the broadphase silently works on the old box)."""
+    obj = (shape if type(shape) is CollisionShape else collision_shape(shape)).coal_object
+    t = np.asarray(t, dtype=float)
+    obj.setRotation(t[:3, :3])
+    obj.setTranslation(t[:3, 3])
+    obj.computeAABB()
+    return obj

@@ -196,6 +196,9 @@ def cmd_plan(args: argparse.Namespace) -> int:
     from mrgc.planner.plan import file_sha256
     from mrgc.planner.search import plan_problem
 
+    if args.skeletons < 1 or args.time_limit <= 0 or (args.max_makespan is not None and args.max_makespan < 1):
+        raise InputError([Diagnostic("E000", "--skeletons and --max-makespan must be at least 1, "
+                                     "--time-limit positive")])
     problem = _load_problem(args.file, args.problem)
     with _progress(f"planning {problem.name} (phase 1, then the tree search; at most {args.time_limit:g} s)"):
         plan = plan_problem(problem, args.file, file_sha256(args.file), __version__, backend=args.backend,

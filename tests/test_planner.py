@@ -138,3 +138,16 @@ def test_puct_prefers_fewer_objects_at_first() -> None:
     search.root.visits = 1
     q = {len(e.skeleton.moved): search.q(search.root, e) for e in search.root.edges}
     assert q[1] == pytest.approx(1.0) and q[2] == pytest.approx(0.5)
+
+
+def test_bad_planner_options_are_usage_errors(capsys: pytest.CaptureFixture[str]) -> None:
+    src = str(ROOT / "domains" / "symbolic" / "chain-3.mrg")
+    for bad in (["--skeletons", "0"], ["--time-limit", "0"], ["--max-makespan", "0"]):
+        assert cli.main(["plan", src, *bad]) == 2
+        assert "error[E000]" in capsys.readouterr().err
+
+
+def test_a_time_limit_is_exit_3(capsys: pytest.CaptureFixture[str]) -> None:
+    src = str(ROOT / "domains" / "packaging" / "pa10.mrg")
+    assert cli.main(["plan", src, "--time-limit", "0.05"]) == 3
+    assert json.loads(capsys.readouterr().out)["status"] == "time limit"

@@ -122,16 +122,19 @@ def _load_problem(path: str, name: str | None) -> "Problem":
 def cmd_compile(args: argparse.Namespace) -> int:
     import json
 
-    from mrgc.planner.skeletons import compile_problem, export_model
+    from mrgc.planner.skeletons import compile_problem, export_model, problem_facts
 
     problem = _load_problem(args.file, args.problem)
     if args.skeletons < 1:
         raise InputError([Diagnostic("E000", "--skeletons must be at least 1")])
+    facts, facts_seconds = problem_facts(problem, seed=args.seed)  # once, for the skeletons and the export
     result = compile_problem(problem, backend=args.backend, encoding=args.encoding, skeletons=args.skeletons,
-                             max_makespan=args.max_makespan, time_limit=args.time_limit, seed=args.seed)
+                             max_makespan=args.max_makespan, time_limit=args.time_limit, facts=facts,
+                             seed=args.seed)
+    result.stats["facts_seconds"] = round(facts_seconds, 6)
     if args.emit:
         horizon = result.skeletons[0].makespan if result.skeletons else None
-        export_model(problem, args.emit, backend=args.backend, encoding=args.encoding, horizon=horizon)
+        export_model(problem, args.emit, backend=args.backend, encoding=args.encoding, horizon=horizon, facts=facts)
     if args.format == "json":
         print(json.dumps(result.to_json(), indent=2))
     else:

@@ -106,19 +106,6 @@ class SkeletonModel:
                hi: int | None = None, name: str = "", big_m: int | None = None) -> None:
         self.cond_rows.append(CondRow(tuple(when), Row(merge_terms(terms), lo, hi, name), big_m))
 
-    def features(self) -> frozenset[Feature]:
-        """The optional features this model uses."""
-        used = set()
-        if self.cond_rows:
-            used.add(Feature.CONDITIONAL)
-        if self.at_most_one:
-            used.add(Feature.AT_MOST_ONE)
-        if self.no_overlap:
-            used.add(Feature.NO_OVERLAP)
-        if len(self.objectives) > 1:
-            used.add(Feature.LEXICOGRAPHIC)
-        return frozenset(used)
-
     def bounds(self, terms: Terms) -> tuple[int, int]:
         """Smallest and largest value of ``sum(c * x)`` over the variable bounds."""
         lo = hi = 0

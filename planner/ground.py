@@ -105,10 +105,9 @@ class ReverseGrounder:
         motions: dict[str, dict[str, list[Volume]]] = {}  # robot -> phase -> volume at each sample
         for a in step:
             avoid_a = sorted((avoid | same) - {a.obj})
-            planned = self._action(a, avoid_a, v_fut + step_volume, f"{key}:{a.obj}")
-            if planned is None:
+            action = self._action(a, avoid_a, v_fut + step_volume, f"{key}:{a.obj}")
+            if action is None:
                 return None
-            action, vols = planned
             mine = self._motions(action)
             # robots of one step move at once: phase by phase (pick, handover, place; drives), samples paired
             # by index as the validator replays them, they must not collide with each other
@@ -118,15 +117,18 @@ class ReverseGrounder:
                         return None
             for robot, phases in mine.items():
                 motions.setdefault(robot, {}).update(phases)
-            for vol in vols.values():
-                step_volume.extend(vol)
+            for phases in mine.values():  # the step's volume is every sample of every motion
+                for samples in phases.values():
+                    for vol in samples:
+                        step_volume.extend(vol)
             assert action.place_pose is not None
             step_volume.append((self.g.shape(a.obj), np.array(action.place_pose)))
             actions.append(action)
         return GroundedStep(actions, step_volume, tuple(a.obj for a in step))
 
     def _motions(self, action: PlannedAction) -> dict[str, dict[str, list[Volume]]]:
-        """Each robot's volume at every sample of every phase of a planned action."""
+        """Each robot's volume at every sample of every phase of a planned action, arm approaches on the
+        validator's finer interpolation (so later placements keep clear between samples too)."""
         g, obj = self.g, action.object
         out: dict[str, dict[str, list[Volume]]] = {}
         if g.is_planar(action.pick_robot):
@@ -146,16 +148,13 @@ class ReverseGrounder:
             for q in refine(np.array(action.configs["place"]))]
         return out
 
-    def _action(self, a: Action, avoid: list[str], v_fut: Volume,
-                key: str) -> tuple[PlannedAction, dict[str, Volume]] | None:
+    def _action(self, a: Action, avoid: list[str], v_fut: Volume, key: str) -> PlannedAction | None:
         if self.g.is_planar(a.pick_robot):
             return self._drive(a, avoid, v_fut, key)
         g = self.g
         pick = g.pick(a.pick_robot, a.obj, a.pick_grasp, avoid=avoid)
         if not pick.ok:
             return None
-        # volumes on the validator's finer interpolation, so later placements keep clear between samples too
-        vols: dict[str, Volume] = {a.pick_robot: g.arm_volume(a.pick_robot, refine(pick.configs))}  # type: ignore[arg-type]
         planned = PlannedAction(a.obj, a.region, a.pick_robot, a.place_robot, a.pick_grasp, a.place_grasp)
         planned.configs["pick"] = _configs(pick.configs)
         if a.handover:
@@ -166,8 +165,6 @@ class ReverseGrounder:
             assert answer.configs is not None
             planned.handover_point = point
             planned.configs["handover"] = _configs(answer.configs)
-            vols[a.pick_robot] += g.arm_volume(a.pick_robot, answer.configs[:1], holding=(a.obj, a.pick_grasp))
-            vols[a.place_robot] = g.arm_volume(a.place_robot, answer.configs[1:], holding=(a.obj, a.place_grasp))
         for k in range(PLACEMENT_TRIES):
             spot = g.placement(a.obj, a.region, avoid=avoid, volume=v_fut, key=key, skip=k)
             if not spot.ok:
@@ -177,14 +174,10 @@ class ReverseGrounder:
             if place.ok:
                 planned.place_pose = _matrix(spot.pose)
                 planned.configs["place"] = _configs(place.configs)
-                # robots of later steps sweep V_fut at other times: only placements must stay out of it
-                vol = g.arm_volume(a.place_robot, refine(place.configs), holding=(a.obj, a.place_grasp))  # type: ignore[arg-type]
-                vols.setdefault(a.place_robot, []).extend(vol)
-                return planned, vols
+                return planned
         return None
 
-    def _drive(self, a: Action, avoid: list[str], v_fut: Volume,
-               key: str) -> tuple[PlannedAction, dict[str, Volume]] | None:
+    def _drive(self, a: Action, avoid: list[str], v_fut: Volume, key: str) -> PlannedAction | None:
         """A planar robot's action (path mode): drive from its start pose to the pick pose, carry the object
         to the place pose, drive back; every path free of fixed objects and of ``avoid``."""
         g, robot = self.g, a.pick_robot
@@ -214,9 +207,7 @@ class ReverseGrounder:
             planned.configs = {"pick": _configs(q_pick), "place": _configs(q_place)}
             planned.paths = {"to-pick": _configs(np.array(to_pick.path)), "to-place": _configs(np.array(carry.path)),
                              "home": _configs(np.array(back.path))}
-            volume = (g.base_volume(robot, to_pick.path) + g.base_volume(robot, carry.path, (a.obj, a.pick_grasp))
-                      + g.base_volume(robot, back.path))
-            return planned, {robot: volume}
+            return planned
         return None
 
     def _handover(self, a: Action, avoid: list[str]) -> tuple[str, Answer] | None:

@@ -9,9 +9,7 @@ Each IR model's expected optimum is hard-coded *and* recomputed by an exhaustive
 from __future__ import annotations
 
 import functools
-import importlib.util
 import itertools
-import sys
 import time
 from pathlib import Path
 from typing import Any, Callable, Sequence
@@ -28,18 +26,7 @@ ENCODINGS = ["paper", "disaggregated", "time-of-move"]
 SYMBOLIC = Path(__file__).resolve().parent.parent / "domains" / "symbolic"
 
 
-def _load_oracle() -> Any:
-    name = "skeleton_oracle"
-    if name not in sys.modules:
-        spec = importlib.util.spec_from_file_location(name, Path(__file__).with_name("skeleton_oracle.py"))
-        assert spec is not None and spec.loader is not None
-        module = importlib.util.module_from_spec(spec)
-        sys.modules[name] = module
-        spec.loader.exec_module(module)
-    return sys.modules[name]
-
-
-oracle = _load_oracle()
+import skeleton_oracle as oracle  # noqa: E402 - registered by tests/conftest.py
 
 
 # ---------------------------------------------------------------- an independent reference solver

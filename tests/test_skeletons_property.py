@@ -12,8 +12,6 @@ A problem whose goal already holds must give the empty skeleton, not "infeasible
 
 from __future__ import annotations
 
-import importlib.util
-import sys
 from pathlib import Path
 from typing import Any, Sequence
 
@@ -28,18 +26,7 @@ from mrgc.language.model import Problem
 from mrgc.planner.skeletons import SkeletonSource, compile_problem, must_move
 
 
-def _load_oracle() -> Any:
-    name = "skeleton_oracle"
-    if name not in sys.modules:
-        spec = importlib.util.spec_from_file_location(name, Path(__file__).with_name("skeleton_oracle.py"))
-        assert spec is not None and spec.loader is not None
-        module = importlib.util.module_from_spec(spec)
-        sys.modules[name] = module
-        spec.loader.exec_module(module)
-    return sys.modules[name]
-
-
-oracle = _load_oracle()
+import skeleton_oracle as oracle  # noqa: E402 - registered by tests/conftest.py
 
 BACKENDS = ["mip", "smt", "pysmt", "cpsat"]
 ENCODINGS = ["paper", "disaggregated", "time-of-move"]

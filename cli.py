@@ -246,6 +246,34 @@ def cmd_validate(args: argparse.Namespace) -> int:
     return EXIT_OK if report.ok else EXIT_NO_PLAN
 
 
+def cmd_generate(args: argparse.Namespace) -> int:
+    from mrgc.generate import KINDS
+    from mrgc.generate.document import domain_path
+
+    text = KINDS[args.kind](robots=args.robots, goals=args.goals, others=args.others, seed=args.seed)
+    if not args.output:
+        sys.stdout.write(text)
+        return EXIT_OK
+    if os.path.exists(args.output) and os.path.samefile(args.output, domain_path(args.kind)):
+        raise InputError([Diagnostic("E000", f"will not overwrite the domain the generator reads: {args.output}")])
+    folder = os.path.dirname(os.path.abspath(args.output))
+    import tempfile
+
+    tmp = None
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=".mrgc-generate-", suffix=".tmp", dir=folder)
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(text)
+        os.replace(tmp, args.output)
+    except OSError as exc:
+        raise InputError([Diagnostic("E000", f"cannot write {args.output}: {exc.strerror or exc}")]) from None
+    finally:
+        if tmp is not None and os.path.exists(tmp):
+            os.unlink(tmp)
+    print(f"{args.output}: {args.kind} problem written")
+    return EXIT_OK
+
+
 def cmd_backends(args: argparse.Namespace) -> int:
     import json
 
@@ -325,6 +353,15 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--problem", help="which problem of the file (default: the one the plan names, else its only one)")
     p.add_argument("--format", choices=["text", "json"], default="text")
     p.set_defaults(func=cmd_validate)
+
+    p = sub.add_parser("generate", help="write a random problem: packaging (arms, table, bins) or box-moving (rooms)")
+    p.add_argument("kind", choices=["packaging", "box-moving"])
+    p.add_argument("--robots", type=int, default=2, metavar="N", help="arms 2-6 (packaging), carts 1-4 (box-moving)")
+    p.add_argument("--goals", type=int, default=3, metavar="G", help="goal objects (default 3)")
+    p.add_argument("--others", type=int, default=2, metavar="K", help="other objects (default 2)")
+    p.add_argument("--seed", type=int, default=0, metavar="S")
+    p.add_argument("-o", "--output", metavar="FILE", help="write here (default: standard output)")
+    p.set_defaults(func=cmd_generate)
 
     p = sub.add_parser("backends", help="list solver backends: installed?, versions, encodings, features")
     p.add_argument("--format", choices=["text", "json"], default="text")

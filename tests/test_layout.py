@@ -21,6 +21,7 @@ MAY_IMPORT: dict[str, set[str]] = {
     "backends": {"errors", "language", "compiler"},
     "geometry": {"errors", "language"},
     "planner": {"errors", "language", "compiler", "backends", "geometry"},
+    "generate": {"errors", "language"},
     "cli": {"*"},
     "__init__": {"*"},
 }

@@ -51,10 +51,12 @@ class Arm:
         """Tool centre point pose(s) in the world at configuration(s) ``q``."""
         return self.base @ ee_pose(self.model, q) @ self.tcp
 
-    def link_transforms(self, q: np.ndarray) -> np.ndarray:
-        """World transforms of the probed links: ``q.shape[:-1] + (L, 4, 4)``."""
+    def link_transforms(self, q: np.ndarray, opening: float | None = None) -> np.ndarray:
+        """World transforms of the probed links: ``q.shape[:-1] + (L, 4, 4)``, the fingers ``opening``
+        metres apart (None: fully open, as the URDF's upper limits)."""
         _, index = self.probes
-        return fk_world(self.model, q, self.base)[..., index, :, :]
+        fingers = None if opening is None else self.model.finger_value(opening)
+        return fk_world(self.model, q, self.base, fingers)[..., index, :, :]
 
     def in_reach(self, point: np.ndarray, margin: float = 0.0) -> bool:
         """Whether a world point can be within reach of the tool (cheap pre-filter)."""

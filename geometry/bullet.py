@@ -21,7 +21,7 @@ import math
 import os
 import sys
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Iterator, Mapping, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Iterator, Mapping, Sequence
 
 import numpy as np
 
@@ -271,7 +271,8 @@ class ReplayRobot:
     the base link to the end-effector link, in order), ``lower``/``upper`` their limits as pybullet reads
     them from the URDF (an unlimited joint: -inf/+inf), ``ee`` the end-effector link index.  Planar robots
     (``planar``) are one rigid body, their footprint, at the base pose lifted by ``lift``; their
-    configuration is ``(x, y, yaw)``, yaw in radians, limits infinite.
+    configuration is ``(x, y, yaw)``, yaw in radians, limits infinite.  ``fingers``: an arm's finger joints
+    (pybullet index, lower, upper, frozen value) and ``finger_value`` the model's opening -> joint value.
     """
 
     name: str
@@ -285,6 +286,8 @@ class ReplayRobot:
     base: np.ndarray
     lift: np.ndarray
     joint_names: tuple[str, ...] = ("x", "y", "yaw")
+    fingers: tuple[tuple[int, float, float, float], ...] = ()
+    finger_value: Callable[[float], float] | None = None
 
     @property
     def dof(self) -> int:
@@ -394,14 +397,18 @@ class ReplayScene:
             lo, hi = float(ji[8]), float(ji[9])
             lower.append(lo if lo <= hi else -math.inf)  # pybullet reports an unlimited joint as lower > upper
             upper.append(hi if lo <= hi else math.inf)
+        fingers = []
         for link in model.links:  # off-chain movable joints stay at their frozen values (fingers open)
             j = by_link.get(link.name, -1)
             if link.chain_index < 0 and link.joint_kind in ("revolute", "prismatic") and j >= 0:
                 pb.resetJointState(body, j, float(link.frozen_value), physicsClientId=cid)
+                if link.finger:
+                    fingers.append((j, link.lower, link.upper, float(link.frozen_value)))
         self.robots[name] = ReplayRobot(
             name=name, body=body, planar=False, joints=tuple(joints), lower=np.array(lower), upper=np.array(upper),
             ee=by_link[model.end_effector], links={i: n for n, i in by_link.items()},
-            base=np.asarray(base, dtype=float), lift=np.eye(4), joint_names=tuple(jt.name for jt in model.joints))
+            base=np.asarray(base, dtype=float), lift=np.eye(4), joint_names=tuple(jt.name for jt in model.joints),
+            fingers=tuple(fingers), finger_value=model.finger_value)
         self._owner[body] = name
 
     def _add_planar(self, name: str, footprint: Shape | None, base: np.ndarray) -> None:
@@ -441,6 +448,13 @@ class ReplayScene:
             self.pb.resetBasePositionAndOrientation(r.body, pos, orn, physicsClientId=self.cid)
             return
         for j, v in zip(r.joints, q):
+            self.pb.resetJointState(r.body, j, float(v), physicsClientId=self.cid)
+
+    def set_fingers(self, robot: str, opening: float | None) -> None:
+        """Open an arm's fingers ``opening`` metres apart (None: back to their frozen, fully open values)."""
+        r = self.robots[robot]
+        for j, lo, hi, frozen in r.fingers:
+            v = frozen if opening is None or r.finger_value is None else min(max(r.finger_value(opening), lo), hi)
             self.pb.resetJointState(r.body, j, float(v), physicsClientId=self.cid)
 
     def ee_pose(self, robot: str) -> np.ndarray:

@@ -125,10 +125,34 @@ def base_transform(base: BasePose) -> np.ndarray | None:
     return np.asarray(base, dtype=float)
 
 
-def fk(model: RobotModel, q: np.ndarray, base: BasePose = None) -> np.ndarray:
+_FINGER_STEPS: dict[tuple[str, float], tuple[tuple[int, int, int, np.ndarray | None], ...]] = {}
+
+
+def _steps(model: RobotModel, p: _Plan, fingers: float | None) -> tuple[tuple[int, int, int, np.ndarray | None], ...]:
+    """The chaining steps of ``p`` with the finger joints (off-chain prismatic) at ``fingers`` (clamped into
+    their limits) instead of their frozen values; cached per (model, value)."""
+    if fingers is None:
+        return p.steps
+    key = (model.key, round(float(fingers), 12))
+    steps = _FINGER_STEPS.get(key)
+    if steps is None:
+        if len(_FINGER_STEPS) > 4096:  # openings come from object widths: few distinct values; stay bounded
+            _FINGER_STEPS.clear()
+        links = model.links
+        steps = tuple(
+            (k, parent, ci, _local("prismatic", links[k].origin, links[k].axis,
+                                   min(max(float(fingers), links[k].lower), links[k].upper))
+             if links[k].finger else const)
+            for k, parent, ci, const in p.steps)
+        _FINGER_STEPS[key] = steps
+    return steps
+
+
+def fk(model: RobotModel, q: np.ndarray, base: BasePose = None, fingers: float | None = None) -> np.ndarray:
     """Frames of every link (in ``model.links`` order): shape ``q.shape[:-1] + (L, 4, 4)``.
 
-    In the base-link frame, or in the world when ``base`` (the base link's pose) is given.
+    In the base-link frame, or in the world when ``base`` (the base link's pose) is given.  ``fingers``
+    sets the finger joints (see :meth:`RobotModel.finger_value`); None leaves them frozen (open).
     """
     q = _as_q(model, q)
     p = plan(model)
@@ -142,14 +166,14 @@ def fk(model: RobotModel, q: np.ndarray, base: BasePose = None) -> np.ndarray:
     out = np.empty((flat.shape[0], len(model.links), 4, 4))
     bt = base_transform(base)
     out[:, 0] = np.eye(4) if bt is None else bt
-    for k, parent, ci, const in p.steps:
+    for k, parent, ci, const in _steps(model, p, fingers):
         np.matmul(out[:, parent], local[:, ci] if const is None else const, out=out[:, k])
     return out.reshape(batch + out.shape[1:])
 
 
-def fk_world(model: RobotModel, q: np.ndarray, base: BasePose) -> np.ndarray:
+def fk_world(model: RobotModel, q: np.ndarray, base: BasePose, fingers: float | None = None) -> np.ndarray:
     """:func:`fk` with the base link at ``base`` (a :class:`Pose` or a 4×4): ``world = base_T @ link_T``."""
-    return fk(model, q, base)
+    return fk(model, q, base, fingers)
 
 
 def link_poses(model: RobotModel, q: np.ndarray, base: BasePose = None) -> dict[str, np.ndarray]:

@@ -26,7 +26,7 @@ import numpy as np
 
 from mrgc.geometry.arm import Arm
 from mrgc.geometry.collision import CollisionShape, CollisionWorld, collision_shape
-from mrgc.geometry.grasps import grasp_transform, known, pregrasp_transform
+from mrgc.geometry.grasps import finger_opening, fits, grasp_transform, pregrasp_transform
 from mrgc.geometry.ik import solve_ik_many
 from mrgc.geometry.motion import plan_joint_path, plan_se2_path
 from mrgc.geometry.planar import DiscGrid, PlanarRobot, is_planar, scene_bounds, to_se2
@@ -106,17 +106,22 @@ class Grounder:
         return collision_shape(self.scene.body(obj).shape)
 
     # ------------------------------------------------------------ volumes
-    def arm_volume(self, robot: str, configs: np.ndarray, holding: tuple[str, str] | None = None) -> Volume:
-        """Link hulls (and the held object) at each of ``configs`` (C, dof)."""
+    def arm_volume(self, robot: str, configs: np.ndarray, holding: tuple[str, str] | None = None,
+                   grasp: tuple[str, str] | None = None) -> Volume:
+        """Link hulls (and the held object) at each of ``configs`` (C, dof); the fingers stand at the opening
+        of the (object, grasp) held, or of ``grasp`` (approaching it), else fully open."""
         arm = self.arm(robot)
         shapes, _ = arm.probes
         out: Volume = []
-        transforms = arm.link_transforms(np.atleast_2d(configs))
+        fingers = holding or grasp
+        opening = None if fingers is None else \
+            finger_opening(self.scene.grasp(fingers[1]), self.scene.body(fingers[0]).shape)
+        transforms = arm.link_transforms(np.atleast_2d(configs), opening)
         for t in transforms:
             out.extend(zip(shapes, t))
         if holding is not None:
-            obj, grasp = holding
-            g_inv = np.linalg.inv(grasp_transform(grasp, self.scene.body(obj).shape))
+            obj, held_grasp = holding
+            g_inv = np.linalg.inv(grasp_transform(self.scene.grasp(held_grasp), self.scene.body(obj).shape))
             for tool in arm.tool_world(np.atleast_2d(configs)):
                 out.append((self.shape(obj), tool @ g_inv))
         return out
@@ -189,10 +194,11 @@ class Grounder:
     # ------------------------------------------------------------ arm configurations
     def _approach(self, robot: str, obj: str, grasp: str, pose: np.ndarray, key: str,
                   avoid: Iterable[str], attempts: int = 8, approach: bool = True, held: bool = False) -> Answer:
-        if not known(grasp):
-            return Answer(Status.NO_IK)
+        spec = self.scene.grasp_specs.get(grasp)
         arm = self.arm(robot)
-        g_t = grasp_transform(grasp, self.scene.body(obj).shape)
+        if spec is None or not fits(spec, self.scene.body(obj).shape, arm.spec.kind):
+            return Answer(Status.NO_IK)  # no geometry, or the gripper does not open wide enough
+        g_t = grasp_transform(spec, self.scene.body(obj).shape)
         avoid = tuple(a for a in avoid if a != obj)
         blockers: set[str] = set()
         status = Status.NO_IK
@@ -214,7 +220,8 @@ class Grounder:
                 configs = np.asarray(q.q)[None]
             # checked on a 4× finer interpolation than the configurations kept (the validator's resolution),
             # with the object in hand when placing
-            volume = self.arm_volume(robot, refine(configs), holding=(obj, grasp) if held else None)
+            volume = self.arm_volume(robot, refine(configs), holding=(obj, grasp) if held else None,
+                                     grasp=(obj, grasp))
             self.queries += 1
             if self.world.probe_collides(volume, against="fixed", ignore=() if held else (obj,)):
                 status = Status.COLLISION
@@ -247,9 +254,9 @@ class Grounder:
             return Answer(a.status if not a.ok else b.status, blockers=a.blockers | b.blockers)
         assert a.configs is not None and b.configs is not None
         world = CollisionWorld()
-        for i, (shape, t) in enumerate(self.arm_volume(taker, b.configs[-1:])):
+        for i, (shape, t) in enumerate(self.arm_volume(taker, b.configs[-1:], grasp=(obj, g2))):
             world.add(f"t{i}", shape, t, "taker")
-        if world.probe_collides(self.arm_volume(giver, a.configs[-1:]), against="taker"):
+        if world.probe_collides(self.arm_volume(giver, a.configs[-1:], grasp=(obj, g1)), against="taker"):
             return Answer(Status.COLLISION)
         return Answer(Status.OK, pose=pose, configs=np.stack([a.configs[-1], b.configs[-1]]))
 

@@ -15,7 +15,9 @@ that imports it); its forward and inverse kinematics and distance references (:f
 Frames: a link's frame is its URDF link frame (pybullet's ``worldLinkFrame``, not its centre of mass); a
 movable joint's frame is its child link's frame.  Off-chain movable joints (the Panda's fingers) are frozen
 at :attr:`Link.frozen_value`: a prismatic one at its upper limit (gripper open), a revolute one at 0
-clamped into its limits.
+clamped into its limits.  The fingers are the off-chain prismatic joints: forward kinematics can set them
+to another value (:meth:`RobotModel.finger_value` turns a finger opening into it: each finger travels
+half the opening, so a Panda finger joint is opening / 2).
 """
 
 from __future__ import annotations
@@ -73,6 +75,7 @@ class Link:
     -1), ``fixed``, ``revolute`` or ``prismatic``.  ``chain_index`` is the joint's position in the
     configuration vector, or -1 when the joint is not on the base→end-effector chain; such a movable joint
     is frozen at ``frozen_value``.  ``points`` (P, 3) are all collision vertices in the link frame.
+    ``lower`` and ``upper`` are the joint's limits (0 for fixed joints and the base).
     """
 
     name: str
@@ -86,6 +89,13 @@ class Link:
     frozen_value: float
     collisions: tuple[Collision, ...]
     points: np.ndarray
+    lower: float = 0.0
+    upper: float = 0.0
+
+    @property
+    def finger(self) -> bool:
+        """An off-chain prismatic joint: a gripper finger."""
+        return self.chain_index < 0 and self.joint_kind == "prismatic"
 
 
 @dataclass(frozen=True, eq=False)
@@ -147,6 +157,11 @@ class RobotModel:
             if link.name == name:
                 return link.index
         raise KeyError(name)
+
+    def finger_value(self, opening: float) -> float:
+        """The finger joint value that opens the gripper ``opening`` metres: each of the two fingers
+        travels half of it (forward kinematics clamps it into each finger joint's limits)."""
+        return opening / 2
 
     def clamp(self, q: np.ndarray) -> np.ndarray:
         """``q`` clipped into the joint limits."""
@@ -318,7 +333,7 @@ def _build_model(path: str, end_effector: str) -> RobotModel:
         links.append(Link(
             name=name, index=k, parent=parent, joint=jname, joint_kind=kind, origin=_ro(origin), axis=_ro(axis),
             chain_index=chain_index, frozen_value=frozen, collisions=collisions,
-            points=_ro(np.concatenate(pts) if pts else np.zeros((0, 3)))))
+            points=_ro(np.concatenate(pts) if pts else np.zeros((0, 3))), lower=float(lo), upper=float(hi)))
 
     joints: list[Joint] = []
     prev = 0  # frame of the previous chain joint (its child link) or the base link

@@ -31,7 +31,7 @@ import numpy as np
 
 from mrgc.geometry.arm import Arm
 from mrgc.geometry.collision import CollisionWorld
-from mrgc.geometry.grasps import grasp_transform, known, pregrasp_transform
+from mrgc.geometry.grasps import finger_opening, fits, grasp_transform, pregrasp_transform
 from mrgc.geometry.ik import solve_ik_many
 from mrgc.geometry.kinematics import model_for_kind
 from mrgc.geometry.scene import SceneSpec, half_extents, inside
@@ -103,15 +103,26 @@ class RobotEvaluator:
                             q_init=start, restarts=restarts, max_iters=IK_ITERS)
         return [r.q if r.solved else None for r in res]
 
-    def _free(self, qs: np.ndarray, ignore: tuple[str, ...], against: str = "fixed") -> bool:
-        shapes, _ = self.arm.probes
-        self.out.collision_checks += 1
-        return not self.world.batch_collides(shapes, self.arm.link_transforms(qs), against=against, ignore=ignore)
+    def usable(self, obj: str, grasp: str) -> bool:
+        """Whether this arm can use ``grasp`` on ``obj``: the grasp has geometry and the gripper opens wide
+        enough for it (geometry/grasps.py)."""
+        spec = self.scene.grasp_specs.get(grasp)
+        return spec is not None and fits(spec, self.scene.body(obj).shape, self.arm.spec.kind)
 
-    def _swept_hits(self, qs: np.ndarray, ignore: tuple[str, ...]) -> set[str]:
+    def opening(self, obj: str, grasp: str) -> float:
+        """The finger opening while approaching or holding ``obj`` with ``grasp``."""
+        return finger_opening(self.scene.grasp(grasp), self.scene.body(obj).shape)
+
+    def _free(self, qs: np.ndarray, ignore: tuple[str, ...], opening: float | None, against: str = "fixed") -> bool:
         shapes, _ = self.arm.probes
         self.out.collision_checks += 1
-        return self.world.batch_hits(shapes, self.arm.link_transforms(qs), against="movable", ignore=ignore)
+        return not self.world.batch_collides(shapes, self.arm.link_transforms(qs, opening), against=against,
+                                             ignore=ignore)
+
+    def _swept_hits(self, qs: np.ndarray, ignore: tuple[str, ...], opening: float | None) -> set[str]:
+        shapes, _ = self.arm.probes
+        self.out.collision_checks += 1
+        return self.world.batch_hits(shapes, self.arm.link_transforms(qs, opening), against="movable", ignore=ignore)
 
     @staticmethod
     def _approach(q_pre: np.ndarray, q: np.ndarray) -> np.ndarray:
@@ -139,7 +150,8 @@ class RobotEvaluator:
         for attempt in range(IK_SEEDS):
             if not todo:
                 break
-            g_ts = [grasp_transform(queries[i][1], self.scene.body(queries[i][0]).shape) for i in todo]
+            g_ts = [grasp_transform(self.scene.grasp(queries[i][1]), self.scene.body(queries[i][0]).shape)
+                    for i in todo]
             qs = self._ik([queries[i][2] @ g for i, g in zip(todo, g_ts)], "grasp", attempt=attempt)
             unsolvable = {i for i, q in zip(todo, qs) if q is None}  # IK with restarts failed: no retry
             ok = [(i, g, q) for i, g, q in zip(todo, g_ts, qs) if q is not None and not (
@@ -150,16 +162,17 @@ class RobotEvaluator:
             for (i, g, q), q_pre in zip(ok, pres):
                 if q_pre is None:
                     continue
-                obj, _, pose, held, _ = queries[i]
+                obj, grasp, pose, held, _ = queries[i]
+                opening = self.opening(obj, grasp)
                 path = self._approach(q_pre, q)
-                if not self._free(refine(path), (obj,)):
+                if not self._free(refine(path), (obj,), opening):
                     continue
                 if held:  # the object in hand, along the approach, must stay clear of fixed objects too
                     shape = self.scene.body(obj).shape
                     in_hand = self.arm.tool_world(refine(path)) @ np.linalg.inv(g)
                     if self.world.probe_collides([(shape, t) for t in in_hand], against="fixed"):
                         continue
-                hits = self._swept_hits(path, (obj,))
+                hits = self._swept_hits(path, (obj,), opening)
                 if held:
                     hits |= self._object_hits(obj, self.scene.body(obj).shape, g, path, pose)
                 if i not in found or (found[i][1] and not hits):
@@ -191,7 +204,7 @@ class RobotEvaluator:
         r, scene = self.arm.name, self.scene
         near = {m.name: self.arm.in_reach(m.pose[:3, 3], margin=0.3) for m in scene.movable}
         picks = [(m.name, g, m.pose, False, "pick") for m in scene.movable if near[m.name]
-                 for g in scene.grasps[m.name] if known(g)]
+                 for g in scene.grasps[m.name] if self.usable(m.name, g)]
         for i, (path, hits) in sorted(self._solve(picks, want_free=True).items()):
             obj, g = picks[i][0], picks[i][1]
             self.out.facts.append(Fact("reachable-pick", (obj, g, r)))
@@ -201,7 +214,8 @@ class RobotEvaluator:
         for m in scene.movable:
             for region in sorted({scene.goal.get(m.name), self.current.get(m.name)} - {None}):  # type: ignore[type-var]
                 poses = [p for p in self.placements(m.name, region) if self.arm.in_reach(p[:3, 3], margin=0.3)]
-                triples.extend((m.name, region, g, poses) for g in scene.grasps[m.name] if known(g) and poses)
+                triples.extend((m.name, region, g, poses) for g in scene.grasps[m.name]
+                               if self.usable(m.name, g) and poses)
         placed: dict[int, set[str]] = {}
         for k in range(PLACEMENT_GRID * PLACEMENT_GRID):
             open_ = [i for i, t in enumerate(triples) if k < len(t[3]) and (i not in placed or placed[i])
@@ -232,11 +246,11 @@ class RobotEvaluator:
                 if not self.arm.in_reach(pose[:3, 3], margin=0.3):
                     continue
                 for g in self.scene.grasps[obj]:
-                    if known(g):
+                    if self.usable(obj, g):
                         keys.append((obj, point, g))
-                        tools.append(pose @ grasp_transform(g, body.shape))
+                        tools.append(pose @ grasp_transform(self.scene.grasp(g), body.shape))
         for key, q in zip(keys, self._ik(tools, "handover")):
-            if q is not None and self._free(q[None], (key[0],)):
+            if q is not None and self._free(q[None], (key[0],), self.opening(key[0], key[2])):
                 self.out.handover[key] = q
 
 
@@ -316,15 +330,19 @@ def _handovers(scene: SceneSpec, per_robot: dict[str, RobotFacts]) -> set[Fact]:
                             continue
                         a1 = arms.setdefault(r1, Arm(scene.robot(r1)))
                         a2 = arms.setdefault(r2, Arm(scene.robot(r2)))
-                        if not _arms_collide(a1, q1, a2, q2):
+                        shape = scene.body(obj).shape
+                        w1 = finger_opening(scene.grasp(g1), shape)
+                        w2 = finger_opening(scene.grasp(g2), shape)
+                        if not _arms_collide(a1, q1, w1, a2, q2, w2):
                             out.add(fact)
     return out
 
 
-def _arms_collide(a1: Arm, q1: np.ndarray, a2: Arm, q2: np.ndarray) -> bool:
+def _arms_collide(a1: Arm, q1: np.ndarray, w1: float, a2: Arm, q2: np.ndarray, w2: float) -> bool:
+    """Whether two arms collide, their fingers ``w1`` and ``w2`` apart."""
     world = CollisionWorld()
     shapes2, _ = a2.probes
-    for i, (shape, t) in enumerate(zip(shapes2, a2.link_transforms(q2))):
+    for i, (shape, t) in enumerate(zip(shapes2, a2.link_transforms(q2, w2))):
         world.add(f"{a2.name}#{i}", shape, t, "robot")
     shapes1, _ = a1.probes
-    return world.batch_collides(shapes1, a1.link_transforms(q1), against="robot")
+    return world.batch_collides(shapes1, a1.link_transforms(q1, w1), against="robot")

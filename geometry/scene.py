@@ -13,7 +13,7 @@ import numpy as np
 
 from mrgc.errors import Diagnostic, InputError
 from mrgc.geometry.transforms import from_pose
-from mrgc.language.model import Box, Cylinder, Mesh, Problem, RobotKind, Shape, Sphere
+from mrgc.language.model import Box, Cylinder, GraspSpec, Mesh, Problem, RobotKind, Shape, Sphere
 
 
 @dataclass(frozen=True)
@@ -48,6 +48,11 @@ class SceneSpec:
     grasps: dict[str, tuple[str, ...]]
     handover_of: dict[str, tuple[str, ...]]
     goal: dict[str, str]
+    grasp_specs: dict[str, GraspSpec] = field(default_factory=dict)  # grasp name -> its geometry
+
+    def grasp(self, name: str) -> GraspSpec:
+        """The geometry of grasp ``name`` (KeyError for a grasp with none: planar-only names)."""
+        return self.grasp_specs[name]
 
     def body(self, name: str) -> Body:
         for b in (*self.movable, *self.fixed, *self.regions):
@@ -80,6 +85,7 @@ def scene_from_problem(problem: Problem) -> SceneSpec:
         grasps={m.name: problem.grasps_of(m.name) for m in problem.movable},
         handover_of={m.name: m.handover_points for m in problem.movable},
         goal=problem.goal_regions,
+        grasp_specs=problem.grasp_specs,
     )
 
 

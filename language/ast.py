@@ -30,7 +30,7 @@ class Number:
 
 @dataclass(frozen=True)
 class Symbol:
-    """A bare name used as a value, e.g. ``:kind panda`` or ``:base fixed``."""
+    """A bare name used as a value, e.g. ``:kind panda`` or ``:base fixed``, or a signed axis word (``-z``)."""
 
     name: str
     span: Span = _span()
@@ -95,11 +95,18 @@ class RobotKindDecl:
 
 @dataclass(frozen=True)
 class Grasps:
-    """``(:grasps top side ...)``: the domain's grasp vocabulary."""
+    """``(:grasps top (top-x :approach -z :fingers x) ...)``: the domain's grasp vocabulary.
 
-    names: tuple[str, ...]
-    name_spans: tuple[Span, ...] = field(default=(), compare=False, repr=False)
+    A bare name (``top``) is a built-in grasp (or, in a domain without robot kinds, just a name); a
+    declaration (``(NAME :approach AXIS :fingers AXIS ...)``) gives a grasp its geometry.
+    """
+
+    decls: tuple[Decl, ...]
     span: Span = _span()
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return tuple(d.name for d in self.decls)
 
 
 @dataclass(frozen=True)

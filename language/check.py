@@ -11,9 +11,13 @@ from typing import Any, Iterable
 from mrgc.errors import Diagnostic, Span
 from mrgc.language import ast
 from mrgc.language.model import (
+    BUILTIN_GRASPS,
+    DEFAULT_GRASP_DEPTH,
+    DEFAULT_GRIPPER_OPENING,
     PREDICATES,
     REQUIREMENTS,
     Domain,
+    GraspSpec,
     Fact,
     FixedObject,
     HandoverPoint,
@@ -86,16 +90,6 @@ class Checker:
                     hint = did_you_mean(flag, REQUIREMENTS) or f" (known: {', '.join(':' + r for r in REQUIREMENTS)})"
                     self.err("E235", f"unknown requirement ':{flag}'{hint}", span)
             reqs = tuple(dict.fromkeys(f for f in req.flags if f in REQUIREMENTS))
-        grasps: tuple[str, ...] = ()
-        if "grasps" in secs:
-            g: ast.Grasps = secs["grasps"]
-            seen: dict[str, Span] = {}
-            spans = g.name_spans or (g.span,) * len(g.names)
-            for name, span in zip(g.names, spans):
-                if name in seen:
-                    self.err("E200", f"grasp '{name}' declared twice (first at {seen[name]})", span)
-                seen.setdefault(name, span)
-            grasps = tuple(seen)
         kinds: dict[str, RobotKind] = {}
         for sec in d.sections:
             if isinstance(sec, ast.RobotKindDecl):
@@ -104,7 +98,45 @@ class Checker:
                     self.err("E200", f"robot kind '{sec.name}' declared twice (first at {kinds[sec.name].span})", sec.span)
                 else:
                     kinds[sec.name] = kind
-        return Domain(d.name, reqs, tuple(kinds.values()), grasps, self.file, d.span)
+        grasps: tuple[str, ...] = ()
+        specs: list[GraspSpec] = []
+        if "grasps" in secs:
+            seen: dict[str, Span] = {}
+            for decl in secs["grasps"].decls:
+                if decl.name in seen:
+                    self.err("E200", f"grasp '{decl.name}' declared twice (first at {seen[decl.name]})", decl.span)
+                    continue
+                seen[decl.name] = decl.span
+                if not decl.bare:
+                    spec = self.grasp(decl)
+                    if spec is not None:
+                        specs.append(spec)
+                elif kinds and decl.name not in BUILTIN_GRASPS:
+                    hint = did_you_mean(decl.name, BUILTIN_GRASPS) or f" (built in: {' '.join(BUILTIN_GRASPS)})"
+                    self.err("E243", f"grasp '{decl.name}' has no geometry: it is not built in and not declared "
+                             f"as ({decl.name} :approach AXIS :fingers AXIS){hint}", decl.span)
+            grasps = tuple(seen)
+        return Domain(d.name, reqs, tuple(kinds.values()), grasps, self.file, d.span, tuple(specs))
+
+    def grasp(self, d: ast.Decl) -> GraspSpec | None:
+        """The geometry of a declared grasp ``(NAME :approach AXIS :fingers AXIS :depth D :offset (X Y Z))``."""
+        what = f"grasp '{d.name}'"
+        table = self.props.table("grasp", what, d.props)
+        vals = {key: self.props.read("grasp", prop) for key, prop in table.items()}
+        for key in ("approach", "fingers"):
+            if key not in table:
+                self.err("E255", f"{what} needs ':{key}'", d.span)
+        approach, fingers = vals.get("approach"), vals.get("fingers")
+        if approach is None or fingers is None or ("depth" in table and vals["depth"] is None) or (
+                "offset" in table and vals["offset"] is None):
+            return None
+        if sum(a * b for a, b in zip(approach, fingers)) != 0:
+            span = table["fingers"].span
+            self.err("E241", f"{what}: the finger axis ({_word(table['fingers'])}) must be perpendicular to the "
+                     f"approach axis ({_word(table['approach'])})", span)
+            return None
+        return GraspSpec(d.name, approach, fingers, vals.get("depth", DEFAULT_GRASP_DEPTH),  # type: ignore[arg-type]
+                         vals.get("offset", (0.0, 0.0, 0.0)), span=d.span)  # type: ignore[arg-type]
 
     def robot_kind(self, k: ast.RobotKindDecl) -> RobotKind:
         what = f"robot kind '{k.name}'"
@@ -125,6 +157,7 @@ class Checker:
             carry=vals.get("carry"),  # type: ignore[arg-type]
             reach=vals.get("reach"),  # type: ignore[arg-type]
             tcp=vals.get("tcp"),  # type: ignore[arg-type]
+            gripper_opening=vals.get("gripper-opening") or DEFAULT_GRIPPER_OPENING,  # type: ignore[arg-type]
             source=self.file,
             span=k.span,
         )
@@ -138,7 +171,8 @@ class Checker:
         sort_of = self._declare(decls)
         geometric = self._classify(decls)
         kinds = {k.name for k in domain.robot_kinds}
-        grasps = set(domain.grasps)
+        # a geometric problem's objects may also name built-in grasps the vocabulary leaves out
+        grasps = set(domain.grasps) | (set(BUILTIN_GRASPS) if geometric else set())
 
         robots, fixed, regions, movable, points = [], [], [], [], []
         for d in decls["robots"]:
@@ -368,6 +402,10 @@ def _grasp_uses(fact: Fact) -> list[tuple[str, str]]:
     if fact.predicate == "enable-goal-handover":
         return [(a[0], a[1]), (a[0], a[2])]
     return []
+
+
+def _word(prop: ast.Property) -> str:
+    return prop.value.name if isinstance(prop.value, ast.Symbol) else "?"
 
 
 def _has(d: ast.Decl, key: str) -> bool:

@@ -46,6 +46,11 @@ CODES: dict[str, str] = {
     "E233": "include leaves the problem's folder tree",
     "E234": "included file not found",
     "E235": "unknown requirement",
+    # grasps
+    "E240": "unknown axis",
+    "E241": "grasp axes not perpendicular",
+    "E242": "negative grasp depth",
+    "E243": "grasp without geometry",
     # numbers, vectors, properties
     "E250": "non-positive size",
     "E251": "non-finite number",
@@ -60,7 +65,12 @@ CODES: dict[str, str] = {
     "E260": "robot of a geometric problem lacks a kind",
     "E261": "symbolic problem mixes in geometry",
     "E262": "geometric declaration lacks its shape or pose",
+    # warnings (the file is accepted)
+    "W270": "grasp wider than the gripper",
 }
+
+#: codes that are warnings: reported, but the input is accepted (exit code 0)
+WARNINGS = frozenset(c for c in CODES if c.startswith("W"))
 
 #: codes the CLI itself uses (not produced by the front end)
 CLI_CODES: dict[str, str] = {
@@ -115,7 +125,8 @@ HELP: dict[str, str] = {
     "E210": "A fact names a robot the problem does not declare.",
     "E211": "A fact or goal names a movable object the problem does not declare.",
     "E212": "A fact or goal names a region the problem does not declare.",
-    "E213": "A grasp that is not in the domain's `(:grasps ...)` vocabulary.",
+    "E213": "A grasp that is not in the domain's `(:grasps ...)` vocabulary (in a geometric problem an object's "
+    "`:grasps` may also name a built-in grasp: top, top-x, side-x+, side-x-, side-y+, side-y-).",
     "E214": "A robot's `:kind` that the domain does not define with `(:robot-kind ...)`.",
     "E215": "A movable object's `:handover` list names a handover point the problem does not declare.",
     "E216": "A declared name used where another sort belongs, e.g. a robot in a movable object's place.",
@@ -137,13 +148,25 @@ HELP: dict[str, str] = {
     "E233": "An include path that resolves outside the folder of the file being checked.",
     "E234": "An include path that names no file.",
     "E235": "A requirement flag that mrgc does not know.",
+    "E240": "A grasp's `:approach` and `:fingers` are axis words of the object frame: `+x -x +y -y +z -z` "
+    "(`x` means `+x`).",
+    "E241": "A grasp's approach axis and finger axis must be perpendicular (the fingers close across the "
+    "direction the hand moves in).",
+    "E242": "A grasp's `:depth` (how far the tool centre point sits inside the approached face) may be 0 but "
+    "not negative.",
+    "E243": "In a domain with robot kinds every grasp needs geometry: a bare name must be a built-in grasp "
+    "(top, top-x, side-x+, side-x-, side-y+, side-y-), any other grasp is declared as "
+    "`(NAME :approach AXIS :fingers AXIS)`. Domains without robot kinds (symbolic) accept any name.",
+    "W270": "A warning, not an error: the object is wider along the grasp's finger axis (plus the 1 cm "
+    "clearance) than a robot kind's `:gripper-opening`, so robots of that kind get no facts for this "
+    "(object, grasp). `mrgc check` exits 0.",
     "E250": "Sizes (box sides, radii, heights, reach, mesh scale) must be positive.",
     "E251": "A number that overflows to infinity (such as `1e999`).",
     "E252": "A pose needs 4 numbers (x y z yaw), a position 3, a shape its own count.",
     "E253": "A property value of the wrong type, e.g. a name where a quoted path belongs.",
     "E254": "A `:property` the declaration does not take; the message suggests the closest or lists them.",
     "E255": "A required property is missing (a fixed-base robot kind needs `:urdf` and `:end-effector`, "
-    "a planar one `:footprint`).",
+    "a planar one `:footprint`, a declared grasp `:approach` and `:fingers`).",
     "E256": "Shapes are `box`, `cylinder`, `sphere` and `mesh`.",
     "E257": "A robot kind's `:base` is `fixed` or `planar`.",
     "E258": "A mesh file that does not exist (paths are relative to the declaring file).",

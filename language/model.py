@@ -30,6 +30,17 @@ REQUIREMENTS: tuple[str, ...] = ("handover", "planar-base", "symbolic")
 
 BASE_TYPES: tuple[str, ...] = ("fixed", "planar")
 
+Axis = tuple[float, float, float]
+
+#: axis word -> unit vector in the object frame (``x`` is ``+x``)
+AXES: dict[str, Axis] = {
+    f"{sign}{name}": tuple(float(s * (i == k)) for i in range(3))  # type: ignore[misc]
+    for k, name in enumerate("xyz") for sign, s in (("+", 1), ("-", -1), ("", 1))
+}
+
+DEFAULT_GRASP_DEPTH = 0.02  # m the tool centre point sits inside the face it approaches
+DEFAULT_GRIPPER_OPENING = 0.08  # m: a Franka Panda's fingers open 2 × 4 cm
+
 
 def _span() -> Span:
     return field(default=NOWHERE, compare=False, repr=False)  # type: ignore[no-any-return]
@@ -89,13 +100,54 @@ Shape = Union[Box, Cylinder, Sphere, Mesh]
 
 
 @dataclass(frozen=True)
+class GraspSpec:
+    """What a grasp means geometrically, in the frame of the object grasped (docs/geometry.md, "Grasps").
+
+    ``approach`` is the direction the tool moves into the object, ``fingers`` the axis the fingers close
+    along (unit axis vectors, perpendicular); the tool centre point sits ``depth`` metres inside the face
+    the tool approaches, moved by ``offset`` (object frame).  How a spec becomes a tool pose and a finger
+    opening is :mod:`mrgc.geometry.grasps`.  ``builtin`` marks the specs of :data:`BUILTIN_GRASPS`.
+    """
+
+    name: str
+    approach: Axis
+    fingers: Axis
+    depth: float = DEFAULT_GRASP_DEPTH
+    offset: Axis = (0.0, 0.0, 0.0)
+    builtin: bool = False
+    span: Span = _span()
+
+    def describe(self) -> str:
+        """``approach -z, fingers +y, depth 0.02`` (and the offset when there is one)."""
+        words = {v: w for w, v in AXES.items() if w[0] in "+-"}
+        text = f"approach {words[self.approach]}, fingers {words[self.fingers]}, depth {self.depth:g}"
+        return text + (f", offset ({' '.join(f'{x:g}' for x in self.offset)})" if any(self.offset) else "")
+
+
+def _builtin(name: str, approach: str, fingers: str) -> GraspSpec:
+    return GraspSpec(name, AXES[approach], AXES[fingers], builtin=True)
+
+
+#: the built-in grasps: what a bare name in ``(:grasps ...)`` means
+BUILTIN_GRASPS: dict[str, GraspSpec] = {g.name: g for g in (
+    _builtin("top", "-z", "+y"),  # from above, fingers closing along y
+    _builtin("top-x", "-z", "+x"),  # from above, the wrist turned 90 degrees: fingers closing along x
+    _builtin("side-x+", "-x", "+y"),  # from the +x side
+    _builtin("side-x-", "+x", "+y"),
+    _builtin("side-y+", "-y", "+x"),
+    _builtin("side-y-", "+y", "+x"),
+)}
+
+
+@dataclass(frozen=True)
 class RobotKind:
     """A kind of robot: its URDF, base type, end-effector link and home configuration.
 
     ``base`` is ``fixed`` (arm bolted to its base pose) or ``planar`` (x, y, yaw driven base).  A planar
     kind may give a ``footprint`` shape and the ``carry`` pose of a held object relative to its base.
     ``tcp`` is the tool centre point (between the fingertips) relative to the end-effector link, ``reach``
-    an upper bound on the distance from the base at which the arm can place its tool centre point.
+    an upper bound on the distance from the base at which the arm can place its tool centre point,
+    ``gripper_opening`` the widest the fingers open (metres between them).
     """
 
     name: str
@@ -107,13 +159,18 @@ class RobotKind:
     carry: Pose | None = None
     reach: float | None = None
     tcp: Pose | None = None
+    gripper_opening: float = DEFAULT_GRIPPER_OPENING
     source: str = field(default="", compare=False)
     span: Span = _span()
 
 
 @dataclass(frozen=True)
 class Domain:
-    """A domain: requirement flags, robot kinds and the grasp vocabulary shared by its problems."""
+    """A domain: requirement flags, robot kinds and the grasp vocabulary shared by its problems.
+
+    ``grasp_specs`` holds the geometry of the vocabulary's grasps that have one (built-in or declared);
+    in a domain without robot kinds a grasp may be a bare name with no geometry.
+    """
 
     name: str
     requirements: tuple[str, ...] = ()
@@ -121,9 +178,15 @@ class Domain:
     grasps: tuple[str, ...] = ()
     source: str = field(default="", compare=False)
     span: Span = _span()
+    grasp_specs: tuple[GraspSpec, ...] = ()
 
     def kind(self, name: str) -> RobotKind:
         return next(k for k in self.robot_kinds if k.name == name)
+
+    def grasp_spec(self, name: str) -> GraspSpec | None:
+        """The geometry of grasp ``name``: the domain's own declaration, else the built-in one, else None."""
+        own = next((g for g in self.grasp_specs if g.name == name), None)
+        return own if own is not None else BUILTIN_GRASPS.get(name)
 
 
 @dataclass(frozen=True)
@@ -228,3 +291,15 @@ class Problem:
     def grasps_of(self, name: str) -> tuple[str, ...]:
         """The grasps robots may use on movable object ``name``."""
         return self.object(name).grasps or self.domain.grasps
+
+    @property
+    def grasp_specs(self) -> dict[str, GraspSpec]:
+        """Grasp name -> its geometry, for every grasp an object of this problem may use that has one
+        (all of them in a geometric problem: the checks guarantee it)."""
+        out: dict[str, GraspSpec] = {}
+        for m in self.movable:
+            for g in self.grasps_of(m.name):
+                spec = self.domain.grasp_spec(g)
+                if spec is not None:
+                    out[g] = spec
+        return out

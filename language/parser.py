@@ -26,6 +26,7 @@ _READABLE = {
     "KEYWORD": "a :keyword",
     "NUMBER": "a number",
     "STRING": "a string",
+    "AXIS": "an axis like -z",
     "$END": "end of file",
 }
 
@@ -65,7 +66,7 @@ def _tok_span(file: str, tok: Token) -> Span:
     return Span(file, line, col, end_line, end_col)
 
 
-_NAMED = frozenset({"NAME", "KEYWORD", "NUMBER", "STRING"})
+_NAMED = frozenset({"NAME", "KEYWORD", "NUMBER", "STRING", "AXIS"})
 
 
 class _ToAst(Transformer[Token, Any]):
@@ -110,8 +111,8 @@ class _ToAst(Transformer[Token, Any]):
         return ast.RobotKindDecl(str(name), tuple(props), span)
 
     def grasps(self, children: list[Any]) -> ast.Grasps:
-        span, names = self._parts(children)
-        return ast.Grasps(tuple(str(t) for t in names), tuple(self._tspan(t) for t in names), span)
+        span, decls = self._parts(children)
+        return ast.Grasps(tuple(decls), span)
 
     def include(self, children: list[Any]) -> ast.Include:
         span, (path,) = self._parts(children)
@@ -288,7 +289,7 @@ def _unknown_section(word: str, sections: list[str], span: Span) -> Diagnostic:
 
 
 def _describe_token(tok: Token) -> str:
-    if tok.type == "NAME":
+    if tok.type in ("NAME", "AXIS"):
         return f"name '{tok}'"
     if tok.type == "NUMBER":
         return f"number {tok}"

@@ -195,7 +195,7 @@ def _section(out: _Out, sec: ast.DomainSection | ast.ProblemSection) -> None:
     if isinstance(sec, ast.Requirements):
         out.emit("(" + " ".join([":requirements", *(":" + f for f in sec.flags)]) + ")", ind, sec.span)
     elif isinstance(sec, ast.Grasps):
-        _fill(out, ":grasps", list(zip(sec.names, sec.name_spans or (sec.span,) * len(sec.names))), sec.span)
+        _decls(out, ":grasps", sec.decls, sec.span)
     elif isinstance(sec, ast.Include):
         out.emit(f"(:include {string(sec.path)})", ind, sec.span)
     elif isinstance(sec, ast.DomainRef):
@@ -206,13 +206,7 @@ def _section(out: _Out, sec: ast.DomainSection | ast.ProblemSection) -> None:
             out.emit(prop(p), ind * 2, p.span)
         _close_group(out, sec.span, ind * 2, ind)
     elif isinstance(sec, ast.DeclSection):
-        if all(d.bare and not d.props for d in sec.decls):
-            _fill(out, ":" + sec.kind, [(d.name, d.span) for d in sec.decls], sec.span)
-        else:
-            out.emit(f"(:{sec.kind}", ind, sec.span, header=True)
-            for d in sec.decls:
-                out.emit(decl(d), ind * 2, d.span)
-            _close_group(out, sec.span, ind * 2, ind)
+        _decls(out, ":" + sec.kind, sec.decls, sec.span)
     elif isinstance(sec, ast.Init):
         if not sec.atoms:
             out.emit("(:init)", ind, sec.span)
@@ -223,6 +217,18 @@ def _section(out: _Out, sec: ast.DomainSection | ast.ProblemSection) -> None:
         _close_group(out, sec.span, ind * 2, ind)
     elif isinstance(sec, ast.Goal):
         _goal(out, sec)
+
+
+def _decls(out: _Out, head: str, decls: tuple[ast.Decl, ...], span: Span) -> None:
+    """A section of declarations: bare names filled to WIDTH, else one declaration per line."""
+    ind = "  "
+    if all(d.bare and not d.props for d in decls):
+        _fill(out, head, [(d.name, d.span) for d in decls], span)
+        return
+    out.emit(f"({head}", ind, span, header=True)
+    for d in decls:
+        out.emit(decl(d), ind * 2, d.span)
+    _close_group(out, span, ind * 2, ind)
 
 
 def _goal(out: _Out, sec: ast.Goal) -> None:

@@ -1,7 +1,7 @@
 """Reading ``:key value`` properties into typed values, with one diagnostic per problem found.
 
 Which properties each declaration accepts is data (:data:`SCHEMAS`); the readers turn a syntax value into a
-pose, a shape, a vector, a name list ... or report E251/E252/E253/E250/E256 and return ``None``.
+pose, a shape, a vector, a name list, an axis ... or report E240/E242/E250-E253/E256 and return ``None``.
 """
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from typing import Callable, Optional
 
 from mrgc.errors import Diagnostic, Span
 from mrgc.language import ast
-from mrgc.language.model import BASE_TYPES, Box, Cylinder, Mesh, Pose, Shape, Sphere
+from mrgc.language.model import AXES, BASE_TYPES, Axis, Box, Cylinder, Mesh, Pose, Shape, Sphere
 from mrgc.language.suggest import did_you_mean
 
 #: declaration kind -> property name -> value type
@@ -26,7 +26,9 @@ SCHEMAS: dict[str, dict[str, str]] = {
         "carry": "pose",
         "reach": "length",
         "tcp": "pose",
+        "gripper-opening": "length",
     },
+    "grasp": {"approach": "axis", "fingers": "axis", "depth": "distance", "offset": "point"},
     "robots": {"kind": "name", "base": "pose"},
     "fixed": {"shape": "shape", "pose": "pose"},
     "regions": {"shape": "shape", "pose": "pose"},
@@ -92,6 +94,24 @@ class PropReader:
             self.err("E250", f"{what} must be positive, got {_fmt(x)}", value.span)
             return None
         return x
+
+    def _distance(self, value: ast.Value, what: str) -> Optional[float]:
+        x = self._number(value, what)
+        if x is not None and x < 0:
+            self.err("E242", f"{what} must not be negative, got {_fmt(x)}", value.span)
+            return None
+        return x
+
+    def _axis(self, value: ast.Value, what: str) -> Optional[Axis]:
+        words = [w for w in AXES if w[0] in "+-"]
+        if not isinstance(value, ast.Symbol):
+            self.err("E240", f"{what} must be an axis ({' '.join(words)}), not {_kind_of(value)}", value.span)
+            return None
+        if value.name not in AXES:
+            hint = did_you_mean(value.name, AXES) or f" (use {' '.join(words)})"
+            self.err("E240", f"unknown axis '{value.name}' for {what}{hint}", value.span)
+            return None
+        return AXES[value.name]
 
     def _numbers(self, value: ast.Value, what: str, length: int | None) -> Optional[tuple[float, ...]]:
         if not isinstance(value, ast.ListValue):

@@ -59,7 +59,7 @@ from typing import Any
 import numpy as np
 
 from mrgc.geometry.bullet import ReplayScene
-from mrgc.geometry.grasps import grasp_transform, known
+from mrgc.geometry.grasps import finger_opening, fits, grasp_transform
 from mrgc.geometry.planar import CLEARANCE, LIFT, PLANAR_GRASPS
 from mrgc.geometry.scene import SceneSpec, half_extents, inside, scene_from_problem
 from mrgc.geometry.transforms import from_pose, inverse, rot_z, translation
@@ -123,6 +123,7 @@ class _Track:
     holding: str | None = None
     grasp: str | None = None
     ignore: frozenset[str] = frozenset()
+    fingers: float | None = None  # finger opening (m) while approaching or holding; None: fully open
 
 
 def replay(problem: Problem, steps: list[list[dict[str, Any]]], usable: set[int], stats: dict[str, Any]
@@ -181,7 +182,7 @@ class _Replayer:
         """Arms: the tool pose in the object frame; planar robots: the object's carry pose in the base frame."""
         shape = self.shapes[obj]
         if not self.planar[robot]:
-            return grasp_transform(grasp, shape)
+            return grasp_transform(self.scene.grasp(grasp), shape)
         kind = self.scene.robot(robot).kind
         face = rot_z(math.radians(PLANAR_GRASPS[grasp][1]))
         if kind.carry is not None:
@@ -189,6 +190,15 @@ class _Replayer:
         fp = half_extents(kind.footprint) if kind.footprint is not None else np.zeros(3)
         lift = 2 * float(fp[2]) + 2 * LIFT + float(half_extents(shape)[2])  # on top of the footprint
         return translation(0.0, 0.0, lift) @ face  # type: ignore[no-any-return]
+
+    def _opening(self, obj: str, grasp: str) -> float:
+        return finger_opening(self.scene.grasp(grasp), self.shapes[obj])
+
+    def _fingers(self, robot: str, obj: str, grasp: str | None) -> float | None:
+        """An arm's finger opening while it approaches or holds ``obj`` with ``grasp`` (None: fully open)."""
+        if grasp is None or self.planar[robot] or grasp not in self.scene.grasp_specs:
+            return None
+        return self._opening(obj, grasp)
 
     def _held_pose(self, robot: str, q: np.ndarray, obj: str, grasp: str) -> np.ndarray:
         t = self._tool(robot, q)
@@ -216,9 +226,15 @@ class _Replayer:
                 self._v(t, obj, "grasp", f"planar robot {robot} cannot use grasp {grasp!r} "
                                          f"(side grasps only: {', '.join(PLANAR_GRASPS)})")
                 act.geometry = False
-            elif not self.planar[robot] and not known(grasp):
-                self._v(t, obj, "grasp", f"grasp {grasp!r} has no geometric meaning (known: top, side-x+, "
-                                         f"side-x-, side-y+, side-y-)")
+            elif not self.planar[robot] and grasp not in self.scene.grasp_specs:
+                self._v(t, obj, "grasp", f"grasp {grasp!r} has no geometric meaning (known: "
+                                         f"{', '.join(sorted(self.scene.grasp_specs))})")
+                act.geometry = False
+            elif not self.planar[robot] and not fits(self.scene.grasp(grasp), self.shapes[obj],
+                                                     self.scene.robot(robot).kind):
+                self._v(t, obj, "grasp", f"grasp {grasp!r} needs the fingers "
+                                         f"{self._opening(obj, grasp):.3f} m apart; {robot} opens "
+                                         f"{self.scene.robot(robot).kind.gripper_opening:g} m")
                 act.geometry = False
         if act.handover and (self.planar[act.pick_robot] or self.planar[act.place_robot]):
             self._v(t, obj, "handover", "planar robots cannot hand objects over")
@@ -324,7 +340,8 @@ class _Replayer:
                                                f"{dr:.3f} rad from where grasp {grasp!r} of {obj} puts it (at "
                                                f"{what}; tolerance {POS_TOL * 1e3:g} mm, {ROT_TOL} rad)")
                 continue
-            dp, dr = _pose_error(self._tool(robot, q), pose @ grasp_transform(grasp, self.shapes[obj]))
+            dp, dr = _pose_error(self._tool(robot, q),
+                                 pose @ grasp_transform(self.scene.grasp(grasp), self.shapes[obj]))
             if dp > POS_TOL or dr > ROT_TOL:
                 self._v(t, robot, "grasp", f"the last {phase} configuration of {robot} puts the tool "
                                            f"{dp * 1e3:.1f} mm, {dr:.3f} rad from grasp {grasp!r} of {obj} at {what} "
@@ -368,8 +385,9 @@ class _Replayer:
                 for name in names:
                     if name in a.paths:
                         role, grasp_role = PATH_PHASES[name][:2]
+                        grasp = a.raw[grasp_role] if grasp_role else None
                         out.append(_Track(a.raw[role], a.paths[name], f"{name} path", a.obj if grasp_role else None,
-                                          a.raw[grasp_role] if grasp_role else None, frozenset({a.obj})))
+                                          grasp, frozenset({a.obj}), self._fingers(a.raw[role], a.obj, grasp)))
             return out
 
         def others(tracks: list[_Track]) -> list[str]:
@@ -377,18 +395,22 @@ class _Replayer:
 
         tracks = paths("to-pick")
         self._sweep(t, "to-pick", tracks, others(tracks), everything)
-        tracks = [_Track(a.pick_robot, a.configs["pick"], "pick", ignore=frozenset({a.obj})) for a in geo]
+        tracks = [_Track(a.pick_robot, a.configs["pick"], "pick", ignore=frozenset({a.obj}),
+                         fingers=self._fingers(a.pick_robot, a.obj, a.g1)) for a in geo]
         self._sweep(t, "pick", tracks, others(tracks), everything)
         self._sweep(t, "to-handover", paths("to-handover", "taker-to-handover"), waiting, present)
         hands = [a for a in geo if a.handover]
         tracks = []
         for a in hands:
             h = a.configs["handover"]
-            tracks.append(_Track(a.pick_robot, h[:1], "handover (giver)", a.obj, a.g1, frozenset({a.obj})))
-            tracks.append(_Track(a.place_robot, h[1:], "handover (taker)", a.obj, a.g2, frozenset({a.obj})))
+            tracks.append(_Track(a.pick_robot, h[:1], "handover (giver)", a.obj, a.g1, frozenset({a.obj}),
+                                 self._fingers(a.pick_robot, a.obj, a.g1)))
+            tracks.append(_Track(a.place_robot, h[1:], "handover (taker)", a.obj, a.g2, frozenset({a.obj}),
+                                 self._fingers(a.place_robot, a.obj, a.g2)))
         self._sweep(t, "handover", tracks, waiting, present)
         self._sweep(t, "to-place", paths("to-place"), waiting, present)
-        tracks = [_Track(a.place_robot, a.configs["place"], "place", a.obj, a.g2, frozenset({a.obj})) for a in geo]
+        tracks = [_Track(a.place_robot, a.configs["place"], "place", a.obj, a.g2, frozenset({a.obj}),
+                         self._fingers(a.place_robot, a.obj, a.g2)) for a in geo]
         self._sweep(t, "place", tracks, others(tracks), present)
         for a in acts:
             if a.place_pose is None:
@@ -438,6 +460,9 @@ class _Replayer:
         rs = self.rs
         for r in static:
             rs.set_config(r, self.home[r])
+            rs.set_fingers(r, None)
+        for tr in tracks:  # fingers: at the grasp's opening while approaching or holding, else fully open
+            rs.set_fingers(tr.robot, tr.fingers)
         held = {tr.holding for tr in tracks if tr.holding}
         for o in self.movable:
             if o in present:

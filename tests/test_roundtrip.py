@@ -55,7 +55,9 @@ texts = st.one_of(
 )
 
 numbers = st.builds(ast.Number, finite_floats)
-symbols = st.builds(ast.Symbol, names)
+#: signed words (axis values such as -z): symbols too, never names of things
+signed = st.builds(lambda sign, name: sign + name, st.sampled_from("+-"), plain_names)
+symbols = st.builds(ast.Symbol, st.one_of(names, signed))
 strings = st.builds(ast.String, texts)
 items = st.one_of(numbers, symbols, strings)
 values = st.one_of(numbers, symbols, strings, st.builds(ast.ListValue, st.lists(items, max_size=6).map(tuple)))
@@ -71,7 +73,7 @@ goal_atoms = st.builds(ast.Atom, goal_predicates, st.lists(names, max_size=5).ma
 
 requirements = st.builds(ast.Requirements, st.lists(keys, max_size=4).map(tuple))
 robot_kinds = st.builds(ast.RobotKindDecl, names, props)
-grasps = st.builds(ast.Grasps, st.lists(names, max_size=30).map(tuple))
+grasps = st.builds(ast.Grasps, st.one_of(decls, only_bare))
 includes = st.builds(ast.Include, texts)
 domain_sections = st.one_of(requirements, robot_kinds, grasps, includes)
 
@@ -154,7 +156,7 @@ def test_strategy_reaches_every_section_kind() -> None:
 def test_reserved_words_as_names(word: str) -> None:
     """`define`/`domain`/`problem`/`and` survive as names in every position but a goal atom's predicate."""
     tree = ast.SourceFile((
-        ast.DomainDef(word, (ast.RobotKindDecl(word, (ast.Property(word, ast.Symbol(word)),)), ast.Grasps((word,)),
+        ast.DomainDef(word, (ast.RobotKindDecl(word, (ast.Property(word, ast.Symbol(word)),)), ast.Grasps((ast.Decl(word),)),
                              ast.Requirements((word,)))),
         ast.ProblemDef(word, (
             ast.DomainRef(word),

@@ -220,7 +220,8 @@ def test_a_pick_through_a_neighbour_is_a_robot_object_collision(pa3: Any, one_st
 
 def test_two_hands_at_one_handover_collide(pa3: Any, one_step: dict[str, Any], grounder: Grounder) -> None:
     arm = grounder.arm("r2")
-    target = arm.ee_target(translation(0, 0, 0.4) @ grasp_transform("top", grounder.scene.body("o1").shape))
+    top = grasp_transform(grounder.scene.grasp("top"), grounder.scene.body("o1").shape)
+    target = arm.ee_target(translation(0, 0, 0.4) @ top)
     res = solve_ik_many(arm.model, target[None], 0, q_init=arm.home)[0]
     assert res.solved
     plan = copy.deepcopy(one_step)

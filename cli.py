@@ -18,6 +18,7 @@ from mrgc import __version__
 from mrgc.errors import Diagnostic, InputError, MrgcError
 
 if TYPE_CHECKING:
+    from mrgc.language.loader import MrgFile
     from mrgc.language.model import Problem
 
 EXIT_OK = 0
@@ -52,6 +53,15 @@ def _report(exc: InputError) -> None:
         print(f"{n} errors", file=sys.stderr)
 
 
+def _warn(mf: "MrgFile") -> None:
+    """Print the warnings of a checked file's problems (grasps no robot can open wide enough for)."""
+    from mrgc.geometry.grasps import grasp_warnings
+
+    for p in mf.problems:
+        for d in grasp_warnings(p):
+            print(d.render(mf.text if d.span is not None and d.span.file == mf.path else None), file=sys.stderr)
+
+
 # ---------------------------------------------------------------- commands
 def cmd_check(args: argparse.Namespace) -> int:
     from mrgc.language.loader import parse_file
@@ -64,6 +74,7 @@ def cmd_check(args: argparse.Namespace) -> int:
             _report(exc)
             status = EXIT_INPUT
             continue
+        _warn(mf)
         parts = [f"{len(mf.domains)} domain{'s' * (len(mf.domains) != 1)}"]
         for p in mf.problems:
             kind = "symbolic" if p.symbolic else "geometric"

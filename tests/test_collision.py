@@ -10,13 +10,20 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import assume, example, given, settings
 from hypothesis import strategies as st
 
+from mrgc import parse_file
 from mrgc.errors import InputError
-from mrgc.geometry.collision import CollisionWorld, ConvexHull, collision_shape
-from mrgc.geometry.transforms import rot_z
+from mrgc.geometry.arm import Arm
+from mrgc.geometry.bullet import ReplayScene
+from mrgc.geometry.collision import TOLERANCE, CollisionWorld, ConvexHull, collision_shape
+from mrgc.geometry.ik import solve_ik_many
+from mrgc.geometry.scene import SceneSpec, scene_from_problem
+from mrgc.geometry.transforms import rot_z, rpy_matrix, translation
 from mrgc.language.model import Box, Cylinder, Mesh, Sphere
+
+ROOT = Path(__file__).resolve().parent.parent
 
 
 def at(x: float, y: float = 0.0, z: float = 0.0, yaw: float = 0.0) -> np.ndarray:
@@ -305,3 +312,173 @@ def test_axis_aligned_boxes_agree_with_the_exact_test(sa, ca, sb, cb, quarter_tu
     assert w.colliding_with("a") == ({"b"} if exact else set())
     assert w.colliding_with("b") == ({"a"} if exact else set())
     assert w.probe_hits([(Box(*a), at(*pa))], ignore="a") == ({"b"} if exact else set())
+
+
+# ------------------------------------------------- near contact: yes/no, coal's distance and pybullet agree
+#
+# Three answers to "do these two shapes overlap?": the yes/no query (GJK against the security margin), coal's
+# signed distance (GJK + EPA) and pybullet's getClosestPoints (bullet's own GJK/EPA, through the validator's
+# ReplayScene).  Outside a band of BAND around contact all three must agree: no "free" for an overlap deeper
+# than BAND, no "collides" for a gap wider than BAND + TOLERANCE.  pybullet gets boxes as 8-vertex meshes:
+# its GEOM_BOX rounds edges and corners by its collision margin (1 mm), which moves its distances near
+# edges by up to 1.1 mm (measured), while ReplayScene removes the margin of a mesh exactly (measured
+# agreement with coal on meshes: 0.05 mm at most).
+
+BAND = 1e-4  # metres
+ANGLES = st.one_of(st.sampled_from([0.0, math.pi / 2, math.pi, -math.pi / 2, math.pi / 4]),
+                   st.floats(-math.pi, math.pi))
+
+
+def rotation(rpy: tuple[float, float, float]) -> np.ndarray:
+    t = np.eye(4)
+    t[:3, :3] = rpy_matrix(*rpy)
+    return t
+
+
+def agree(name: str, collides: bool, d_coal: float, d_bullet: float | None = None) -> None:
+    """The yes/no answer, coal's signed distance and pybullet's distance tell the same story."""
+    if d_coal < -BAND:
+        assert collides, f"{name}: overlap of {-d_coal * 1e3:.3f} mm reported free"
+    if d_coal > BAND + TOLERANCE:
+        assert not collides, f"{name}: gap of {d_coal * 1e3:.3f} mm reported colliding"
+    if d_bullet is not None and abs(d_coal) > BAND:
+        assert (d_bullet < 0) == (d_coal < 0), f"{name}: coal {d_coal * 1e3:.3f} mm, pybullet {d_bullet * 1e3:.3f} mm"
+
+
+class MeshFiles:
+    """Convex shapes for both engines: coal gets the Box or ConvexHull, pybullet a mesh file of its vertices."""
+
+    def __init__(self, folder: Path) -> None:
+        self.folder, self.count = folder, 0
+
+    def write(self, points: np.ndarray, faces: list[tuple[int, int, int]]) -> Mesh:
+        self.count += 1  # pybullet caches meshes by file name: one file per shape
+        path = self.folder / f"shape{self.count}.obj"
+        lines = [f"v {float(x)!r} {float(y)!r} {float(z)!r}" for x, y, z in points]
+        path.write_text("\n".join(lines + [f"f {a} {b} {c}" for a, b, c in faces]) + "\n")
+        return Mesh(str(path))
+
+    def box(self, size: np.ndarray) -> tuple[Box, Mesh, np.ndarray]:
+        corners = CUBE_POINTS * size
+        faces = [(1, 2, 4), (1, 4, 3), (5, 7, 8), (5, 8, 6), (1, 5, 6), (1, 6, 2),
+                 (3, 4, 8), (3, 8, 7), (1, 3, 7), (1, 7, 5), (2, 6, 8), (2, 8, 4)]
+        return Box(*size), self.write(corners, faces), corners
+
+    def hull(self, seed: int, axes: np.ndarray) -> tuple[ConvexHull, Mesh, np.ndarray]:
+        pts = np.random.default_rng(seed).normal(size=(40, 3))
+        pts = pts / np.linalg.norm(pts, axis=1, keepdims=True) * axes  # every point on the hull
+        # pybullet takes the convex hull of the vertices the faces use: a fan through all of them will do
+        return ConvexHull(pts), self.write(pts, [(1, i, i + 1) for i in range(2, len(pts))]), pts
+
+
+@pytest.fixture(scope="module")
+def bullet(tmp_path_factory: pytest.TempPathFactory):  # type: ignore[no-untyped-def]
+    replay = ReplayScene(SceneSpec("near-contact", (), (), (), (), {}, {}, {}, {}))
+    yield replay, MeshFiles(tmp_path_factory.mktemp("near-contact"))
+    replay.close()
+
+
+sides = st.tuples(*[st.integers(5, 300)] * 3).map(lambda mm: np.array(mm) / 1000)
+hull_axes = st.tuples(*[st.integers(10, 150)] * 3).map(lambda mm: np.array(mm) / 1000)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.sampled_from(["box-box", "hull-box", "hull-hull", "same-hull"]), sides, sides, hull_axes,
+       st.integers(0, 2**16), st.tuples(ANGLES, ANGLES, ANGLES), st.tuples(ANGLES, ANGLES, ANGLES),
+       st.tuples(ANGLES, ANGLES), st.floats(-0.02, 0.02))
+def test_near_contact_pairs_agree(bullet, kind: str, size_a, size_b, axes, seed: int, rpy_a, rpy_b,  # type: ignore[no-untyped-def]
+                                  direction, s: float) -> None:
+    """Two convex shapes placed so that their extents along a direction ``u`` overlap by ``-s`` (gap ``s``
+    along u, |s| <= 20 mm): a near-contact pose, often with faces lined up (angles of 0, 90°, 45°).
+    "same-hull" is one hull against a copy of itself, turned (or not), the hard case for GJK."""
+    replay, files = bullet
+    a = files.hull(seed, axes) if kind != "box-box" else files.box(size_a)
+    b = files.box(size_b) if kind in ("box-box", "hull-box") else files.hull(seed if kind == "same-hull" else seed + 1,
+                                                                            axes)
+    ta, tb = rotation(rpy_a), rotation(rpy_b)
+    u = rpy_matrix(0.0, direction[0], direction[1])[:, 0]
+    reach_a = max((ta[:3, :3] @ a[2].T).T @ u)
+    reach_b = max(-(tb[:3, :3] @ b[2].T).T @ u)
+    tb[:3, 3] = (reach_a + reach_b + s) * u
+    world = CollisionWorld()
+    world.add("a", a[0], ta)
+    world.add("b", b[0], tb)
+    d = world.distance("a", "b")
+    name = f"n{files.count}"
+    replay.add_object(name + "a", a[1], ta)
+    replay.add_object(name + "b", b[1], tb)
+    try:
+        near = replay.closest(name + "a", name + "b", 0.1)
+    finally:
+        replay.set_pose(name + "a", None)
+        replay.set_pose(name + "b", None)
+    agree(kind, world.collides("a"), d, near.distance if near is not None else 0.1)
+    agree(kind + " (probe)", world.probe_collides([(a[0], ta)], against="b"), d)
+
+
+# Two Pandas facing each other across a table (pa3-handover's r1 and r2), both holding an object at one
+# point: each hand takes one of the classic grasps (approach axis, finger axis in the object frame), its tool
+# centre point 5 mm short of the object's centre, and the second hand is pushed along its approach axis by
+# up to 20 mm.  Fingers then overlap tip to tip or just miss each other.
+
+GRASP_AXES = {"top": ((0, 0, -1), (0, 1, 0)), "side-x+": ((-1, 0, 0), (0, 1, 0)), "side-x-": ((1, 0, 0), (0, 1, 0)),
+              "side-y+": ((0, -1, 0), (1, 0, 0)), "side-y-": ((0, 1, 0), (1, 0, 0))}
+GRIPPER_LINKS = ("panda_hand", "panda_leftfinger", "panda_rightfinger")
+
+
+def hand_pose(grasp: str, standoff: float) -> np.ndarray:
+    """The tool pose in the object frame (+z the approach axis, +y the finger axis)."""
+    z, y = (np.array(v, dtype=float) for v in GRASP_AXES[grasp])
+    t = np.eye(4)
+    t[:3, 0], t[:3, 1], t[:3, 2] = np.cross(y, z), y, z
+    t[:3, 3] = -z * standoff
+    return t
+
+
+@pytest.fixture(scope="module")
+def facing_pandas():  # type: ignore[no-untyped-def]
+    scene = scene_from_problem(parse_file(ROOT / "domains" / "packaging" / "pa3-handover.mrg").problem())
+    arms = Arm(scene.robot("r1")), Arm(scene.robot("r2"))
+    replay = ReplayScene(scene)
+    for body in (*scene.fixed, *scene.movable):
+        replay.set_pose(body.name, None)
+    yield arms, replay
+    replay.close()
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.one_of(st.sampled_from([math.radians(d) for d in range(0, 180, 5)]), st.floats(-math.pi, math.pi)),
+       st.sampled_from(sorted(GRASP_AXES)), st.sampled_from(sorted(GRASP_AXES)),
+       st.one_of(st.just(0.0), st.floats(-0.02, 0.02)), st.one_of(st.just(0.0), st.floats(-0.1, 0.1)),
+       st.one_of(st.just(0.4), st.floats(0.3, 0.5)))
+@example(math.radians(120), "side-x-", "side-x+", 0.0, 0.0, 0.4)  # fingers overlap 4.4 mm: "free" at 1e-9
+@example(math.radians(105), "side-y-", "side-y+", 0.0, 0.0, 0.4)  # the same, along the other axis
+@example(math.radians(120), "top", "top", 0.0, 0.0, 0.4)  # both hands in one place: hand pair "free" at 1e-9
+def test_panda_grippers_in_handover_poses_agree(facing_pandas, yaw: float, g1: str, g2: str,  # type: ignore[no-untyped-def]
+                                                push: float, x: float, z: float) -> None:
+    (r1, r2), replay = facing_pandas
+    obj = translation(x, 0.0, z) @ rot_z(yaw)
+    tools = obj @ hand_pose(g1, 0.005), obj @ hand_pose(g2, 0.005) @ translation(0.0, 0.0, push)
+    qs = [solve_ik_many(arm.model, arm.ee_target(t)[None], 0, q_init=arm.home)[0] for arm, t in zip((r1, r2), tools)]
+    assume(all(q.solved for q in qs))
+    shapes, index = r1.probes
+    names = [r1.model.links[i].name for i in index]
+    t1, t2 = r1.link_transforms(qs[0].q), r2.link_transforms(qs[1].q)
+    # every link pair of the two grippers, one pair at a time
+    nearest = math.inf
+    for i, j in itertools.product(range(len(shapes)), repeat=2):
+        pair_world = CollisionWorld()
+        pair_world.add("a", shapes[i], t1[i])
+        pair_world.add("b", shapes[j], t2[j])
+        d = pair_world.distance("a", "b")
+        nearest = min(nearest, d)
+        if names[i] in GRIPPER_LINKS and names[j] in GRIPPER_LINKS:
+            agree(f"{names[i]} of r1 / {names[j]} of r2", pair_world.collides("a"), d)
+    # the whole arms, as phase 1 checks a handover (r1's link hulls probed against r2's), and the validator
+    world = CollisionWorld()
+    for k, (shape, t) in enumerate(zip(shapes, t2)):
+        world.add(f"r2#{k}", shape, t, "r2")
+    replay.set_config("r1", qs[0].q)
+    replay.set_config("r2", qs[1].q)
+    near = replay.closest("r1", "r2", 0.1)
+    agree("r1 / r2", world.batch_collides(shapes, t1, against="r2"), nearest, near.distance if near else 0.1)

@@ -1,8 +1,9 @@
 """The ``mrgc`` command: a thin layer over the Python API.
 
-Exit codes (docs/errors.md): 0 ok; 1 no plan / infeasible / ``fmt --check`` found unformatted files /
-``validate`` found the plan invalid; 2 input error (bad file, bad plan file or bad command line); 3 time
-limit; 4 missing backend; 70 internal error; 130 interrupted.  No input produces a Python traceback:
+Exit codes (docs/errors.md): 0 ok; 1 infeasible (no skeleton under the facts) / ``fmt --check`` found
+unformatted files / ``validate`` found the plan invalid; 2 input error (bad file, bad plan file or bad
+command line); 3 time limit; 4 missing backend; 5 ``plan``: every skeleton tried, none grounded into a valid
+plan; 70 internal error; 130 interrupted (SIGINT), 143 terminated (SIGTERM).  No input produces a Python traceback:
 unexpected exceptions are reported in one line with exit code 70.
 """
 
@@ -207,26 +208,34 @@ def _progress(message: str) -> "contextlib.AbstractContextManager[object]":
 
 
 def cmd_plan(args: argparse.Namespace) -> int:
+    from mrgc.planner.outcome import EXIT_CODES, PlanStatus
     from mrgc.planner.plan import file_sha256
     from mrgc.planner.search import plan_problem
 
-    if args.skeletons < 1 or args.time_limit <= 0 or (args.max_makespan is not None and args.max_makespan < 1):
+    if args.skeletons < 1 or not args.time_limit > 0 or args.time_limit == float("inf") or (
+            args.max_makespan is not None and args.max_makespan < 1):
         raise InputError([Diagnostic("E000", "--skeletons and --max-makespan must be at least 1, "
-                                     "--time-limit positive")])
+                                     "--time-limit positive and finite")])
     problem = _load_problem(args.file, args.problem)
+    log = (lambda line: print(line, file=sys.stderr, flush=True)) if args.verbose else None
     with _progress(f"planning {problem.name} (phase 1, then the tree search; at most {args.time_limit:g} s)"):
         plan = plan_problem(problem, args.file, file_sha256(args.file), __version__, backend=args.backend,
                             encoding=args.encoding, seed=args.seed, time_limit=args.time_limit, c=args.c,
-                            alpha=args.alpha, skeletons=args.skeletons, max_makespan=args.max_makespan)
-    text = plan.dumps()
-    if args.output:
-        tmp = args.output + ".mrgc-tmp"
-        with open(tmp, "w", encoding="utf-8") as fh:
-            fh.write(text)
-        os.replace(tmp, args.output)
+                            alpha=args.alpha, skeletons=args.skeletons, max_makespan=args.max_makespan,
+                            anytime=args.anytime, log=log)
+    status = PlanStatus(plan.status)
+    out = sys.stderr if not args.output or status is PlanStatus.INTERRUPTED else sys.stdout
+    if status is not PlanStatus.INTERRUPTED:  # an interrupted run writes no result, only what it had
+        text = plan.dumps()
+        if args.output:
+            tmp = args.output + ".mrgc-tmp"
+            with open(tmp, "w", encoding="utf-8") as fh:
+                fh.write(text)
+            os.replace(tmp, args.output)
+        else:
+            sys.stdout.write(text)
     else:
-        sys.stdout.write(text)
-    out = sys.stderr if not args.output else sys.stdout
+        print("mrgc: interrupted; no plan file written. The search so far:", file=out)
     for line in plan.summary():
         print(line, file=out)
     st = plan.stats
@@ -234,7 +243,10 @@ def cmd_plan(args: argparse.Namespace) -> int:
           f"{st.get('skeleton_seconds', 0):.2f} s, grounding {st.get('grounding_seconds', 0):.2f} s; "
           f"{st.get('skeletons', 0)} skeletons, {st.get('groundings', 0)} grounded, {st.get('nodes', 0)} nodes",
           file=out)
-    return {"solved": EXIT_OK, "no plan": EXIT_NO_PLAN, "time limit": EXIT_TIME_LIMIT}[plan.status]
+    if plan.validation:
+        print(f"  validated: {plan.validation['plans_checked']} complete plan(s) replayed by the validator, "
+              f"the returned one valid", file=out)
+    return EXIT_CODES[status]
 
 
 def cmd_validate(args: argparse.Namespace) -> int:
@@ -356,6 +368,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--max-makespan", type=int, default=None, metavar="T")
     p.add_argument("-c", type=float, default=1.0, help="PUCT exploration constant (default 1)")
     p.add_argument("--alpha", type=float, default=1.0, help="reward weight of fewer moved objects (default 1)")
+    p.add_argument("--anytime", action="store_true",
+                   help="keep searching after the first plan until the time limit; return the best "
+                        "(makespan, then objects moved)")
+    p.add_argument("-v", "--verbose", action="store_true", help="print a search log line per grounded skeleton")
     p.set_defaults(func=cmd_plan)
 
     p = sub.add_parser("validate", help="independently re-check a plan: replay it in pybullet, check every step")

@@ -37,6 +37,9 @@ from mrgc.language.model import Box
 
 Volume = list[tuple[CollisionShape, np.ndarray]]  # shapes at world transforms
 
+#: largest step (m of translation, rad of turn) between checked states of a planar path: the validator's
+PATH_RESOLUTION = 0.01
+
 
 class Status(str, enum.Enum):
     OK = "ok"
@@ -287,8 +290,10 @@ class Grounder:
         ignore = (holding[0],) if holding else ()
         if robot not in self._grids:
             self._grids[robot] = DiscGrid(self.planar(robot), self.scene, scene_bounds(self.scene, 0.5))
+        # the disc grid knows objects at their initial poses only: objects moved since are left to the sampler
         obstacles = frozenset([b.name for b in self.scene.fixed]
-                              + [a for a in against if a != "fixed" and not a.startswith("@")])
+                              + [a for a in against if a != "fixed" and not a.startswith("@")
+                                 and np.array_equal(self.poses[a], self.scene.body(a).pose)])
         if not self._grids[robot].connected(np.asarray(start), np.asarray(goal), obstacles):
             return Answer(Status.NO_PATH)  # not even the footprint's inscribed disc gets through
 
@@ -296,8 +301,11 @@ class Grounder:
             self.queries += 1
             return not self.world.probe_collides(self.base_volume(robot, [q], holding), against=against, ignore=ignore)
 
+        # states checked at the validator's resolution (0.01 m, 0.01 rad), so a carried object cannot clip an
+        # obstacle between them by more than the validator's samples could
         res = plan_se2_path(scene_bounds(self.scene, 0.5), tuple(start), tuple(goal), valid,  # type: ignore[arg-type]
-                            time_limit=time_limit, seed=seed_for(robot, "base-path", seed=self.seed))
+                            time_limit=time_limit, seed=seed_for(robot, "base-path", seed=self.seed),
+                            resolution=PATH_RESOLUTION, yaw_resolution=PATH_RESOLUTION)
         return Answer(Status.OK if res.solved else Status.NO_PATH, path=list(res.path))
 
 

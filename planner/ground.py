@@ -12,7 +12,7 @@ objects not moved in S' plus the M_out objects that obstruct S'; otherwise it fa
 from __future__ import annotations
 
 import enum
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Iterable
 
 import numpy as np
@@ -20,9 +20,10 @@ import numpy as np
 from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action
 from mrgc.geometry.collision import CollisionWorld
-from mrgc.geometry.grounding import Answer, Grounder, Volume
+from mrgc.geometry.grounding import Answer, Grounder, Status, Volume
 from mrgc.geometry.predicates import refine
 from mrgc.geometry.planar import to_se2
+from mrgc.planner.outcome import Failure
 from mrgc.planner.plan import PlannedAction
 
 PLACEMENT_TRIES = 6  # placements sampled per place before the step gives up
@@ -51,6 +52,8 @@ class Grounding:
     steps: list[GroundedStep] = field(default_factory=list)
     must_move: set[str] = field(default_factory=set)
     reason: str = ""
+    #: why steps failed (the strict attempt of a PARTIAL step, or the failing step of a FAIL)
+    failures: list[Failure] = field(default_factory=list)
 
 
 def _matrix(t: np.ndarray) -> list[list[float]]:
@@ -78,20 +81,22 @@ class ReverseGrounder:
         for t in range(skeleton.makespan - 1, -1, -1):
             step = skeleton.steps[t]
             same = {a.obj for a in step}
-            strict = self._step(step, fut_objs | out_objs, same, volume, f"{key}:{t}")
-            if strict is None:
-                relaxed = self._step(step, fut_objs, same, volume, f"{key}:{t}:relaxed")
-                if relaxed is None:
-                    return Grounding(Outcome.FAIL, reason=f"step {t + 1} cannot be grounded")
+            strict = self._step(step, fut_objs | out_objs, same, volume, f"{key}:{t}", t + 1)
+            if isinstance(strict, Failure):
+                relaxed = self._step(step, fut_objs, same, volume, f"{key}:{t}:relaxed", t + 1)
+                if isinstance(relaxed, Failure):
+                    return Grounding(Outcome.FAIL, reason=relaxed.line(), failures=[relaxed])
                 grounded.insert(0, relaxed)
                 steps = grounded + suffix
                 moved = {o for s in steps for o in s.moved}
-                # the grounded steps assumed the objects of the discarded earlier steps were out of the way:
-                # those are blockers too when the steps hit them, just like the never-moved ones
-                earlier = {a.obj for step in skeleton.steps[:t] for a in step}
-                blockers = self.g.hits([p for s in grounded for p in s.volume], among=sorted(out_objs | earlier))
+                # M* as the paper defines it: every movable object not moved in S' that obstructs the whole
+                # grounded sequence S' (this call's steps *and* the older suffix: an object the suffix hits
+                # was to be moved by a step of this skeleton that is now discarded)
+                blockers = self.g.hits([p for s in steps for p in s.volume],
+                                       among=sorted(o for o in self.movable if o not in moved))
                 must = {o for o in self.goal if o not in moved} | blockers
-                return Grounding(Outcome.PARTIAL, steps, must, reason=f"step {t + 1} needs {sorted(blockers)} moved")
+                return Grounding(Outcome.PARTIAL, steps, must, reason=f"step {t + 1} needs {sorted(blockers)} moved",
+                                 failures=[strict])
             grounded.insert(0, strict)
             volume = volume + strict.volume
             fut_objs |= same
@@ -99,22 +104,25 @@ class ReverseGrounder:
 
     # ------------------------------------------------------------ one joint action
     def _step(self, step: tuple[Action, ...], avoid: set[str], same: set[str], v_fut: Volume,
-              key: str) -> GroundedStep | None:
+              key: str, index: int = 0) -> GroundedStep | Failure:
         actions: list[PlannedAction] = []
         step_volume: Volume = []
         motions: dict[str, dict[str, list[Volume]]] = {}  # robot -> phase -> volume at each sample
+        placed: dict[str, np.ndarray] = {}  # objects of this step already placed by its earlier actions
         for a in step:
             avoid_a = sorted((avoid | same) - {a.obj})
-            action = self._action(a, avoid_a, v_fut + step_volume, f"{key}:{a.obj}")
-            if action is None:
-                return None
+            action = self._action(a, avoid_a, v_fut + step_volume, f"{key}:{a.obj}", placed)
+            if isinstance(action, Failure):
+                return replace(action, step=index, action=label(a))
             mine = self._motions(action)
             # robots of one step move at once: phase by phase (pick, handover, place; drives), samples paired
             # by index as the validator replays them, they must not collide with each other
             for robot, phases in mine.items():
                 for other, their in motions.items():
-                    if other != robot and _phases_collide(phases, their):
-                        return None
+                    phase = _phases_collide(phases, their)
+                    if other != robot and phase:
+                        return Failure(index, label(a), f"{phase}: robots of the step collide",
+                                       tuple(sorted((robot, other))))
             for robot, phases in mine.items():
                 motions.setdefault(robot, {}).update(phases)
             for phases in mine.values():  # the step's volume is every sample of every motion
@@ -123,6 +131,7 @@ class ReverseGrounder:
                         step_volume.extend(vol)
             assert action.place_pose is not None
             step_volume.append((self.g.shape(a.obj), np.array(action.place_pose)))
+            placed[a.obj] = np.array(action.place_pose)
             actions.append(action)
         return GroundedStep(actions, step_volume, tuple(a.obj for a in step))
 
@@ -148,59 +157,78 @@ class ReverseGrounder:
             for q in refine(np.array(action.configs["place"]))]
         return out
 
-    def _action(self, a: Action, avoid: list[str], v_fut: Volume, key: str) -> PlannedAction | None:
+    def _action(self, a: Action, avoid: list[str], v_fut: Volume, key: str,
+                placed: dict[str, np.ndarray] | None = None) -> PlannedAction | Failure:
         if self.g.is_planar(a.pick_robot):
-            return self._drive(a, avoid, v_fut, key)
+            return self._drive(a, avoid, v_fut, key, placed or {})
         g = self.g
         pick = g.pick(a.pick_robot, a.obj, a.pick_grasp, avoid=avoid)
         if not pick.ok:
-            return None
+            return _failed(f"pick by {a.pick_robot}", pick)
         planned = PlannedAction(a.obj, a.region, a.pick_robot, a.place_robot, a.pick_grasp, a.place_grasp)
         planned.configs["pick"] = _configs(pick.configs)
         if a.handover:
             hand = self._handover(a, avoid)
-            if hand is None:
-                return None
+            if isinstance(hand, Failure):
+                return hand
             point, answer = hand
             assert answer.configs is not None
             planned.handover_point = point
             planned.configs["handover"] = _configs(answer.configs)
+        last: Failure | None = None
         for k in range(PLACEMENT_TRIES):
             spot = g.placement(a.obj, a.region, avoid=avoid, volume=v_fut, key=key, skip=k)
             if not spot.ok:
-                return None
+                return last or Failure(0, "", f"placement: no free pose of {a.obj} in {a.region}")
             assert spot.pose is not None
             place = g.place(a.place_robot, a.obj, a.place_grasp, spot.pose, avoid=avoid)
             if place.ok:
                 planned.place_pose = _matrix(spot.pose)
                 planned.configs["place"] = _configs(place.configs)
                 return planned
-        return None
+            last = _failed(f"place by {a.place_robot}", place)
+        assert last is not None
+        return last
 
-    def _drive(self, a: Action, avoid: list[str], v_fut: Volume, key: str) -> PlannedAction | None:
+    def _drive(self, a: Action, avoid: list[str], v_fut: Volume, key: str,
+               placed: dict[str, np.ndarray]) -> PlannedAction | Failure:
         """A planar robot's action (path mode): drive from its start pose to the pick pose, carry the object
-        to the place pose, drive back; every path free of fixed objects and of ``avoid``."""
+        to the place pose, drive back; every path free of fixed objects and of ``avoid``.  The drive home
+        sees every object of the step at its new pose (the validator's home phase): the one just placed and
+        those ``placed`` by the step's actions grounded before this one (the ones grounded after it keep
+        clear of this drive, which is in the step's volume)."""
         g, robot = self.g, a.pick_robot
         if a.handover:
-            return None  # planar robots do not hand over (no such facts are computed)
+            return Failure(0, "", "planar robots do not hand over")  # no such facts are computed
         pr = g.planar(robot)
         shape = g.scene.body(a.obj).shape
         home = to_se2(g.scene.robot(robot).base)
         q_pick = pr.grasp_base(g.poses[a.obj], shape, a.pick_grasp)
         to_pick = g.base_path(robot, home, q_pick, avoid=avoid)
         if not to_pick.ok:
-            return None
+            return _failed("drive to the pick", to_pick)
+        last: Failure | None = None
         for k in range(PLACEMENT_TRIES):
             spot = g.placement(a.obj, a.region, avoid=avoid, volume=v_fut, key=key, skip=k)
             if not spot.ok:
-                return None
+                return last or Failure(0, "", f"placement: no free pose of {a.obj} in {a.region}")
             assert spot.pose is not None
             q_place = pr.grasp_base(spot.pose, shape, a.place_grasp)
             carry = g.base_path(robot, q_pick, q_place, holding=(a.obj, a.pick_grasp), avoid=avoid)
             if not carry.ok:
+                last = _failed("carry to the placement", carry)
                 continue
-            back = g.base_path(robot, q_place, home, avoid=avoid)
+            new = {**placed, a.obj: spot.pose}
+            initial = {o: g.poses[o] for o in new}
+            for o, pose in new.items():
+                g.move(o, pose)
+            try:
+                back = g.base_path(robot, q_place, home, avoid=sorted({*avoid, *new}))
+            finally:
+                for o, pose in initial.items():
+                    g.move(o, pose)
             if not back.ok:
+                last = _failed("drive home", back)
                 continue
             planned = PlannedAction(a.obj, a.region, robot, robot, a.pick_grasp, a.place_grasp,
                                     place_pose=_matrix(spot.pose))
@@ -208,20 +236,39 @@ class ReverseGrounder:
             planned.paths = {"to-pick": _configs(np.array(to_pick.path)), "to-place": _configs(np.array(carry.path)),
                              "home": _configs(np.array(back.path))}
             return planned
-        return None
+        assert last is not None
+        return last
 
-    def _handover(self, a: Action, avoid: list[str]) -> tuple[str, Answer] | None:
+    def _handover(self, a: Action, avoid: list[str]) -> tuple[str, Answer] | Failure:
+        failure = Failure(0, "", f"handover: no handover point usable for {a.obj}")
         for point in self.g.scene.handover_of.get(a.obj, ()):
             if point not in self.g.scene.handover_points:
                 continue
             ans = self.g.handover(a.obj, point, a.pick_robot, a.pick_grasp, a.place_robot, a.place_grasp, avoid=avoid)
             if ans.ok:
                 return point, ans
-        return None
+            failure = _failed(f"handover at {point}", ans)
+            if ans.status is Status.COLLISION and not ans.blockers:
+                failure = replace(failure, check=f"handover at {point}: the two arms collide",
+                                  bodies=tuple(sorted((a.pick_robot, a.place_robot))))
+        return failure
 
 
-def _phases_collide(mine: dict[str, list[Volume]], theirs: dict[str, list[Volume]]) -> bool:
-    """Do two robots collide in a phase both move in, their samples paired by index (resampled)?"""
+def label(a: Action) -> str:
+    """An action as a failure line names it: ``r1 moves o3 to bin-a (top)``, ``r1->r2 hands o3 to bin-a ...``."""
+    if a.pick_robot == a.place_robot:
+        return f"{a.pick_robot} moves {a.obj} to {a.region} ({a.pick_grasp})"
+    return f"{a.pick_robot}->{a.place_robot} hand {a.obj} over to {a.region} ({a.pick_grasp}->{a.place_grasp})"
+
+
+def _failed(what: str, answer: Answer) -> Failure:
+    """A failure of a geometric query: its status as the check, the objects that were in the way as bodies."""
+    return Failure(0, "", f"{what}: {answer.status.value}", tuple(sorted(answer.blockers)))
+
+
+def _phases_collide(mine: dict[str, list[Volume]], theirs: dict[str, list[Volume]]) -> str:
+    """The first phase both robots move in where they collide, their samples paired by index (resampled);
+    "" when they never do."""
     for phase, samples in mine.items():
         other = theirs.get(phase)
         if not other:
@@ -229,8 +276,8 @@ def _phases_collide(mine: dict[str, list[Volume]], theirs: dict[str, list[Volume
         n = max(len(samples), len(other))
         for i in range(n):
             if _volumes_collide(samples[i * len(samples) // n], other[i * len(other) // n]):
-                return True
-    return False
+                return phase
+    return ""
 
 
 def _volumes_collide(a: Volume, b: Volume) -> bool:

@@ -61,9 +61,14 @@ class Node:
 
 @dataclass
 class SearchResult:
+    """The best plan found (None if none) and why the search ended: ``solved`` (first plan, or the anytime
+    search ran until the tree was used up with a plan in hand), ``exhausted`` (the root ran out of
+    skeletons), ``time limit``, ``iteration limit`` or ``interrupted`` (KeyboardInterrupt)."""
+
     steps: list[GroundedStep] | None
     iterations: int
     stats: dict[str, float]
+    ended: str = "exhausted"
 
 
 class MCTS:
@@ -79,44 +84,63 @@ class MCTS:
         self.root.refill(k)
         first_skeletons = time.perf_counter() - t0
         self.memo: set[tuple[frozenset[tuple[str, ...]], frozenset[object]]] = set()
+        #: the best full plan found so far (by makespan, then objects moved)
+        self.best: list[GroundedStep] | None = None
         self.stats: dict[str, float] = {"groundings": 0, "grounding_seconds": 0.0, "skeleton_seconds": first_skeletons,
                                         "skeletons": len(self.root.edges), "nodes": 1, "memo_hits": 0}
 
     def q(self, node: Node, e: Edge) -> float:
         return e.value / (e.visits + 1) + self.c * e.prior * math.sqrt(node.visits) / (e.visits + 1)
 
-    def run(self, deadline: float, max_iterations: int = 10_000) -> SearchResult:
-        for it in range(1, max_iterations + 1):
-            if time.perf_counter() >= deadline:
-                return SearchResult(None, it - 1, self.stats)
-            path: list[tuple[Node, Edge]] = []
-            node = self.root
-            reward = 0.0
-            while True:
-                if not node.open_edges:  # beyond the paper: ask for more skeletons before giving up
-                    t0 = time.perf_counter()
-                    before = len(node.edges)
-                    node.refill(self.k)
-                    self.stats["skeleton_seconds"] += time.perf_counter() - t0
-                    self.stats["skeletons"] += len(node.edges) - before
-                edges = node.open_edges
-                if not edges:
-                    if path:
-                        path[-1][1].dead = True  # nothing left below this edge
-                    break
-                edge = max(edges, key=lambda e: self.q(node, e))
-                path.append((node, edge))
-                if edge.child is None:
-                    done, reward = self._expand(node, edge)
-                    if done is not None:
-                        self._backprop(path, reward)
-                        return SearchResult(done, it, self.stats)
-                    break
-                node = edge.child
-            if not path:
-                return SearchResult(None, it, self.stats)  # the root ran out of skeletons: no plan
-            self._backprop(path, reward)
-        return SearchResult(None, max_iterations, self.stats)
+    def run(self, deadline: float, max_iterations: int = 10_000, anytime: bool = False) -> SearchResult:
+        """Search until a plan is found (or, ``anytime``, until the deadline or the end of the tree, keeping
+        the best plan by (makespan, objects moved)); Ctrl-C ends the search with what it has."""
+        it = 0
+        try:
+            for it in range(1, max_iterations + 1):
+                if time.perf_counter() >= deadline:
+                    return SearchResult(self.best, it - 1, self.stats, "time limit")
+                if not self._iterate(anytime):
+                    return SearchResult(self.best, it, self.stats,
+                                        "solved" if self.best is not None else "exhausted")
+                if self.best is not None and not anytime:
+                    return SearchResult(self.best, it, self.stats, "solved")
+        except KeyboardInterrupt:
+            return SearchResult(self.best, it, self.stats, "interrupted")
+        return SearchResult(self.best, max_iterations, self.stats, "iteration limit")
+
+    def _iterate(self, anytime: bool) -> bool:
+        """One selection-expansion-backpropagation round; False when the root has nothing left to try."""
+        path: list[tuple[Node, Edge]] = []
+        node = self.root
+        reward = 0.0
+        while True:
+            if not node.open_edges:  # beyond the paper: ask for more skeletons before giving up
+                t0 = time.perf_counter()
+                before = len(node.edges)
+                node.refill(self.k)
+                self.stats["skeleton_seconds"] += time.perf_counter() - t0
+                self.stats["skeletons"] += len(node.edges) - before
+            edges = node.open_edges
+            if not edges:
+                if path:
+                    path[-1][1].dead = True  # nothing left below this edge
+                break
+            edge = max(edges, key=lambda e: self.q(node, e))
+            path.append((node, edge))
+            if edge.child is None:
+                done, reward = self._expand(node, edge)
+                if done is not None:
+                    edge.dead = True  # a full plan: nothing more to ground below this edge
+                    if self.best is None or _cost(done) < _cost(self.best):
+                        self.best = done
+                        self.stats["plans"] = self.stats.get("plans", 0) + 1
+                break
+            node = edge.child
+        if not path:
+            return False  # the root ran out of skeletons
+        self._backprop(path, reward)
+        return True
 
     def _expand(self, node: Node, edge: Edge) -> tuple[list[GroundedStep] | None, float]:
         memo_key = (frozenset((a.object, a.region, a.pick_robot, a.place_robot) for s in node.suffix
@@ -157,3 +181,8 @@ class MCTS:
             edge.value += reward
             edge.visits += 1
             node.visits += 1
+
+
+def _cost(steps: list[GroundedStep]) -> tuple[int, int]:
+    """The paper's order of plans: makespan, then the number of objects moved."""
+    return (len(steps), len(moved_objects(steps)))

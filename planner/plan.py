@@ -14,6 +14,8 @@ import json
 from dataclasses import dataclass, field
 from typing import Any
 
+from mrgc.planner.outcome import PlanStatus, Why
+
 SCHEMA = "mrgc-plan/1"
 
 
@@ -67,10 +69,14 @@ class Plan:
     backend: str
     encoding: str
     seed: int
-    status: str  # solved | no plan | time limit
+    status: PlanStatus | str  # a PlanStatus (its value is what the JSON holds)
     steps: list[list[PlannedAction]] = field(default_factory=list)
     symbolic: bool = False
     stats: dict[str, Any] = field(default_factory=dict)
+    #: why the run ended as it did (reasons for "no plan", failures met on the way)
+    why: Why | None = None
+    #: the independent validator's verdict on the returned plan (geometric plans)
+    validation: dict[str, Any] | None = None
 
     @property
     def makespan(self) -> int:
@@ -91,12 +97,14 @@ class Plan:
             "backend": self.backend,
             "encoding": self.encoding,
             "seed": self.seed,
-            "status": self.status,
+            "status": str(PlanStatus(self.status)),
             "symbolic": self.symbolic,
-            "makespan": self.makespan if self.status == "solved" else None,
-            "motion_cost": self.motion_cost if self.status == "solved" else None,
+            "makespan": self.makespan if self.steps else None,
+            "motion_cost": self.motion_cost if self.steps else None,
             "steps": [{"index": i, "actions": [a.to_json() for a in step],
                        "waiting": self._waiting(step)} for i, step in enumerate(self.steps, 1)],
+            **({"validation": self.validation} if self.validation is not None else {}),
+            **({"why": self.why.to_json()} if self.why is not None else {}),
             "stats": self.stats,
         }
 
@@ -108,8 +116,8 @@ class Plan:
         return json.dumps(self.to_json(), indent=1, sort_keys=False) + "\n"
 
     def summary(self) -> list[str]:
-        lines = [f"plan for {self.problem}: {self.status}"
-                 + (f", makespan {self.makespan}, {self.motion_cost} objects moved" if self.status == "solved" else "")]
+        lines = [f"plan for {self.problem}: {PlanStatus(self.status)}"
+                 + (f", makespan {self.makespan}, {self.motion_cost} objects moved" if self.steps else "")]
         for i, step in enumerate(self.steps, 1):
             parts = []
             for a in step:
@@ -117,6 +125,8 @@ class Plan:
                 grasp = a.pick_grasp if a.kind == "pick-place" else f"{a.pick_grasp}->{a.place_grasp}"
                 parts.append(f"{who} moves {a.object} to {a.region} ({grasp})")
             lines.append(f"  step {i}: " + "; ".join(parts))
+        if self.why is not None and PlanStatus(self.status) is not PlanStatus.SOLVED:
+            lines += self.why.lines()
         return lines
 
 

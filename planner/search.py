@@ -1,8 +1,14 @@
 """``mrgc plan``: phase 1, then the MCTS over skeletons with reverse-search grounding, then a Plan.
 
 Symbolic problems have no geometry to ground: their plan is the best skeleton (documented in
-docs/planner.md).  The outcome is a status on the plan (``solved``, ``no plan``, ``time limit``) with
-statistics: time per phase, skeletons generated and grounded, tree size, geometric queries.
+docs/planner.md).  Every outcome is a :class:`~mrgc.planner.outcome.PlanStatus` on the plan, with its
+reasons (:class:`~mrgc.planner.outcome.Why`) and statistics: time per phase, skeletons generated and
+grounded, tree size, geometric queries.
+
+**Nothing is solved until the validator says so.**  Each complete plan the search grounds is replayed by
+the independent validator (:mod:`mrgc.planner.validate`) before it is accepted; a rejected plan is a
+grounding failure like any other (reward 0, memoised) and the search goes on.  The plan records the
+verdict (``validation``).
 """
 
 from __future__ import annotations
@@ -10,70 +16,175 @@ from __future__ import annotations
 import time
 from typing import Any, Callable
 
+from mrgc.compiler.enumerate import EXHAUSTED
 from mrgc.compiler.facts import FactBase
 from mrgc.compiler.skeleton import Skeleton
 from mrgc.geometry.grounding import Grounder
 from mrgc.geometry.scene import scene_from_problem
 from mrgc.language.model import Problem
-from mrgc.planner.ground import GroundedStep, ReverseGrounder
+from mrgc.planner.ground import GroundedStep, Grounding, Outcome, ReverseGrounder, moved_objects
 from mrgc.planner.mcts import MCTS
+from mrgc.planner.outcome import Failure, PlanStatus, Why
 from mrgc.planner.plan import Plan, PlannedAction
 from mrgc.planner.skeletons import DEFAULT_BACKEND, DEFAULT_ENCODING, SkeletonSource, must_move, problem_facts
+
+#: a search log line sink (``mrgc plan --verbose`` prints them)
+Log = Callable[[str], None]
 
 
 def plan_problem(problem: Problem, problem_file: str, sha256: str, version: str, backend: str = DEFAULT_BACKEND,
                  encoding: str = DEFAULT_ENCODING, seed: int = 0, time_limit: float = 60.0, c: float = 1.0,
-                 alpha: float = 1.0, skeletons: int = 5, max_makespan: int | None = None) -> Plan:
-    """Plan ``problem`` (see the module docstring)."""
+                 alpha: float = 1.0, skeletons: int = 5, max_makespan: int | None = None, anytime: bool = False,
+                 log: Log | None = None, max_iterations: int = 10_000) -> Plan:
+    """Plan ``problem`` (see the module docstring).  ``anytime`` keeps searching after the first plan until
+    the time limit (or the end of the tree) and returns the best by (makespan, objects moved); ``log`` gets
+    one line per grounded skeleton."""
     t0 = time.perf_counter()
     deadline = t0 + time_limit
+    say: Log = log or (lambda line: None)
     facts, facts_seconds = problem_facts(problem, seed=seed)
     base = FactBase.from_problem(problem, facts)
-    plan = Plan(problem.name, problem_file, sha256, version, backend, encoding, seed, "no plan",
+    plan = Plan(problem.name, problem_file, sha256, version, backend, encoding, seed, PlanStatus.EXHAUSTED,
                 symbolic=problem.symbolic)
+    why = Why()
+    plan.why = why
     stats: dict[str, Any] = {"robots": [r.name for r in problem.robots], "facts": len(facts),
                              "facts_seconds": round(facts_seconds, 4)}
     start = must_move(problem, facts)
+    roots: list[SkeletonSource] = []
 
     def sources(need: set[str], moved: set[str]) -> Callable[[int], list[Skeleton]]:
         src = SkeletonSource(base, sorted(need, key=_order(problem)), sorted(moved), backend, encoding,
                              max_makespan, seed)
+        if not roots:
+            roots.append(src)
+        state = {"count": 0, "outcome": ""}
 
         def more(k: int) -> list[Skeleton]:
             left = max(0.01, deadline - time.perf_counter())
-            return src.next(k, time_limit=left).skeletons
+            batch = src.next(k, time_limit=left)
+            state["count"] += len(batch.skeletons)
+            state["outcome"] = batch.outcome
+            return batch.skeletons
 
+        more.state = state  # type: ignore[attr-defined]
         return more
 
+    def infeasible_reasons(source: SkeletonSource) -> list[str]:
+        return list(source.reasons) or ["no task skeleton exists under the facts (the skeleton model is infeasible "
+                                        "at every horizon)"]
+
     if problem.symbolic:
-        first = sources(set(start), set())(1)
+        more = sources(set(start), set())
+        first = more(1)
         if first:
-            plan.status = "solved"
+            plan.status = PlanStatus.SOLVED
             plan.steps = [[_planned(a) for a in step] for step in first[0].steps]
+        elif more.state["outcome"] == EXHAUSTED:  # type: ignore[attr-defined]
+            plan.status = PlanStatus.INFEASIBLE
+            why.facts = infeasible_reasons(roots[0])
+            why.summary = "infeasible by the facts"
+        else:
+            plan.status = PlanStatus.TIME_LIMIT
+            why.summary = f"skeleton generation did not finish within {time_limit:g} s"
         stats["skeleton_seconds"] = round(time.perf_counter() - t0 - facts_seconds, 4)
     else:
         scene = scene_from_problem(problem)
         grounder = Grounder(scene, seed=seed)
         reverse = ReverseGrounder(grounder, problem.goal_regions)
         count = [0]
+        validation: dict[str, Any] = {}
 
-        def ground(skel: Skeleton, suffix: list[GroundedStep]):  # type: ignore[no-untyped-def]
+        def ground(skel: Skeleton, suffix: list[GroundedStep]) -> Grounding:
             count[0] += 1
-            return reverse.ground(skel, suffix, key=str(count[0]))
+            result = reverse.ground(skel, suffix, key=str(count[0]))
+            if result.outcome is Outcome.SUCCESS:
+                result = _referee(problem, problem_file, plan, result, why, validation)
+            for f in result.failures:
+                why.add(f)
+            say(_log_line(time.perf_counter() - t0, count[0], skel, suffix, result))
+            return result
 
         search = MCTS(ground, sources, set(start), c=c, alpha=alpha, k=skeletons)
-        result = search.run(deadline)
+        result = search.run(deadline, max_iterations=max_iterations, anytime=anytime)
+        root_state = search.root.more.state  # type: ignore[attr-defined]
         if result.steps is not None:
-            plan.status = "solved"
             plan.steps = [s.actions for s in result.steps]
-        elif time.perf_counter() >= deadline:
-            plan.status = "time limit"
+            plan.status = PlanStatus.SOLVED if result.ended != "interrupted" else PlanStatus.INTERRUPTED
+            plan.validation = _verdict_of(plan, validation)
+        elif result.ended == "interrupted":
+            plan.status = PlanStatus.INTERRUPTED
+        elif result.ended in ("time limit", "iteration limit") or time.perf_counter() >= deadline:
+            plan.status = PlanStatus.TIME_LIMIT
+        elif root_state["count"] == 0 and root_state["outcome"] == EXHAUSTED:
+            plan.status = PlanStatus.INFEASIBLE
+            why.facts = infeasible_reasons(roots[0])
+        else:
+            plan.status = PlanStatus.EXHAUSTED
         stats.update({k: (round(v, 4) if isinstance(v, float) else v) for k, v in result.stats.items()})
         stats["iterations"] = result.iterations
         stats["geometric_queries"] = grounder.queries
+        why.summary = _summary(plan.status, result.ended, time_limit, max_iterations, why)
     stats["seconds"] = round(time.perf_counter() - t0, 4)
     plan.stats = stats
     return plan
+
+
+def _referee(problem: Problem, problem_file: str, plan: Plan, result: Grounding, why: Why,
+             verdicts: dict[str, Any]) -> Grounding:
+    """The validator's verdict on a complete grounded plan: SUCCESS stays SUCCESS only when it accepts it;
+    otherwise the grounding is a failure (named by the validator's first violation)."""
+    from mrgc.planner.validate import validate
+
+    candidate = Plan(plan.problem, plan.problem_file, plan.problem_sha256, plan.mrgc_version, plan.backend,
+                     plan.encoding, plan.seed, PlanStatus.SOLVED, [s.actions for s in result.steps],
+                     symbolic=False, stats={"robots": [r.name for r in problem.robots]})
+    t0 = time.perf_counter()
+    report = validate(problem, candidate.to_json(), problem_file)
+    seconds = time.perf_counter() - t0
+    verdicts["seconds"] = verdicts.get("seconds", 0.0) + seconds
+    verdicts["checked"] = verdicts.get("checked", 0) + 1
+    if report.ok:
+        return result
+    why.rejected_plans += 1
+    first = report.violations[0]
+    failure = Failure(first.step or 0, f"validator ({len(report.violations)} violation"
+                                       f"{'s' * (len(report.violations) != 1)})", first.code,
+                      (first.subject,) if first.subject else (), first.message)
+    return Grounding(Outcome.FAIL, reason=failure.line(), failures=[failure])
+
+
+def _verdict_of(plan: Plan, verdicts: dict[str, Any]) -> dict[str, Any]:
+    """What the plan JSON records of the validator's verdict on the returned plan."""
+    return {"valid": True, "validator": "mrgc validate (independent pybullet replay)",
+            "plans_checked": verdicts.get("checked", 0), "seconds": round(verdicts.get("seconds", 0.0), 4)}
+
+
+def _summary(status: PlanStatus, ended: str, time_limit: float, max_iterations: int, why: Why) -> str:
+    if status is PlanStatus.SOLVED:
+        return "solved" + (f" after the validator rejected {why.rejected_plans} plan(s)" if why.rejected_plans else "")
+    if status is PlanStatus.INFEASIBLE:
+        return "infeasible by the facts: no task skeleton exists"
+    if status is PlanStatus.INTERRUPTED:
+        return "interrupted"
+    if status is PlanStatus.TIME_LIMIT:
+        if ended == "iteration limit":
+            return f"the search's iteration limit ({max_iterations}) was reached before a plan was found"
+        return f"no plan within the time limit of {time_limit:g} s"
+    return "every skeleton the compiler could generate was tried; none could be grounded into a valid plan"
+
+
+def _log_line(elapsed: float, n: int, skel: Skeleton, suffix: list[GroundedStep], result: Grounding) -> str:
+    head = f"[t={elapsed:.1f}s] skeleton {n} (makespan {skel.makespan}, moves {len(skel.moved)}"
+    head += f", under a suffix of {len(suffix)} step{'s' * (len(suffix) != 1)})" if suffix else ")"
+    if result.outcome is Outcome.SUCCESS:
+        return f"{head}: plan found, makespan {len(result.steps)}, {len(moved_objects(result.steps))} moved, valid"
+    if result.outcome is Outcome.PARTIAL:
+        f = result.failures[0] if result.failures else None
+        why = f" ({f.line()})" if f else ""
+        return f"{head}: grounded {len(result.steps) - len(suffix)} step(s); must move {sorted(result.must_move)}{why}"
+    f = result.failures[0] if result.failures else None
+    return f"{head}: fails at {f.line() if f else result.reason}"
 
 
 def _planned(a: Any) -> PlannedAction:

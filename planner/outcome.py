@@ -1,0 +1,130 @@
+"""How a planning run ended, and why: the status of a plan and the reasons behind "no plan".
+
+Every run of ``mrgc plan`` ends in exactly one :class:`PlanStatus`; each status has its own exit code
+(the table is :data:`EXIT_CODES`, documented in docs/errors.md and docs/planner.md):
+
+===============  ====  ==========================================================================
+status           exit  meaning
+===============  ====  ==========================================================================
+``solved``       0     a plan was found **and the independent validator accepted it**
+``infeasible``   1     no task skeleton exists under the facts (the reasons name the goals, the
+                       missing facts or the blocking cycle); more time cannot help
+``exhausted``    5     every skeleton the compiler could generate was tried and none could be
+                       grounded into a valid plan (the grounding-failure summary says why)
+``time limit``   3     the time limit (or the search's iteration limit) ended the search first
+``interrupted``  130   Ctrl-C / SIGINT ended the search (143 for SIGTERM)
+===============  ====  ==========================================================================
+
+A :class:`Why` travels with every plan that is not ``solved`` (and with a ``solved`` one, holding the
+failures met on the way): one summary line, the compiler's reasons (goals without an achievable action and
+the facts they miss), blocking cycles (objects that obstruct every pick of each other, with the bodies
+that overlap and by how much), and a count of grounding failures by (step, action, check, bodies).
+"""
+
+from __future__ import annotations
+
+import enum
+from collections import Counter
+from dataclasses import dataclass, field
+from typing import Any
+
+
+class PlanStatus(str, enum.Enum):
+    """The outcome of a planning run (see the module docstring for the exit codes)."""
+
+    SOLVED = "solved"
+    INFEASIBLE = "infeasible"
+    EXHAUSTED = "exhausted"
+    TIME_LIMIT = "time limit"
+    INTERRUPTED = "interrupted"
+
+    def __str__(self) -> str:
+        return self.value
+
+
+#: status -> process exit code of ``mrgc plan``
+EXIT_CODES: dict[PlanStatus, int] = {
+    PlanStatus.SOLVED: 0,
+    PlanStatus.INFEASIBLE: 1,
+    PlanStatus.TIME_LIMIT: 3,
+    PlanStatus.EXHAUSTED: 5,
+    PlanStatus.INTERRUPTED: 130,
+}
+
+
+@dataclass(frozen=True)
+class Failure:
+    """Why one grounding of a skeleton failed: the skeleton step (1-based), the action that could not be
+    grounded (``"r1 picks o3 (top)"``), the check that failed (``"pick: no inverse kinematics"``,
+    ``"pick: collision"``, ``"placement: no free pose in bin-a"``, ``"robots collide"``, ``"validator"``
+    ...), the bodies involved (sorted names), and a detail line (a depth, a validator message)."""
+
+    step: int
+    action: str
+    check: str
+    bodies: tuple[str, ...] = ()
+    detail: str = ""
+
+    def key(self) -> tuple[int, str, str, tuple[str, ...]]:
+        return (self.step, self.action, self.check, self.bodies)
+
+    def line(self) -> str:
+        bodies = f" [{', '.join(self.bodies)}]" if self.bodies else ""
+        detail = f": {self.detail}" if self.detail else ""
+        return f"step {self.step}, {self.action}: {self.check}{bodies}{detail}"
+
+
+@dataclass(frozen=True)
+class BlockingCycle:
+    """Objects that must each move strictly before the next (every action of one is obstructed by the next
+    at its pick), closing a cycle: no order of moves exists.  ``edges`` are (object, blocker, how), and
+    ``how`` lists the picks and, where the geometry was consulted, the overlapping bodies and the depth."""
+
+    objects: tuple[str, ...]
+    edges: tuple[tuple[str, str, str], ...]
+
+    def line(self) -> str:
+        ring = " -> ".join(self.objects + self.objects[:1])
+        return f"blocking cycle {ring}: " + "; ".join(f"every pick of {o} is obstructed by {b} ({how})"
+                                                       for o, b, how in self.edges)
+
+
+@dataclass
+class Why:
+    """The reasons of a run's outcome (see the module docstring)."""
+
+    summary: str = ""
+    facts: list[str] = field(default_factory=list)
+    cycles: list[BlockingCycle] = field(default_factory=list)
+    failures: Counter[Failure] = field(default_factory=Counter)
+    rejected_plans: int = 0  # full plans the validator rejected
+
+    def add(self, failure: Failure) -> None:
+        self.failures[failure] += 1
+
+    def top_failures(self, n: int = 10) -> list[tuple[Failure, int]]:
+        """The ``n`` most frequent failures, ties in a stable order (step, action, check, bodies)."""
+        return sorted(self.failures.items(), key=lambda fc: (-fc[1], fc[0].key(), fc[0].detail))[:n]
+
+    def lines(self, n: int = 10) -> list[str]:
+        out = [f"why: {self.summary}"] if self.summary else []
+        out += [f"  {r}" for r in self.facts]
+        out += [f"  {c.line()}" for c in self.cycles]
+        if self.rejected_plans:
+            out.append(f"  {self.rejected_plans} complete plan(s) rejected by the validator")
+        top = self.top_failures(n)
+        if top:
+            out.append(f"  grounding failures ({sum(self.failures.values())} in all; most frequent first):")
+            out += [f"    {count} x {f.line()}" for f, count in top]
+        return out
+
+    def to_json(self, n: int = 20) -> dict[str, Any]:
+        return {
+            "summary": self.summary,
+            "facts": list(self.facts),
+            "cycles": [{"objects": list(c.objects), "edges": [{"object": o, "blocker": b, "how": how}
+                                                              for o, b, how in c.edges]} for c in self.cycles],
+            "rejected_plans": self.rejected_plans,
+            "grounding_failures": [{"step": f.step, "action": f.action, "check": f.check, "bodies": list(f.bodies),
+                                    "detail": f.detail, "count": count} for f, count in self.top_failures(n)],
+        }

@@ -145,7 +145,8 @@ def _pb_links(model: RobotModel) -> tuple[int, dict[str, int], list[tuple[int, L
     return body, by_name, movable
 
 
-def _set_state(model: RobotModel, q: np.ndarray, base: np.ndarray | None) -> tuple[Any, int, int]:
+def _set_state(model: RobotModel, q: np.ndarray, base: np.ndarray | None,
+               fingers: float | None = None) -> tuple[Any, int, int]:
     pb, cid = _pb()
     body, _, movable = _pb_links(model)
     base_t = np.eye(4) if base is None else np.asarray(base, dtype=float)
@@ -155,17 +156,21 @@ def _set_state(model: RobotModel, q: np.ndarray, base: np.ndarray | None) -> tup
     pb.resetBasePositionAndOrientation(body, pos, orn, physicsClientId=cid)
     for j, link in movable:
         v = q[link.chain_index] if link.chain_index >= 0 else link.frozen_value
+        if link.finger and fingers is not None:
+            v = min(max(fingers, link.lower), link.upper)
         pb.resetJointState(body, j, float(v), physicsClientId=cid)
     return pb, cid, body
 
 
-def pybullet_fk(model: RobotModel, q: Sequence[float], base: np.ndarray | None = None) -> dict[str, np.ndarray]:
+def pybullet_fk(model: RobotModel, q: Sequence[float], base: np.ndarray | None = None,
+                fingers: float | None = None) -> dict[str, np.ndarray]:
     """pybullet's forward kinematics (reference): link name → 4×4 URDF link frame in the world, with the
-    base link's frame at ``base`` (identity when None); off-chain joints at their frozen values.
+    base link's frame at ``base`` (identity when None); off-chain joints at their frozen values, the finger
+    joints at ``fingers`` when given (clamped into their limits).
 
     pybullet reports link frames in single precision (errors up to about 1e-7 m).
     """
-    pb, cid, body = _set_state(model, np.asarray(q, dtype=float), base)
+    pb, cid, body = _set_state(model, np.asarray(q, dtype=float), base, fingers)
     _, by_name, _ = _pb_links(model)
     out = {}
     bpos, born = pb.getBasePositionAndOrientation(body, physicsClientId=cid)

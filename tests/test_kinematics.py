@@ -214,6 +214,21 @@ def test_fk_with_a_base_pose_matches_pybullet(panda, u, x, y, z, yaw) -> None:
     assert np.allclose(F.ee_pose(panda, q, base), ours[panda.ee_link], atol=1e-12)
 
 
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(u=unit_floats(7), opening=st.floats(0.0, 0.1))
+def test_fk_with_the_fingers_at_an_opening_matches_pybullet(panda, u, opening) -> None:
+    q = in_limits(panda, u)
+    value = panda.finger_value(opening)
+    ours = F.fk(panda, q, fingers=value)
+    assert_same_frames(pybullet_fk(panda, q, fingers=value), ours, panda)
+    left, right = panda.link_index("panda_leftfinger"), panda.link_index("panda_rightfinger")
+    gap = np.linalg.norm(ours[left][:3, 3] - ours[right][:3, 3])
+    assert gap == pytest.approx(min(opening, 0.08), abs=1e-9)  # the finger frames stand the opening apart
+    # only the fingers move; at the upper limit they are where the frozen (open) model puts them
+    assert np.allclose(np.delete(ours, [left, right], axis=0), np.delete(F.fk(panda, q), [left, right], axis=0))
+    assert np.allclose(F.fk(panda, q, fingers=panda.finger_value(0.08)), F.fk(panda, q), atol=1e-15)
+
+
 def test_fk_batches(panda) -> None:
     rng = np.random.default_rng(0)
     q = rng.uniform(panda.lower, panda.upper, size=(4, 3, 7))

@@ -235,7 +235,8 @@ def cmd_plan(args: argparse.Namespace) -> int:
         else:
             sys.stdout.write(text)
     else:
-        print("mrgc: interrupted; no plan file written. The search so far:", file=out)
+        print(f"mrgc: {'terminated (SIGTERM)' if _SIGNALLED else 'interrupted'}; no plan file written. "
+              "The search so far:", file=out)
     for line in plan.summary():
         print(line, file=out)
     st = plan.stats
@@ -246,6 +247,8 @@ def cmd_plan(args: argparse.Namespace) -> int:
     if plan.validation:
         print(f"  validated: {plan.validation['plans_checked']} complete plan(s) replayed by the validator, "
               f"the returned one valid", file=out)
+    if status is PlanStatus.INTERRUPTED and _SIGNALLED:
+        return EXIT_TERMINATED
     return EXIT_CODES[status]
 
 
@@ -312,6 +315,13 @@ def cmd_backends(args: argparse.Namespace) -> int:
     print()
     print(feature_table())
     return EXIT_OK
+
+
+def threading_main() -> bool:
+    """Whether this is the main thread (only it may install signal handlers)."""
+    import threading
+
+    return threading.current_thread() is threading.main_thread()
 
 
 # ---------------------------------------------------------------- wiring
@@ -396,10 +406,29 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+EXIT_TERMINATED = 143
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised where the process is (like Ctrl-C) so that every command stops the same way."""
+
+
+_SIGNALLED: list[int] = []  # SIGTERM seen (a search that stops on it reports "interrupted")
+
+
+def _on_sigterm(signum: int, frame: object) -> None:
+    _SIGNALLED.append(signum)
+    raise Terminated()
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the CLI; returns the exit code (the console script exits with it)."""
+    import signal
+
     parser = build_parser()
     try:
+        if threading_main():
+            signal.signal(signal.SIGTERM, _on_sigterm)
         args = parser.parse_args(argv)
         if not getattr(args, "func", None):
             parser.print_help()
@@ -414,6 +443,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except MrgcError as exc:
         print(f"mrgc: error: {exc}", file=sys.stderr)
         return exc.exit_code
+    except Terminated:
+        print("mrgc: terminated (SIGTERM)", file=sys.stderr)
+        return EXIT_TERMINATED
     except KeyboardInterrupt:
         print("mrgc: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED

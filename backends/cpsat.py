@@ -65,6 +65,9 @@ class CpSatBackend(Backend):
         solver = cp.CpSolver()
         solver.parameters.num_workers = max(1, int(self.threads))
         solver.parameters.random_seed = int(self.seed)
+        # CP-SAT's own SIGINT handler would swallow Ctrl-C (the solve just stops and the run goes on to a
+        # wrong verdict): the CLI's handler must see it
+        solver.parameters.catch_sigint_signal = False
         if time_limit is not None:
             solver.parameters.max_time_in_seconds = max(0.001, float(time_limit))
         status = solver.Solve(self.m)

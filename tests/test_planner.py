@@ -72,7 +72,7 @@ def test_symbolic_plans_are_the_best_skeleton(capsys: pytest.CaptureFixture[str]
     data = json.loads(capsys.readouterr().out)
     assert data["symbolic"] and data["makespan"] == 3 and data["motion_cost"] == 7
     assert cli.main(["plan", str(ROOT / "domains" / "symbolic" / "infeasible.mrg")]) == 1
-    assert json.loads(capsys.readouterr().out)["status"] == "no plan"
+    assert json.loads(capsys.readouterr().out)["status"] == "infeasible"
 
 
 # ------------------------------------------------------------------ MCTS mechanics, scripted grounding

@@ -1,0 +1,191 @@
+"""Every way `mrgc plan` can end, each with its status, exit code and reasons; M* as the paper defines it;
+the validator as the referee inside the search."""
+
+from __future__ import annotations
+
+import json
+import signal
+import subprocess
+import sys
+from pathlib import Path
+from types import SimpleNamespace
+from typing import Any
+
+import numpy as np
+import pytest
+
+from mrgc import __version__, cli, parse_file
+from mrgc.compiler.skeleton import Skeleton
+from mrgc.compiler.task_graph import Action
+from mrgc.geometry.grounding import Answer, Status
+from mrgc.planner.ground import GroundedStep, Outcome, ReverseGrounder
+from mrgc.planner.outcome import EXIT_CODES, PlanStatus
+from mrgc.planner.plan import PlannedAction, file_sha256
+from mrgc.planner.search import plan_problem
+
+ROOT = Path(__file__).resolve().parent.parent
+PA3 = (ROOT / "domains" / "packaging" / "pa3-handover.mrg").read_text(encoding="utf-8")
+
+
+def run_plan(tmp_path: Path, text: str, *extra: str) -> tuple[int, dict[str, Any], str]:
+    src = tmp_path / "p.mrg"
+    src.write_text(text, encoding="utf-8")
+    (tmp_path / "domain.mrg").write_text((ROOT / "domains" / "packaging" / "domain.mrg").read_text(encoding="utf-8"),
+                                         encoding="utf-8")
+    out = tmp_path / "plan.json"
+    proc = subprocess.run([sys.executable, "-m", "mrgc.cli", "plan", str(src), "-o", str(out), *extra],
+                          capture_output=True, text=True, timeout=300)
+    data = json.loads(out.read_text(encoding="utf-8")) if out.exists() else {}
+    return proc.returncode, data, proc.stdout + proc.stderr
+
+
+def test_exit_codes_are_distinct_per_status() -> None:
+    assert len(set(EXIT_CODES.values())) == len(PlanStatus) and EXIT_CODES[PlanStatus.SOLVED] == 0
+
+
+# ------------------------------------------------------------------ infeasible by the facts
+def test_a_blocking_cycle_is_named(capsys: pytest.CaptureFixture[str]) -> None:
+    assert cli.main(["plan", str(ROOT / "domains" / "symbolic" / "pick-cycle.mrg")]) == 1
+    cap = capsys.readouterr()
+    data = json.loads(cap.out)
+    assert data["status"] == "infeasible" and data["steps"] == []
+    (cycle,) = data["why"]["facts"]
+    assert cycle.startswith("blocking cycle o1 -> o2 -> o1") and "top by r1" in cycle and "top by r2" in cycle
+    assert "blocking cycle" in cap.err
+
+
+def test_a_goal_nobody_can_reach_is_infeasible_with_the_missing_fact(tmp_path: Path) -> None:
+    far = PA3.replace("(bin-b :shape (box 0.2 0.2 0.3) :pose (-0.3 0.35 0.15 0))",
+                      "(bin-b :shape (box 0.2 0.2 0.3) :pose (-3 3.5 0.15 0))")
+    code, data, text = run_plan(tmp_path, far, "--time-limit", "60")
+    assert code == 1 and data["status"] == "infeasible"
+    assert data["why"]["facts"] == ["no robot can reach goal region bin-b"]
+    assert "no robot can reach goal region bin-b" in text
+
+
+# ------------------------------------------------------------------ every skeleton tried
+def test_facts_that_no_geometry_backs_exhaust_the_search(tmp_path: Path) -> None:
+    """Facts claiming r1 can pick and place o1 with a grasp whose approach hits the table every time: the
+    compiler finds skeletons, grounding fails each one, and the run says which check failed."""
+    lying = PA3.replace("(:goal (in-region o1 bin-b))", """(:init (in-region o1 start) (in-region o2 start)
+           (in-region o3 start) (reachable-pick o1 side-x+ r2) (reachable-place o1 bin-b side-x+ r2))
+    (:goal (in-region o1 bin-b))""")
+    code, data, text = run_plan(tmp_path, lying, "--time-limit", "60")
+    assert code == 5 and data["status"] == "exhausted", text
+    failures = data["why"]["grounding_failures"]
+    assert failures and failures[0]["action"] == "r2 moves o1 to bin-b (side-x+)"
+    assert failures[0]["check"].startswith("pick by r2:") and failures[0]["count"] >= 1
+    assert "every skeleton" in data["why"]["summary"]
+
+
+# ------------------------------------------------------------------ time limit, interrupt
+def test_a_time_limit_names_itself(capsys: pytest.CaptureFixture[str]) -> None:
+    assert cli.main(["plan", str(ROOT / "domains" / "packaging" / "pa10.mrg"), "--time-limit", "0.05"]) == 3
+    data = json.loads(capsys.readouterr().out)
+    assert data["status"] == "time limit" and "time limit" in data["why"]["summary"]
+
+
+@pytest.mark.parametrize(("sig", "code", "word"), [(signal.SIGINT, 130, "interrupted"),
+                                                   (signal.SIGTERM, 143, "terminated")])
+def test_a_signal_during_the_search_reports_and_writes_nothing(tmp_path: Path, sig: int, code: int,
+                                                               word: str) -> None:
+    out = tmp_path / "plan.json"
+    proc = subprocess.Popen([sys.executable, "-m", "mrgc.cli", "plan",
+                             str(ROOT / "domains" / "box-moving" / "bo8-two-doors.mrg"), "-o", str(out), "-v"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    assert proc.stderr is not None
+    first = proc.stderr.readline()  # the first search log line: the search is running
+    assert first.startswith("[t="), first
+    proc.send_signal(sig)
+    stdout, stderr = proc.communicate(timeout=120)
+    assert proc.returncode == code, stderr
+    assert word in stderr and "no plan file written" in stderr and "skeletons" in stderr
+    assert not out.exists() and "Traceback" not in stderr
+
+
+# ------------------------------------------------------------------ the validator inside the search
+def test_every_solved_plan_carries_the_validators_verdict(tmp_path: Path) -> None:
+    code, data, _ = run_plan(tmp_path, PA3, "--seed", "1")
+    assert code == 0 and data["status"] == "solved"
+    assert data["validation"]["valid"] is True and data["validation"]["plans_checked"] >= 1
+
+
+def test_a_plan_the_validator_rejects_is_a_failure_fed_back() -> None:
+    from mrgc.planner.outcome import Why
+    from mrgc.planner.plan import Plan
+    from mrgc.planner.search import _referee
+
+    path = ROOT / "domains" / "packaging" / "pa3-handover.mrg"
+    problem = parse_file(path).problem()
+    plan = plan_problem(problem, str(path), file_sha256(str(path)), __version__, seed=1)
+    assert plan.status == "solved"
+    action = plan.steps[0][0]
+    assert action.place_pose is not None
+    moved = [row[:] for row in action.place_pose]
+    moved[2][3] += 0.12  # released 12 cm higher than its place configuration puts it
+    action.place_pose = moved
+    result = SimpleNamespace(outcome=Outcome.SUCCESS, steps=[GroundedStep([action], [], (action.object,))])
+    why = Why()
+    shell = Plan(problem.name, str(path), file_sha256(str(path)), __version__, "cpsat", "time-of-move", 1, "solved")
+    verdict = _referee(problem, str(path), shell, result, why, {})  # type: ignore[arg-type]
+    assert verdict.outcome is Outcome.FAIL and why.rejected_plans == 1
+    assert verdict.failures[0].check == "grasp" and verdict.failures[0].step == 1
+
+
+# ------------------------------------------------------------------ M* as the paper defines it
+class ScriptedGrounder:
+    """Answers the reverse grounder's geometric queries from a script: picks of an object fail while any
+    object of ``blocked_by[obj]`` must be avoided; volumes are tokens, and ``hits`` reads them."""
+
+    def __init__(self, movable: list[str], blocked_by: dict[str, set[str]], sweeps: dict[str, set[str]]) -> None:
+        self.scene = SimpleNamespace(movable=[SimpleNamespace(name=m) for m in movable], handover_of={},
+                                     handover_points={})
+        self.blocked_by, self.sweeps = blocked_by, sweeps
+        self.poses = {m: np.eye(4) for m in movable}
+
+    def is_planar(self, robot: str) -> bool:
+        return False
+
+    def pick(self, robot: str, obj: str, grasp: str, avoid: Any = ()) -> Answer:
+        hit = self.blocked_by.get(obj, set()) & set(avoid)
+        if hit:
+            return Answer(Status.COLLISION, blockers=hit)
+        return Answer(Status.OK, configs=np.array([[0.0], [1.0]]))
+
+    def place(self, robot: str, obj: str, grasp: str, pose: np.ndarray, avoid: Any = ()) -> Answer:
+        return Answer(Status.OK, configs=np.array([[1.0], [0.0]]))
+
+    def placement(self, obj: str, region: str, avoid: Any = (), volume: Any = None, key: str = "",
+                  skip: int = 0) -> Answer:
+        return Answer(Status.OK, pose=np.eye(4))
+
+    def arm_volume(self, robot: str, configs: np.ndarray, holding: Any = None) -> list[Any]:
+        return [(f"arm:{robot}:{holding[0] if holding else ''}", None)]
+
+    def shape(self, obj: str) -> str:
+        return f"shape:{obj}"
+
+    def hits(self, volume: list[Any], among: Any = "movable", ignore: Any = ()) -> set[str]:
+        out: set[str] = set()
+        for token, _ in volume:
+            out |= self.sweeps.get(token, set())
+        return out & set(among)
+
+
+def test_m_star_keeps_the_blockers_of_an_older_suffix() -> None:
+    """The suffix S (placing goal g) sweeps through b.  A skeleton meant to move b (step 1) and c (step 2)
+    grounds c only with d out of the way: S' = [c] + S, and M* must still hold b (hit by S, not by c)."""
+    movable = ["g", "b", "c", "d"]
+    sweeps = {"suffix-volume": {"b"}, "arm:r1:": {"d"}}
+    grounder = ScriptedGrounder(movable, blocked_by={"c": {"d"}}, sweeps=sweeps)
+    reverse = ReverseGrounder(grounder, {"g": "goal"})  # type: ignore[arg-type]
+    suffix = [GroundedStep([PlannedAction("g", "goal", "r1", "r1", "top", "top")], [("suffix-volume", None)],
+                           ("g",))]
+    skeleton = Skeleton(((Action("b", "start", "r1", "r1", "top", "top"),),
+                         (Action("c", "start", "r1", "r1", "top", "top"),)))
+    result = reverse.ground(skeleton, suffix)
+    assert result.outcome is Outcome.PARTIAL
+    assert [s.moved for s in result.steps] == [("c",), ("g",)]
+    assert result.must_move == {"b", "d"}  # b from the older suffix, d from this call's step
+    (failure,) = result.failures
+    assert failure.step == 2 and failure.check.startswith("pick by r1") and failure.bodies == ("d",)

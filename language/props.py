@@ -108,7 +108,9 @@ class PropReader:
             self.err("E240", f"{what} must be an axis ({' '.join(words)}), not {_kind_of(value)}", value.span)
             return None
         if value.name not in AXES:
-            hint = did_you_mean(value.name, AXES) or f" (use {' '.join(words)})"
+            word = value.name.lower()
+            word = word if word in AXES else word[::-1] if word[::-1] in AXES else ""  # -Z, z-
+            hint = f" (did you mean '{word}'?)" if word else did_you_mean(value.name, AXES) or f" (use {' '.join(words)})"
             self.err("E240", f"unknown axis '{value.name}' for {what}{hint}", value.span)
             return None
         return AXES[value.name]

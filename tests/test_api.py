@@ -16,7 +16,7 @@ DOMAIN = """(define (domain kitchen)
   (:requirements :handover)
   (:robot-kind panda :urdf "panda.urdf" :end-effector "hand" :home (0 0 0 -90 0 90 45))
   (:robot-kind cart :base planar :footprint (box 0.6 0.4 0.3) :carry (0 0 0.5 0) :reach 1.5)
-  (:grasps top side))
+  (:grasps top side-x+))
 """
 
 GEOMETRIC = DOMAIN + """
@@ -146,7 +146,7 @@ def test_geometric_problem_values() -> None:
     p = mrgc.parse_string(GEOMETRIC).problem()
     assert p.symbolic is False
     assert p.domain.name == "kitchen" and p.domain.requirements == ("handover",)
-    assert p.domain.grasps == ("top", "side")
+    assert p.domain.grasps == ("top", "side-x+")
 
     panda = p.domain.kind("panda")
     assert panda.urdf == "panda.urdf" and panda.end_effector == "hand" and panda.base == "fixed"
@@ -167,7 +167,7 @@ def test_geometric_problem_values() -> None:
     assert o1.shape == Cylinder(0.03, 0.1) and o1.pose.position == (0.3, 0, 0.46)
     assert o2.shape == Sphere(0.04) and o2.pose == Pose(1.2, -0.5, 0.45, -30)
     # default grasps are the domain's grasps; an explicit :grasps narrows them
-    assert o1.grasps == ("top", "side") == p.grasps_of("o1")
+    assert o1.grasps == ("top", "side-x+") == p.grasps_of("o1")
     assert o2.grasps == ("top",) == p.grasps_of("o2")
     assert o2.handover_points == ("h",)
     assert p.object("o2") is o2
@@ -242,7 +242,7 @@ def test_domain_in_the_same_file(tmp_path: Path) -> None:
 def test_own_domain_wins_over_domain_mrg(tmp_path: Path) -> None:
     write(tmp_path / "domain.mrg", "(define (domain kitchen) (:grasps other))")
     path = write(tmp_path / "p.mrg", DOMAIN + problem_text("p"))
-    assert mrgc.parse_file(path).problem().domain.grasps == ("top", "side")
+    assert mrgc.parse_file(path).problem().domain.grasps == ("top", "side-x+")
 
 
 def test_domain_in_domain_mrg_beside_the_file(tmp_path: Path) -> None:
@@ -250,7 +250,7 @@ def test_domain_in_domain_mrg_beside_the_file(tmp_path: Path) -> None:
     path = write(tmp_path / "p.mrg", problem_text("p"))
     mf = mrgc.parse_file(path)
     p = mf.problem()
-    assert p.domain.name == "kitchen" and p.domain.grasps == ("top", "side")
+    assert p.domain.name == "kitchen" and p.domain.grasps == ("top", "side-x+")
     assert os.path.samefile(p.domain.source, dom)
     assert mf.domains == ()  # the file itself defines no domain
     # parse_string finds domain.mrg in base_dir too
@@ -261,7 +261,7 @@ def test_domain_mrg_may_include_the_domain(tmp_path: Path) -> None:
     write(tmp_path / "domain.mrg", '(define (domain index) (:include "lib/kitchen.mrg"))')
     write(tmp_path / "lib" / "kitchen.mrg", DOMAIN)
     path = write(tmp_path / "p.mrg", problem_text("p"))
-    assert mrgc.parse_file(path).problem().domain.grasps == ("top", "side")
+    assert mrgc.parse_file(path).problem().domain.grasps == ("top", "side-x+")
 
 
 def test_domain_via_include(tmp_path: Path) -> None:
@@ -351,7 +351,7 @@ def test_include_inside_the_folder_through_dotdot_is_fine(tmp_path: Path) -> Non
 
 
 def test_include_not_found(tmp_path: Path) -> None:
-    path = write(tmp_path / "p.mrg", DOMAIN.replace("(:grasps top side)", '(:grasps top side) (:include "nope.mrg")'))
+    path = write(tmp_path / "p.mrg", DOMAIN.replace("(:grasps top side-x+)", '(:grasps top side-x+) (:include "nope.mrg")'))
     with pytest.raises(InputError) as info:
         mrgc.parse_file(path)
     assert codes(info) == ["E234"]

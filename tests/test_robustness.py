@@ -433,7 +433,7 @@ def test_overflowing_number_is_E251(capsys, tmp_path, text: str) -> None:
 
 
 def test_overflowing_number_in_a_geometric_problem(capsys, tmp_path) -> None:
-    text = """(define (domain d) (:robot-kind k :urdf "u" :end-effector "e") (:grasps g))
+    text = """(define (domain d) (:robot-kind k :urdf "u" :end-effector "e") (:grasps top))
 (define (problem p) (:domain d)
   (:robots (r :kind k :base (0 0 0 0)))
   (:regions (a :shape (box 1 1 1) :pose (0 0 0 0)) (b :shape (box 1 1 1) :pose (2 0 0 0)))

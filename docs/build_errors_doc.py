@@ -38,12 +38,14 @@ file, that mrgc prints exactly the `.out` text for it, and that this page is cur
 | code | meaning |
 | --- | --- |
 | 0 | success (`check`: every file is fine; `fmt --check`: every file is canonical) |
-| 1 | no plan / infeasible / no skeleton within the limits; `fmt --check`: some file would be reformatted; `validate`: the plan is invalid |
+| 1 | infeasible: no task skeleton exists under the facts (`plan`, `compile`; the reasons are printed and, for `plan`, in the plan's `why`); `fmt --check`: some file would be reformatted; `validate`: the plan is invalid |
 | 2 | input error: a bad `.mrg` file (any `E0xx`–`E2xx` code below), a bad plan file (`E5xx`) or a bad command line (`E000`) |
 | 3 | time limit reached before an answer |
 | 4 | a needed backend (solver or geometry library) is not installed |
+| 5 | `plan`: every skeleton was tried and none could be grounded into a plan the validator accepts (the grounding-failure summary says why) |
 | 70 | internal error (`E070`): a bug in mrgc |
-| 130 | interrupted (Ctrl-C) |
+| 130 | interrupted (Ctrl-C, SIGINT): `plan` prints what its search had (best plan, statistics, reasons) and writes no plan file |
+| 143 | terminated (SIGTERM): as 130 |
 
 ## Codes
 """

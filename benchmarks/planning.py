@@ -4,7 +4,7 @@
     python benchmarks/planning.py --problems pa5 pa10 --seeds 10
 
 Each run is a fresh process (cold caches) calling the planner with one seed; the table gives the success
-rate, the median and max wall time of the planner (phase 1 included, interpreter start-up excluded), the
+rate (plans the validator accepts, re-checked in the child after planning), the median and max wall time of the planner (phase 1 included, interpreter start-up excluded), the
 median makespan and motion cost (objects moved), and the median share of time in each phase.
 """
 
@@ -26,9 +26,13 @@ import json, sys
 from mrgc import __version__, parse_file
 from mrgc.planner.plan import file_sha256
 from mrgc.planner.search import plan_problem
+from mrgc.planner.validate import validate
 path, seed, limit = sys.argv[1], int(sys.argv[2]), float(sys.argv[3])
-plan = plan_problem(parse_file(path).problem(), path, file_sha256(path), __version__, seed=seed, time_limit=limit)
-print(json.dumps({"status": plan.status, "makespan": plan.makespan, "cost": plan.motion_cost, **plan.stats}))
+problem = parse_file(path).problem()
+plan = plan_problem(problem, path, file_sha256(path), __version__, seed=seed, time_limit=limit)
+valid = plan.status == "solved" and validate(problem, plan.to_json(), path).ok  # re-checked here, not trusted
+print(json.dumps({"status": str(plan.status), "valid": valid, "makespan": plan.makespan, "cost": plan.motion_cost,
+                  **plan.stats}))
 """
 
 
@@ -49,7 +53,9 @@ def main() -> None:
                 print(f"{name} seed {seed}: crashed: {out.stderr.strip().splitlines()[-1:]}", file=sys.stderr)
                 continue
             runs.append(json.loads(out.stdout.strip().splitlines()[-1]))
-        ok = [r for r in runs if r["status"] == "solved"]
+        ok = [r for r in runs if r["status"] == "solved" and r["valid"]]  # an invalid plan is a failure
+        if any(r["status"] == "solved" and not r["valid"] for r in runs):
+            print(f"{name}: a plan called solved failed validation", file=sys.stderr)
         if not ok:
             print(f"| {name} | 0/{args.seeds} | - | - | - | - | - | - | - |", flush=True)
             continue

@@ -24,7 +24,7 @@ from mrgc.geometry.scene import scene_from_problem
 from mrgc.language.model import Problem
 from mrgc.planner.ground import GroundedStep, Grounding, Outcome, ReverseGrounder, moved_objects
 from mrgc.planner.mcts import MCTS
-from mrgc.planner.outcome import Failure, PlanStatus, Why
+from mrgc.planner.outcome import BlockingCycle, Failure, PlanStatus, Why
 from mrgc.planner.plan import Plan, PlannedAction
 from mrgc.planner.skeletons import DEFAULT_BACKEND, DEFAULT_ENCODING, SkeletonSource, must_move, problem_facts
 
@@ -119,6 +119,9 @@ def plan_problem(problem: Problem, problem_file: str, sha256: str, version: str,
         elif root_state["count"] == 0 and root_state["outcome"] == EXHAUSTED:
             plan.status = PlanStatus.INFEASIBLE
             why.facts = infeasible_reasons(roots[0])
+            why.cycles = _cycles_with_evidence(roots[0], grounder)
+            if why.cycles:  # the cycles are told with their evidence instead
+                why.facts = [f for f in why.facts if not f.startswith("blocking cycle")]
         else:
             plan.status = PlanStatus.EXHAUSTED
         stats.update({k: (round(v, 4) if isinstance(v, float) else v) for k, v in result.stats.items()})
@@ -129,6 +132,26 @@ def plan_problem(problem: Problem, problem_file: str, sha256: str, version: str,
     stats["seconds"] = round(time.perf_counter() - t0, 4)
     plan.stats = stats
     return plan
+
+
+def _cycles_with_evidence(source: SkeletonSource, grounder: Grounder, per_edge: int = 2) -> list[BlockingCycle]:
+    """The blocking cycles of the root task graph, each obstruction shown on the geometry (bodies, depth)
+    for up to ``per_edge`` of the obstructed picks."""
+    from mrgc.compiler.diagnose import blocking_cycles
+    from mrgc.planner.explain import pick_obstruction
+
+    out = []
+    for cycle in blocking_cycles(source.graph):
+        edges = []
+        for obj, blocker, _, actions in cycle:
+            picks = sorted({(a.pick_robot, a.pick_grasp) for a in actions})[:per_edge]
+            if grounder.is_planar(picks[0][0]):
+                how = ", ".join(f"{g} by {r}" for r, g in picks)
+            else:
+                how = "; ".join(pick_obstruction(grounder, r, obj, g, blocker) for r, g in picks)
+            edges.append((obj, blocker, how))
+        out.append(BlockingCycle(tuple(o for o, _, _, _ in cycle), tuple(edges)))
+    return out
 
 
 def _referee(problem: Problem, problem_file: str, plan: Plan, result: Grounding, why: Why,

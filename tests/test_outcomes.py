@@ -4,6 +4,7 @@ the validator as the referee inside the search."""
 from __future__ import annotations
 
 import json
+import re
 import signal
 import subprocess
 import sys
@@ -61,6 +62,24 @@ def test_a_goal_nobody_can_reach_is_infeasible_with_the_missing_fact(tmp_path: P
     assert code == 1 and data["status"] == "infeasible"
     assert data["why"]["facts"] == ["no robot can reach goal region bin-b"]
     assert "no robot can reach goal region bin-b" in text
+
+
+def test_a_geometric_blocking_cycle_shows_the_bodies_and_the_depth(tmp_path: Path) -> None:
+    """Two boxes 7 cm apart, each allowed only the side grasp whose approach comes through the other."""
+    cycle = PA3.replace("""    (o1 :shape (box 0.05 0.05 0.12) :pose (0 -0.25 0.06 0))
+    (o2 :shape (box 0.05 0.05 0.12) :pose (0.07 -0.25 0.06 0))
+    (o3 :shape (box 0.05 0.05 0.12) :pose (-0.07 -0.25 0.06 0)))""", """    (o1 :shape (box 0.05 0.05 0.12) :pose (0 -0.25 0.06 0) :grasps (side-x+))
+    (o2 :shape (box 0.05 0.05 0.12) :pose (0.07 -0.25 0.06 0) :grasps (side-x-)))""").replace(
+        "(:goal (in-region o1 bin-b))", "(:goal (and (in-region o1 bin-a) (in-region o2 bin-a)))")
+    code, data, text = run_plan(tmp_path, cycle, "--time-limit", "60")
+    assert code == 1 and data["status"] == "infeasible", text
+    (found,) = data["why"]["cycles"]
+    assert found["objects"] == ["o1", "o2"]
+    for edge, blocker in zip(found["edges"], ["o2", "o1"]):
+        assert edge["blocker"] == blocker
+        match = re.search(rf"of r1 overlaps {blocker} by ([0-9.]+) mm", edge["how"])
+        assert match and float(match.group(1)) > 1.0, edge["how"]
+    assert "blocking cycle o1 -> o2 -> o1" in text and "overlaps" in text
 
 
 # ------------------------------------------------------------------ every skeleton tried

@@ -13,8 +13,9 @@ close along, ``depth`` and ``offset``.  The conventions (docs/geometry.md, "Gras
   (:func:`pregrasp_transform`).
 - **Finger opening**: the object's width along the finger axis (of its bounding box) plus
   :data:`FINGER_CLEARANCE` (:func:`finger_opening`).  A robot kind whose ``gripper_opening`` is smaller cannot
-  use the grasp on that object (:func:`fits`; ``mrgc check`` warns, W270).  The arm's fingers stand at
-  that opening while it approaches the object and while it holds it (:func:`opening_for`).
+  use the grasp on that object (:func:`fits`; ``mrgc check`` warns, W270).  An arm's fingers stand at
+  that opening while it approaches the object and while it holds it, fully open otherwise (callers pass
+  the opening to :meth:`~mrgc.geometry.arm.Arm.link_transforms` / ``ReplayScene.set_fingers``).
 
 Phase 1 (geometry/predicates.py), grounding (geometry/grounding.py) and the validator (planner/replay.py)
 read grasps only through this module.  The built-in names' specs are data of the language
@@ -65,14 +66,6 @@ def finger_opening(spec: GraspSpec, shape: Shape) -> float:
 def fits(spec: GraspSpec, shape: Shape, kind: RobotKind) -> bool:
     """Whether robots of ``kind`` open wide enough for this grasp of an object of ``shape``."""
     return finger_opening(spec, shape) <= kind.gripper_opening + 1e-9
-
-
-def opening_for(problem_specs: dict[str, GraspSpec], shape: Shape, grasp: str | None) -> float | None:
-    """The finger opening while approaching or holding an object of ``shape`` with ``grasp`` (None: no
-    grasp in progress, the fingers are fully open)."""
-    if grasp is None or grasp not in problem_specs:
-        return None
-    return finger_opening(problem_specs[grasp], shape)
 
 
 def grasp_warnings(problem: Problem) -> list[Diagnostic]:

@@ -146,7 +146,7 @@ class ReverseGrounder:
                                       for ph, path in action.paths.items()}
             return out
         out.setdefault(action.pick_robot, {})["pick"] = [
-            g.arm_volume(action.pick_robot, q[None]) for q in refine(np.array(action.configs["pick"]))]
+            g.arm_volume(action.pick_robot, q[None], grasp=(obj, action.pick_grasp)) for q in refine(np.array(action.configs["pick"]))]
         if "handover" in action.configs:
             giver, taker = np.array(action.configs["handover"])
             out[action.pick_robot]["handover"] = [g.arm_volume(action.pick_robot, giver[None], (obj, action.pick_grasp))]

@@ -178,7 +178,7 @@ class ScriptedGrounder:
                   skip: int = 0) -> Answer:
         return Answer(Status.OK, pose=np.eye(4))
 
-    def arm_volume(self, robot: str, configs: np.ndarray, holding: Any = None) -> list[Any]:
+    def arm_volume(self, robot: str, configs: np.ndarray, holding: Any = None, grasp: Any = None) -> list[Any]:
         return [(f"arm:{robot}:{holding[0] if holding else ''}", None)]
 
     def shape(self, obj: str) -> str:

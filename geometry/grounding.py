@@ -28,7 +28,7 @@ from mrgc.geometry.arm import Arm
 from mrgc.geometry.collision import CollisionShape, CollisionWorld, collision_shape
 from mrgc.geometry.grasps import finger_opening, fits, grasp_transform, pregrasp_transform
 from mrgc.geometry.ik import solve_ik_many
-from mrgc.geometry.motion import plan_joint_path, plan_se2_path
+from mrgc.geometry.motion import BASE_PATH_CHECKS, MAX_CHECKS, plan_joint_path, plan_se2_path
 from mrgc.geometry.planar import DiscGrid, PlanarRobot, is_planar, scene_bounds, to_se2
 from mrgc.geometry.predicates import APPROACH_SAMPLES, LIFT, refine, scene_world, seed_for
 from mrgc.geometry.scene import SceneSpec, half_extents, inside
@@ -265,9 +265,9 @@ class Grounder:
 
     # ------------------------------------------------------------ paths
     def arm_path(self, robot: str, start: np.ndarray, goal: np.ndarray, holding: tuple[str, str] | None = None,
-                 avoid: Iterable[str] = (), time_limit: float = 1.0) -> Answer:
-        """A joint-space path (RRTConnect) free of fixed objects and ``avoid`` (and of the held object's
-        collisions with them)."""
+                 avoid: Iterable[str] = (), max_checks: int = MAX_CHECKS) -> Answer:
+        """A joint-space path (RRTConnect, at most ``max_checks`` validity checks: no clock decides) free of
+        fixed objects and ``avoid`` (and of the held object's collisions with them)."""
         arm = self.arm(robot)
         against = ("fixed", *[a for a in avoid if not holding or a != holding[0]])
         ignore = (holding[0],) if holding else ()
@@ -277,14 +277,15 @@ class Grounder:
             return not self.world.probe_collides(self.arm_volume(robot, q[None], holding), against=against,
                                                  ignore=ignore)
 
-        res = plan_joint_path(arm.model.lower, arm.model.upper, start, goal, valid, time_limit=time_limit,
+        res = plan_joint_path(arm.model.lower, arm.model.upper, start, goal, valid, max_checks=max_checks,
                               seed=seed_for(robot, "arm-path", seed=self.seed))
         return Answer(Status.OK if res.solved else Status.NO_PATH, path=list(res.path))
 
     def base_path(self, robot: str, start: np.ndarray, goal: np.ndarray, holding: tuple[str, str] | None = None,
-                  avoid: Iterable[str] = (), time_limit: float = 0.25) -> Answer:
-        """An SE(2) path for a planar robot, free of fixed objects and ``avoid`` (objects at their initial
-        poses); hopeless queries are refused at once by an inscribed-disc grid test."""
+                  avoid: Iterable[str] = (), max_checks: int = BASE_PATH_CHECKS) -> Answer:
+        """An SE(2) path for a planar robot (RRTConnect, at most ``max_checks`` validity checks), free of
+        fixed objects and ``avoid`` (objects at their initial poses); hopeless queries are refused at once by
+        an inscribed-disc grid test."""
         others = [name for r, name in self.parked.items() if r != robot]
         against = ("fixed", *others, *[a for a in avoid if not holding or a != holding[0]])
         ignore = (holding[0],) if holding else ()
@@ -304,7 +305,7 @@ class Grounder:
         # states checked at the validator's resolution (0.01 m, 0.01 rad), so a carried object cannot clip an
         # obstacle between them by more than the validator's samples could
         res = plan_se2_path(scene_bounds(self.scene, 0.5), tuple(start), tuple(goal), valid,  # type: ignore[arg-type]
-                            time_limit=time_limit, seed=seed_for(robot, "base-path", seed=self.seed),
+                            max_checks=max_checks, seed=seed_for(robot, "base-path", seed=self.seed),
                             resolution=PATH_RESOLUTION, yaw_resolution=PATH_RESOLUTION)
         return Answer(Status.OK if res.solved else Status.NO_PATH, path=list(res.path))
 

@@ -1,14 +1,20 @@
 """Motion planning on OMPL: RRTConnect (the paper's BiRRT) in joint space and in SE(2).
 
-Both planners take a validity test on plain numpy states, a time limit and a seed, and return a
-:class:`MotionResult` whose ``status`` says what happened; not finding a path is an outcome, not an error.
+Both planners take a validity test on plain numpy states, a budget of validity checks and a seed, and
+return a :class:`MotionResult` whose ``status`` says what happened; not finding a path is an outcome, not
+an error.
 The returned path is *dense*: consecutive states are at most ``resolution`` apart (joint space: Euclidean
 distance in radians/metres; SE(2): ``resolution`` metres of translation and ``yaw_resolution`` radians of
 turn), and every returned state is one that OMPL's motion validator checked with ``is_valid``.
 
 Paths are not simplified unless asked (``simplify=True``): shortcutting costs 5–15× the solve (DESIGN §6).
-The same seed gives the same path when the solve finishes within its time limit.  OMPL's console output is
-silenced.
+
+Determinism: no clock is read to decide anything.  A solve stops when RRTConnect connects its trees or
+when it has made ``max_checks`` calls to ``is_valid`` (an OMPL ``PlannerTerminationCondition`` on a
+counter, evaluated by the planner between iterations, so a solve may overrun the budget by the checks of
+one iteration); OMPL's random generator is seeded per call.  The same inputs and seed therefore give the
+same result and the same path on an idle or a loaded machine.  ``planning_time`` is for statistics only.
+OMPL's console output is silenced.
 """
 
 from __future__ import annotations
@@ -23,21 +29,32 @@ import numpy as np
 
 Validity = Callable[[np.ndarray], bool]
 
+#: default budget of one solve: calls to the validity test before RRTConnect gives up (no path); phase 1's
+#: SE(2) queries and grounding's arm paths use it.  Measured (docs/geometry.md, "Motion planning"): phase 1's
+#: solved queries needed at most 2,923 checks on the shipped box-moving problems, 10,718 on generated ones;
+#: a check costs 17-26 µs, so the old time limit of 0.25 s bought 10,000-14,000 checks on an idle core.
+MAX_CHECKS = 20_000
+#: budget of grounding's SE(2) paths (states every 1 cm, the validator's resolution): what the old 0.25 s
+#: bought; a failed query costs all of it, and grounding asks many (solved ones: median 460-1,033 checks)
+BASE_PATH_CHECKS = 10_000
+
 
 class MotionStatus(str, enum.Enum):
     SOLVED = "solved"
-    NO_PATH = "no-path"              # no exact solution within the time limit
+    NO_PATH = "no-path"              # no exact solution within the budget of validity checks
     INVALID_START = "invalid-start"  # the start is out of bounds or fails is_valid
     INVALID_GOAL = "invalid-goal"    # the goal is out of bounds or fails is_valid
 
 
 @dataclass(frozen=True)
 class MotionResult:
-    """What a planner found: ``path`` (start first, goal last) is empty unless ``status`` is SOLVED."""
+    """What a planner found: ``path`` (start first, goal last) is empty unless ``status`` is SOLVED;
+    ``checks``: calls the solve made to the validity test; ``planning_time``: seconds (statistics only)."""
 
     status: MotionStatus
     path: list[np.ndarray] = field(default_factory=list)
     planning_time: float = 0.0
+    checks: int = 0
 
     @property
     def solved(self) -> bool:
@@ -63,7 +80,7 @@ def _seed(ou: Any, seed: int) -> None:
 
 
 def plan_joint_path(lower: Sequence[float], upper: Sequence[float], start: Sequence[float],
-                    goal: Sequence[float], is_valid: Validity, time_limit: float = 1.0, seed: int = 0,
+                    goal: Sequence[float], is_valid: Validity, max_checks: int = MAX_CHECKS, seed: int = 0,
                     resolution: float = 0.05, simplify: bool = False) -> MotionResult:
     """A collision-free path in the box ``lower <= q <= upper`` from ``start`` to ``goal`` (RRTConnect).
 
@@ -76,8 +93,8 @@ def plan_joint_path(lower: Sequence[float], upper: Sequence[float], start: Seque
     if n == 0 or lo.shape != (n,) or hi.shape != (n,) or q0.shape != (n,) or q1.shape != (n,):
         raise ValueError(f"bounds, start and goal must be 1-D of one length (got {lo.shape}, {hi.shape}, "
                          f"{q0.shape}, {q1.shape})")
-    if np.any(hi < lo) or resolution <= 0 or time_limit <= 0:
-        raise ValueError("need lower <= upper, resolution > 0 and time_limit > 0")
+    if np.any(hi < lo) or resolution <= 0 or max_checks < 1:
+        raise ValueError("need lower <= upper, resolution > 0 and max_checks >= 1")
     if np.any(q0 < lo) or np.any(q0 > hi) or not is_valid(q0.copy()):
         return MotionResult(MotionStatus.INVALID_START)
     if np.any(q1 < lo) or np.any(q1 > hi) or not is_valid(q1.copy()):
@@ -92,8 +109,10 @@ def plan_joint_path(lower: Sequence[float], upper: Sequence[float], start: Seque
         bounds.setHigh(i, float(hi[i]))
     space.setBounds(bounds)
     index = range(n)
+    budget = _Budget(max_checks)
 
     def check(state: Any) -> bool:
+        budget.used += 1
         return bool(is_valid(np.fromiter((state[i] for i in index), float, n)))
 
     setup = og.SimpleSetup(space)
@@ -109,11 +128,11 @@ def plan_joint_path(lower: Sequence[float], upper: Sequence[float], start: Seque
     def read(state: Any) -> np.ndarray:
         return np.fromiter((state[i] for i in index), float, n)
 
-    return _solve(og, setup, time_limit, simplify, read)
+    return _solve(ob, og, setup, budget, simplify, read)
 
 
 def plan_se2_path(bounds: Sequence[float], start: Sequence[float], goal: Sequence[float], is_valid: Validity,
-                  time_limit: float = 1.0, seed: int = 0, resolution: float = 0.02,
+                  max_checks: int = MAX_CHECKS, seed: int = 0, resolution: float = 0.02,
                   yaw_resolution: float = 0.05, simplify: bool = False) -> MotionResult:
     """A collision-free path of a planar pose (x, y, yaw) within ``bounds`` = (xmin, xmax, ymin, ymax).
 
@@ -125,8 +144,8 @@ def plan_se2_path(bounds: Sequence[float], start: Sequence[float], goal: Sequenc
     p0, p1 = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
     if p0.shape != (3,) or p1.shape != (3,):
         raise ValueError("start and goal are (x, y, yaw)")
-    if not (xmin < xmax and ymin < ymax) or resolution <= 0 or yaw_resolution <= 0 or time_limit <= 0:
-        raise ValueError("need xmin < xmax, ymin < ymax, resolutions > 0 and time_limit > 0")
+    if not (xmin < xmax and ymin < ymax) or resolution <= 0 or yaw_resolution <= 0 or max_checks < 1:
+        raise ValueError("need xmin < xmax, ymin < ymax, resolutions > 0 and max_checks >= 1")
     p0[2], p1[2] = _wrap(p0[2]), _wrap(p1[2])
 
     def inside(p: np.ndarray) -> bool:
@@ -146,8 +165,10 @@ def plan_se2_path(bounds: Sequence[float], start: Sequence[float], goal: Sequenc
     box.setLow(1, ymin)
     box.setHigh(1, ymax)
     space.setBounds(box)
+    budget = _Budget(max_checks)
 
     def check(state: Any) -> bool:
+        budget.used += 1
         return bool(is_valid(np.array([state.getX(), state.getY(), state.getYaw()])))
 
     setup = og.SimpleSetup(space)
@@ -167,22 +188,35 @@ def plan_se2_path(bounds: Sequence[float], start: Sequence[float], goal: Sequenc
     def read(state: Any) -> np.ndarray:
         return np.array([state.getX(), state.getY(), state.getYaw()])
 
-    return _solve(og, setup, time_limit, simplify, read)
+    return _solve(ob, og, setup, budget, simplify, read)
 
 
-def _solve(og: Any, setup: Any, time_limit: float, simplify: bool,
+class _Budget:
+    """Validity checks allowed (``limit``) and made so far (``used``) by one solve."""
+
+    __slots__ = ("limit", "used")
+
+    def __init__(self, limit: int) -> None:
+        self.limit, self.used = int(limit), 0
+
+    def spent(self) -> bool:
+        return self.used >= self.limit
+
+
+def _solve(ob: Any, og: Any, setup: Any, budget: _Budget, simplify: bool,
            read: Callable[[Any], np.ndarray]) -> MotionResult:
     setup.setPlanner(og.RRTConnect(setup.getSpaceInformation()))
-    t0 = time.perf_counter()
-    setup.solve(float(time_limit))
+    t0 = time.perf_counter()  # statistics only: the budget is counted in validity checks
+    # evaluated by the planner itself, between iterations (no watcher thread: no period argument)
+    setup.solve(ob.PlannerTerminationCondition(budget.spent))
     if not setup.haveExactSolutionPath():
-        return MotionResult(MotionStatus.NO_PATH, [], time.perf_counter() - t0)
+        return MotionResult(MotionStatus.NO_PATH, [], time.perf_counter() - t0, budget.used)
     if simplify:
-        setup.simplifySolution()
+        setup.simplifySolution()  # shortcuts until no improvement: no time limit
     path = setup.getSolutionPath()
     path.interpolate()  # exactly the states the discrete motion validator checked
     states = [read(path.getState(i)) for i in range(path.getStateCount())]
-    return MotionResult(MotionStatus.SOLVED, states, time.perf_counter() - t0)
+    return MotionResult(MotionStatus.SOLVED, states, time.perf_counter() - t0, budget.used)
 
 
 def _wrap(angle: float) -> float:

@@ -2,7 +2,8 @@
 
 The robot model (footprint, grasp faces, pick/place base poses, carried objects, placements) is in
 :mod:`mrgc.geometry.planar`.  Swept volumes come from planned SE(2) base paths (RRTConnect,
-:func:`~mrgc.geometry.motion.plan_se2_path`, :data:`TIME_LIMIT` per query, seeded by :func:`seed_for`):
+:func:`~mrgc.geometry.motion.plan_se2_path`, at most :data:`~mrgc.geometry.motion.MAX_CHECKS` validity
+checks per query, seeded by :func:`seed_for`):
 the footprint (and the carried object) at every state of the dense path.  For robot R:
 
 - ``reachable-pick M g R`` (g a side grasp): the footprint at the pick base pose is free of fixed objects
@@ -14,7 +15,7 @@ the footprint (and the carried object) at every state of the dense path.  For ro
   had to cross movable objects, the set is reduced greedily (a cheap minimum-constraint-removal): for each
   object hit, in name order, a path avoiding every movable object except the remaining hits is tried, and
   when one exists its (smaller) hit set is kept.  An object therefore appears when R really has to move it,
-  up to the planner's time limit.
+  up to the planner's budget of validity checks.
 - ``reachable-place M Re g R`` (for a reachable pick, Re = M's goal region and M's current region): some
   placement of M in Re (:func:`~mrgc.geometry.planar.placements`) whose object pose and place base pose are
   free of fixed objects, and a base path from the pick base pose to the place base pose carrying M,
@@ -31,29 +32,26 @@ the footprint (and the carried object) at every state of the dense path.  For ro
 
 Before a query is planned, :class:`~mrgc.geometry.planar.DiscGrid` checks a necessary condition (can the
 footprint's inscribed disc get from start to goal on a 5 cm grid?); a query it rules out is one the planner
-could not have solved, so it is answered "no path" at once instead of after the whole time limit — which is
+could not have solved, so it is answered "no path" at once instead of after the whole budget — which is
 what most "free of movable objects, if possible" attempts in a blocked doorway are.  Paths are cached per
-(start, goal, carried object and grasp, obstacle set).  Everything is deterministic
-for a seed as long as each solve that succeeds does so within its time limit (RRTConnect with a fixed seed
-returns the same path; a solve that finishes just at the limit may flip).
+(start, goal, carried object and grasp, obstacle set).  Everything is deterministic for a seed, on an idle
+or a loaded machine: every solve is RRTConnect seeded from its query, stopped by a count of validity
+checks, never by a clock (the seconds in ``stats`` are statistics only).
 """
 
 from __future__ import annotations
 
-import time
 from typing import Iterable
 
 import numpy as np
 
 from mrgc.geometry.collision import CollisionShape, CollisionWorld, collision_shape
-from mrgc.geometry.motion import plan_se2_path
+from mrgc.geometry.motion import MAX_CHECKS, plan_se2_path
 from mrgc.geometry.planar import DiscGrid, PlanarRobot, planar_grasp, placements, scene_bounds
 from mrgc.geometry.predicates import RobotFacts, scene_world, seed_for
 from mrgc.geometry.scene import Body, SceneSpec, inside
 from mrgc.language.model import Fact
 
-#: seconds per SE(2) path query (a query that finds no path costs all of it)
-TIME_LIMIT = 0.25
 #: largest translation (m) and turn (rad) between checked path states
 RESOLUTION = 0.05
 YAW_RESOLUTION = 0.1
@@ -70,12 +68,12 @@ Path = list[np.ndarray]
 class PlanarEvaluator:
     """Computes one planar robot's facts of a scene: ``PlanarEvaluator(scene, robot, seed).run()``."""
 
-    def __init__(self, scene: SceneSpec, robot: str, seed: int = 0, time_limit: float = TIME_LIMIT) -> None:
+    def __init__(self, scene: SceneSpec, robot: str, seed: int = 0, max_checks: int = MAX_CHECKS) -> None:
         self.scene = scene
         self.robot = PlanarRobot(scene.robot(robot))
         self.world: CollisionWorld = scene_world(scene)
         self.seed = seed
-        self.time_limit = time_limit
+        self.max_checks = max_checks
         self.bounds = scene_bounds(scene, self.robot.radius + 0.1)
         self.movable = frozenset(m.name for m in scene.movable)
         self.fixed = frozenset(b.name for b in scene.fixed)
@@ -83,9 +81,9 @@ class PlanarEvaluator:
         self.current = {m.name: r.name for m in scene.movable for r in scene.regions if inside(r, m.shape, m.pose)}
         self.out = RobotFacts()
         self.paths: dict[tuple[object, ...], Path | None] = {}
-        #: counters: path queries planned, their seconds, cache hits
-        self.stats: dict[str, float] = {"path_queries": 0, "path_seconds": 0.0, "path_cache_hits": 0,
-                                         "grid_rejections": 0}
+        #: counters: path queries planned, their validity checks and seconds, cache hits
+        self.stats: dict[str, float] = {"path_queries": 0, "path_checks": 0, "path_seconds": 0.0,
+                                         "path_cache_hits": 0, "grid_rejections": 0}
 
     # ------------------------------------------------------------------------------------ primitives
     def _collides(self, probe: list[tuple[CollisionShape, np.ndarray]], obstacles: Iterable[str]) -> bool:
@@ -116,11 +114,11 @@ class PlanarEvaluator:
 
         ends = " ".join(f"{v:.4f}" for v in (*start, *goal))
         seed = seed_for(robot.name, ends, *carry_key, *sorted(obstacles), seed=self.seed)
-        t0 = time.perf_counter()
-        res = plan_se2_path(self.bounds, start, goal, valid, time_limit=self.time_limit, seed=seed,
+        res = plan_se2_path(self.bounds, start, goal, valid, max_checks=self.max_checks, seed=seed,
                             resolution=RESOLUTION, yaw_resolution=YAW_RESOLUTION)
         self.stats["path_queries"] += 1
-        self.stats["path_seconds"] += time.perf_counter() - t0
+        self.stats["path_checks"] += res.checks
+        self.stats["path_seconds"] += res.planning_time
         path = res.path if res.solved else None
         self.paths[key] = path
         return path

@@ -70,7 +70,7 @@ def test_arm_path_and_its_volume(pa3: Grounder) -> None:
     arm = pa3.arm("r1")
     pick = pa3.pick("r1", "o1", "top")
     assert pick.ok and pick.configs is not None
-    path = pa3.arm_path("r1", arm.home, pick.configs[0], time_limit=2.0)
+    path = pa3.arm_path("r1", arm.home, pick.configs[0])
     assert path.ok and np.allclose(path.path[0], arm.home) and np.allclose(path.path[-1], pick.configs[0])
     volume = pa3.arm_volume("r1", np.array(path.path))
     assert pa3.hits(volume, among="fixed") == set()
@@ -85,7 +85,7 @@ def test_base_path_for_a_planar_robot() -> None:
     assert g.is_planar(robot)
     start = to_se2(g.scene.robot(robot).base)
     goal = start + np.array([0.3, 0.0, 0.0])
-    res = g.base_path(robot, start, goal, time_limit=1.0)
+    res = g.base_path(robot, start, goal)
     assert res.ok and np.allclose(res.path[-1], goal, atol=1e-6)
     assert g.hits(g.base_volume(robot, res.path), among="fixed") == set()
 

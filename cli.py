@@ -209,8 +209,8 @@ def _progress(message: str) -> "contextlib.AbstractContextManager[object]":
 
 def cmd_plan(args: argparse.Namespace) -> int:
     from mrgc.planner.outcome import EXIT_CODES, PlanStatus
+    from mrgc.planner.baselines import plan_with
     from mrgc.planner.plan import file_sha256
-    from mrgc.planner.search import plan_problem
 
     if args.skeletons < 1 or not args.time_limit > 0 or args.time_limit == float("inf") or (
             args.max_makespan is not None and args.max_makespan < 1):
@@ -219,10 +219,10 @@ def cmd_plan(args: argparse.Namespace) -> int:
     problem = _load_problem(args.file, args.problem)
     log = (lambda line: print(line, file=sys.stderr, flush=True)) if args.verbose else None
     with _progress(f"planning {problem.name} (phase 1, then the tree search; at most {args.time_limit:g} s)"):
-        plan = plan_problem(problem, args.file, file_sha256(args.file), __version__, backend=args.backend,
-                            encoding=args.encoding, seed=args.seed, time_limit=args.time_limit, c=args.c,
-                            alpha=args.alpha, skeletons=args.skeletons, max_makespan=args.max_makespan,
-                            anytime=args.anytime, log=log)
+        plan = plan_with(args.planner, problem, args.file, file_sha256(args.file), __version__, backend=args.backend,
+                         encoding=args.encoding, seed=args.seed, time_limit=args.time_limit, c=args.c,
+                         alpha=args.alpha, skeletons=args.skeletons, max_makespan=args.max_makespan,
+                         anytime=args.anytime, log=log)
     status = PlanStatus(plan.status)
     out = sys.stderr if not args.output or status is PlanStatus.INTERRUPTED else sys.stdout
     if status is not PlanStatus.INTERRUPTED:  # an interrupted run writes no result, only what it had
@@ -273,10 +273,11 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
 
 def cmd_generate(args: argparse.Namespace) -> int:
-    from mrgc.generate import KINDS
+    from mrgc.generate import generate
     from mrgc.generate.document import domain_path
 
-    text = KINDS[args.kind](robots=args.robots, goals=args.goals, others=args.others, seed=args.seed)
+    text = generate(args.kind, seed=args.seed, preset_name=args.preset, robots=args.robots, goals=args.goals,
+                    others=args.others)
     if not args.output:
         sys.stdout.write(text)
         return EXIT_OK
@@ -370,6 +371,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("file", metavar="FILE")
     p.add_argument("--problem", help="which problem of the file (default: its only one)")
     p.add_argument("-o", "--output", metavar="PLAN", help="write the plan JSON here (default: standard output)")
+    p.add_argument("--planner", default="mcts", metavar="NAME",
+                   help="mcts (the paper's method, default) | ap1 (its baseline Ap1; docs/baselines.md)")
     p.add_argument("--backend", default="cpsat")
     p.add_argument("--encoding", default="time-of-move")
     p.add_argument("--seed", type=int, default=0)
@@ -393,9 +396,12 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("generate", help="write a random problem: packaging (arms, table, bins) or box-moving (rooms)")
     p.add_argument("kind", choices=["packaging", "box-moving"])
-    p.add_argument("--robots", type=int, default=2, metavar="N", help="arms 2-6 (packaging), carts 1-4 (box-moving)")
-    p.add_argument("--goals", type=int, default=3, metavar="G", help="goal objects (default 3)")
-    p.add_argument("--others", type=int, default=2, metavar="K", help="other objects (default 2)")
+    p.add_argument("--robots", type=int, default=None, metavar="N",
+                   help="arms 2-6 (packaging), carts 1-4 (box-moving); default 2")
+    p.add_argument("--goals", type=int, default=None, metavar="G", help="goal objects (default 3)")
+    p.add_argument("--others", type=int, default=None, metavar="K", help="other objects (default 2)")
+    p.add_argument("--preset", metavar="NAME", help="a suite of the paper: pa5, pa7, pa10, pa18 (--robots 2-6) "
+                   "(packaging), bo8 (box-moving); fixes the counts (docs/generators.md)")
     p.add_argument("--seed", type=int, default=0, metavar="S")
     p.add_argument("-o", "--output", metavar="FILE", help="write here (default: standard output)")
     p.set_defaults(func=cmd_generate)

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from mrgc.generate.document import document, num, pose
+from mrgc.generate.document import box_decl, document, pose, problem_text
 from mrgc.generate.footprint import Footprint, overlaps
 from mrgc.generate.sampling import ATTEMPTS, draw_layout
 from mrgc.generate.sampling import uniform as _u
@@ -56,29 +56,15 @@ def box_moving(robots: int = 2, goals: int = 2, others: int = 4, seed: int = 0) 
         f"{others} other boxes ({blocked} blocking doorways){', an alcove in the start room' if alcove else ''}.",
         "Generated within the ranges of docs/generators.md; a plan may not exist.",
     ]
-    lines = [
-        f"(define (problem {name})",
-        "  (:domain box-moving)",
-        "  (:robots",
-        *[f"    (r{k + 1} :kind mover :base {pose(c.x, c.y, 0, c.yaw)})" for k, c in enumerate(carts)],
-        "  )",
-        "  (:fixed",
-        *[f"    {_decl(n, f, WALL_H)}" for n, f in walls],
-        "  )",
-        "  (:regions",
-        *[f"    {_decl(n, f, WALL_H)}" for n, f in regions],
-        "  )",
-        "  (:movable",
-        *[f"    {_decl(n, f, h)}" for n, f, h in boxes],
-        "  )",
-        f"  (:goal (and {' '.join(f'(in-region g{k + 1} goal)' for k in range(goals))})))",
-    ]
-    return document("box-moving", command, summary, "\n".join(lines))
+    body = problem_text(
+        name, "box-moving", [f"(r{k + 1} :kind mover :base {pose(c.x, c.y, 0, c.yaw)})" for k, c in enumerate(carts)],
+        [_decl(n, f, WALL_H) for n, f in walls], [_decl(n, f, WALL_H) for n, f in regions],
+        [_decl(n, f, h) for n, f, h in boxes], [f"(in-region g{k + 1} goal)" for k in range(goals)])
+    return document("box-moving", command, summary, body)
 
 
 def _decl(name: str, f: Footprint, height: float) -> str:
-    return (f"({name} :shape (box {num(2 * f.hx)} {num(2 * f.hy)} {num(height)}) "
-            f":pose {pose(f.x, f.y, height / 2, f.yaw)})")
+    return box_decl(name, f.x, f.y, f.hx, f.hy, height, f.yaw)
 
 
 def _layout(rng: np.random.Generator, robots: int, goals: int, others: int):  # type: ignore[no-untyped-def]

@@ -34,6 +34,24 @@ def pose(x: float, y: float, z: float, yaw: float) -> str:
     return f"({num(x)} {num(y)} {num(z, 4)} {num(yaw)})"
 
 
+def box_decl(name: str, x: float, y: float, hx: float, hy: float, height: float, yaw: float = 0.0) -> str:
+    """A box standing on z = 0: ``(name :shape (box ...) :pose (...))``, half sizes ``hx``, ``hy``."""
+    return f"({name} :shape (box {num(2 * hx)} {num(2 * hy)} {num(height)}) :pose {pose(x, y, height / 2, yaw)})"
+
+
+def problem_text(name: str, domain: str, robots: Sequence[str], fixed: Sequence[str], regions: Sequence[str],
+                 movable: Sequence[str], goal: Sequence[str], handovers: Sequence[str] = ()) -> str:
+    """A ``(define (problem ...))`` form from its declarations (each one line) and its goal atoms."""
+    def section(head: str, items: Sequence[str]) -> list[str]:
+        return [f"  ({head}", *[f"    {item}" for item in items], "  )"]
+
+    lines = [f"(define (problem {name})", f"  (:domain {domain})", *section(":robots", robots),
+             *section(":fixed", fixed), *section(":regions", regions), *section(":movable", movable),
+             *(section(":handover-points", handovers) if handovers else []),
+             f"  (:goal (and {' '.join(goal)})))"]
+    return "\n".join(lines)
+
+
 def document(kind: str, command: str, summary: Sequence[str], problem: str) -> str:
     """The canonical text of a generated file: header comments, the shipped domain, ``problem``."""
     with open(domain_path(kind), encoding="utf-8") as fh:

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from mrgc.errors import Diagnostic
-from mrgc.generate.document import document, num, pose
+from mrgc.generate.document import document, num, pose, problem_text
 from mrgc.generate.footprint import Footprint, overlaps
 from mrgc.generate.sampling import ATTEMPTS, draw_layout
 from mrgc.generate.sampling import uniform as _u
@@ -100,26 +100,13 @@ def packaging(robots: int = 2, goals: int = 3, others: int = 2, seed: int = 0) -
         f"{len(handovers)} handover points.",
         "Generated within the ranges of docs/generators.md; a plan may not exist.",
     ]
-    lines = [
-        f"(define (problem {name})",
-        "  (:domain packaging)",
-        "  (:robots",
-        *[f"    ({a.name} :kind panda :base {pose(a.x, a.y, 0, a.yaw)})" for a in arms],
-        "  )",
-        "  (:fixed",
-        f"    (table :shape (box {num(2 * table.hx)} {num(2 * table.hy)} 0.05) :pose (0 0 -0.025 0)))",
-        "  (:regions",
-        *[f"    {r.decl()}" for r in (start, *bins)],
-        "  )",
-        "  (:movable",
-        *[f"    {o.decl()}" for o in objects],
-        "  )",
-        "  (:handover-points",
-        *[f"    ({h} :position ({num(x)} {num(y)} {num(z)}))" for h, (x, y, z) in handovers],
-        "  )",
-        f"  (:goal (and {' '.join(f'(in-region {objects[i].name} {goal_bin[i]})' for i in goal_idx)})))",
-    ]
-    return document("packaging", command, summary, "\n".join(lines))
+    body = problem_text(
+        name, "packaging", [f"({a.name} :kind panda :base {pose(a.x, a.y, 0, a.yaw)})" for a in arms],
+        [f"(table :shape (box {num(2 * table.hx)} {num(2 * table.hy)} 0.05) :pose (0 0 -0.025 0))"],
+        [r.decl() for r in (start, *bins)], [o.decl() for o in objects],
+        [f"(in-region {objects[i].name} {goal_bin[i]})" for i in goal_idx],
+        [f"({h} :position ({num(x)} {num(y)} {num(z)}))" for h, (x, y, z) in handovers])
+    return document("packaging", command, summary, body)
 
 
 def _layout(rng: np.random.Generator, robots: int, goals: int, others: int):  # type: ignore[no-untyped-def]

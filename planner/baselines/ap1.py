@@ -1,0 +1,343 @@
+"""Ap1, the paper's first baseline: ResolveSpatialConstraints (Stilman et al., ICRA 2007) for several robots.
+
+The robots form one composite robot whose actions are every single-robot pick-and-place and every handover
+the facts allow (phase 1 gives Ap1 the robots' reachability, as the paper gives both baselines; it does not
+use the occlusion facts to plan).  The search runs backwards in time, depth first, over a stack of objects
+that must still move (at first the goal objects, in the order of the run):
+
+1. an object of the stack (the *primary*: the top one first, Stilman's order, then the others) is moved by
+   the step grounded now, which happens **before** every step grounded so far (the suffix).  Its actions
+   are tried first strictly (free of every object still in place at that step), then, for those that
+   failed, with the objects nothing moves yet ignored (the minimum-constraint retry): the objects such a
+   step hits must be cleared **earlier**, so they go on top of the stack;
+2. the composite robot fills its idle robots: other objects of the stack join the step when an action of
+   theirs grounds beside the primary's without hitting anything new;
+3. recurse on the rest; a dead end backtracks to the next action, then the next primary.  An empty stack is
+   a complete plan, which the independent validator must accept before it counts (as in ``mrgc plan``).
+
+Each object moves at most once: objects moved later in time stay where they are for the steps grounded
+after them and are always obstacles, so a step that could only run by moving one of them again fails.
+Placements avoid the volume every later step sweeps, as in the planner's grounding (planner/ground.py),
+whose joint-action grounding, grasps, handovers and collision checks Ap1 reuses unchanged.
+
+Restarts: each run of the depth-first search may ground at most a budget of joint actions
+(:data:`RESTART_BUDGET`, doubled at every restart); when it is used up the search restarts with the objects
+in another order (seeded): the order the goal objects are stacked in and the hit objects are pushed in.
+Nothing but the time limit depends on the clock, so a seed gives the same plan whenever the time limit does
+not stop the search first.  Symbolic problems have no geometry: an action's ``occludes-pick`` obstacles are
+what its step hits (they must move strictly earlier), its ``occludes-goal-place`` obstacles what its place
+hits (no later).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import random
+import time
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+from mrgc.compiler.facts import FactBase
+from mrgc.compiler.task_graph import Action, build_task_graph
+from mrgc.compiler.task_graph import _actions_for as facts_actions
+from mrgc.language.model import Problem
+from mrgc.planner.ground import GroundedStep, label, moved_objects
+from mrgc.planner.outcome import Failure, PlanStatus, Why
+from mrgc.planner.plan import Plan, PlannedAction
+from mrgc.planner.skeletons import must_move, problem_facts
+
+#: joint-action groundings the first depth-first run may make; every restart doubles it
+RESTART_BUDGET = 64
+#: actions tried per other object of the stack when filling a step's idle robots
+PACK_TRIES = 2
+
+Log = Callable[[str], None]
+
+
+class _Stop(Exception):
+    """The time limit: the search ends with what it has."""
+
+
+class _Budget(Exception):
+    """The restart's budget of groundings is used up."""
+
+
+@dataclass
+class Attempt:
+    """A grounded joint action and the objects it hits that nothing moves yet (they must move earlier)."""
+
+    step: GroundedStep
+    hits: set[str]
+
+
+class GeometricSteps:
+    """Joint actions grounded on the scene by the planner's reverse grounding (planner/ground.py)."""
+
+    def __init__(self, problem: Problem, seed: int) -> None:
+        from mrgc.geometry.grounding import Grounder
+        from mrgc.geometry.scene import scene_from_problem
+        from mrgc.planner.ground import ReverseGrounder
+
+        self.grounder = Grounder(scene_from_problem(problem), seed=seed)
+        self.reverse = ReverseGrounder(self.grounder, problem.goal_regions)
+
+    def ground(self, actions: tuple[Action, ...], fut: set[str], free: set[str], strict: bool, v_fut: list[Any],
+               key: str, index: int) -> Attempt | Failure:
+        """Ground ``actions`` as one step before the suffix: ``fut`` (moved later) are always obstacles, ``free``
+        (moved by nothing yet) too when ``strict``, else the objects of ``free`` the step hits are returned."""
+        same = {a.obj for a in actions}
+        avoid = fut | free if strict else set(fut)
+        step = self.reverse._step(actions, avoid, same, v_fut, key, index)
+        if isinstance(step, Failure):
+            return step
+        among = sorted(free - same)
+        hits = self.grounder.hits(step.volume, among=among) if among and not strict else set()
+        return Attempt(step, hits)
+
+
+class SymbolicSteps:
+    """Joint actions checked against the facts of a symbolic problem (see the module docstring)."""
+
+    def __init__(self, facts: FactBase) -> None:
+        self.facts = facts
+
+    def ground(self, actions: tuple[Action, ...], fut: set[str], free: set[str], strict: bool, v_fut: list[Any],
+               key: str, index: int) -> Attempt | Failure:
+        facts, same = self.facts, {a.obj for a in actions}
+        hits: set[str] = set()
+        for a in actions:
+            pick = facts.occludes_pick.get((a.obj, a.pick_grasp, a.pick_robot), ())
+            place = facts.occludes_place.get((a.obj, a.region, a.place_grasp, a.place_robot), ()) \
+                if a.obj in facts.goal else ()
+            for b in pick + place:
+                if b in fut:
+                    return Failure(index, label(a), "obstructed by an object that moves later", (b,))
+                if b in same and b in pick:
+                    return Failure(index, label(a), "pick obstructed by an object of the same step", (b,))
+                if b in free:
+                    hits.add(b)
+        if strict and hits:
+            return Failure(index, " + ".join(label(a) for a in actions), "obstructed", tuple(sorted(hits)))
+        planned = [PlannedAction(a.obj, a.region, a.pick_robot, a.place_robot, a.pick_grasp, a.place_grasp)
+                   for a in actions]
+        return Attempt(GroundedStep(planned, [], tuple(a.obj for a in actions)), hits)
+
+
+@dataclass
+class Ap1Search:
+    """The reverse-time depth-first search with restarts (see the module docstring)."""
+
+    steps: GeometricSteps | SymbolicSteps
+    facts: FactBase
+    accept: Callable[[list[GroundedStep]], bool]
+    deadline: float
+    why: Why
+    one_handover: bool = False
+    stats: dict[str, float] = field(default_factory=lambda: {"groundings": 0, "grounding_seconds": 0.0, "nodes": 0,
+                                                             "restarts": 0})
+    left: int = 0  # groundings left in this run
+    rank: dict[str, int] = field(default_factory=dict)  # this run's order of the objects
+    ordered: bool = False
+    _actions: dict[str, list[Action]] = field(default_factory=dict)
+
+    def actions(self, obj: str) -> list[Action]:
+        """The composite robot's actions moving ``obj`` (to its goal region, or within its region): the
+        single-robot ones first, then the handovers, each in the facts' order."""
+        if obj not in self._actions:
+            acts = facts_actions(self.facts, obj)
+            self._actions[obj] = [a for a in acts if not a.handover] + [a for a in acts if a.handover]
+        return self._actions[obj]
+
+    def run(self, goals: list[str], seed: int, log: Log) -> tuple[list[GroundedStep] | None, str]:
+        """Restart the depth-first search with other orders until a plan is found (``solved``), a run is
+        searched to its end (``exhausted``: every node tried every object of its stack, so no other order
+        explores anything else) or the time limit (``time limit``).
+
+        An order ranks every movable object: the goal objects are stacked by it (the first on top) and the
+        objects a step hits are pushed by it, so it decides what the search tries first.  The first run
+        takes the declaration order; each restart draws a random one (seeded) and doubles the budget."""
+        rng = random.Random(seed)
+        order, budget = list(self.facts.objects), RESTART_BUDGET
+        while True:
+            self.left, self.rank = budget, {o: k for k, o in enumerate(order)}
+            stack = tuple(sorted(goals, key=self.rank.__getitem__))
+            head = f"restart {int(self.stats['restarts'])} (goals {' '.join(stack)})"
+            try:
+                plan = self._resolve(stack, [], ())
+            except _Budget:
+                log(f"{head}: budget of {budget} groundings used up")
+            except _Stop:
+                return None, "time limit"
+            else:
+                if plan is not None:
+                    return plan, "solved"
+                log(f"{head}: searched to its end")
+                return None, "exhausted"  # every object was tried as the next to move at every node
+            self.stats["restarts"] += 1
+            budget *= 2
+            rng.shuffle(order)
+
+    # ------------------------------------------------------------ the recursion
+    def _resolve(self, pending: tuple[str, ...], suffix: list[GroundedStep],
+                 signature: tuple[Any, ...]) -> list[GroundedStep] | None:
+        if not pending:
+            return suffix if self.accept(suffix) else None
+        state = (pending, signature)
+        self.stats["nodes"] += 1
+        fut = moved_objects(suffix)
+        free = set(self.facts.objects) - fut - set(pending)
+        v_fut = [p for s in suffix for p in s.volume]
+        index = -(len(suffix) + 1)
+        tag = hashlib.sha256(repr(state).encode()).hexdigest()[:16]
+        for j, primary in enumerate(pending):
+            strict_ok: set[int] = set()
+            for strict in (True, False):
+                for i, a in enumerate(self.actions(primary)):
+                    if not strict and i in strict_ok:
+                        continue
+                    key = f"{tag}:{j}:{i}:{'s' if strict else 'r'}"
+                    got = self._ground((a,), fut, free, strict, v_fut, key, index, record=not strict)
+                    if got is None:
+                        continue
+                    strict_ok.add(i)
+                    got = self._fill((a,), got, pending, fut, free, strict, v_fut, key, index)
+                    rest = tuple(sorted(got.hits, key=self.rank.__getitem__)) + tuple(
+                        p for p in pending if p not in got.step.moved)
+                    # the state names the whole path (each step with the stack it was grounded under); the
+                    # grounding's random streams derive from it
+                    step_sig = tuple((x.object, x.region, x.pick_robot, x.place_robot, x.pick_grasp, x.place_grasp)
+                                     for x in got.step.actions)
+                    plan = self._resolve(rest, [got.step] + suffix, ((pending, step_sig),) + signature)
+                    if plan is not None:
+                        return plan
+        return None
+
+    def _fill(self, actions: tuple[Action, ...], got: Attempt, pending: tuple[str, ...], fut: set[str],
+              free: set[str], strict: bool, v_fut: list[Any], key: str, index: int) -> Attempt:
+        """The composite robot's idle robots take other objects of the stack, in stack order, when an action
+        of theirs grounds in the same step without hitting anything the step did not hit already."""
+        busy = {r for a in actions for r in a.robots}
+        handovers = sum(a.handover for a in actions)
+        for obj in pending:
+            if obj in got.step.moved:
+                continue
+            if len(busy) >= len(self.facts.robots):
+                break
+            tried = 0
+            for b in self.actions(obj):
+                if busy & set(b.robots) or (b.handover and self.one_handover and handovers):
+                    continue
+                if tried >= PACK_TRIES:
+                    break
+                tried += 1
+                more = self._ground(actions + (b,), fut, free, strict, v_fut, key, index, record=False)
+                if more is not None and more.hits <= got.hits:
+                    actions, got = actions + (b,), more
+                    busy |= set(b.robots)
+                    handovers += b.handover
+                    break
+        return got
+
+    def _ground(self, actions: tuple[Action, ...], fut: set[str], free: set[str], strict: bool, v_fut: list[Any],
+                key: str, index: int, record: bool) -> Attempt | None:
+        if time.perf_counter() >= self.deadline:
+            raise _Stop()
+        if self.left <= 0:
+            raise _Budget()
+        self.left -= 1
+        t0 = time.perf_counter()
+        got = self.steps.ground(actions, fut, free, strict, v_fut, key, index)
+        self.stats["groundings"] += 1
+        self.stats["grounding_seconds"] += time.perf_counter() - t0
+        if isinstance(got, Failure):
+            if record:
+                self.why.add(got)
+            return None
+        return got
+
+
+def plan_ap1(problem: Problem, problem_file: str, sha256: str, version: str, seed: int = 0,
+             time_limit: float = 60.0, log: Log | None = None) -> Plan:
+    """Plan ``problem`` with Ap1 (see the module docstring); the same Plan, statuses and validation as
+    :func:`mrgc.planner.search.plan_problem`."""
+    t0 = time.perf_counter()
+    say: Log = log or (lambda line: None)
+    facts, facts_seconds = problem_facts(problem, seed=seed)
+    base = FactBase.from_problem(problem, facts)
+    robots = [r.name for r in problem.robots]
+    plan = Plan(problem.name, problem_file, sha256, version, "none", "none", seed, PlanStatus.EXHAUSTED,
+                symbolic=problem.symbolic)
+    why = plan.why = Why()
+    stats: dict[str, Any] = {"planner": "ap1", "robots": robots, "facts": len(facts),
+                             "facts_seconds": round(facts_seconds, 4)}
+    goals = must_move(problem, facts)
+    reasons = _infeasible(base, goals)
+    if reasons:
+        plan.status, why.facts, why.summary = PlanStatus.INFEASIBLE, reasons, "infeasible by the facts"
+    else:
+        verdicts: dict[str, float] = {"checked": 0, "seconds": 0.0}
+
+        def accept(steps: list[GroundedStep]) -> bool:
+            return _referee(problem, plan, steps, why, verdicts)
+
+        steps = SymbolicSteps(base) if problem.symbolic else GeometricSteps(problem, seed)
+        search = Ap1Search(steps, base, accept, t0 + time_limit, why, one_handover=base.handover_capacity == 1)
+        try:
+            found, ended = search.run(goals, seed, lambda line: say(f"[t={time.perf_counter() - t0:.1f}s] {line}"))
+        except KeyboardInterrupt:
+            found, ended = None, "interrupted"
+        if found is not None:
+            plan.steps = [s.actions for s in found]
+            plan.status = PlanStatus.SOLVED
+            plan.validation = {"valid": True, "validator": "mrgc validate (independent replay)",
+                               "plans_checked": int(verdicts["checked"])}
+        else:
+            plan.status = {"time limit": PlanStatus.TIME_LIMIT, "interrupted": PlanStatus.INTERRUPTED}.get(
+                ended, PlanStatus.EXHAUSTED)
+        why.summary = _summary(PlanStatus(plan.status), time_limit, why)
+        stats.update({k: (round(v, 4) if isinstance(v, float) else int(v)) for k, v in search.stats.items()})
+        stats["validation_seconds"] = round(verdicts["seconds"], 4)
+        if isinstance(steps, GeometricSteps):
+            stats["geometric_queries"] = steps.grounder.queries
+    stats["seconds"] = round(time.perf_counter() - t0, 4)
+    plan.stats = stats
+    return plan
+
+
+def _infeasible(facts: FactBase, goals: list[str]) -> list[str]:
+    """The facts' reasons why no plan exists (a goal object no robot can pick or bring to its region, a
+    blocking cycle): the same diagnosis ``mrgc plan`` gives, so both methods agree on what is infeasible."""
+    from mrgc.compiler.diagnose import explain_infeasible
+
+    return explain_infeasible(build_task_graph(facts, goals), facts)
+
+
+def _referee(problem: Problem, plan: Plan, steps: list[GroundedStep], why: Why, verdicts: dict[str, float]) -> bool:
+    """Whether the independent validator accepts the complete plan ``steps``; a rejection is counted as a
+    failure named by its first violation."""
+    from mrgc.planner.validate import validate
+
+    t0 = time.perf_counter()
+    candidate = Plan(plan.problem, plan.problem_file, plan.problem_sha256, plan.mrgc_version, plan.backend,
+                     plan.encoding, plan.seed, PlanStatus.SOLVED, [s.actions for s in steps],
+                     symbolic=problem.symbolic, stats={"robots": [r.name for r in problem.robots]})
+    report = validate(problem, candidate.to_json(), plan.problem_file)
+    verdicts["seconds"] += time.perf_counter() - t0
+    verdicts["checked"] += 1
+    if report.ok:
+        return True
+    why.rejected_plans += 1
+    v = report.violations[0]
+    why.add(Failure(v.step or 0, "validator", v.code, (v.subject,) if v.subject else (), v.message))
+    return False
+
+
+def _summary(status: PlanStatus, time_limit: float, why: Why) -> str:
+    if status is PlanStatus.SOLVED:
+        return "solved" + (f" after the validator rejected {why.rejected_plans} plan(s)" if why.rejected_plans else "")
+    if status is PlanStatus.TIME_LIMIT:
+        return f"no plan within the time limit of {time_limit:g} s"
+    if status is PlanStatus.INTERRUPTED:
+        return "interrupted"
+    return ("the depth-first search ran to its end (every object of the stack, with every action, at every "
+            "step); no valid plan")

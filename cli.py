@@ -409,6 +409,10 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("backends", help="list solver backends: installed?, versions, encodings, features")
     p.add_argument("--format", choices=["text", "json"], default="text")
     p.set_defaults(func=cmd_backends)
+
+    from mrgc.render.command import add_commands as add_render_commands
+
+    add_render_commands(sub)  # render, graph
     return parser
 
 

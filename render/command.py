@@ -1,0 +1,168 @@
+"""``mrgc render`` and ``mrgc graph``: their command-line options and what they run.
+
+:func:`add_commands` registers both on the CLI's sub-parsers; nothing here imports a heavy library until a
+command runs.  Output files are written through :mod:`mrgc.outputs` (checked before any drawing, replaced
+atomically); the replay's path is printed when it is written.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import os
+import sys
+from typing import Any, Iterator
+
+from mrgc.errors import Diagnostic, InputError
+
+MAX_SIDE = 4096  # pixels
+MAX_FPS = 60.0
+#: the camera presets of :data:`mrgc.render.camera.PRESETS`, for --help without loading numpy (a test keeps
+#: the two in step)
+CAMERA_HELP = "iso, front, back, side or top"
+
+
+def add_commands(sub: Any) -> None:
+    """Add ``render`` and ``graph`` to the CLI's sub-parsers."""
+    p = sub.add_parser("render", help="draw a plan or a scene: .gif/.mp4 replay, .png sheet or scene, .html 3D "
+                                      "replay, .svg/.png Gantt chart")
+    p.add_argument("file", metavar="FILE", help="the problem file")
+    p.add_argument("plan", metavar="PLAN", nargs="?", help="the plan JSON (mrgc plan -o PLAN); leave out to "
+                                                           "draw the scene alone")
+    p.add_argument("-o", "--output", metavar="OUT", required=True,
+                   help=".gif or .mp4 (replay), .png (key frames; the scene without PLAN), .html (3D replay), "
+                        ".svg or *gantt.png (Gantt chart)")
+    p.add_argument("--problem", help="which problem of the file (default: the one the plan names, else its only one)")
+    p.add_argument("--size", default="400x300", metavar="WxH", help="picture size in pixels (default 400x300)")
+    p.add_argument("--fps", type=float, default=10.0, help="frames per second of the replay (default 10)")
+    p.add_argument("--camera", default="iso", help=f"viewing direction: {CAMERA_HELP} (default iso)")
+    p.add_argument("--gantt", action="store_true", help="write the Gantt chart (.svg or .png)")
+    p.set_defaults(func=cmd_render)
+
+    p = sub.add_parser("graph", help="draw the collaborative manipulation task graph (CMTG): .dot, .svg or .png")
+    p.add_argument("file", metavar="FILE")
+    p.add_argument("-o", "--output", metavar="OUT", required=True, help=".dot, or .svg/.png through Graphviz's dot")
+    p.add_argument("--problem", help="which problem of the file (default: its only one)")
+    p.add_argument("--skeleton", type=int, metavar="K", help="highlight the K-th task skeleton (1 = the first)")
+    p.add_argument("--backend", default="cpsat", help="backend generating skeletons for --skeleton (default cpsat)")
+    p.add_argument("--encoding", default="time-of-move")
+    p.add_argument("--seed", type=int, default=0)
+    p.set_defaults(func=cmd_graph)
+
+
+def _usage(message: str) -> InputError:
+    return InputError([Diagnostic("E000", message)])
+
+
+def parse_size(text: str) -> tuple[int, int]:
+    """``WxH`` → (width, height), each 16 to :data:`MAX_SIDE` pixels (E000 otherwise)."""
+    parts = text.lower().split("x")
+    try:
+        w, h = (int(v) for v in parts)
+    except ValueError:
+        raise _usage(f"--size {text!r}: give width x height in pixels, e.g. 640x480") from None
+    if not (16 <= w <= MAX_SIDE and 16 <= h <= MAX_SIDE):
+        raise _usage(f"--size {text!r}: each side must be 16 to {MAX_SIDE} pixels")
+    return w, h
+
+
+@contextlib.contextmanager
+def _progress(label: str) -> Iterator[Any]:
+    """A rich progress bar on a terminal (stderr); a silent callback otherwise."""
+    if not sys.stderr.isatty():
+        yield None
+        return
+    from rich.console import Console
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+
+    with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
+                  console=Console(stderr=True), transient=True) as bar:
+        task = bar.add_task(label, total=None)
+
+        def update(done: int, total: int) -> None:
+            bar.update(task, completed=done, total=total)
+
+        yield update
+
+
+def cmd_render(args: argparse.Namespace) -> int:
+    from mrgc import outputs as files
+    from mrgc.language.loader import parse_file
+    from mrgc.render import outputs
+    from mrgc.render.camera import PRESETS
+
+    width, height = parse_size(args.size)
+    if args.camera not in PRESETS:
+        raise _usage(f"--camera {args.camera!r}: choose {CAMERA_HELP}")
+    if not 0 < args.fps <= MAX_FPS:
+        raise _usage(f"--fps must be above 0 and at most {MAX_FPS:g}")
+    kind = outputs.kind_of(args.output, args.gantt, args.plan is not None)
+    mf = parse_file(args.file)
+    inputs = list(mf.files) + ([args.plan] if args.plan else [])
+    files.check_output(args.output, inputs)
+    plan = None
+    name = args.problem
+    if args.plan is not None:
+        from mrgc.planner.validate import load_plan
+
+        plan = load_plan(args.plan)
+        if name is None and len(mf.problems) > 1 and any(p.name == plan["problem"] for p in mf.problems):
+            name = plan["problem"]
+    problem = mf.problem(name)
+    opts = outputs.Options(width, height, args.fps, args.camera)
+    source = args.plan or args.file
+    with files.atomic_path(args.output, inputs) as tmp, _progress(f"drawing {os.path.basename(args.output)}") as bar:
+        if kind == "gantt":
+            assert plan is not None
+            stats = outputs.write_gantt(problem, plan, tmp)
+        elif kind == "html":
+            stats = outputs.write_html(problem, plan, tmp, opts, source, bar)
+        elif kind == "scene":
+            stats = outputs.write_scene(problem, tmp, opts)
+        elif kind == "sheet":
+            assert plan is not None
+            stats = outputs.write_sheet(problem, plan, tmp, opts, source, bar)
+        else:
+            assert plan is not None
+            stats = outputs.write_animation(problem, plan, tmp, opts, source, bar)
+    print(_written(kind, args.output, stats))
+    return 0
+
+
+def _written(kind: str, path: str, stats: dict[str, Any]) -> str:
+    where = os.path.abspath(path)
+    what = {
+        "animation": f"replay of {stats['steps']} steps, {stats['frames']} frames",
+        "sheet": f"contact sheet of {stats['frames']} key frames",
+        "scene": "the scene",
+        "html": (f"3D replay of {stats['steps']} steps, {stats['frames']} frames; open it in a web browser"
+                 if stats["steps"] else "the scene in 3D; open it in a web browser"),
+        "gantt": f"Gantt chart of {stats['steps']} steps",
+    }[kind]
+    timing = f", {stats['draw_seconds']:.1f} s" if "draw_seconds" in stats else ""
+    return f"{path}: {what}{timing}\n  written to {where}"
+
+
+def cmd_graph(args: argparse.Namespace) -> int:
+    from mrgc import outputs as files
+    from mrgc.language.loader import parse_file
+    from mrgc.render import graph
+
+    ext = os.path.splitext(args.output.lower())[1]
+    if ext not in graph.FORMATS:
+        raise _usage(f"cannot write {args.output!r}: mrgc graph writes {', '.join(graph.FORMATS)}")
+    if args.skeleton is not None and args.skeleton < 1:
+        raise _usage("--skeleton must be at least 1")
+    mf = parse_file(args.file)
+    files.check_output(args.output, list(mf.files))
+    if ext != ".dot":
+        graph.require_dot()
+    problem = mf.problem(args.problem)
+    text, info = graph.task_graph_dot(problem, args.skeleton, args.backend, args.encoding, args.seed)
+    if ext == ".dot":
+        files.write_text(args.output, text, list(mf.files))
+    else:
+        with files.atomic_path(args.output, list(mf.files)) as tmp:
+            graph.run_dot(text, ext[1:], tmp)
+    print(f"{args.output}: task graph of {problem.name}: {info}")
+    return 0

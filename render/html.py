@@ -1,0 +1,129 @@
+"""The interactive 3D replay: one self-contained HTML file built with viser (the one module importing it).
+
+Why viser: it is maintained on PyPI (1.x, released through 2026; meshcat-python's last release, 0.3.2, is
+from 2021), its wheel ships its whole web viewer as one ``index.html`` (about 0.8 MB: JavaScript, fonts and
+environment map inline), and it records a scene with timed updates into a file the viewer replays with
+play/pause, a time slider and speeds, the camera orbiting freely.  :meth:`StateSerializer.as_html` puts the
+recording (zstd-compressed msgpack, base64) into that page: no server, no network, no CDN.  meshcat's static
+HTML is self-contained too, but it would tie mrgc to an unmaintained package and a ZeroMQ server process.
+
+viser records what a live ``ViserServer`` sends, so a server is started for the duration of the export,
+bound to the loopback interface on a free port (``127.0.0.1:0``); no client ever connects and it is stopped
+before the file is written.  The scene is :class:`~mrgc.render.world.World`'s drawables: fixed objects,
+regions (translucent), objects coloured by role, robots as their collision shapes; each frame updates only
+the poses that changed, and a label shows the caption.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import math
+from typing import Any, Callable
+
+import numpy as np
+
+from mrgc.geometry.transforms import to_quaternion
+from mrgc.render.camera import Camera
+from mrgc.render.frames import Frame
+from mrgc.render.palette import REGION_ALPHA, byte_colour
+from mrgc.render.world import Drawable, World, shape_drawable
+
+
+def write(world: World, frames: list[Frame], camera: Camera, fps: float, path: str,
+          progress: Callable[[int, int], None] | None = None) -> int:
+    """Write the replay of ``frames`` (one frame: a still scene) to ``path``; returns its size in bytes."""
+    page = build(world, frames, camera, fps, progress)
+    data = page.encode("utf-8")
+    with open(path, "wb") as fh:
+        fh.write(data)
+    return len(data)
+
+
+def build(world: World, frames: list[Frame], camera: Camera, fps: float,
+          progress: Callable[[int, int], None] | None = None) -> str:
+    """The HTML page of the replay."""
+    with contextlib.redirect_stdout(io.StringIO()):  # viser reports its server's start and stop
+        import viser
+
+        server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
+        try:
+            return _record(server, world, frames, camera, fps, progress)
+        finally:
+            server.stop()
+
+
+def _record(server: Any, world: World, frames: list[Frame], camera: Camera, fps: float,
+            progress: Callable[[int, int], None] | None) -> str:
+    scene = server.scene
+    scene.set_up_direction("+z")
+    cam = server.initial_camera
+    cam.position = tuple(float(v) for v in camera.eye)
+    cam.look_at = tuple(float(v) for v in camera.target)
+    cam.up = tuple(float(v) for v in camera.up)
+    cam.fov = math.radians(camera.fov)
+    for part, pose in world.fixed:
+        _add(scene, f"/fixed/{part.name}", part, pose)
+    for body, colour in world.regions:
+        _add(scene, f"/regions/{body.name}", shape_drawable(body.name, body.shape, colour, REGION_ALPHA), body.pose)
+    first = frames[0]
+    handles: dict[str, Any] = {}
+    for name, part in world.objects.items():
+        handles[name] = _add(scene, f"/objects/{name}", part, first.poses[name])
+    for robot, q in first.configs.items():
+        for part, pose in world.robots[robot].part_poses(q, first.fingers.get(robot)):
+            handles[part.name] = _add(scene, f"/robots/{part.name}", part, pose)
+    top = camera.target + np.array([0.0, 0.0, 1.0]) * 0.5 * float(np.linalg.norm(camera.eye - camera.target)) * 0.4
+    label = scene.add_label("/caption", first.caption, position=tuple(float(v) for v in top),
+                            anchor="bottom-center", font_screen_scale=1.2)
+    serializer = server.get_scene_serializer()
+    last = {name: None for name in handles}
+    text = first.caption
+    for i, frame in enumerate(frames[1:], 2):
+        serializer.insert_sleep(1.0 / fps)
+        for name, pose in frame.poses.items():
+            _move(handles[name], pose, last, name)
+        for robot, q in frame.configs.items():
+            for part, pose in world.robots[robot].part_poses(q, frame.fingers.get(robot)):
+                _move(handles[part.name], pose, last, part.name)
+        if frame.caption != text:
+            label.text = text = frame.caption
+        if progress is not None:
+            progress(i, len(frames))
+    if len(frames) > 1:
+        serializer.insert_sleep(1.5)  # hold the end before the replay loops
+    return str(serializer.as_html())
+
+
+def _move(handle: Any, pose: np.ndarray, last: dict[str, Any], name: str) -> None:
+    """Send ``pose`` to ``handle`` unless it is where it was (to a micrometre and a microradian)."""
+    pos, (x, y, z, w) = to_quaternion(np.asarray(pose, dtype=float))
+    key = tuple(round(v, 6) for v in (*pos, w, x, y, z))
+    if last[name] == key:
+        return
+    last[name] = key
+    handle.position = pos
+    handle.wxyz = (w, x, y, z)
+
+
+def _add(scene: Any, name: str, d: Drawable, pose: np.ndarray) -> Any:
+    """Add drawable ``d`` at ``pose`` as scene node ``name``."""
+    pos, (x, y, z, w) = to_quaternion(np.asarray(pose, dtype=float))
+    where: dict[str, Any] = {"position": pos, "wxyz": (w, x, y, z)}
+    colour = byte_colour(d.colour)
+    opacity = d.opacity if d.opacity < 1 else None
+    if d.kind == "box":
+        return scene.add_box(name, colour, tuple(d.size), opacity=opacity, **where)
+    if d.kind == "sphere":
+        return scene.add_icosphere(name, radius=d.size[0], color=colour, opacity=opacity, **where)
+    if d.kind in ("cylinder", "capsule"):
+        return scene.add_cylinder(name, radius=d.size[0], height=d.size[1], color=colour, opacity=opacity, **where)
+    vertices, faces = d.vertices, d.faces
+    if vertices is None or faces is None:
+        assert d.mesh_path is not None
+        from mrgc.geometry.kinematics import read_mesh
+
+        v, faces = read_mesh(d.mesh_path)
+        vertices = v * np.asarray(d.size)
+    return scene.add_mesh_simple(name, np.asarray(vertices, dtype=np.float32), np.asarray(faces, dtype=np.uint32),
+                                 color=colour, opacity=opacity, side="double" if opacity else "front", **where)

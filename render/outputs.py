@@ -1,0 +1,189 @@
+"""What ``mrgc render`` writes, chosen by the output file's name: one function per kind of picture.
+
+| output | with a plan | without a plan |
+| --- | --- | --- |
+| ``.gif``, ``.mp4`` | the replay, every phase of every step interpolated | (needs a plan) |
+| ``.png`` | a contact sheet of the key frames | the scene |
+| ``.html`` | an interactive 3D replay, self-contained | the scene in 3D |
+| ``.svg``, ``*gantt.png``, ``--gantt`` | the Gantt chart (symbolic plans too) | (needs a plan) |
+
+Animations, sheets and scenes are drawn by :mod:`mrgc.render.raster` and framed by one camera for the
+whole replay (:func:`mrgc.render.camera.fit` over the scene and every robot pose), so nothing leaves the
+picture and the view never jumps.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from dataclasses import dataclass
+from typing import Any, Callable, Mapping
+
+import numpy as np
+
+from mrgc.errors import Diagnostic, InputError
+from mrgc.language.model import Problem
+from mrgc.render.camera import DEFAULT_PRESET, Camera, fit
+from mrgc.render.frames import Frame, Timeline, build_timeline
+from mrgc.render.world import World
+
+Progress = Callable[[int, int], None]  # (frames done, frames in all)
+
+ANIMATIONS = (".gif", ".mp4")
+#: robot poses used to frame a replay's camera: every k-th frame
+FRAMING_STRIDE = 4
+
+
+@dataclass(frozen=True)
+class Options:
+    """How to draw: picture size in pixels, frames per second, camera preset."""
+
+    width: int = 400
+    height: int = 300
+    fps: float = 10.0
+    camera: str = DEFAULT_PRESET
+
+
+def kind_of(path: str, gantt: bool, has_plan: bool) -> str:
+    """``animation``, ``sheet``, ``scene``, ``html`` or ``gantt`` for output ``path`` (E000 when the name
+    or the missing plan does not allow one)."""
+    lower = path.lower()
+    ext = os.path.splitext(lower)[1]
+    if gantt or ext == ".svg" or lower.endswith("gantt.png"):
+        if ext not in (".svg", ".png"):
+            raise _usage(f"a Gantt chart is written as .svg or .png, not {ext or 'a file without extension'}")
+        kind = "gantt"
+    elif ext in ANIMATIONS:
+        kind = "animation"
+    elif ext == ".png":
+        kind = "sheet" if has_plan else "scene"
+    elif ext == ".html":
+        kind = "html"
+    else:
+        raise _usage(f"cannot write {path!r}: mrgc render writes .gif, .mp4, .png, .html or .svg")
+    if not has_plan and kind in ("animation", "gantt"):
+        raise _usage(f"{'an animation' if kind == 'animation' else 'a Gantt chart'} needs a plan: "
+                     f"mrgc render FILE PLAN -o {os.path.basename(path)} (without a plan, write the scene as .png "
+                     "or .html)")
+    return kind
+
+
+def _usage(message: str) -> InputError:
+    return InputError([Diagnostic("E000", message)])
+
+
+def replay_frames(problem: Problem, plan: Mapping[str, Any], opts: Options, source: str
+                  ) -> tuple[World, Timeline, list[Frame], Camera]:
+    """The world, timeline, frames at ``opts.fps`` and one camera framing all of them."""
+    world = World(problem, plan)
+    timeline = build_timeline(world, plan, source)
+    frames = timeline.frames(opts.fps)
+    return world, timeline, frames, frame_camera(world, frames, opts)
+
+
+def frame_camera(world: World, frames: list[Frame], opts: Options) -> Camera:
+    """The camera of ``opts.camera`` showing the scene and every robot and object in ``frames``."""
+    pts = [world.static_points()]
+    for f in frames[::FRAMING_STRIDE] + frames[-1:]:
+        pts.append(world.robot_points(f.configs))
+        pts.append(np.array([p[:3, 3] for p in f.poses.values()]).reshape(-1, 3))
+    return fit(np.concatenate(pts), opts.camera, opts.width / opts.height)
+
+
+def draw(world: World, frames: list[Frame], camera: Camera, opts: Options, progress: Progress | None = None,
+         captions: bool = True) -> tuple[list[np.ndarray], float]:
+    """Every frame as an image (captioned), and the seconds the drawing took."""
+    from mrgc.render.picture import caption
+    from mrgc.render.raster import Rasterizer
+
+    images = []
+    t0 = time.perf_counter()
+    with Rasterizer(world) as r:
+        for i, f in enumerate(frames, 1):
+            img = r.draw(f, camera, opts.width, opts.height)
+            images.append(caption(img, f.caption) if captions else img)
+            if progress is not None:
+                progress(i, len(frames))
+    return images, time.perf_counter() - t0
+
+
+def write_animation(problem: Problem, plan: Mapping[str, Any], path: str, opts: Options, source: str,
+                    progress: Progress | None = None) -> dict[str, Any]:
+    """The replay as ``.gif`` or ``.mp4``; returns what was written (frames, steps, seconds)."""
+    from mrgc.render.picture import HOLD_LAST, write_gif
+
+    mp4 = path.lower().endswith(".mp4")
+    if mp4:
+        from mrgc.render.video import require_mp4, write_mp4
+
+        require_mp4(path)  # before any drawing
+    world, timeline, frames, camera = replay_frames(problem, plan, opts, source)
+    images, seconds = draw(world, frames, camera, opts, progress)
+    t0 = time.perf_counter()
+    if mp4:
+        write_mp4(path, images, opts.fps, HOLD_LAST)
+    else:
+        write_gif(path, images, opts.fps)
+    return {"frames": len(images), "steps": timeline.steps, "draw_seconds": seconds,
+            "write_seconds": time.perf_counter() - t0, "duration": timeline.duration}
+
+
+def write_sheet(problem: Problem, plan: Mapping[str, Any], path: str, opts: Options, source: str,
+                progress: Progress | None = None) -> dict[str, Any]:
+    """A contact sheet of the key frames (the start, the end of every pick, handover and place, the end)."""
+    from mrgc.render.picture import sheet, write_png
+
+    world, timeline, frames, camera = replay_frames(problem, plan, opts, source)
+    keys = [f for f in frames if f.key]
+    images, seconds = draw(world, keys, camera, opts, progress)
+    write_png(path, sheet(images))
+    return {"frames": len(images), "steps": timeline.steps, "draw_seconds": seconds}
+
+
+def write_scene(problem: Problem, path: str, opts: Options) -> dict[str, Any]:
+    """The scene alone, robots at home, with the problem's name and what it asks as the caption."""
+    from mrgc.render.picture import write_png
+
+    world = World(problem)
+    frame = scene_frame(world)
+    camera = frame_camera(world, [frame], opts)
+    images, seconds = draw(world, [frame], camera, opts)
+    write_png(path, images[0])
+    return {"frames": 1, "steps": 0, "draw_seconds": seconds}
+
+
+def scene_frame(world: World) -> Frame:
+    """The scene at the start: robots at home, objects where the problem puts them."""
+    goal = ", ".join(f"{o} in {r}" for o, r in sorted(world.scene.goal.items()))
+    text = (f"{world.problem.name}: {len(world.robots)} robots, {len(world.objects)} objects, "
+            f"{len(world.regions)} regions; goal: {goal or 'none'}")
+    return Frame(0.0, 0, "start", text, {r: v.home for r, v in world.robots.items()},
+                 {r: None for r in world.robots}, dict(world.start), key=True)
+
+
+def write_html(problem: Problem, plan: Mapping[str, Any] | None, path: str, opts: Options, source: str,
+               progress: Progress | None = None) -> dict[str, Any]:
+    """The interactive 3D replay (or the scene) as one self-contained HTML file."""
+    from mrgc.render.html import write
+
+    if plan is None:
+        world = World(problem)
+        frames = [scene_frame(world)]
+        steps = 0
+    else:
+        world = World(problem, plan)
+        timeline = build_timeline(world, plan, source)
+        frames = timeline.frames(opts.fps)
+        steps = timeline.steps
+    camera = frame_camera(world, frames, opts)
+    t0 = time.perf_counter()
+    size = write(world, frames, camera, opts.fps, path, progress)
+    return {"frames": len(frames), "steps": steps, "draw_seconds": time.perf_counter() - t0, "bytes": size}
+
+
+def write_gantt(problem: Problem, plan: Mapping[str, Any], path: str) -> dict[str, Any]:
+    """The plan's Gantt chart (.svg or .png)."""
+    from mrgc.render.gantt import write
+
+    write(problem, plan, path)
+    return {"frames": 0, "steps": len(plan.get("steps", []))}

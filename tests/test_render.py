@@ -1,0 +1,322 @@
+"""mrgc render and mrgc graph: pictures of real plans, checked by what they hold (sizes, frames, colours, text).
+
+The plan comes from ``mrgc plan`` on the shipped handover problem (once per session); generated problems are
+drawn too.  The HTML replay is loaded in a real headless Chromium (tests/headless_chromium.py).  Pictures
+are kept small (160×120) and frame rates low so the file runs in well under a minute, the browser included.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from PIL import Image
+
+from mrgc import cli
+from mrgc.language.loader import parse_file
+from mrgc.render.camera import PRESETS
+from mrgc.render.command import CAMERA_HELP
+from mrgc.render.frames import PHASES, build_timeline, interpolate
+from mrgc.render.palette import GOAL_REGION, ROBOT_COLOURS, byte_colour
+from mrgc.render.world import World
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def _helper(name: str):  # type: ignore[no-untyped-def]
+    """A sibling helper module of tests/ (no tests/__init__.py, importlib import mode)."""
+    import importlib.util
+    import sys
+
+    if name not in sys.modules:
+        spec = importlib.util.spec_from_file_location(name, Path(__file__).with_name(f"{name}.py"))
+        assert spec is not None and spec.loader is not None
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[name] = module
+        spec.loader.exec_module(module)
+    return sys.modules[name]
+
+
+colour_share = _helper("headless_chromium").colour_share
+screenshot_when = _helper("headless_chromium").screenshot_when
+HANDOVER = ROOT / "domains" / "packaging" / "pa3-handover.mrg"
+SMALL = ["--size", "160x120", "--fps", "4"]
+
+
+def run(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
+    code = cli.main([str(a) for a in args])
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+@pytest.fixture(scope="session")
+def plan_file(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A validated plan of the shipped handover problem, from mrgc plan."""
+    path = tmp_path_factory.mktemp("plan") / "pa3-handover.plan.json"
+    assert cli.main(["plan", str(HANDOVER), "-o", str(path), "--time-limit", "120"]) == 0
+    plan = json.loads(path.read_text())
+    assert any(a["kind"] == "handover" for s in plan["steps"] for a in s["actions"])
+    return path
+
+
+def non_blank(img: np.ndarray) -> bool:
+    """Many distinct colours and real contrast: something was drawn."""
+    flat = img.reshape(-1, img.shape[-1])[:, :3]
+    return len(np.unique(flat, axis=0)) > 20 and float(flat.std()) > 20
+
+
+def test_gif_has_a_frame_for_every_phase_of_every_step(plan_file: Path, tmp_path: Path,
+                                                       capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "plan.gif"
+    code, stdout, _ = run(["render", HANDOVER, plan_file, "-o", out, *SMALL], capsys)
+    assert code == 0 and str(out.resolve()) in stdout
+    plan = json.loads(plan_file.read_text())
+    world = World(parse_file(str(HANDOVER)).problem(None), plan)
+    timeline = build_timeline(world, plan)
+    phases = {(p.step, p.name) for p in timeline.phases}
+    for t, step in enumerate(plan["steps"], 1):  # every motion of the step has its phase
+        assert {(t, "to-pick"), (t, "pick"), (t, "to-place"), (t, "place"), (t, "home")} <= phases
+        if any(a["kind"] == "handover" for a in step["actions"]):
+            assert {(t, "to-handover"), (t, "handover")} <= phases
+    with Image.open(out) as gif:
+        assert gif.size == (160, 120)
+        frames = []
+        for i in range(gif.n_frames):
+            gif.seek(i)
+            frames.append(np.asarray(gif.convert("RGB")))
+    assert len(frames) >= 1 + len(timeline.phases)
+    assert all(non_blank(f) for f in frames[:: max(1, len(frames) // 5)])
+    assert any(not np.array_equal(frames[0], f) for f in frames[1:]), "nothing moves"
+
+
+def test_held_objects_follow_the_grasp_and_land_on_the_place_pose(plan_file: Path) -> None:
+    """Taking an object and putting it down do not make it jump (the plan was validated: the tool is at
+    the grasp), and after the place the object is at its place_pose."""
+    plan = json.loads(plan_file.read_text())
+    world = World(parse_file(str(HANDOVER)).problem(None), plan)
+    frames = build_timeline(world, plan).frames(6)
+    for before, after in zip(frames, frames[1:]):
+        for obj in world.objects:
+            jump = float(np.linalg.norm(after.poses[obj][:3, 3] - before.poses[obj][:3, 3]))
+            if after.phase in ("pick", "handover", "place") and before.phase == after.phase:
+                continue  # moving with a robot
+            assert jump < 0.25, (after.step, after.phase, obj, jump)
+    last = frames[-1]
+    for step in plan["steps"]:
+        for a in step["actions"]:
+            assert np.allclose(last.poses[a["object"]], np.array(a["place_pose"]), atol=1e-9)
+    ends = [f for f in frames if f.key and f.phase == "pick"]
+    assert ends, "no pick key frame"
+    # at the end of a pick the object is still where it was grasped, now held by the robot
+    for t, step in enumerate(plan["steps"], 1):
+        end = next(f for f in ends if f.step == t)
+        start = next(f for f in frames if f.step == t)
+        for a in step["actions"]:
+            d = np.linalg.norm(end.poses[a["object"]][:3, 3] - start.poses[a["object"]][:3, 3])
+            assert d < 2e-3, (t, a["object"], d)
+
+
+def test_sheet_scene_and_camera_presets(plan_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    sheet = tmp_path / "sheet.png"
+    assert run(["render", HANDOVER, plan_file, "-o", sheet, *SMALL], capsys)[0] == 0
+    img = np.asarray(Image.open(sheet).convert("RGB"))
+    assert img.shape[0] > 120 and img.shape[1] > 160 and non_blank(img)  # several tiles
+    scenes = {}
+    for preset in sorted(PRESETS):
+        path = tmp_path / f"scene-{preset}.png"
+        assert run(["render", HANDOVER, "-o", path, "--size", "160x120", "--camera", preset], capsys)[0] == 0
+        scenes[preset] = np.asarray(Image.open(path).convert("RGB"))
+        assert scenes[preset].shape == (120, 160, 3) and non_blank(scenes[preset])
+        # both robots are in the picture (their colours survive the shading)
+        for colour in ROBOT_COLOURS[:2]:
+            assert colour_share(scenes[preset], byte_colour(colour)) > 0.0005, preset
+    assert not np.array_equal(scenes["iso"], scenes["top"])
+    assert all(name in CAMERA_HELP for name in PRESETS) and CAMERA_HELP.count(",") + 2 == len(PRESETS)
+
+
+def test_generated_problems_are_drawn(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    for kind, seed in (("packaging", 7), ("box-moving", 3)):
+        problem = tmp_path / f"{kind}.mrg"
+        assert run(["generate", kind, "--seed", seed, "--robots", 2, "--goals", 2, "--others", 1, "-o", problem],
+                   capsys)[0] == 0
+        out = tmp_path / f"{kind}.png"
+        code, _, err = run(["render", problem, "-o", out, "--size", "320x240"], capsys)
+        assert code == 0, err
+        img = np.asarray(Image.open(out).convert("RGB"))
+        assert img.shape == (240, 320, 3) and non_blank(img)
+        region = byte_colour(GOAL_REGION)  # translucent over the floor: its hue, faintly saturated
+        assert colour_share(img, region, hue_tolerance=0.05, min_saturation=0.08) > 0.005, f"{kind}: no goal region"
+        for colour in ROBOT_COLOURS[:2]:  # (maybe seen through a region's tint)
+            assert colour_share(img, byte_colour(colour), hue_tolerance=0.06) > 0.0005, f"{kind}: a robot is missing"
+
+
+def test_gantt_svg_and_png(plan_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    plan = json.loads(plan_file.read_text())
+    svg = tmp_path / "plan-gantt.svg"
+    assert run(["render", HANDOVER, plan_file, "-o", svg], capsys)[0] == 0
+    text = svg.read_text()
+    assert text.lstrip().startswith("<?xml") and "<svg" in text
+    for robot in ("r1", "r2"):
+        assert f">{robot}<" in text
+    for step in plan["steps"]:
+        for a in step["actions"]:
+            assert f"{a['object']} \u2192 {a['region']}" in text
+            if a["kind"] == "handover":
+                assert a["handover_point"] in text and f"{a['object']} \u2192 {a['place_robot']}" in text
+    again = tmp_path / "again-gantt.svg"
+    assert run(["render", HANDOVER, plan_file, "-o", again], capsys)[0] == 0
+    assert again.read_text() == text  # deterministic
+    png = tmp_path / "plan.png"
+    assert run(["render", HANDOVER, plan_file, "-o", png, "--gantt"], capsys)[0] == 0
+    img = np.asarray(Image.open(png).convert("RGB"))
+    assert img.shape[1] > 300 and non_blank(img)
+
+
+def test_mp4(plan_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str],
+             monkeypatch: pytest.MonkeyPatch) -> None:
+    from mrgc.render import video
+
+    out = tmp_path / "plan.mp4"
+    code, _, err = run(["render", HANDOVER, plan_file, "-o", out, *SMALL], capsys)
+    if video.mp4_available():
+        import imageio.v3 as iio
+
+        assert code == 0, err
+        frames = iio.imread(out, plugin="FFMPEG")
+        assert frames.shape[1:] == (120, 160, 3) and frames.shape[0] > 10
+    else:
+        assert code == 4 and "imageio-ffmpeg" in err
+    monkeypatch.setattr(video, "mp4_available", lambda: False)
+    code, _, err = run(["render", HANDOVER, plan_file, "-o", tmp_path / "no.mp4", *SMALL], capsys)
+    assert code == 4 and "pip install imageio-ffmpeg" in err and not (tmp_path / "no.mp4").exists()
+
+
+def test_html_replay_is_self_contained_and_shows_the_robots_in_chromium(plan_file: Path, tmp_path: Path,
+                                                                        capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "plan.html"
+    code, stdout, _ = run(["render", HANDOVER, plan_file, "-o", out, "--fps", "5"], capsys)
+    assert code == 0 and str(out.resolve()) in stdout and "web browser" in stdout
+    page = out.read_text(encoding="utf-8")
+    assert "__VISER_EMBED_DATA__" in page
+    # nothing is fetched from elsewhere: no script, stylesheet or image from a URL
+    assert not re.search(r"""<(script|link|img)[^>]+(src|href)=["']?(https?:)?//""", page, re.I)
+    blue, purple = (byte_colour(c) for c in ROBOT_COLOURS[:2])
+    picture, ok = screenshot_when(out.as_uri(), lambda p: colour_share(p, blue) > 0.004
+                                  and colour_share(p, purple) > 0.004, timeout=150, size=(640, 480))
+    Image.fromarray(picture).save(tmp_path / "chromium.png")
+    assert non_blank(picture), "the page stayed blank"
+    assert ok, (f"the robots did not appear (blue {colour_share(picture, blue):.4f}, purple "
+                f"{colour_share(picture, purple):.4f}); screenshot at {tmp_path / 'chromium.png'}")
+
+
+def test_bad_requests_are_one_line_errors(plan_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    cases = [
+        (["render", HANDOVER, plan_file, "-o", tmp_path / "x.bmp"], 2, "E000"),
+        (["render", HANDOVER, "-o", tmp_path / "x.gif"], 2, "needs a plan"),
+        (["render", HANDOVER, plan_file, "-o", tmp_path / "x.gif", "--size", "10x10"], 2, "--size"),
+        (["render", HANDOVER, plan_file, "-o", tmp_path / "x.gif", "--camera", "fisheye"], 2, "--camera"),
+        (["render", HANDOVER, plan_file, "-o", tmp_path / "x.gif", "--fps", "0"], 2, "--fps"),
+        (["render", ROOT / "domains/symbolic/handover.mrg", "-o", tmp_path / "x.png"], 2, "E402"),
+        (["render", HANDOVER, tmp_path / "none.json", "-o", tmp_path / "x.gif"], 2, "E500"),
+        (["render", HANDOVER, plan_file, "-o", tmp_path / "missing" / "x.gif"], 2, "error[E"),
+    ]
+    bad = json.loads(plan_file.read_text())
+    bad["steps"][0]["actions"][0]["object"] = "o99"
+    wrong = tmp_path / "wrong.json"
+    wrong.write_text(json.dumps(bad))
+    cases.append((["render", HANDOVER, wrong, "-o", tmp_path / "x.gif"], 2, "E510"))
+    for args, want, text in cases:
+        code, _, err = run(args, capsys)
+        assert code == want and text in err, (args, code, err)
+        assert "Traceback" not in err and len(err.strip().splitlines()) <= 3
+    assert not list(tmp_path.glob("x.*"))
+
+
+# ------------------------------------------------------------------------------------------- graph
+GOLDEN_GRAPH = ROOT / "tests" / "golden" / "graph"
+
+
+@pytest.mark.parametrize("name,skeleton", [("place-obstacle", None), ("chain-3", 1), ("handover", None)])
+def test_graph_dot_is_golden(name: str, skeleton: int | None, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+                             ) -> None:
+    out = tmp_path / f"{name}.dot"
+    args = ["graph", ROOT / "domains" / "symbolic" / f"{name}.mrg", "-o", out]
+    if skeleton:
+        args += ["--skeleton", skeleton]
+    assert run(args, capsys)[0] == 0
+    golden = GOLDEN_GRAPH / f"{name}{'-skeleton' if skeleton else ''}.dot"
+    if os.environ.get("MRGC_UPDATE_GOLDEN"):
+        golden.write_text(out.read_text(encoding="utf-8"), encoding="utf-8")
+    assert out.read_text(encoding="utf-8") == golden.read_text(encoding="utf-8")
+
+
+def test_graph_styles_edges_as_the_paper(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from mrgc.render.graph import ACTION_EDGE, BLOCK_PICK, BLOCK_PLACE
+
+    out = tmp_path / "chain.dot"
+    assert run(["graph", ROOT / "domains/symbolic/chain-3.mrg", "-o", out], capsys)[0] == 0
+    text = out.read_text()
+    edges = [ln for ln in text.splitlines() if "->" in ln and "legend" not in ln]
+    assert all(ACTION_EDGE in ln for ln in edges if re.match(r'\s*"o', ln))  # object -> action
+    assert all(BLOCK_PICK in ln or BLOCK_PLACE in ln for ln in edges if re.match(r'\s*"a\d', ln))
+    assert any(BLOCK_PICK in ln for ln in edges) or any(BLOCK_PLACE in ln for ln in edges)
+
+
+def test_graph_svg_through_dot_and_a_clear_message_without_it(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                             monkeypatch: pytest.MonkeyPatch) -> None:
+    import shutil
+
+    from mrgc.render import graph
+
+    assert shutil.which("dot"), "Graphviz's dot is needed: apt-get install -y graphviz (.ci/run installs it)"
+    svg = tmp_path / "g.svg"
+    code, _, err = run(["graph", ROOT / "domains/symbolic/handover.mrg", "-o", svg, "--skeleton", 1], capsys)
+    assert code == 0, err
+    text = svg.read_text()
+    assert "<svg" in text and "step 1" in text and "o3" in text
+    monkeypatch.setattr(graph.shutil, "which", lambda name: None)
+    code, _, err = run(["graph", ROOT / "domains/symbolic/handover.mrg", "-o", tmp_path / "h.png"], capsys)
+    assert code == 4 and "apt-get install graphviz" in err and not (tmp_path / "h.png").exists()
+    code, _, err = run(["graph", ROOT / "domains/symbolic/handover.mrg", "-o", tmp_path / "h.dot",
+                        "--skeleton", 99], capsys)
+    assert code == 2 and "--skeleton 99" in err
+
+
+# ------------------------------------------------------------------------------------------- frames
+configs = st.integers(2, 6).flatmap(lambda m: st.lists(
+    st.lists(st.floats(-3, 3), min_size=3, max_size=3), min_size=m, max_size=m))
+
+
+@settings(max_examples=60, deadline=None)
+@given(configs, st.floats(0, 1))
+def test_interpolation_passes_every_configuration_in_order(cs: list[list[float]], s: float) -> None:
+    c = np.array(cs)
+    assert np.allclose(interpolate(c, 0.0), c[0]) and np.allclose(interpolate(c, 1.0), c[-1])
+    m = len(c)
+    for k in range(m):
+        assert np.allclose(interpolate(c, k / (m - 1)), c[k])
+    q = interpolate(c, s)
+    j = min(int(s * (m - 1)), m - 2)  # between configurations j and j+1, on the segment
+    lo, hi = np.minimum(c[j], c[j + 1]), np.maximum(c[j], c[j + 1])
+    assert np.all(q >= lo - 1e-9) and np.all(q <= hi + 1e-9)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.floats(-np.pi, np.pi), st.floats(-np.pi, np.pi))
+def test_planar_yaw_turns_the_short_way(a: float, b: float) -> None:
+    mid = interpolate(np.array([[0.0, 0.0, a], [0.0, 0.0, b]]), 0.5, planar=True)[2]
+    turn = (b - a + np.pi) % (2 * np.pi) - np.pi
+    assert abs(((mid - a) + np.pi) % (2 * np.pi) - np.pi - turn / 2) < 1e-9
+
+
+def test_phases_are_the_validators() -> None:
+    from mrgc.planner.replay import PATH_PHASES
+
+    assert set(PATH_PHASES) <= {"to-pick", "to-handover", "taker-to-handover", "to-place", "home", "giver-home"}
+    assert PHASES == ("to-pick", "pick", "to-handover", "handover", "to-place", "place", "home")

@@ -77,7 +77,8 @@ class Item:
         return f"(box {num(2 * self.foot.hx)} {num(2 * self.foot.hy)} {num(self.height)})"
 
     def decl(self) -> str:
-        return f"({self.name} :shape {self.shape()} :pose {pose(self.foot.x, self.foot.y, self.height / 2, self.foot.yaw)})"
+        where = pose(self.foot.x, self.foot.y, self.height / 2, self.foot.yaw)
+        return f"({self.name} :shape {self.shape()} :pose {where})"
 
 
 def packaging(robots: int = 2, goals: int = 3, others: int = 2, seed: int = 0) -> str:

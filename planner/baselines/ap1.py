@@ -12,8 +12,9 @@ that must still move (at first the goal objects, in the order of the run):
    step hits must be cleared **earlier**, so they go on top of the stack;
 2. the composite robot fills its idle robots: other objects of the stack join the step when an action of
    theirs grounds beside the primary's without hitting anything new;
-3. recurse on the rest; a dead end backtracks to the next action, then the next primary.  An empty stack is
-   a complete plan, which the independent validator must accept before it counts (as in ``mrgc plan``).
+3. recurse on the rest; a dead end backtracks to the primary's step without the objects that joined it,
+   then to the primary's next action, then to the next primary.  An empty stack is a complete plan, which
+   the independent validator must accept before it counts (as in ``mrgc plan``).
 
 Each object moves at most once: objects moved later in time stay where they are for the steps grounded
 after them and are always obstacles, so a step that could only run by moving one of them again fails.
@@ -200,17 +201,25 @@ class Ap1Search:
                     if got is None:
                         continue
                     strict_ok.add(i)
-                    got = self._fill((a,), got, pending, fut, free, strict, v_fut, key, index)
-                    rest = tuple(sorted(got.hits, key=self.rank.__getitem__)) + tuple(
-                        p for p in pending if p not in got.step.moved)
-                    # the state names the whole path (each step with the stack it was grounded under); the
-                    # grounding's random streams derive from it
-                    step_sig = tuple((x.object, x.region, x.pick_robot, x.place_robot, x.pick_grasp, x.place_grasp)
-                                     for x in got.step.actions)
-                    plan = self._resolve(rest, [got.step] + suffix, ((pending, step_sig),) + signature)
-                    if plan is not None:
-                        return plan
+                    filled = self._fill((a,), got, pending, fut, free, strict, v_fut, key, index)
+                    # the filled step first; the primary alone too, since moving an object together with
+                    # the primary can rule out an order that moving it earlier allows
+                    for step in (filled, got) if filled is not got else (got,):
+                        plan = self._descend(step, pending, suffix, signature)
+                        if plan is not None:
+                            return plan
         return None
+
+    def _descend(self, got: Attempt, pending: tuple[str, ...], suffix: list[GroundedStep],
+                 signature: tuple[Any, ...]) -> list[GroundedStep] | None:
+        """Recurse below a grounded step: the objects it hits go on top of the stack, by this run's order."""
+        rest = tuple(sorted(got.hits, key=self.rank.__getitem__)) + tuple(
+            p for p in pending if p not in got.step.moved)
+        # the state names the whole path (each step with the stack it was grounded under); the grounding's
+        # random streams derive from it
+        step_sig = tuple((x.object, x.region, x.pick_robot, x.place_robot, x.pick_grasp, x.place_grasp)
+                         for x in got.step.actions)
+        return self._resolve(rest, [got.step] + suffix, ((pending, step_sig),) + signature)
 
     def _fill(self, actions: tuple[Action, ...], got: Attempt, pending: tuple[str, ...], fut: set[str],
               free: set[str], strict: bool, v_fut: list[Any], key: str, index: int) -> Attempt:
@@ -321,7 +330,9 @@ def _referee(problem: Problem, plan: Plan, steps: list[GroundedStep], why: Why, 
     candidate = Plan(plan.problem, plan.problem_file, plan.problem_sha256, plan.mrgc_version, plan.backend,
                      plan.encoding, plan.seed, PlanStatus.SOLVED, [s.actions for s in steps],
                      symbolic=problem.symbolic, stats={"robots": [r.name for r in problem.robots]})
-    report = validate(problem, candidate.to_json(), plan.problem_file)
+    # the referee judges the plan against the problem it was made for (no file need exist: a problem parsed
+    # from a string is planned too); ``mrgc validate`` checks the file's digest besides
+    report = validate(problem, candidate.to_json(), None)
     verdicts["seconds"] += time.perf_counter() - t0
     verdicts["checked"] += 1
     if report.ok:

@@ -28,12 +28,13 @@ from mrgc.geometry.arm import Arm
 from mrgc.geometry.collision import CollisionShape, CollisionWorld, collision_shape
 from mrgc.geometry.grasps import finger_opening, fits, grasp_transform, pregrasp_transform
 from mrgc.geometry.ik import solve_ik_many
-from mrgc.geometry.motion import BASE_PATH_CHECKS, MAX_CHECKS, plan_joint_path, plan_se2_path
-from mrgc.geometry.planar import DiscGrid, PlanarRobot, is_planar, scene_bounds, to_se2
+from mrgc.geometry.lattice import LatticePlanner, box_corners
+from mrgc.geometry.motion import MAX_CHECKS, plan_joint_path
+from mrgc.geometry.planar import DiscGrid, PlanarRobot, is_planar, scene_bounds, se2, to_se2
 from mrgc.geometry.predicates import APPROACH_SAMPLES, LIFT, refine, scene_world, seed_for
 from mrgc.geometry.scene import SceneSpec, half_extents, inside
 from mrgc.geometry.transforms import rot_z, translation
-from mrgc.language.model import Box
+from mrgc.language.model import Box, Shape
 
 Volume = list[tuple[CollisionShape, np.ndarray]]  # shapes at world transforms
 
@@ -76,6 +77,7 @@ class Grounder:
         self._arms: dict[str, Arm] = {}
         self._planar: dict[str, PlanarRobot] = {}
         self._grids: dict[str, DiscGrid] = {}
+        self._lattices: dict[str, LatticePlanner] = {}
         # planar robots wait at their start pose (as the validator assumes): obstacles for the others
         self.parked: dict[str, str] = {}
         for spec in scene.robots:
@@ -282,32 +284,72 @@ class Grounder:
         return Answer(Status.OK if res.solved else Status.NO_PATH, path=list(res.path))
 
     def base_path(self, robot: str, start: np.ndarray, goal: np.ndarray, holding: tuple[str, str] | None = None,
-                  avoid: Iterable[str] = (), max_checks: int = BASE_PATH_CHECKS) -> Answer:
-        """An SE(2) path for a planar robot (RRTConnect, at most ``max_checks`` validity checks), free of
-        fixed objects and ``avoid`` (objects at their initial poses); hopeless queries are refused at once by
-        an inscribed-disc grid test."""
+                  avoid: Iterable[str] = (), busy: Sequence[tuple[CollisionShape, np.ndarray]] = ()) -> Answer:
+        """An SE(2) path for a planar robot, free of fixed objects, of the other robots parked at their
+        starts, of ``avoid`` (objects at their current poses) and of the volume ``busy`` (what robots moving
+        at the same time sweep), searched on the robot's lattice
+        (:mod:`mrgc.geometry.lattice`: deterministic, complete at the lattice's resolution) and checked
+        state by state at the validator's resolution; hopeless queries are refused at once by an
+        inscribed-disc grid test."""
         others = [name for r, name in self.parked.items() if r != robot]
-        against = ("fixed", *others, *[a for a in avoid if not holding or a != holding[0]])
+        movers = [a for a in avoid if not holding or a != holding[0]]
+        against = ("fixed", *others, *movers)
         ignore = (holding[0],) if holding else ()
         if robot not in self._grids:
             self._grids[robot] = DiscGrid(self.planar(robot), self.scene, scene_bounds(self.scene, 0.5))
-        # the disc grid knows objects at their initial poses only: objects moved since are left to the sampler
+            self._lattices[robot] = LatticePlanner(scene_bounds(self.scene, 0.5))
+        # the disc grid knows objects at their initial poses only: objects moved since are left to the lattice
         obstacles = frozenset([b.name for b in self.scene.fixed]
-                              + [a for a in against if a != "fixed" and not a.startswith("@")
-                                 and np.array_equal(self.poses[a], self.scene.body(a).pose)])
+                              + [a for a in movers if np.array_equal(self.poses[a], self.scene.body(a).pose)])
         if not self._grids[robot].connected(np.asarray(start), np.asarray(goal), obstacles):
             return Answer(Status.NO_PATH)  # not even the footprint's inscribed disc gets through
 
+        sweep = None
+        if busy:
+            sweep = CollisionWorld()
+            for i, (shape, t) in enumerate(busy):
+                sweep.add(f"busy{i}", shape, t, "busy")
+
         def valid(q: np.ndarray) -> bool:
             self.queries += 1
-            return not self.world.probe_collides(self.base_volume(robot, [q], holding), against=against, ignore=ignore)
+            probe = self.base_volume(robot, [q], holding)
+            if sweep is not None and sweep.probe_collides(probe, against="busy"):
+                return False
+            return not self.world.probe_collides(probe, against=against, ignore=ignore)
 
-        # states checked at the validator's resolution (0.01 m, 0.01 rad), so a carried object cannot clip an
-        # obstacle between them by more than the validator's samples could
-        res = plan_se2_path(scene_bounds(self.scene, 0.5), tuple(start), tuple(goal), valid,  # type: ignore[arg-type]
-                            max_checks=max_checks, seed=seed_for(robot, "base-path", seed=self.seed),
-                            resolution=PATH_RESOLUTION, yaw_resolution=PATH_RESOLUTION)
+        pr = self.planar(robot)
+        parts: list[tuple[Shape, np.ndarray]] = [(pr.footprint, pr.lift)]
+        if holding is not None:
+            body = self.scene.body(holding[0])
+            parts.append((body.shape, pr.carry_transform(body.shape, holding[1])))
+        bodies = [(b.name, b.shape, b.pose) for b in self.scene.fixed]
+        bodies += [((a, self.poses[a].tobytes()), self.scene.body(a).shape, self.poses[a]) for a in movers]
+        for r in others:
+            other = self.planar(r.lstrip("@"))
+            bodies.append((r, other.footprint, se2(*other.start) @ other.lift))
+        bodies += [(("busy", pts.tobytes()), pts, np.eye(4)) for pts in _swept_hulls(busy)]
+        lattice = self._lattices[robot]
+        occupied = lattice.occupancy(parts, bodies)
+        res = lattice.plan(occupied, np.asarray(start, dtype=float), np.asarray(goal, dtype=float), valid,
+                           PATH_RESOLUTION, PATH_RESOLUTION)
         return Answer(Status.OK if res.solved else Status.NO_PATH, path=list(res.path))
+
+
+def _swept_hulls(volume: Sequence[tuple[CollisionShape, np.ndarray]], chunk: int = 8) -> list[np.ndarray]:
+    """World points whose hulls cover ``volume``: the bounding-box corners of runs of ``chunk`` consecutive
+    pieces of one shape (a path's states sweep little between them), for the lattice's occupancy."""
+    runs: dict[int, list[np.ndarray]] = {}
+    flushed: set[int] = set()
+    out = []
+    for shape, t in volume:
+        run = runs.setdefault(id(shape), [])
+        run.append(box_corners(shape) @ t[:3, :3].T + t[:3, 3])
+        if len(run) == chunk:
+            out.append(np.concatenate(run))
+            runs[id(shape)] = [run[-1]]  # the next run starts where this one ended
+            flushed.add(id(shape))
+    out += [np.concatenate(run) for key, run in runs.items() if len(run) > 1 or key not in flushed]
+    return out
 
 
 def _against(among: Iterable[str] | str) -> str | tuple[str, ...]:

@@ -1,11 +1,11 @@
-"""Motion planning on OMPL: RRTConnect (the paper's BiRRT) in joint space and in SE(2).
+"""Motion planning on OMPL: RRTConnect (the paper's BiRRT) in joint space (planar robots' base paths are
+searched on a lattice instead: :mod:`mrgc.geometry.lattice`).
 
-Both planners take a validity test on plain numpy states, a budget of validity checks and a seed, and
+The planner takes a validity test on plain numpy states, a budget of validity checks and a seed, and
 return a :class:`MotionResult` whose ``status`` says what happened; not finding a path is an outcome, not
 an error.
 The returned path is *dense*: consecutive states are at most ``resolution`` apart (joint space: Euclidean
-distance in radians/metres; SE(2): ``resolution`` metres of translation and ``yaw_resolution`` radians of
-turn), and every returned state is one that OMPL's motion validator checked with ``is_valid``.
+distance in radians/metres), and every returned state is one that OMPL's motion validator checked with ``is_valid``.
 
 Paths are not simplified unless asked (``simplify=True``): shortcutting costs 5–15× the solve (DESIGN §6).
 
@@ -20,7 +20,6 @@ OMPL's console output is silenced.
 from __future__ import annotations
 
 import enum
-import math
 import time
 from dataclasses import dataclass, field
 from typing import Any, Callable, Sequence
@@ -29,14 +28,9 @@ import numpy as np
 
 Validity = Callable[[np.ndarray], bool]
 
-#: default budget of one solve: calls to the validity test before RRTConnect gives up (no path); phase 1's
-#: SE(2) queries and grounding's arm paths use it.  Measured (docs/geometry.md, "Motion planning"): phase 1's
-#: solved queries needed at most 2,923 checks on the shipped box-moving problems, 10,718 on generated ones;
-#: a check costs 17-26 µs, so the old time limit of 0.25 s bought 10,000-14,000 checks on an idle core.
+#: default budget of one solve: calls to the validity test before RRTConnect gives up (no path)
+#: (docs/geometry.md, "Motion planning").
 MAX_CHECKS = 20_000
-#: budget of grounding's SE(2) paths (states every 1 cm, the validator's resolution): what the old 0.25 s
-#: bought; a failed query costs all of it, and grounding asks many (solved ones: median 460-1,033 checks)
-BASE_PATH_CHECKS = 10_000
 
 
 class MotionStatus(str, enum.Enum):
@@ -131,66 +125,6 @@ def plan_joint_path(lower: Sequence[float], upper: Sequence[float], start: Seque
     return _solve(ob, og, setup, budget, simplify, read)
 
 
-def plan_se2_path(bounds: Sequence[float], start: Sequence[float], goal: Sequence[float], is_valid: Validity,
-                  max_checks: int = MAX_CHECKS, seed: int = 0, resolution: float = 0.02,
-                  yaw_resolution: float = 0.05, simplify: bool = False) -> MotionResult:
-    """A collision-free path of a planar pose (x, y, yaw) within ``bounds`` = (xmin, xmax, ymin, ymax).
-
-    ``is_valid`` gets ``np.array([x, y, yaw])``; yaw is in radians, in [-π, π) on the returned path, and
-    turns the short way round.  ``resolution`` (metres) and ``yaw_resolution`` (radians) bound the step
-    between checked (and returned) states.
-    """
-    xmin, xmax, ymin, ymax = (float(b) for b in bounds)
-    p0, p1 = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
-    if p0.shape != (3,) or p1.shape != (3,):
-        raise ValueError("start and goal are (x, y, yaw)")
-    if not (xmin < xmax and ymin < ymax) or resolution <= 0 or yaw_resolution <= 0 or max_checks < 1:
-        raise ValueError("need xmin < xmax, ymin < ymax, resolutions > 0 and max_checks >= 1")
-    p0[2], p1[2] = _wrap(p0[2]), _wrap(p1[2])
-
-    def inside(p: np.ndarray) -> bool:
-        return xmin <= p[0] <= xmax and ymin <= p[1] <= ymax
-
-    if not inside(p0) or not is_valid(p0.copy()):
-        return MotionResult(MotionStatus.INVALID_START)
-    if not inside(p1) or not is_valid(p1.copy()):
-        return MotionResult(MotionStatus.INVALID_GOAL)
-
-    ob, og, ou = _ompl()
-    _seed(ou, seed)
-    space = ob.SE2StateSpace()
-    box = ob.RealVectorBounds(2)
-    box.setLow(0, xmin)
-    box.setHigh(0, xmax)
-    box.setLow(1, ymin)
-    box.setHigh(1, ymax)
-    space.setBounds(box)
-    budget = _Budget(max_checks)
-
-    def check(state: Any) -> bool:
-        budget.used += 1
-        return bool(is_valid(np.array([state.getX(), state.getY(), state.getYaw()])))
-
-    setup = og.SimpleSetup(space)
-    setup.setStateValidityChecker(check)
-    setup.getSpaceInformation().setStateValidityCheckingResolution(0.01)
-    # per-component resolutions (they survive setup()): translation in metres, rotation in radians
-    space.getSubspace(0).setLongestValidSegmentFraction(
-        min(1.0, resolution / space.getSubspace(0).getMaximumExtent()))
-    space.getSubspace(1).setLongestValidSegmentFraction(min(1.0, yaw_resolution / math.pi))
-    s, g = space.allocState(), space.allocState()
-    for state, p in ((s, p0), (g, p1)):
-        state.setX(float(p[0]))
-        state.setY(float(p[1]))
-        state.setYaw(float(p[2]))
-    setup.setStartAndGoalStates(s, g)
-
-    def read(state: Any) -> np.ndarray:
-        return np.array([state.getX(), state.getY(), state.getYaw()])
-
-    return _solve(ob, og, setup, budget, simplify, read)
-
-
 class _Budget:
     """Validity checks allowed (``limit``) and made so far (``used``) by one solve."""
 
@@ -217,8 +151,3 @@ def _solve(ob: Any, og: Any, setup: Any, budget: _Budget, simplify: bool,
     path.interpolate()  # exactly the states the discrete motion validator checked
     states = [read(path.getState(i)) for i in range(path.getStateCount())]
     return MotionResult(MotionStatus.SOLVED, states, time.perf_counter() - t0, budget.used)
-
-
-def _wrap(angle: float) -> float:
-    """``angle`` in [-π, π)."""
-    return (float(angle) + math.pi) % (2 * math.pi) - math.pi

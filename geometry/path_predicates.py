@@ -1,9 +1,9 @@
 """Phase 1 in *path mode*: the geometric facts of a planar mobile robot (the box-moving domain).
 
 The robot model (footprint, grasp faces, pick/place base poses, carried objects, placements) is in
-:mod:`mrgc.geometry.planar`.  Swept volumes come from planned SE(2) base paths (RRTConnect,
-:func:`~mrgc.geometry.motion.plan_se2_path`, at most :data:`~mrgc.geometry.motion.MAX_CHECKS` validity
-checks per query, seeded by :func:`seed_for`):
+:mod:`mrgc.geometry.planar`.  Swept volumes come from base paths searched on the robot's SE(2) lattice
+(:class:`~mrgc.geometry.lattice.LatticePlanner`: deterministic, complete at the lattice's resolution, every
+state of a returned path checked with coal at :data:`RESOLUTION` / :data:`YAW_RESOLUTION`):
 the footprint (and the carried object) at every state of the dense path.  For robot R:
 
 - ``reachable-pick M g R`` (g a side grasp): the footprint at the pick base pose is free of fixed objects
@@ -15,7 +15,7 @@ the footprint (and the carried object) at every state of the dense path.  For ro
   had to cross movable objects, the set is reduced greedily (a cheap minimum-constraint-removal): for each
   object hit, in name order, a path avoiding every movable object except the remaining hits is tried, and
   when one exists its (smaller) hit set is kept.  An object therefore appears when R really has to move it,
-  up to the planner's budget of validity checks.
+  as far as the lattice can tell.
 - ``reachable-place M Re g R`` (for a reachable pick, Re = M's goal region and M's current region): some
   placement of M in Re (:func:`~mrgc.geometry.planar.placements`) whose object pose and place base pose are
   free of fixed objects, and a base path from the pick base pose to the place base pose carrying M,
@@ -32,11 +32,11 @@ the footprint (and the carried object) at every state of the dense path.  For ro
 
 Before a query is planned, :class:`~mrgc.geometry.planar.DiscGrid` checks a necessary condition (can the
 footprint's inscribed disc get from start to goal on a 5 cm grid?); a query it rules out is one the planner
-could not have solved, so it is answered "no path" at once instead of after the whole budget — which is
-what most "free of movable objects, if possible" attempts in a blocked doorway are.  Paths are cached per
-(start, goal, carried object and grasp, obstacle set).  Everything is deterministic for a seed, on an idle
-or a loaded machine: every solve is RRTConnect seeded from its query, stopped by a count of validity
-checks, never by a clock (the seconds in ``stats`` are statistics only).
+could not have solved, so it is answered "no path" at once without building the lattice's occupancy —
+which is what most "free of movable objects, if possible" attempts in a blocked doorway are.  Paths are cached per
+(start, goal, carried object and grasp, obstacle set).  Everything is deterministic, on an idle or a loaded
+machine: the lattice search draws no random numbers and reads no clock (the seconds in ``stats`` are
+statistics only).
 """
 
 from __future__ import annotations
@@ -46,9 +46,9 @@ from typing import Iterable
 import numpy as np
 
 from mrgc.geometry.collision import CollisionShape, CollisionWorld, collision_shape
-from mrgc.geometry.motion import MAX_CHECKS, plan_se2_path
+from mrgc.geometry.lattice import LatticePlanner
 from mrgc.geometry.planar import DiscGrid, PlanarRobot, planar_grasp, placements, scene_bounds
-from mrgc.geometry.predicates import RobotFacts, scene_world, seed_for
+from mrgc.geometry.predicates import RobotFacts, scene_world
 from mrgc.geometry.scene import Body, SceneSpec, inside
 from mrgc.language.model import Fact
 
@@ -68,16 +68,18 @@ Path = list[np.ndarray]
 class PlanarEvaluator:
     """Computes one planar robot's facts of a scene: ``PlanarEvaluator(scene, robot, seed).run()``."""
 
-    def __init__(self, scene: SceneSpec, robot: str, seed: int = 0, max_checks: int = MAX_CHECKS) -> None:
+    def __init__(self, scene: SceneSpec, robot: str, seed: int = 0) -> None:
         self.scene = scene
         self.robot = PlanarRobot(scene.robot(robot))
         self.world: CollisionWorld = scene_world(scene)
         self.seed = seed
-        self.max_checks = max_checks
         self.bounds = scene_bounds(scene, self.robot.radius + 0.1)
         self.movable = frozenset(m.name for m in scene.movable)
         self.fixed = frozenset(b.name for b in scene.fixed)
         self.grid = DiscGrid(self.robot, scene, self.bounds)
+        self.lattice = LatticePlanner(self.bounds)
+        #: movable objects named as occluders by the facts so far (preferred when a path must cross some)
+        self.occluders: set[str] = set()
         self.current = {m.name: r.name for m in scene.movable for r in scene.regions if inside(r, m.shape, m.pose)}
         self.out = RobotFacts()
         self.paths: dict[tuple[object, ...], Path | None] = {}
@@ -112,10 +114,13 @@ class PlanarEvaluator:
             out.collision_checks += 1
             return not world.probe_collides(robot.probe(q, carried), against=against)
 
-        ends = " ".join(f"{v:.4f}" for v in (*start, *goal))
-        seed = seed_for(robot.name, ends, *carry_key, *sorted(obstacles), seed=self.seed)
-        res = plan_se2_path(self.bounds, start, goal, valid, max_checks=self.max_checks, seed=seed,
-                            resolution=RESOLUTION, yaw_resolution=YAW_RESOLUTION)
+        parts: list[tuple[object, np.ndarray]] = [(robot.footprint, robot.lift)]
+        if carried is not None:
+            parts.append(carried)
+        bodies = [(b.name, b.shape, b.pose) for b in self.scene.fixed]
+        bodies += [(name, self.scene.body(name).shape, self.scene.body(name).pose) for name in sorted(obstacles)]
+        occupied = self.lattice.occupancy(parts, bodies)  # type: ignore[arg-type]
+        res = self.lattice.plan(occupied, start, goal, valid, RESOLUTION, YAW_RESOLUTION)
         self.stats["path_queries"] += 1
         self.stats["path_checks"] += res.checks
         self.stats["path_seconds"] += res.planning_time
@@ -134,17 +139,25 @@ class PlanarEvaluator:
                        avoid: frozenset[str], candidates: frozenset[str]) -> tuple[Path, set[str]] | None:
         """A path avoiding fixed objects and ``avoid``, crossing as few of ``candidates`` as found.
 
-        Tries a path free of every candidate first, then one crossing any of them, then greedily shrinks
-        its hit set (:data:`MAX_REDUCE` attempts).
+        Tries a path free of every candidate first, then one crossing only objects that earlier facts of
+        this robot already name as occluders (so that the facts agree on which of two blocked doorways to
+        clear, instead of each query taking its own shortest way), then one crossing any of them; then
+        greedily shrinks its hit set (:data:`MAX_REDUCE` attempts).
         """
         path = self._path(start, goal, carried, carry_key, avoid | candidates)
         if path is not None:
             return path, set()
-        path = self._path(start, goal, carried, carry_key, avoid)
+        path = None
+        if self.occluders & candidates:
+            path = self._path(start, goal, carried, carry_key, avoid | (candidates - self.occluders))
+        if path is None:
+            path = self._path(start, goal, carried, carry_key, avoid)
         if path is None:
             return None
         hits = self._sweep(path, carried, candidates)
-        return self._reduce(start, goal, carried, carry_key, avoid, candidates, path, hits)
+        path, hits = self._reduce(start, goal, carried, carry_key, avoid, candidates, path, hits)
+        self.occluders |= hits
+        return path, hits
 
     def _reduce(self, start: np.ndarray, goal: np.ndarray, carried: Carried, carry_key: tuple[str, ...],
                 avoid: frozenset[str], candidates: frozenset[str], path: Path,
@@ -240,6 +253,11 @@ class PlanarEvaluator:
             return None
         path, hits, pose, q = best
         at_place = self.world.probe_hits([(shape, pose)], against=others)
+        if hits - at_place - self.occluders and self.occluders & others:  # as _least_blocked: known occluders
+            known = self._path(q_pick, q, carried, key, others - self.occluders - at_place)
+            if known is not None:
+                path, hits = known, self._sweep(known, carried, others) | at_place
         path, path_hits = self._reduce(q_pick, q, carried, key, frozenset(), others - at_place, path,
                                        hits - at_place)
+        self.occluders |= path_hits
         return path_hits | at_place

@@ -111,7 +111,13 @@ class ReverseGrounder:
         placed: dict[str, np.ndarray] = {}  # objects of this step already placed by its earlier actions
         for a in step:
             avoid_a = sorted((avoid | same) - {a.obj})
-            action = self._action(a, avoid_a, v_fut + step_volume, f"{key}:{a.obj}", placed)
+            # what the other robots of the step sweep in each phase (planar robots drive around it)
+            busy: dict[str, Volume] = {}
+            for robot, phases in motions.items():
+                if robot != a.pick_robot:
+                    for phase, samples in phases.items():
+                        busy.setdefault(phase, []).extend(p for vol in samples for p in vol)
+            action = self._action(a, avoid_a, v_fut + step_volume, f"{key}:{a.obj}", placed, busy)
             if isinstance(action, Failure):
                 return replace(action, step=index, action=label(a))
             mine = self._motions(action)
@@ -158,9 +164,10 @@ class ReverseGrounder:
         return out
 
     def _action(self, a: Action, avoid: list[str], v_fut: Volume, key: str,
-                placed: dict[str, np.ndarray] | None = None) -> PlannedAction | Failure:
+                placed: dict[str, np.ndarray] | None = None,
+                busy: dict[str, Volume] | None = None) -> PlannedAction | Failure:
         if self.g.is_planar(a.pick_robot):
-            return self._drive(a, avoid, v_fut, key, placed or {})
+            return self._drive(a, avoid, v_fut, key, placed or {}, busy or {})
         g = self.g
         pick = g.pick(a.pick_robot, a.obj, a.pick_grasp, avoid=avoid)
         if not pick.ok:
@@ -191,12 +198,14 @@ class ReverseGrounder:
         return last
 
     def _drive(self, a: Action, avoid: list[str], v_fut: Volume, key: str,
-               placed: dict[str, np.ndarray]) -> PlannedAction | Failure:
+               placed: dict[str, np.ndarray], busy: dict[str, Volume]) -> PlannedAction | Failure:
         """A planar robot's action (path mode): drive from its start pose to the pick pose, carry the object
         to the place pose, drive back; every path free of fixed objects and of ``avoid``.  The drive home
         sees every object of the step at its new pose (the validator's home phase): the one just placed and
         those ``placed`` by the step's actions grounded before this one (the ones grounded after it keep
-        clear of this drive, which is in the step's volume)."""
+        clear of this drive, which is in the step's volume).  Robots of one step move at once, phase by
+        phase: each path keeps clear of everything the step's robots grounded before sweep in that phase
+        (``busy``: conservative, as it ignores when they pass)."""
         g, robot = self.g, a.pick_robot
         if a.handover:
             return Failure(0, "", "planar robots do not hand over")  # no such facts are computed
@@ -204,7 +213,7 @@ class ReverseGrounder:
         shape = g.scene.body(a.obj).shape
         home = to_se2(g.scene.robot(robot).base)
         q_pick = pr.grasp_base(g.poses[a.obj], shape, a.pick_grasp)
-        to_pick = g.base_path(robot, home, q_pick, avoid=avoid)
+        to_pick = g.base_path(robot, home, q_pick, avoid=avoid, busy=busy.get("to-pick", []))
         if not to_pick.ok:
             return _failed("drive to the pick", to_pick)
         last: Failure | None = None
@@ -214,7 +223,8 @@ class ReverseGrounder:
                 return last or Failure(0, "", f"placement: no free pose of {a.obj} in {a.region}")
             assert spot.pose is not None
             q_place = pr.grasp_base(spot.pose, shape, a.place_grasp)
-            carry = g.base_path(robot, q_pick, q_place, holding=(a.obj, a.pick_grasp), avoid=avoid)
+            carry = g.base_path(robot, q_pick, q_place, holding=(a.obj, a.pick_grasp), avoid=avoid,
+                                busy=busy.get("to-place", []))
             if not carry.ok:
                 last = _failed("carry to the placement", carry)
                 continue
@@ -223,7 +233,7 @@ class ReverseGrounder:
             for o, pose in new.items():
                 g.move(o, pose)
             try:
-                back = g.base_path(robot, q_place, home, avoid=sorted({*avoid, *new}))
+                back = g.base_path(robot, q_place, home, avoid=sorted({*avoid, *new}), busy=busy.get("home", []))
             finally:
                 for o, pose in initial.items():
                     g.move(o, pose)

@@ -139,7 +139,7 @@ def test_disc_grid_separates_blocked_rooms_only(doorway: tuple[SceneSpec, set[Fa
 def test_disc_grid_never_rules_out_a_path_the_planner_finds(door_y: float) -> None:
     scene = scene_from_problem(problem_of(DOORWAY.replace("(door :shape (box 0.3 0.3 0.3) :pose (0 0 0.15 0))",
                                                           f"(door :shape (box 0.3 0.3 0.3) :pose (0 {door_y} 0.15 0))")))
-    ev = PlanarEvaluator(scene, "r1", max_checks=5_000)
+    ev = PlanarEvaluator(scene, "r1")
     ev.grid.enabled = False
     start, goal = ev.robot.start, np.array([1.0, 0.0, 0.0])
     found = ev._path(start, goal, None, (), frozenset({"door"}))
@@ -153,7 +153,7 @@ def test_disc_grid_never_rules_out_a_path_the_planner_finds(door_y: float) -> No
 
 def test_disc_grid_changes_no_fact(doorway: tuple[SceneSpec, set[Fact]]) -> None:
     scene, facts = doorway
-    ev = PlanarEvaluator(scene, "r1", max_checks=5_000)
+    ev = PlanarEvaluator(scene, "r1")
     ev.grid.enabled = False
     assert set(ev.run().facts) == facts
 

@@ -8,7 +8,7 @@ import time
 import numpy as np
 import pytest
 
-from mrgc.geometry.motion import MAX_CHECKS, MotionResult, MotionStatus, plan_joint_path, plan_se2_path
+from mrgc.geometry.motion import MAX_CHECKS, MotionResult, MotionStatus, plan_joint_path
 
 LOWER, UPPER = [0.0, 0.0], [1.0, 1.0]
 
@@ -156,43 +156,3 @@ def test_seven_joints() -> None:
     check_path(r, start, goal, valid, 0.05)
     simple = plan_joint_path(lo, hi, start, goal, valid, seed=2, resolution=0.05, simplify=True)
     check_path(simple, start, goal, valid, 0.05)
-
-
-# -------------------------------------------------------------------------------------- SE(2)
-
-BOUNDS = (0.0, 4.0, 0.0, 4.0)
-
-
-def base_valid(p: np.ndarray) -> bool:
-    """A 0.6 × 0.2 robot (corners tested) in the 4 × 4 square with a wall at x = 2 open only for y > 3."""
-    x, y, yaw = p
-    c, s = math.cos(yaw), math.sin(yaw)
-    for dx, dy in ((0.3, 0.1), (0.3, -0.1), (-0.3, 0.1), (-0.3, -0.1), (0, 0)):
-        px, py = x + c * dx - s * dy, y + s * dx + c * dy
-        if not (0 <= px <= 4 and 0 <= py <= 4):
-            return False
-        if 1.9 <= px <= 2.1 and py <= 3.0:
-            return False
-    return True
-
-
-def test_se2_around_a_wall() -> None:
-    start, goal = (1.0, 1.0, 0.0), (3.0, 1.0, math.pi / 2)
-    r = plan_se2_path(BOUNDS, start, goal, base_valid, seed=0, resolution=0.02)
-    check_path(r, start, goal, base_valid, 0.02, yaw=True)
-    assert max(q[1] for q in r.path) > 3.0  # it went round the end of the wall
-    assert all(-math.pi <= q[2] < math.pi for q in r.path)
-    yaw_steps = np.abs((np.diff([q[2] for q in r.path]) + math.pi) % (2 * math.pi) - math.pi)
-    assert yaw_steps.max() <= 0.05 + 1e-9
-
-
-def test_se2_outcomes_and_determinism() -> None:
-    assert plan_se2_path(BOUNDS, (2.0, 1.0, 0.0), (3, 1, 0), base_valid).status is MotionStatus.INVALID_START
-    assert plan_se2_path(BOUNDS, (1.0, 1.0, 0.0), (2, 1, 0), base_valid).status is MotionStatus.INVALID_GOAL
-    assert plan_se2_path(BOUNDS, (1.0, 1.0, 0.0), (9, 1, 0), base_valid).status is MotionStatus.INVALID_GOAL
-    a = plan_se2_path(BOUNDS, (1.0, 1.0, 0.0), (3.0, 1.0, 3.0), base_valid, seed=4)
-    b = plan_se2_path(BOUNDS, (1.0, 1.0, 0.0), (3.0, 1.0, 3.0), base_valid, seed=4)
-    assert a.solved and len(a.path) == len(b.path) and all(np.array_equal(p, q) for p, q in zip(a.path, b.path))
-    # a yaw beyond π is taken modulo 2π
-    c = plan_se2_path(BOUNDS, (1.0, 1.0, 2 * math.pi), (1.5, 1.0, 0.0), base_valid)
-    assert c.solved and abs(c.path[0][2]) < 1e-9

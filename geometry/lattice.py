@@ -1,0 +1,342 @@
+"""Base paths of planar robots on an SE(2) lattice: deterministic and complete at the lattice's resolution.
+
+A sampling planner with a budget of validity checks (RRTConnect, :func:`~mrgc.geometry.motion.plan_se2_path`)
+answers "no path" for a cart carrying a box through a doorway it fits through whenever the budget runs out
+first; the answer then depends on the budget, not on the scene.  This module answers the same queries by
+search on a lattice of base poses, which finds a path whenever one exists among the lattice's states:
+
+- **States.**  Cell centres of a grid of side :data:`CELL` over the bounds × :data:`YAWS` headings
+  (multiples of 2π / YAWS).  Moves: to the 8 neighbouring cells at the same heading, or one heading step
+  (either way, wrapping).
+- **Occupancy (the approximation).**  The robot is its parts (the footprint and, when carrying, the carried
+  object), each projected on the floor to the convex hull of its outline; an obstacle likewise.  A state is
+  occupied when some part's hull, turned to the state's heading and put at the cell centre, overlaps an
+  obstacle whose height range meets the part's: the Minkowski difference of the two hulls, rasterised at
+  cell centres (numpy; per obstacle and heading, cached).  Projecting to the floor over-approximates; sampling
+  at cell centres under-approximates between centres.
+- **Search.**  A breadth-first wavefront from the goal (vectorised over the whole lattice, stopped as soon as
+  it reaches the start or stops growing), then descent from the start.  The start and goal poses join the
+  lattice through their nearest free states, each join checked.
+- **The exact check decides.**  Every motion of the returned path (joins, lattice moves) is checked with
+  the caller's exact validity test at the caller's resolution; a move that fails removes its end state and
+  the search is repeated (at most :data:`REPAIRS` times).  Then the path is shortened greedily (straight
+  shortcuts, each checked the same way).  So a returned path is valid by the exact test at every state of
+  the dense path returned; "no path" means no path through the lattice's states (up to the repairs).
+
+Everything is deterministic: no random numbers, no clock.  The count of exact checks is reported in
+:class:`~mrgc.geometry.motion.MotionResult` like the sampling planner's.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Callable, Hashable, Sequence, Union
+
+import numpy as np
+
+from mrgc.geometry.collision import CollisionShape
+from mrgc.geometry.motion import MotionResult, MotionStatus
+from mrgc.geometry.scene import outline
+from mrgc.language.model import Shape
+
+#: lattice cell side (m) and number of headings
+CELL = 0.05
+YAWS = 32
+#: searches repeated after an exact check rejected a lattice move
+REPAIRS = 12
+#: lattice states tried to join the start (and the goal) to the lattice
+JOINS = 12
+
+Validity = Callable[[np.ndarray], bool]
+#: a body for the lattice: a shape (or an (N, 3) array of points whose hull it is) at a transform (world for
+#: obstacles, base frame for robot parts)
+Body = Union[Shape, CollisionShape, np.ndarray]
+Placed = tuple[Body, np.ndarray]
+# 8 moves in the plane and the two turns, as (dk, di, dj)
+_MOVES = [(0, di, dj) for di in (-1, 0, 1) for dj in (-1, 0, 1) if (di, dj) != (0, 0)] + [(1, 0, 0), (-1, 0, 0)]
+
+
+def hull2d(points: np.ndarray) -> np.ndarray:
+    """The convex hull of 2-D points, counter-clockwise, no repeated or collinear vertices."""
+    pts = sorted({(round(float(x), 12), round(float(y), 12)) for x, y in points})
+    if len(pts) <= 2:
+        return np.array(pts, dtype=float)
+
+    def cross(o: tuple[float, float], a: tuple[float, float], b: tuple[float, float]) -> float:
+        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+
+    lower: list[tuple[float, float]] = []
+    upper: list[tuple[float, float]] = []
+    for p in pts:
+        while len(lower) >= 2 and cross(lower[-2], lower[-1], p) <= 0:
+            lower.pop()
+        lower.append(p)
+    for p in reversed(pts):
+        while len(upper) >= 2 and cross(upper[-2], upper[-1], p) <= 0:
+            upper.pop()
+        upper.append(p)
+    return np.array(lower[:-1] + upper[:-1], dtype=float)
+
+
+_SIGNS = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=float)
+
+
+def box_corners(shape: CollisionShape) -> np.ndarray:
+    """The 8 corners of a collision shape's bounding box, in the shape's frame."""
+    return shape.center + _SIGNS * shape.half
+
+
+def _footprint(body: Placed) -> tuple[np.ndarray, float, float]:
+    """A body's floor hull and height range (a collision shape by the corners of its bounding box, an array
+    as the points it holds)."""
+    shape, t = body
+    if isinstance(shape, np.ndarray):  # points in the body's frame
+        local = shape
+    elif isinstance(shape, CollisionShape):
+        local = box_corners(shape)
+    else:
+        local = outline(shape)
+    pts = local @ t[:3, :3].T + t[:3, 3]
+    return hull2d(pts[:, :2]), float(pts[:, 2].min()), float(pts[:, 2].max())
+
+
+def _normals(poly: np.ndarray) -> np.ndarray:
+    """Edge normals of a convex polygon (any orientation; for a degenerate one, the coordinate axes)."""
+    if len(poly) < 3:
+        return np.eye(2)
+    e = np.roll(poly, -1, axis=0) - poly
+    return np.stack([-e[:, 1], e[:, 0]], axis=1)
+
+
+def wrap(angle: float) -> float:
+    """``angle`` in [-π, π)."""
+    return (float(angle) + math.pi) % (2 * math.pi) - math.pi
+
+
+def interpolate(a: np.ndarray, b: np.ndarray, resolution: float, yaw_resolution: float) -> list[np.ndarray]:
+    """The states of the straight motion from ``a`` to ``b`` (yaw the short way round), ``a`` excluded, ``b``
+    included, no step longer than the resolutions."""
+    d = np.array([b[0] - a[0], b[1] - a[1], wrap(b[2] - a[2])])
+    n = max(1, math.ceil(math.hypot(d[0], d[1]) / resolution - 1e-9), math.ceil(abs(d[2]) / yaw_resolution - 1e-9))
+    return [np.array([a[0] + d[0] * s, a[1] + d[1] * s, wrap(a[2] + d[2] * s)]) for s in np.arange(1, n + 1) / n]
+
+
+class LatticePlanner:
+    """Base paths of one planar robot within ``bounds`` = (xmin, xmax, ymin, ymax) (see the module docstring).
+
+    Occupancy is cached per (robot parts key, obstacle key): callers pass keys that change when the parts
+    (what is carried, how) or an obstacle's pose change.
+    """
+
+    def __init__(self, bounds: Sequence[float], cell: float = CELL, yaws: int = YAWS) -> None:
+        self.xmin, xmax, self.ymin, ymax = (float(b) for b in bounds)
+        self.cell, self.yaws = float(cell), int(yaws)
+        self.nx = max(1, int(math.floor((xmax - self.xmin) / cell)))
+        self.ny = max(1, int(math.floor((ymax - self.ymin) / cell)))
+        self.headings = np.arange(self.yaws) * (2 * math.pi / self.yaws)
+        self._blocks: dict[tuple[Hashable, Hashable], list[tuple[int, int, np.ndarray]]] = {}
+
+    # ------------------------------------------------------------------------------------ lattice states
+    def state(self, k: int, i: int, j: int) -> np.ndarray:
+        return np.array([self.xmin + (i + 0.5) * self.cell, self.ymin + (j + 0.5) * self.cell,
+                         wrap(self.headings[k])])
+
+    def _near(self, q: np.ndarray) -> list[tuple[int, int, int]]:
+        """Lattice states near ``q``, nearest first (position, then heading)."""
+        fi, fj = (q[0] - self.xmin) / self.cell - 0.5, (q[1] - self.ymin) / self.cell - 0.5
+        fk = (q[2] % (2 * math.pi)) / (2 * math.pi / self.yaws)
+        out = []
+        for i in range(math.floor(fi) - 1, math.floor(fi) + 3):
+            for j in range(math.floor(fj) - 1, math.floor(fj) + 3):
+                if not (0 <= i < self.nx and 0 <= j < self.ny):
+                    continue
+                for k in (math.floor(fk), math.floor(fk) + 1):
+                    dk = min(abs(fk - k), self.yaws - abs(fk - k))
+                    out.append((math.hypot(fi - i, fj - j) + dk, k % self.yaws, i, j))
+        return [(k, i, j) for _, k, i, j in sorted(out)]
+
+    # ------------------------------------------------------------------------------------ occupancy
+    def _c_obstacle(self, parts: Sequence[tuple[np.ndarray, float, float]], obstacle: Placed
+                    ) -> list[tuple[int, int, np.ndarray]]:
+        """(i0, j0, mask over headings × cells) blocks of the states where a part (floor hull and height
+        range) overlaps ``obstacle``."""
+        o_hull, o_lo, o_hi = _footprint(obstacle)
+        out = []
+        for p_hull, p_lo, p_hi in parts:
+            if p_hi < o_lo or o_hi < p_lo or len(o_hull) == 0 or len(p_hull) == 0:
+                continue
+            block = self._overlaps(p_hull, o_hull)
+            if block is not None:
+                out.append(block)
+        return out
+
+    def _overlaps(self, part: np.ndarray, obstacle: np.ndarray) -> tuple[int, int, np.ndarray] | None:
+        """Where the convex polygon ``part`` (base frame), turned to each heading and put at a cell centre,
+        meets the convex polygon ``obstacle`` (touching counts): separating axes, vectorised over headings
+        and the cells of the block that can overlap."""
+        reach = float(np.max(np.hypot(part[:, 0], part[:, 1])))
+        lo, hi = obstacle.min(axis=0) - reach, obstacle.max(axis=0) + reach
+        i0 = max(0, math.ceil((lo[0] - self.xmin) / self.cell - 0.5))
+        i1 = min(self.nx - 1, math.floor((hi[0] - self.xmin) / self.cell - 0.5))
+        j0 = max(0, math.ceil((lo[1] - self.ymin) / self.cell - 0.5))
+        j1 = min(self.ny - 1, math.floor((hi[1] - self.ymin) / self.cell - 0.5))
+        if i1 < i0 or j1 < j0:
+            return None
+        xs = self.xmin + (np.arange(i0, i1 + 1) + 0.5) * self.cell
+        ys = self.ymin + (np.arange(j0, j1 + 1) + 0.5) * self.cell
+        c, s = np.cos(self.headings), np.sin(self.headings)
+        rot = np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2)  # (H, 2, 2)
+        turned = np.einsum("hab,kb->hka", rot, part)  # (H, K, 2): the part's vertices at each heading
+        mask = np.ones((self.yaws, len(xs), len(ys)), dtype=bool)
+        eps = 1e-9
+        # the obstacle's edge normals do not turn with the heading
+        for n in _normals(obstacle):
+            shift = n[0] * xs[:, None] + n[1] * ys[None, :]
+            p_proj, o_proj = turned @ n, obstacle @ n  # (H, K), (M,)
+            mask &= shift >= (o_proj.min() - eps - p_proj.max(-1))[:, None, None]
+            mask &= shift <= (o_proj.max() + eps - p_proj.min(-1))[:, None, None]
+        # the part's edge normals turn with it
+        for normals in np.einsum("hab,kb->kha", rot, _normals(part)):  # (H, 2) per edge
+            shift = normals[:, 0, None, None] * xs[:, None] + normals[:, 1, None, None] * ys[None, :]
+            p_proj = np.einsum("hka,ha->hk", turned, normals)
+            o_proj = obstacle @ normals.T  # (M, H)
+            mask &= shift >= (o_proj.min(0) - eps - p_proj.max(-1))[:, None, None]
+            mask &= shift <= (o_proj.max(0) + eps - p_proj.min(-1))[:, None, None]
+        return (i0, j0, mask) if mask.any() else None
+
+    def occupancy(self, parts: Sequence[Placed], obstacles: Sequence[tuple[Hashable, Body, np.ndarray]]
+                  ) -> np.ndarray:
+        """(headings, nx, ny) booleans: states where the robot's parts overlap an obstacle (see the module
+        docstring); ``obstacles`` are (key, shape, world transform), the key naming the obstacle at its pose
+        (the occupancy of each is cached per key and the parts' floor hulls)."""
+        footprints = [_footprint(p) for p in parts]
+        parts_key = tuple((h.round(9).tobytes(), round(lo, 9), round(hi, 9)) for h, lo, hi in footprints)
+        occ = np.zeros((self.yaws, self.nx, self.ny), dtype=bool)
+        for key, shape, t in obstacles:
+            blocks = self._blocks.get((parts_key, key))
+            if blocks is None:
+                blocks = self._blocks[(parts_key, key)] = self._c_obstacle(footprints, (shape, t))
+            for i0, j0, m in blocks:
+                occ[:, i0:i0 + m.shape[1], j0:j0 + m.shape[2]] |= m
+        return occ
+
+    # ------------------------------------------------------------------------------------ search
+    def plan(self, occupied: np.ndarray, start: Sequence[float], goal: Sequence[float], valid: Validity,
+             resolution: float, yaw_resolution: float) -> MotionResult:
+        """A path from ``start`` to ``goal`` through free lattice states, every state of it (at the
+        resolutions) accepted by ``valid``; the first state is ``start``, the last ``goal``."""
+        t0 = time.perf_counter()
+        checks = [0]
+
+        def ok(q: np.ndarray) -> bool:
+            checks[0] += 1
+            return bool(valid(q.copy()))
+
+        def motion_ok(a: np.ndarray, b: np.ndarray) -> bool:
+            return all(ok(q) for q in interpolate(a, b, resolution, yaw_resolution))
+
+        def result(status: MotionStatus, path: list[np.ndarray] | None = None) -> MotionResult:
+            return MotionResult(status, path or [], time.perf_counter() - t0, checks[0])
+
+        p0 = np.array([start[0], start[1], wrap(start[2])], dtype=float)
+        p1 = np.array([goal[0], goal[1], wrap(goal[2])], dtype=float)
+        if not ok(p0):
+            return result(MotionStatus.INVALID_START)
+        if not ok(p1):
+            return result(MotionStatus.INVALID_GOAL)
+        if motion_ok(p0, p1):
+            return result(MotionStatus.SOLVED, [p0, *interpolate(p0, p1, resolution, yaw_resolution)])
+        free = ~occupied
+        starts = self._joins(p0, free, lambda s: motion_ok(p0, self.state(*s)))
+        goals = self._joins(p1, free, lambda s: motion_ok(self.state(*s), p1))
+        if not starts or not goals:
+            return result(MotionStatus.NO_PATH)
+        for _ in range(REPAIRS + 1):
+            nodes = self._wavefront(free, goals, starts)
+            if nodes is None:
+                return result(MotionStatus.NO_PATH)
+            waypoints = [p0] + [self.state(*n) for n in nodes] + [p1]
+            bad = next((m for m in range(1, len(nodes)) if not motion_ok(waypoints[m], waypoints[m + 1])), None)
+            if bad is None:
+                return result(MotionStatus.SOLVED, self._shortcut(waypoints, motion_ok, resolution, yaw_resolution))
+            free = free.copy()
+            free[nodes[bad]] = False
+            goals = [g for g in goals if g != nodes[bad]]
+            starts = [s for s in starts if s != nodes[bad]]
+            if not starts or not goals:
+                return result(MotionStatus.NO_PATH)
+        return result(MotionStatus.NO_PATH)
+
+    def _joins(self, q: np.ndarray, free: np.ndarray, check: Callable[[tuple[int, int, int]], bool]
+               ) -> list[tuple[int, int, int]]:
+        """Free lattice states near ``q`` whose join to ``q`` passes ``check``; stops at the first few."""
+        out = []
+        for s in self._near(q)[:JOINS]:
+            if free[s] and check(s):
+                out.append(s)
+                if len(out) >= 2:
+                    break
+        return out
+
+    def _wavefront(self, free: np.ndarray, goals: list[tuple[int, int, int]],
+                   starts: list[tuple[int, int, int]]) -> list[tuple[int, int, int]] | None:
+        """Lattice states from a start to a goal (inclusive), fewest moves, or None when none connect."""
+        dist = np.full(free.shape, -1, dtype=np.int32)
+        front = np.zeros(free.shape, dtype=bool)
+        for g in goals:
+            front[g] = True
+        dist[front] = 0
+        open_ = free & ~front  # free states not reached yet
+        grown, plane = np.empty_like(front), np.empty_like(front)
+        d = 0
+        while all(dist[s] < 0 for s in starts):
+            # the 8 neighbours in the plane (x, then y of the x-grown layer), then one heading either way
+            np.copyto(plane, front)
+            plane[:, 1:, :] |= front[:, :-1, :]
+            plane[:, :-1, :] |= front[:, 1:, :]
+            np.copyto(grown, plane)
+            grown[:, :, 1:] |= plane[:, :, :-1]
+            grown[:, :, :-1] |= plane[:, :, 1:]
+            grown[1:] |= front[:-1]
+            grown[0] |= front[-1]
+            grown[:-1] |= front[1:]
+            grown[-1] |= front[0]
+            grown &= open_
+            new = np.flatnonzero(grown)
+            if new.size == 0:
+                return None
+            d += 1
+            dist.flat[new] = d
+            open_.flat[new] = False
+            front, grown = grown, front
+        here = min((s for s in starts if dist[s] >= 0), key=lambda s: (dist[s], starts.index(s)))
+        path = [here]
+        while dist[here] > 0:
+            k, i, j = here
+            for dk, di, dj in _MOVES:
+                n = ((k + dk) % self.yaws, i + di, j + dj)
+                if 0 <= n[1] < self.nx and 0 <= n[2] < self.ny and dist[n] == dist[here] - 1:
+                    here = n
+                    break
+            path.append(here)
+        return path
+
+    @staticmethod
+    def _shortcut(waypoints: list[np.ndarray], motion_ok: Callable[[np.ndarray, np.ndarray], bool],
+                  resolution: float, yaw_resolution: float) -> list[np.ndarray]:
+        """Greedy straight shortcuts over ``waypoints`` (each checked), then the dense path."""
+        kept = [0]
+        i, n = 0, len(waypoints)
+        while i < n - 1:
+            nxt = i + 1
+            for j in sorted({min(i + span, n - 1) for span in (64, 32, 16, 8, 4, 2)}, reverse=True):
+                if j > i + 1 and motion_ok(waypoints[i], waypoints[j]):
+                    nxt = j
+                    break
+            kept.append(nxt)
+            i = nxt
+        dense = [waypoints[0]]
+        for a, b in zip(kept, kept[1:]):
+            dense.extend(interpolate(waypoints[a], waypoints[b], resolution, yaw_resolution))
+        return dense

@@ -1,0 +1,131 @@
+"""The SE(2) lattice planner of planar robots (geometry/lattice.py): exact occupancy at lattice states,
+paths valid state by state, doorways found whatever their width as long as the robot fits, "no path" when it
+does not, determinism."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from hypothesis import given, settings, strategies as st
+
+from mrgc.geometry.collision import CollisionWorld, collision_shape
+from mrgc.geometry.lattice import LatticePlanner, hull2d, interpolate, wrap
+from mrgc.geometry.motion import MotionStatus
+from mrgc.geometry.planar import se2
+from mrgc.geometry.transforms import rot_z, translation
+from mrgc.language.model import Box
+
+ROBOT = Box(0.5, 0.4, 0.3)
+LIFT = translation(0, 0, 0.151)
+BOUNDS = (0.0, 4.0, 0.0, 3.0)
+
+
+def wall_with_door(door_y: float, width: float) -> list[tuple[str, Box, np.ndarray]]:
+    """A wall at x = 2 from y = 0 to 3 with a door of ``width`` centred at ``door_y``."""
+    lo, hi = door_y - width / 2, door_y + width / 2
+    return [("south", Box(0.1, lo, 0.5), translation(2.0, lo / 2, 0.25)),
+            ("north", Box(0.1, 3.0 - hi, 0.5), translation(2.0, (3.0 + hi) / 2, 0.25))]
+
+
+def validity(obstacles: list[tuple[str, Box, np.ndarray]], parts: list[tuple[Box, np.ndarray]]):
+    world = CollisionWorld()
+    for name, shape, t in obstacles:
+        world.add(name, collision_shape(shape), t, "fixed")
+
+    def valid(q: np.ndarray) -> bool:
+        if not (BOUNDS[0] <= q[0] <= BOUNDS[1] and BOUNDS[2] <= q[1] <= BOUNDS[3]):
+            return False
+        base = se2(*q)
+        return not world.probe_collides([(collision_shape(s), base @ t) for s, t in parts], against="fixed")
+
+    return valid
+
+
+def plan(obstacles, start, goal, parts=((ROBOT, LIFT),)):
+    lattice = LatticePlanner(BOUNDS)
+    parts = list(parts)
+    occupied = lattice.occupancy(parts, obstacles)
+    valid = validity(obstacles, parts)
+    return lattice.plan(occupied, np.array(start, float), np.array(goal, float), valid, 0.01, 0.01), valid
+
+
+def assert_valid_path(res, start, goal, valid) -> None:
+    assert res.status is MotionStatus.SOLVED
+    assert np.allclose(res.path[0], start) and np.allclose(res.path[-1][:2], goal[:2])
+    assert abs(wrap(res.path[-1][2] - goal[2])) < 1e-9
+    for a, b in zip(res.path, res.path[1:]):  # dense: no step longer than the resolution
+        assert math.hypot(b[0] - a[0], b[1] - a[1]) <= 0.01 + 1e-9 and abs(wrap(b[2] - a[2])) <= 0.01 + 1e-9
+    assert all(valid(q) for q in res.path)
+
+
+@settings(max_examples=40, deadline=None)
+@given(x=st.floats(0.3, 3.7), y=st.floats(0.3, 2.7), yaw=st.floats(-math.pi, math.pi),
+       ox=st.floats(1.0, 3.0), oy=st.floats(0.8, 2.2), oyaw=st.floats(-math.pi, math.pi),
+       sx=st.floats(0.05, 0.8), sy=st.floats(0.05, 0.8))
+def test_occupancy_is_exact_at_lattice_states(x, y, yaw, ox, oy, oyaw, sx, sy) -> None:
+    """At every lattice state the rasterised occupancy says what coal says of the footprint and a box
+    (boxes standing on the floor: the floor projection loses nothing), up to touching."""
+    lattice = LatticePlanner(BOUNDS)
+    obstacle = ("box", Box(sx, sy, 0.4), translation(ox, oy, 0.2) @ rot_z(oyaw))
+    occupied = lattice.occupancy([(ROBOT, LIFT)], [obstacle])
+    valid = validity([obstacle], [(ROBOT, LIFT)])
+    k = int(round((yaw % (2 * math.pi)) / (2 * math.pi / lattice.yaws))) % lattice.yaws
+    i, j = int((x - BOUNDS[0]) / lattice.cell), int((y - BOUNDS[2]) / lattice.cell)
+    q = lattice.state(k, i, j)
+    # away from touching (coal's distance), so that the comparison is not about the last micrometre
+    world = CollisionWorld()
+    world.add("box", collision_shape(obstacle[1]), obstacle[2], "fixed")
+    world.add("robot", collision_shape(ROBOT), se2(*q) @ LIFT, "robot")
+    if abs(world.distance("box", "robot")) > 1e-5:
+        assert bool(occupied[k, i, j]) == (not valid(q))
+
+
+def test_hull2d() -> None:
+    pts = np.random.default_rng(3).uniform(-1, 1, (200, 2))
+    hull = hull2d(pts)
+    e = np.roll(hull, -1, axis=0) - hull
+    # counter-clockwise, and every point on the inner side of every edge
+    cross = e[:, 0, None] * (pts[None, :, 1] - hull[:, 1, None]) - e[:, 1, None] * (pts[None, :, 0] - hull[:, 0, None])
+    assert (cross >= -1e-12).all()
+    assert {tuple(v) for v in hull} <= {tuple(p) for p in np.round(pts, 12)}
+
+
+def test_interpolate_turns_the_short_way_and_keeps_steps_small() -> None:
+    a, b = np.array([0.0, 0.0, 3.0]), np.array([0.05, 0.0, -3.0])
+    states = interpolate(a, b, 0.01, 0.01)
+    assert np.allclose(states[-1], [0.05, 0.0, -3.0])
+    yaws = [a[2]] + [q[2] for q in states]
+    assert max(abs(wrap(v - u)) for u, v in zip(yaws, yaws[1:])) <= 0.01 + 1e-9
+    assert len(states) == math.ceil((2 * math.pi - 6.0) / 0.01 - 1e-9)
+
+
+def test_through_the_door_when_the_robot_fits() -> None:
+    # the robot is 0.4 wide: a 0.46 m door leaves 3 cm each side
+    start, goal = (1.0, 0.5, 0.0), (3.0, 2.5, 0.0)
+    obstacles = wall_with_door(1.5, 0.46)
+    res, valid = plan(obstacles, start, goal)
+    assert_valid_path(res, np.array(start), np.array(goal), valid)
+    assert any(abs(q[0] - 2.0) < 0.05 and 1.27 < q[1] < 1.73 for q in res.path)  # through the door
+    again, _ = plan(obstacles, start, goal)
+    assert len(again.path) == len(res.path) and all(np.array_equal(p, q) for p, q in zip(again.path, res.path))
+
+
+def test_no_path_when_the_door_is_too_narrow() -> None:
+    res, _ = plan(wall_with_door(1.5, 0.36), (1.0, 0.5, 0.0), (3.0, 2.5, 0.0))
+    assert res.status is MotionStatus.NO_PATH
+
+
+def test_turns_to_pass_a_door_narrower_than_its_length() -> None:
+    """Carrying a box in front makes the robot 1 m long: it must face the door to pass it."""
+    carried = (Box(0.3, 0.3, 0.2), translation(0.45, 0, 0.2))
+    parts = [(ROBOT, LIFT), carried]
+    start, goal = (1.0, 1.5, math.pi / 2), (3.0, 1.5, -math.pi / 2)  # facing along the wall at both ends
+    res, valid = plan(wall_with_door(1.5, 0.6), start, goal, parts)
+    assert_valid_path(res, np.array(start), np.array(goal), valid)
+
+
+def test_start_and_goal_states_are_reported() -> None:
+    obstacles = wall_with_door(1.5, 0.6)
+    assert plan(obstacles, (2.0, 0.5, 0.0), (3.0, 1.5, 0.0))[0].status is MotionStatus.INVALID_START
+    assert plan(obstacles, (1.0, 1.5, 0.0), (2.0, 2.5, 0.0))[0].status is MotionStatus.INVALID_GOAL

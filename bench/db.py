@@ -1,0 +1,174 @@
+"""The results database: SQLite, one row per finished run, committed per run (WAL journal).
+
+Tables (schema version :data:`SCHEMA_VERSION` in ``PRAGMA user_version``):
+
+- ``runs``: one row per finished run, the columns of :class:`~mrgc.bench.outcome.RunResult`; unique on
+  the run key ``(study, instance_sha256, method, seed)``.  A run is written when it finishes, in its own
+  transaction, so killing ``bench run`` loses at most the runs in flight.
+- ``studies``: the study file's path and text at its last ``bench run``.
+- ``methods``: each method's spec per study; ``bench run`` refuses (E603) a method whose spec changed
+  under the same name, since its recorded runs would mix two methods.
+- ``skips``: methods this mrgc could not run (an unknown planner) and why, per study, from the last
+  ``bench run``; the report prints them.
+
+Only the process running ``bench run`` writes (one writer per database, held by a lock file
+``DB.lock``); reports read concurrently.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import sqlite3
+from typing import Any, Iterator
+
+from mrgc.bench.outcome import RunResult
+from mrgc.errors import Diagnostic, InputError
+
+SCHEMA_VERSION = 1
+#: diagnostic code: the results database cannot be used
+E_DB = "E603"
+
+_COLUMNS: list[tuple[str, str]] = [
+    ("study", "TEXT NOT NULL"), ("instance", "TEXT NOT NULL"), ("instance_set", "TEXT NOT NULL"),
+    ("set_index", "INTEGER NOT NULL"), ("instance_file", "TEXT NOT NULL"), ("instance_sha256", "TEXT NOT NULL"),
+    ("method", "TEXT NOT NULL"), ("method_index", "INTEGER NOT NULL"), ("seed", "INTEGER NOT NULL"),
+    ("status", "TEXT NOT NULL"), ("success", "INTEGER NOT NULL"), ("detail", "TEXT"), ("exit_code", "INTEGER"),
+    ("signal", "INTEGER"), ("planning_seconds", "REAL"), ("facts_seconds", "REAL"), ("wall_seconds", "REAL"),
+    ("validate_seconds", "REAL"), ("peak_mb", "REAL"), ("makespan", "INTEGER"), ("objects_moved", "INTEGER"),
+    ("arm_path", "REAL"), ("base_path", "REAL"), ("valid", "INTEGER"), ("plan_status", "TEXT"),
+    ("stderr_tail", "TEXT"), ("command", "TEXT"), ("time_limit", "REAL"), ("wall_limit", "REAL"),
+    ("memory_limit_mb", "REAL"), ("mrgc_version", "TEXT"), ("host", "TEXT"), ("started", "TEXT"),
+    ("finished", "TEXT"), ("plan_file", "TEXT"),
+]
+COLUMNS = [name for name, _ in _COLUMNS]
+
+_SCHEMA = f"""
+CREATE TABLE IF NOT EXISTS runs (
+    id INTEGER PRIMARY KEY,
+    {', '.join(f'{n} {t}' for n, t in _COLUMNS)},
+    UNIQUE (study, instance_sha256, method, seed)
+);
+CREATE TABLE IF NOT EXISTS studies (name TEXT PRIMARY KEY, path TEXT, text TEXT, updated TEXT);
+CREATE TABLE IF NOT EXISTS methods (study TEXT, method TEXT, spec TEXT, PRIMARY KEY (study, method));
+CREATE TABLE IF NOT EXISTS skips (study TEXT, method TEXT, reason TEXT, runs INTEGER, PRIMARY KEY (study, method));
+"""
+
+RunKey = tuple[str, str, str, int]
+
+
+class ResultsDB:
+    """An open results database (module docstring).  ``readonly`` opens an existing one for reports."""
+
+    def __init__(self, path: str, readonly: bool = False) -> None:
+        self.path = path
+        if readonly and not os.path.isfile(path):
+            raise InputError([Diagnostic(E_DB, f"no results database at '{path}' (mrgc bench run writes one)")])
+        try:
+            uri = f"file:{os.path.abspath(path)}{'?mode=ro' if readonly else ''}"
+            self.conn = sqlite3.connect(uri, uri=True, timeout=30)
+            self.conn.row_factory = sqlite3.Row
+            version = self.conn.execute("PRAGMA user_version").fetchone()[0]
+            tables = {r[0] for r in self.conn.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
+        except sqlite3.DatabaseError as exc:
+            raise InputError([Diagnostic(E_DB, f"'{path}' is not a results database: {exc}")]) from None
+        if version > SCHEMA_VERSION or (tables and "runs" not in tables) or (version == 0 and tables):
+            self.conn.close()
+            raise InputError([Diagnostic(E_DB, f"'{path}' is not a results database of this mrgc "
+                                         f"(schema {version}; this mrgc reads {SCHEMA_VERSION})")])
+        if not readonly:
+            self.conn.execute("PRAGMA journal_mode = WAL")
+            self.conn.execute("PRAGMA synchronous = NORMAL")
+            self.conn.executescript(_SCHEMA)
+            self.conn.execute(f"PRAGMA user_version = {SCHEMA_VERSION}")
+            self.conn.commit()
+        elif not tables:
+            self.conn.close()
+            raise InputError([Diagnostic(E_DB, f"'{path}' holds no results")])
+
+    def close(self) -> None:
+        self.conn.close()
+
+    def __enter__(self) -> "ResultsDB":
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    # ------------------------------------------------------------ writing
+    def begin_study(self, name: str, path: str, text: str, specs: dict[str, dict[str, Any]],
+                    skips: dict[str, tuple[str, int]], updated: str) -> None:
+        """Record the study and its method specs; E603 if a method changed under the same name."""
+        known = {r["method"]: r["spec"] for r in self.conn.execute("SELECT method, spec FROM methods WHERE study = ?", (name,))}
+        for method, spec in specs.items():
+            text_spec = json.dumps(spec, sort_keys=True)
+            if method in known and known[method] != text_spec:
+                n = self.conn.execute("SELECT COUNT(*) FROM runs WHERE study = ? AND method = ?", (name, method)).fetchone()[0]
+                if n:
+                    raise InputError([Diagnostic(E_DB, f"method '{method}' of study '{name}' changed since its {n} "
+                                                 f"recorded run(s) in {self.path} (was {known[method]}, now "
+                                                 f"{text_spec}): give the changed method a new name, or use another "
+                                                 "--db")])
+        with self.conn:
+            self.conn.execute("INSERT OR REPLACE INTO studies VALUES (?, ?, ?, ?)", (name, path, text, updated))
+            for method, spec in specs.items():
+                self.conn.execute("INSERT OR REPLACE INTO methods VALUES (?, ?, ?)",
+                                  (name, method, json.dumps(spec, sort_keys=True)))
+            self.conn.execute("DELETE FROM skips WHERE study = ?", (name,))
+            for method, (reason, runs) in skips.items():
+                self.conn.execute("INSERT INTO skips VALUES (?, ?, ?, ?)", (name, method, reason, runs))
+
+    def add(self, result: RunResult) -> None:
+        """Write one finished run (replacing an earlier row of the same key: a retried run) and commit."""
+        row = result.to_row()
+        with self.conn:
+            self.conn.execute(f"INSERT OR REPLACE INTO runs ({', '.join(COLUMNS)}) VALUES "
+                              f"({', '.join('?' for _ in COLUMNS)})", [row[c] for c in COLUMNS])
+
+    # ------------------------------------------------------------ reading
+    def finished(self, study: str) -> dict[RunKey, str]:
+        """The keys of the study's recorded runs → their status."""
+        return {(r["study"], r["instance_sha256"], r["method"], r["seed"]): r["status"]
+                for r in self.conn.execute("SELECT study, instance_sha256, method, seed, status FROM runs "
+                                           "WHERE study = ?", (study,))}
+
+    def studies(self) -> list[str]:
+        """Study names in the order they were first run."""
+        return [r[0] for r in self.conn.execute("SELECT study FROM runs GROUP BY study ORDER BY MIN(id)")]
+
+    def runs(self, study: str | None = None) -> Iterator[dict[str, Any]]:
+        """The recorded runs (all studies, or one) in a stable order."""
+        where, args = ("WHERE study = ?", (study,)) if study is not None else ("", ())
+        for r in self.conn.execute(f"SELECT {', '.join(COLUMNS)} FROM runs {where} ORDER BY study, set_index, "
+                                   "instance, method_index, method, seed", args):
+            yield dict(r)
+
+    def skips(self, study: str) -> list[tuple[str, str, int]]:
+        return [(r["method"], r["reason"], r["runs"])
+                for r in self.conn.execute("SELECT method, reason, runs FROM skips WHERE study = ? ORDER BY method",
+                                           (study,))]
+
+
+class WriterLock:
+    """The one-writer lock of a database (``DB.lock``, an flock): E603 if another ``bench run`` holds it."""
+
+    def __init__(self, db_path: str) -> None:
+        self.path = db_path + ".lock"
+        self.fd: int | None = None
+
+    def __enter__(self) -> "WriterLock":
+        import fcntl
+
+        self.fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
+        try:
+            fcntl.flock(self.fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            os.close(self.fd)
+            self.fd = None
+            raise InputError([Diagnostic(E_DB, f"another mrgc bench run is writing to {self.path[:-5]}")]) from None
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self.fd is not None:
+            os.close(self.fd)
+            self.fd = None

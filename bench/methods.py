@@ -1,0 +1,131 @@
+"""Methods as command lines: a study's method becomes ``mrgc plan ...`` or ``mrgc compile ...`` arguments.
+
+The options a method may give are the options of the installed ``mrgc plan`` / ``mrgc compile`` (read from
+the command line's own parser, so a planner option added to ``mrgc plan`` is usable in studies at once);
+an unknown option, a value of the wrong type, an unknown backend or encoding is a located study error
+(E601).  A planner that this mrgc does not offer (``planner: ap1`` before ``mrgc plan --planner ap1``
+exists) is *not* an error: the spec stays valid for the mrgc that offers it, and ``bench run`` skips that
+method's runs with the reason, storing none of them, so that a later ``bench run`` of the same study runs
+them (docs/bench.md).
+"""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any
+
+from mrgc.bench.study import E_STUDY_SCHEMA, Method, Study
+from mrgc.errors import Diagnostic
+
+#: the planner of ``mrgc plan`` without ``--planner`` (the paper's method)
+DEFAULT_PLANNER = "mcts"
+
+#: options the runner sets itself; a method may not give them in ``options``
+RESERVED = {"-o", "--output", "--seed", "--time-limit", "--format", "--problem", "--backend", "--encoding",
+            "--planner", "--emit", "-h", "--help", "-v", "--verbose"}
+
+
+def _command_parser(command: str) -> argparse.ArgumentParser:
+    from mrgc.cli import build_parser
+
+    parser = build_parser()
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            found: argparse.ArgumentParser = action.choices[command]
+            return found
+    raise AssertionError("mrgc's parser has no subcommands")  # pragma: no cover
+
+
+def _options(command: str) -> dict[str, argparse.Action]:
+    return {s: a for a in _command_parser(command)._actions for s in a.option_strings}
+
+
+def planners() -> tuple[str, ...] | None:
+    """The planners ``mrgc plan --planner`` offers (the planner registry, else the option's choices; only
+    the default planner when ``mrgc plan`` has no ``--planner``); None when that cannot be known."""
+    try:
+        from mrgc.planner.baselines import PLANNERS
+    except ImportError:
+        action = _options("plan").get("--planner")
+        if action is None:
+            return (DEFAULT_PLANNER,)
+        return tuple(str(c) for c in action.choices) if action.choices else None
+    return tuple(PLANNERS)
+
+
+def option_flag(key: str) -> str:
+    """``skeletons`` → ``--skeletons``, ``max_makespan`` → ``--max-makespan``, ``c`` → ``-c``."""
+    return f"-{key}" if len(key) == 1 else "--" + key.replace("_", "-")
+
+
+def check_methods(study: Study) -> tuple[list[Diagnostic], dict[str, str]]:
+    """Located errors in the study's methods, and the methods this mrgc cannot run → why (to skip them)."""
+    from mrgc.backends.registry import names as backend_names
+    from mrgc.compiler.encodings import ENCODINGS
+    from mrgc.language.suggest import did_you_mean
+
+    diags: list[Diagnostic] = []
+    skip: dict[str, str] = {}
+    offered = planners()
+    tables = {"plan": _options("plan"), "compile": _options("compile")}
+    backends = backend_names()
+    for m in study.methods:
+        def err(message: str) -> None:
+            diags.append(Diagnostic(E_STUDY_SCHEMA, f"method '{m.name}': {message}", m.span))
+
+        if m.backend is not None and m.backend not in backends:
+            err(f"unknown backend '{m.backend}'{did_you_mean(m.backend, backends)} (known: {', '.join(backends)})")
+        if m.encoding is not None and m.encoding not in ENCODINGS:
+            err(f"unknown encoding '{m.encoding}'{did_you_mean(m.encoding, ENCODINGS)} "
+                f"(known: {', '.join(ENCODINGS)})")
+        command = "compile" if m.compile else "plan"
+        table = tables[command]
+        for key, value in m.options:
+            flag = option_flag(key)
+            action = table.get(flag)
+            if flag in RESERVED:
+                err(f"option '{key}' is set by the study itself (seeds:, limits:, backend:, encoding:, planner:)")
+            elif action is None:
+                known = sorted(s.lstrip("-") for s in table if s not in RESERVED and s.startswith("--"))
+                err(f"mrgc {command} has no option {flag}{did_you_mean(key.replace('_', '-'), known)}")
+            else:
+                problem = _bad_value(action, value)
+                if problem:
+                    err(f"option '{key}': {problem}")
+        if not m.compile and offered is not None and m.planner not in offered:
+            skip[m.name] = (f"planner '{m.planner}' is not offered by this mrgc "
+                            f"(mrgc plan offers: {', '.join(offered)})")
+    return diags, skip
+
+
+def _bad_value(action: argparse.Action, value: Any) -> str:
+    """Why ``value`` is not acceptable for ``action`` ('' if it is)."""
+    if action.nargs == 0:  # a flag
+        return "" if isinstance(value, bool) else "is a flag: give true or false"
+    if isinstance(value, bool):
+        return "takes a value, not true/false"
+    try:
+        converted = action.type(str(value)) if callable(action.type) else str(value)
+    except (TypeError, ValueError, argparse.ArgumentTypeError):
+        kind = getattr(action.type, "__name__", "value")
+        return f"'{value}' is not {'an' if kind[0] in 'aeiou' else 'a'} {kind}"
+    if action.choices is not None and converted not in action.choices:
+        return f"'{value}' is not one of {', '.join(map(str, action.choices))}"
+    return ""
+
+
+def method_args(method: Method) -> list[str]:
+    """The subcommand and the method's own arguments (the runner adds the file, output, seed, time limit)."""
+    out = ["compile", "--format", "json"] if method.compile else ["plan"]
+    if not method.compile and method.planner != DEFAULT_PLANNER:
+        out += ["--planner", method.planner]
+    if method.backend is not None:
+        out += ["--backend", method.backend]
+    if method.encoding is not None:
+        out += ["--encoding", method.encoding]
+    for key, value in method.options:
+        if isinstance(value, bool):
+            out += [option_flag(key)] if value else []
+        else:
+            out += [option_flag(key), str(value)]
+    return out

@@ -1,0 +1,306 @@
+"""The checks of a study file's schema (:mod:`mrgc.bench.study` documents it), on the composed YAML tree so
+that every error is located at ``file:line:col`` (code E601), all of them reported at once.
+
+Also the readers of the schema's small value languages: seed ranges (``"0..19"``) and memory sizes
+(``"4GB"``).
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from dataclasses import replace
+from typing import Any
+
+from mrgc.bench.study import E_STUDY_SCHEMA, InstanceSpec, Limits, Method, Study
+from mrgc.errors import Diagnostic, Span
+
+_NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.+-]*$")
+_RANGE = re.compile(r"^\s*(\d+)\s*\.\.\s*(\d+)\s*$")
+_SIZE = re.compile(r"^\s*(\d+(?:\.\d+)?)\s*([KMGT]i?B?|)\s*$", re.IGNORECASE)
+_UNITS = {"": 1.0, "k": 1 / 1024, "m": 1.0, "g": 1024.0, "t": 1024.0 ** 2}
+
+STUDY_KEYS = ("study", "description", "seeds", "limits", "instances", "methods")
+LIMIT_KEYS = ("time", "wall", "memory")
+METHOD_KEYS = ("name", "planner", "compile", "backend", "encoding", "options", "limits", "only")
+FILE_KEYS = ("file", "name", "problem")
+GLOB_KEYS = ("glob", "name", "problem")
+GENERATE_KEYS = ("generate", "name", "seeds")  # plus the generator's own options
+
+
+def parse_seeds(value: Any) -> tuple[int, ...] | None:
+    """``3`` → (3,); ``"0..19"`` → (0, ..., 19); a list of those → their concatenation; None if malformed."""
+    if isinstance(value, bool):
+        return None
+    if isinstance(value, int):
+        return (value,) if value >= 0 else None
+    if isinstance(value, str):
+        m = _RANGE.match(value)
+        if not m or int(m.group(1)) > int(m.group(2)):
+            return None
+        return tuple(range(int(m.group(1)), int(m.group(2)) + 1))
+    if isinstance(value, list) and value:
+        out: list[int] = []
+        for v in value:
+            part = parse_seeds(v) if not isinstance(v, list) else None
+            if part is None:
+                return None
+            out += part
+        return tuple(out)
+    return None
+
+
+def parse_megabytes(value: Any) -> float | None:
+    """A memory size: a number of MiB, or ``"512MB"``, ``"4GB"``, ``"4 GiB"`` (binary units); None if malformed."""
+    if isinstance(value, bool):
+        return None
+    if isinstance(value, (int, float)):
+        return float(value) if value > 0 else None
+    if isinstance(value, str):
+        m = _SIZE.match(value)
+        if m:
+            mb = float(m.group(1)) * _UNITS[m.group(2)[:1].lower()]
+            return mb if mb > 0 else None
+    return None
+
+
+class Reader:
+    """Walks the composed YAML tree, collecting a located diagnostic per problem."""
+
+    def __init__(self, path: str) -> None:
+        self.path = path
+        self.diags: list[Diagnostic] = []
+        self.set_names: list[str] = []
+
+    def span(self, node: Any) -> Span:
+        s, e = node.start_mark, node.end_mark
+        return Span(self.path, s.line + 1, s.column + 1, e.line + 1, e.column + 1)
+
+    def error(self, node: Any, message: str) -> None:
+        self.diags.append(Diagnostic(E_STUDY_SCHEMA, message, self.span(node)))
+
+    def value(self, node: Any) -> Any:
+        from yaml.constructor import ConstructorError, SafeConstructor
+
+        try:
+            return SafeConstructor().construct_object(node, deep=True)
+        except ConstructorError as exc:
+            self.error(node, f"not plain data: {exc.problem}")
+            return None
+
+    def mapping(self, node: Any, what: str, keys: tuple[str, ...] | None) -> dict[str, tuple[Any, Any]] | None:
+        """key -> (key node, value node), after checking the node is a mapping of known, unique keys."""
+        import yaml
+
+        if not isinstance(node, yaml.MappingNode):
+            self.error(node, f"{what} must be a mapping (key: value)")
+            return None
+        out: dict[str, tuple[Any, Any]] = {}
+        for k, v in node.value:
+            key = k.value if isinstance(k, yaml.ScalarNode) else None
+            if not isinstance(key, str):
+                self.error(k, f"{what}: keys must be names")
+                continue
+            if key in out:
+                self.error(k, f"{what}: duplicate key '{key}'")
+                continue
+            if keys is not None and key not in keys:
+                from mrgc.language.suggest import did_you_mean
+
+                self.error(k, f"{what}: unknown key '{key}'{did_you_mean(key, keys)} (known: {', '.join(keys)})")
+                continue
+            out[key] = (k, v)
+        return out
+
+    def scalar(self, node: Any, what: str, types: tuple[type, ...]) -> Any:
+        """The node's value if it is of one of ``types`` (a bool counts only where bool is listed)."""
+        value = self.value(node)
+        if value is None or not isinstance(value, types) or (isinstance(value, bool) and bool not in types):
+            want = ("true or false" if types == (bool,) else "a number" if float in types
+                    else "a name" if str in types and int in types else "text")
+            self.error(node, f"{what} must be {want}")
+            return None
+        return value
+
+    def name(self, node: Any, what: str) -> str | None:
+        value = self.scalar(node, what, (str, int))
+        if value is None:
+            return None
+        value = str(value)
+        if not _NAME.match(value):
+            self.error(node, f"{what} '{value}' is not a name (letters, digits, _ . + -; a letter or digit first)")
+            return None
+        return value
+
+    def seeds(self, node: Any, what: str) -> tuple[int, ...] | None:
+        seeds = parse_seeds(self.value(node))
+        if seeds is None:
+            self.error(node, f"{what} must be a seed (integer >= 0), a range 'a..b' (a <= b) or a list of those")
+        elif len(set(seeds)) != len(seeds):
+            self.error(node, f"{what} repeat a seed")
+            return None
+        return seeds
+
+    def study(self, root: Any) -> Study | None:
+        if root is None:
+            return None
+        top = self.mapping(root, "the study", STUDY_KEYS)
+        if top is None:
+            return None
+        for key in ("study", "instances", "methods"):
+            if key not in top:
+                self.diags.append(Diagnostic(E_STUDY_SCHEMA, f"the study lacks '{key}'", self.span(root)))
+        name = self.name(top["study"][1], "study") if "study" in top else None
+        description = self.scalar(top["description"][1], "description", (str,)) if "description" in top else ""
+        seeds = self.seeds(top["seeds"][1], "seeds") if "seeds" in top else (0,)
+        limits = self.limits(top["limits"][1], Limits()) if "limits" in top else Limits()
+        instances = self.instances(top["instances"][1]) if "instances" in top else []
+        self.set_names = [i.name for i in instances]
+        methods = self.methods(top["methods"][1], limits or Limits()) if "methods" in top else []
+        if name is None or seeds is None or limits is None or self.diags:
+            return None
+        return Study(name, self.path, "", tuple(instances), tuple(methods), seeds, limits, description or "")
+
+    def limits(self, node: Any, base: Limits) -> Limits | None:
+        m = self.mapping(node, "limits", LIMIT_KEYS)
+        if m is None:
+            return None
+        out = base
+        for key in ("time", "wall"):
+            if key in m:
+                t = self.scalar(m[key][1], f"limits: {key} (seconds)", (int, float))
+                if t is not None and not 0 < t < float("inf"):
+                    self.error(m[key][1], f"limits: {key} must be positive and finite (seconds)")
+                elif t is not None:
+                    out = replace(out, **{key: float(t)})
+        if "memory" in m:
+            mb = parse_megabytes(self.value(m["memory"][1]))
+            if mb is None:
+                self.error(m["memory"][1], "limits: memory must be a size such as 4GB, 512MB or a number of MiB")
+            else:
+                out = replace(out, memory_mb=mb)
+        return out
+
+    def sequence(self, node: Any, what: str) -> list[Any]:
+        import yaml
+
+        if not isinstance(node, yaml.SequenceNode) or not node.value:
+            self.error(node, f"{what} must be a non-empty list")
+            return []
+        return list(node.value)
+
+    def instances(self, node: Any) -> list[InstanceSpec]:
+        out: list[InstanceSpec] = []
+        names: dict[str, Any] = {}
+        for item in self.sequence(node, "instances"):
+            spec = self.instance(item)
+            if spec is None:
+                continue
+            if spec.name in names:
+                self.error(item, f"instances: two entries are named '{spec.name}' (give one a name: ...)")
+                continue
+            names[spec.name] = item
+            out.append(spec)
+        return out
+
+    def instance(self, node: Any) -> InstanceSpec | None:
+        m = self.mapping(node, "an instance", None)
+        if m is None:
+            return None
+        kinds = [k for k in ("file", "glob", "generate") if k in m]
+        if len(kinds) != 1:
+            self.error(node, "an instance has exactly one of file:, glob: or generate:")
+            return None
+        kind = kinds[0]
+        if kind != "generate":
+            allowed = FILE_KEYS if kind == "file" else GLOB_KEYS
+            for key, (knode, _) in m.items():
+                if key not in allowed:
+                    from mrgc.language.suggest import did_you_mean
+
+                    self.error(knode, f"a {kind} instance: unknown key '{key}'{did_you_mean(key, allowed)} "
+                               f"(known: {', '.join(allowed)})")
+        source = self.scalar(m[kind][1], kind, (str,))
+        if source is None:
+            return None
+        if kind == "file":
+            default = os.path.splitext(os.path.basename(source))[0]
+        elif kind == "glob":
+            default = re.sub(r"[^A-Za-z0-9_.+-]+", "-", source).strip("-.") or "glob"
+        else:
+            default = source
+        name = self.name(m["name"][1], "name") if "name" in m else default
+        problem = self.name(m["problem"][1], "problem") if "problem" in m else None
+        if name is None or not _NAME.match(name):
+            if "name" not in m:
+                self.error(node, f"cannot name this instance after '{source}': give it a name:")
+            return None
+        span = self.span(node)
+        if kind != "generate":
+            return InstanceSpec(kind, name, source, problem, span=span)
+        seeds = self.seeds(m["seeds"][1], "seeds") if "seeds" in m else (0,)
+        options: list[tuple[str, Any]] = []
+        for key, (knode, vnode) in m.items():
+            if key in GENERATE_KEYS:
+                continue
+            value = self.value(vnode)
+            if value is None or isinstance(value, (list, dict)):
+                self.error(vnode, f"generator option '{key}' must be a number, a word or true/false")
+                continue
+            options.append((key, value))
+        if seeds is None:
+            return None
+        return InstanceSpec("generate", name, source, None, tuple(options), seeds, span)
+
+    def methods(self, node: Any, limits: Limits) -> list[Method]:
+        out: list[Method] = []
+        names: set[str] = set()
+        for item in self.sequence(node, "methods"):
+            method = self.method(item, limits)
+            if method is None:
+                continue
+            if method.name in names:
+                self.error(item, f"methods: two methods are named '{method.name}'")
+                continue
+            names.add(method.name)
+            out.append(method)
+        return out
+
+    def method(self, node: Any, limits: Limits) -> Method | None:
+        m = self.mapping(node, "a method", METHOD_KEYS)
+        if m is None:
+            return None
+        if "name" not in m:
+            self.error(node, "a method lacks 'name'")
+            return None
+        name = self.name(m["name"][1], "name")
+        compile_only = bool(self.scalar(m["compile"][1], "compile", (bool,))) if "compile" in m else False
+        planner = self.name(m["planner"][1], "planner") if "planner" in m else "mcts"
+        if compile_only and "planner" in m:
+            self.error(m["planner"][0], "a compile: true method generates skeletons only: it has no planner")
+        backend = self.name(m["backend"][1], "backend") if "backend" in m else None
+        encoding = self.name(m["encoding"][1], "encoding") if "encoding" in m else None
+        options: list[tuple[str, Any]] = []
+        if "options" in m:
+            om = self.mapping(m["options"][1], "options", None)
+            for key, (knode, vnode) in (om or {}).items():
+                value = self.value(vnode)
+                if value is None or isinstance(value, (list, dict)):
+                    self.error(vnode, f"option '{key}' must be a number, a word or true/false")
+                    continue
+                options.append((key, value))
+        own = self.limits(m["limits"][1], limits) if "limits" in m else limits
+        only: list[str] = []
+        if "only" in m:
+            for item in self.sequence(m["only"][1], "only (instance set names)"):
+                set_name = self.name(item, "only")
+                if set_name is not None and set_name not in self.set_names:
+                    from mrgc.language.suggest import did_you_mean
+
+                    self.error(item, f"only: no instance set '{set_name}'{did_you_mean(set_name, self.set_names)}")
+                elif set_name is not None:
+                    only.append(set_name)
+        if name is None or planner is None or own is None:
+            return None
+        return Method(name, planner, compile_only, backend, encoding, tuple(options), own, tuple(only),
+                      self.span(node))

@@ -1,0 +1,169 @@
+"""Study files: which instances, which methods, which seeds, under which per-run limits (docs/bench.md).
+
+A study is a YAML file read with pyyaml's safe loader (plain data only: no tags that build objects).  Its
+schema, checked here with every error located at ``file:line:col`` (code E601, E600 for a file that is not
+YAML at all)::
+
+    study: smoke                  # the study's name: part of every run's key in the results database
+    description: free text        # optional
+    seeds: 0..1                   # planner seeds of every run: an integer, "a..b" (inclusive) or a list
+    limits: {time: 60, memory: 4GB}   # per run (see Limits); a method may override them
+    instances:                    # one entry per instance set (a row group of the report)
+      - file: ../domains/packaging/pa5.mrg     # relative to the study file
+      - glob: ../domains/symbolic/c*.mrg      # every match is an instance of the set
+        name: symbolic
+      - generate: packaging                    # `mrgc generate packaging --robots 2 ... --seed S`
+        name: PA5
+        robots: 2
+        goals: 3
+        others: 2
+        seeds: 0..19                           # generator seeds: one instance per seed
+    methods:
+      - {name: Ours, planner: mcts, backend: cpsat, encoding: time-of-move, options: {skeletons: 5}}
+      - {name: Ap1, planner: ap1}
+      - {name: cpsat-tom, compile: true, backend: cpsat, encoding: time-of-move, only: [PA5]}
+
+Nothing here touches the file system beyond reading the study file: expanding instance entries into files
+is :mod:`mrgc.bench.instances`, turning methods into command lines :mod:`mrgc.bench.methods`; the checks
+of the schema are :mod:`mrgc.bench.schema`.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+from mrgc.errors import Diagnostic, InputError, Span
+
+#: diagnostic codes of study files
+E_STUDY_READ, E_STUDY_SCHEMA = "E600", "E601"
+
+_MAX_BYTES = 1 << 20
+
+
+@dataclass(frozen=True)
+class Limits:
+    """Per-run limits.  ``time`` is the planner's own limit (``--time-limit``, seconds): the paper's timeout.
+    ``wall`` is the runner's hard wall-clock limit on each process (default ``2 * time + 30``): a process
+    still alive then is killed with its whole process group and the run recorded as ``timeout``.
+    ``memory_mb`` bounds the proportional set size (PSS) of the run's process group: at the limit the group
+    is killed and the run recorded as ``memout``."""
+
+    time: float = 60.0
+    wall: float | None = None
+    memory_mb: float = 8192.0
+
+    @property
+    def wall_seconds(self) -> float:
+        return self.wall if self.wall is not None else 2 * self.time + 30
+
+    def to_json(self) -> dict[str, float]:
+        return {"time": self.time, "wall": self.wall_seconds, "memory_mb": self.memory_mb}
+
+
+@dataclass(frozen=True)
+class InstanceSpec:
+    """One entry of ``instances``: a file, a glob or a generator call; ``name`` is the instance set's name
+    (the report's row label).  ``options`` are the generator's options (``robots: 2`` → ``--robots 2``)."""
+
+    kind: str  # "file" | "glob" | "generate"
+    name: str
+    source: str  # the path, the glob pattern (relative to the study's folder) or the generator kind
+    problem: str | None = None
+    options: tuple[tuple[str, Any], ...] = ()
+    seeds: tuple[int, ...] = ()
+    span: Span | None = field(default=None, compare=False)
+
+
+@dataclass(frozen=True)
+class Method:
+    """One entry of ``methods``: how a run plans (``planner``, default ``mcts``: the paper's method) or,
+    with ``compile``, only generates skeletons (``mrgc compile``).  ``options`` are further command-line
+    options of ``mrgc plan`` / ``mrgc compile`` (``skeletons: 5`` → ``--skeletons 5``, ``anytime: true``
+    → ``--anytime``)."""
+
+    name: str
+    planner: str = "mcts"
+    compile: bool = False
+    backend: str | None = None
+    encoding: str | None = None
+    options: tuple[tuple[str, Any], ...] = ()
+    limits: Limits = Limits()
+    #: the instance sets the method runs on (empty: all of them)
+    only: tuple[str, ...] = ()
+    span: Span | None = field(default=None, compare=False)
+
+    def runs_on(self, instance_set: str) -> bool:
+        return not self.only or instance_set in self.only
+
+    def spec(self) -> dict[str, Any]:
+        """What the method is, as stored in the results database: a changed spec under the same name is
+        refused there (docs/bench.md)."""
+        out: dict[str, Any] = {"compile": True} if self.compile else {"planner": self.planner}
+        if self.backend is not None:
+            out["backend"] = self.backend
+        if self.encoding is not None:
+            out["encoding"] = self.encoding
+        if self.options:
+            out["options"] = dict(self.options)
+        out["limits"] = self.limits.to_json()
+        return out
+
+
+@dataclass(frozen=True)
+class Study:
+    """A checked study file."""
+
+    name: str
+    path: str
+    text: str
+    instances: tuple[InstanceSpec, ...]
+    methods: tuple[Method, ...]
+    seeds: tuple[int, ...] = (0,)
+    limits: Limits = Limits()
+    description: str = ""
+
+    @property
+    def folder(self) -> str:
+        return os.path.dirname(os.path.abspath(self.path))
+
+
+def load_study(path: str | os.PathLike[str]) -> Study:
+    """Read and check a study file; :class:`~mrgc.errors.InputError` lists every problem found (E600/E601)."""
+    path = os.fspath(path)
+    try:
+        with open(path, "rb") as fh:
+            data = fh.read(_MAX_BYTES + 1)
+    except OSError as exc:
+        raise InputError([Diagnostic(E_STUDY_READ, f"cannot read study '{path}': {exc.strerror or exc}")]) from None
+    if len(data) > _MAX_BYTES:
+        raise InputError([Diagnostic(E_STUDY_READ, f"study '{path}' is larger than {_MAX_BYTES} bytes")])
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise InputError([Diagnostic(E_STUDY_READ, f"study '{path}' is not UTF-8 text (byte {exc.start})")]) from None
+    return parse_study(text, path)
+
+
+def parse_study(text: str, path: str = "<study>") -> Study:
+    """Check the text of a study file named ``path`` (relative paths in it resolve against its folder)."""
+    import yaml
+
+    try:
+        root = yaml.compose(text, Loader=yaml.SafeLoader)
+    except yaml.MarkedYAMLError as exc:
+        mark = exc.problem_mark or exc.context_mark
+        span = Span(path, mark.line + 1, mark.column + 1, mark.line + 1, mark.column + 2) if mark else None
+        raise InputError([Diagnostic(E_STUDY_READ, f"study is not YAML: {exc.problem or exc}", span)],
+                         {path: text}) from None
+    except yaml.YAMLError as exc:
+        raise InputError([Diagnostic(E_STUDY_READ, f"study is not YAML: {exc}")], {path: text}) from None
+    from mrgc.bench.schema import Reader
+
+    reader = Reader(path)
+    study = reader.study(root)
+    if reader.diags or study is None:
+        diags = reader.diags or [Diagnostic(E_STUDY_SCHEMA, "the study is empty", Span(path, 1, 1, 1, 2))]
+        raise InputError(diags, {path: text})
+    return replace(study, text=text)

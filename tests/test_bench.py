@@ -1,0 +1,377 @@
+"""Studies (mrgc bench): schema errors, method command lines, resume after SIGTERM, limits (timeout, memout),
+crashes, invalid plans, skipped planners, the Ray executor, golden reports on a fixed database, figures.
+
+Runs are real ``mrgc plan`` / ``mrgc validate`` processes on symbolic problems (fast) or a shipped
+packaging problem where a run must outlast a limit.  Golden reports: ``tests/golden/bench/runs.sql`` is a
+fixed database (recorded from a real run of ``tests/golden/bench/study.yaml``, see docs/bench.md); the
+expected reports are regenerated with MRGC_UPDATE_GOLDEN=1.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import signal
+import sqlite3
+import subprocess
+import sys
+import threading
+import time
+from dataclasses import replace
+from pathlib import Path
+
+import pytest
+from hypothesis import given, strategies as st
+
+from mrgc.bench import ResultsDB, RunStatus, parse_study, render, run_study
+from mrgc.bench.execute import RunTask, execute_run, mrgc_argv
+from mrgc.bench.instances import expand_instances
+from mrgc.bench.methods import check_methods, method_args
+from mrgc.bench.outcome import classify
+from mrgc.bench.runner import run_limited
+from mrgc.bench.schema import parse_megabytes, parse_seeds
+from mrgc.bench.study import Limits
+from mrgc.errors import InputError
+
+ROOT = Path(__file__).resolve().parent.parent
+SYMBOLIC = ROOT / "domains" / "symbolic"
+GOLDEN = ROOT / "tests" / "golden" / "bench"
+MRGC = [sys.executable, "-m", "mrgc.cli"]
+
+
+def symbolic_copy(folder: Path, *names: str) -> Path:
+    """Copies of shipped symbolic problems (and their domain) in ``folder``: paths no other test uses."""
+    folder.mkdir(parents=True, exist_ok=True)
+    for name in ("domain", *names):
+        shutil.copy(SYMBOLIC / f"{name}.mrg", folder / f"{name}.mrg")
+    return folder
+
+
+def packaging_copy(folder: Path, name: str) -> Path:
+    """A copy of a shipped packaging problem (and its domain) in ``folder``."""
+    folder.mkdir(parents=True, exist_ok=True)
+    for file in ("domain", name):
+        shutil.copy(ROOT / "domains" / "packaging" / f"{file}.mrg", folder / f"{file}.mrg")
+    return folder
+
+
+def write_study(path: Path, text: str) -> Path:
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def leftover(marker: str) -> list[str]:
+    """Command lines of live processes that mention ``marker`` (a test's temporary folder)."""
+    out = []
+    for pid in filter(str.isdigit, os.listdir("/proc")):
+        try:
+            cmd = Path(f"/proc/{pid}/cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
+            state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+        except OSError:
+            continue
+        if marker in cmd and state != "Z" and int(pid) != os.getpid():
+            out.append(cmd)
+    return out
+
+
+def rows(db: Path) -> list[dict[str, object]]:
+    with ResultsDB(str(db), readonly=True) as results:
+        return list(results.runs())
+
+
+# ---------------------------------------------------------------- study files
+def test_a_study_file_is_checked_with_every_error_located() -> None:
+    text = ("study: demo\n"
+            "seeds: 0..x\n"
+            "limits: {time: -1, memory: lots}\n"
+            "instances:\n"
+            "  - file: a.mrg\n"
+            "    glob: '*.mrg'\n"
+            "methods:\n"
+            "  - {name: Ours, planer: mcts}\n"
+            "  - {name: Skel, compile: true, planner: mcts}\n")
+    with pytest.raises(InputError) as err:
+        parse_study(text, "s.yaml")
+    lines = {(d.span.line, d.span.column, d.code) for d in err.value.diagnostics if d.span}
+    assert (2, 8, "E601") in lines  # seeds
+    assert (3, 16, "E601") in lines and (3, 28, "E601") in lines  # time, memory
+    assert (5, 5, "E601") in lines  # file and glob
+    assert (8, 18, "E601") in lines  # planer
+    assert (9, 33, "E601") in lines  # a compile-only method has no planner
+    messages = " ".join(d.message for d in err.value.diagnostics)
+    assert "did you mean 'planner'" in messages
+    with pytest.raises(InputError) as err:
+        parse_study("study: x\ninstances: [\n", "s.yaml")
+    assert err.value.diagnostics[0].code == "E600" and err.value.diagnostics[0].span is not None
+
+
+def test_a_valid_study_and_its_methods_as_mrgc_command_lines() -> None:
+    study = parse_study("study: demo\nseeds: [0, 3..4]\nlimits: {time: 20, memory: 2GB}\n"
+                        "instances: [{file: ../domains/symbolic/chain-3.mrg}]\n"
+                        "methods:\n"
+                        "  - {name: Ours, backend: mip, encoding: paper, options: {skeletons: 3, c: 0.5, anytime: true,"
+                        " max_makespan: 4}, limits: {wall: 9}}\n"
+                        "  - {name: Ap1, planner: ap1}\n"
+                        "  - {name: Skel, compile: true, backend: smt, options: {skeletons: 2}, only: [chain-3]}\n",
+                        str(ROOT / "benchmarks" / "x.yaml"))
+    assert study.seeds == (0, 3, 4)
+    ours, ap1, skel = study.methods
+    assert ours.limits == Limits(time=20.0, wall=9.0, memory_mb=2048.0) and ap1.limits.wall_seconds == 70
+    assert method_args(ours) == ["plan", "--backend", "mip", "--encoding", "paper", "--skeletons", "3", "-c", "0.5",
+                                 "--anytime", "--max-makespan", "4"]
+    assert method_args(ap1) == ["plan", "--planner", "ap1"]
+    assert method_args(skel) == ["compile", "--format", "json", "--backend", "smt", "--skeletons", "2"]
+    assert check_methods(study) == ([], {})
+    from mrgc.cli import build_parser
+
+    for m in study.methods:  # every command line is one the real parser accepts
+        args = build_parser().parse_args([*method_args(m)[:1], "x.mrg", *method_args(m)[1:]])
+        assert args.backend == (m.backend or "cpsat")
+    bad = parse_study("study: d\ninstances: [{file: a.mrg}]\nmethods:\n  - {name: A, options: {skeleton: 3}}\n"
+                      "  - {name: B, backend: cplex, options: {anytime: 3}}\n  - {name: C, options: {seed: 1}}\n", "s.yaml")
+    diags, _ = check_methods(bad)
+    text = "\n".join(d.message for d in diags)
+    assert "no option --skeleton (did you mean 'skeletons'?)" in text and "unknown backend 'cplex'" in text
+    assert "is a flag" in text and "set by the study itself" in text
+
+
+@given(st.integers(0, 10**6), st.integers(0, 50))
+def test_seed_ranges_are_inclusive(a: int, n: int) -> None:
+    assert parse_seeds(f"{a}..{a + n}") == tuple(range(a, a + n + 1))
+    assert parse_seeds([a, f"{a + 1}..{a + 1 + n}"]) == (a, *range(a + 1, a + n + 2))
+    assert parse_seeds(f"{a + n + 1}..{a}") is None and parse_seeds(-1 - a) is None
+
+
+def test_memory_sizes() -> None:
+    assert [parse_megabytes(v) for v in (512, "512MB", "4GB", "4 GiB", "1.5G", "2048k")] == [512, 512, 4096, 4096,
+                                                                                          1536, 2]
+    assert [parse_megabytes(v) for v in ("lots", 0, -3, True, "4 parsecs")] == [None] * 5
+
+
+def test_generated_instances_are_the_generator_s_text_and_bad_calls_are_located(tmp_path: Path) -> None:
+    study = parse_study("study: gen\ninstances:\n  - {generate: packaging, name: tiny, robots: 2, goals: 1, "
+                        "others: 0, seeds: 0..1}\nmethods: [{name: Ours}]\n", str(tmp_path / "s.yaml"))
+    instances = expand_instances(study, str(tmp_path / "work"))
+    assert [i.name for i in instances] == ["tiny-s0", "tiny-s1"] and instances[0].sha256 != instances[1].sha256
+    cli = subprocess.run([*MRGC, "generate", "packaging", "--robots", "2", "--goals", "1", "--others", "0",
+                          "--seed", "1"], capture_output=True, text=True, check=True)
+    assert Path(instances[1].path).read_text(encoding="utf-8") == cli.stdout
+    assert dict(instances[0].bases) == {"r1": "fixed", "r2": "fixed"}
+    bad = parse_study("study: gen\ninstances:\n  - {generate: packaging, robots: 99}\nmethods: [{name: O}]\n",
+                      str(tmp_path / "s.yaml"))
+    with pytest.raises(InputError) as err:
+        expand_instances(bad, str(tmp_path / "work"))
+    d = err.value.diagnostics[0]
+    assert d.code == "E602" and d.span is not None and d.span.line == 3 and "--robots" in d.message
+
+
+# ---------------------------------------------------------------- running
+def test_a_study_killed_mid_way_and_resumed_loses_no_finished_run_and_repeats_none(tmp_path: Path) -> None:
+    symbolic_copy(tmp_path / "p", "chain-3", "parallel", "place-obstacle")
+    study = write_study(tmp_path / "s.yaml", "study: resume\nseeds: 0..1\nlimits: {time: 30}\n"
+                        "instances: [{glob: p/*.mrg, name: sym}]\nmethods: [{name: Ours}]\n")
+    db = tmp_path / "r.db"
+    proc = subprocess.Popen([*MRGC, "bench", "run", str(study), "--db", str(db)], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    assert proc.stdout is not None
+    seen = []
+    deadline = time.monotonic() + 120
+    while len(seen) < 2 and time.monotonic() < deadline:
+        line = proc.stdout.readline()
+        if line.startswith("["):
+            seen.append(line)
+    time.sleep(0.3)  # let the third run start: it is in flight when the signal comes
+    proc.send_signal(signal.SIGTERM)
+    out, err = proc.communicate(timeout=60)
+    assert proc.returncode == 143, err
+    assert "terminated (SIGTERM)" in err
+    first = rows(db)
+    assert len(first) >= 2 and all(r["success"] for r in first)
+    assert not leftover(str(tmp_path / "p")), "a run outlived bench run"
+    again = subprocess.run([*MRGC, "bench", "run", str(study), "--db", str(db)], capture_output=True, text=True,
+                           timeout=300)
+    assert again.returncode == 0, again.stderr
+    assert f"6 runs, {len(first)} already recorded, {6 - len(first)} to run" in again.stdout
+    final = rows(db)
+    keys = [(r["instance"], r["seed"]) for r in final]
+    assert len(final) == 6 and len(set(keys)) == 6
+    assert [r for r in final if (r["instance"], r["seed"]) in {(f["instance"], f["seed"]) for f in first}] == first
+    assert sum(line.startswith("[") for line in again.stdout.splitlines()) == 6 - len(first)
+
+
+def test_a_run_past_its_wall_clock_limit_is_killed_as_a_group(tmp_path: Path) -> None:
+    folder = packaging_copy(tmp_path / "g", "pa10")
+    study = write_study(tmp_path / "s.yaml", "study: hang\nlimits: {time: 600, wall: 2}\n"
+                        "instances: [{file: g/pa10.mrg}]\nmethods: [{name: Ours}]\n")
+    summary = run_study(str(study), str(tmp_path / "r.db"))
+    (r,) = rows(tmp_path / "r.db")
+    assert summary.outcomes == {"timeout": 1}
+    assert r["status"] == "timeout" and not r["success"] and 2 <= r["wall_seconds"] < 6  # type: ignore[operator]
+    assert r["signal"] == signal.SIGKILL and r["planning_seconds"] is None
+    assert not leftover(str(folder))
+
+
+def test_a_run_over_its_memory_limit_is_recorded_as_memout(tmp_path: Path) -> None:
+    symbolic_copy(tmp_path / "p", "chain-3")
+    study = write_study(tmp_path / "s.yaml", "study: mem\nlimits: {memory: 30MB}\n"
+                        "instances: [{file: p/chain-3.mrg}]\nmethods: [{name: Ours}]\n")
+    run_study(str(study), str(tmp_path / "r.db"))
+    (r,) = rows(tmp_path / "r.db")
+    assert r["status"] == "memout" and not r["success"] and r["peak_mb"] > 30  # type: ignore[operator]
+    assert "memory limit of 30 MiB" in str(r["detail"])
+
+
+def test_a_crashing_run_is_recorded_as_a_crash_with_its_stderr(tmp_path: Path) -> None:
+    folder = packaging_copy(tmp_path / "g", "pa10")
+    study = write_study(tmp_path / "s.yaml", "study: crash\nlimits: {time: 600, wall: 120}\n"
+                        "instances: [{file: g/pa10.mrg}]\nmethods: [{name: Ours}]\n")
+
+    def segfault() -> None:  # what a crash in a C extension looks like from outside: SIGSEGV mid-run
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline:
+            for pid in filter(str.isdigit, os.listdir("/proc")):
+                try:
+                    cmd = Path(f"/proc/{pid}/cmdline").read_bytes()
+                except OSError:
+                    continue
+                if str(folder).encode() in cmd and b"\0plan\0" in cmd:
+                    time.sleep(1.0)
+                    os.kill(int(pid), signal.SIGSEGV)
+                    return
+            time.sleep(0.05)
+
+    killer = threading.Thread(target=segfault)
+    killer.start()
+    run_study(str(study), str(tmp_path / "r.db"))
+    killer.join()
+    (r,) = rows(tmp_path / "r.db")
+    assert r["status"] == "crash" and not r["success"] and r["signal"] == signal.SIGSEGV
+    assert "SIGSEGV" in str(r["detail"]) and r["exit_code"] is None
+
+
+def test_an_invalid_plan_is_a_failure(tmp_path: Path) -> None:
+    """A real plan, doctored (its goal object put back in the start region), judged by the real validator."""
+    symbolic_copy(tmp_path / "p", "chain-3")
+    study = parse_study("study: inv\ninstances: [{file: p/chain-3.mrg}]\nmethods: [{name: Ours}]\n",
+                        str(tmp_path / "s.yaml"))
+    (inst,) = expand_instances(study, str(tmp_path / "w"))
+    task = RunTask("inv", inst, "Ours", tuple(method_args(study.methods[0])), 0, Limits(time=30), str(tmp_path / "out"))
+    raw = execute_run(task)
+    good = classify(raw)
+    assert good.status == "solved" and good.success and good.valid
+    plan = json.loads(raw.plan_text or "")
+    plan["steps"][0]["actions"][0]["region"] = "start"
+    doctored = tmp_path / "doctored.plan.json"
+    doctored.write_text(json.dumps(plan), encoding="utf-8")
+    check = run_limited(mrgc_argv(["validate", inst.path, str(doctored), "--format", "json"]), wall=60,
+                        memory_mb=4096, stdout=str(tmp_path / "v.json"), stderr=str(tmp_path / "v.err"))
+    bad = classify(replace(raw, plan_text=doctored.read_text(), validate=check,
+                           validate_text=(tmp_path / "v.json").read_text()))
+    assert bad.status == RunStatus.INVALID.value and not bad.success and bad.valid is False
+    assert "goal" in bad.detail
+    with ResultsDB(str(tmp_path / "r.db")) as db:
+        db.add(bad)
+        assert "| chain-3 | Ours | 1 | 0.0 |" in render(db, "markdown")
+
+
+def test_an_unknown_planner_is_skipped_with_its_reason_and_nothing_recorded(tmp_path: Path) -> None:
+    symbolic_copy(tmp_path / "p", "chain-3")
+    study = write_study(tmp_path / "s.yaml", "study: skip\nseeds: 0..1\ninstances: [{file: p/chain-3.mrg}]\n"
+                        "methods: [{name: Ours}, {name: Ap9, planner: ap9}]\n")
+    db = tmp_path / "r.db"
+    out = subprocess.run([*MRGC, "bench", "run", str(study), "--db", str(db)], capture_output=True, text=True,
+                         timeout=300)
+    assert out.returncode == 0, out.stderr
+    assert "skipped method Ap9 (2 runs): planner 'ap9' is not offered by this mrgc" in out.stdout
+    assert {r["method"] for r in rows(db)} == {"Ours"}
+    report = subprocess.run([*MRGC, "bench", "report", "--db", str(db)], capture_output=True, text=True, timeout=60)
+    assert "Skipped: method Ap9 (2 runs): planner 'ap9'" in report.stdout
+    changed = write_study(tmp_path / "s.yaml", study.read_text().replace("{name: Ours}", "{name: Ours, backend: mip}"))
+    refused = subprocess.run([*MRGC, "bench", "run", str(changed), "--db", str(db)], capture_output=True, text=True,
+                             timeout=120)
+    assert refused.returncode == 2 and "error[E603]: method 'Ours' of study 'skip' changed" in refused.stderr
+
+
+def test_the_ray_executor_runs_a_two_run_study_on_a_local_ray(tmp_path: Path) -> None:
+    import ray  # the test extra installs it (pip install -e '.[test]')
+
+    symbolic_copy(tmp_path / "p", "chain-3")
+    study = write_study(tmp_path / "s.yaml", "study: ray\nseeds: 0..1\ninstances: [{file: p/chain-3.mrg}]\n"
+                        "methods: [{name: Ours}]\n")
+    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
+    try:
+        summary = run_study(str(study), str(tmp_path / "r.db"), executor="ray")
+    finally:
+        ray.shutdown()
+    assert summary.outcomes == {"solved": 2}
+    got = rows(tmp_path / "r.db")
+    assert sorted(r["seed"] for r in got) == [0, 1] and all(r["valid"] for r in got)
+    for r in got:  # the plans came back from the workers and are kept here
+        assert json.loads(Path(str(r["plan_file"])).read_text())["status"] == "solved"
+
+
+def test_without_ray_the_ray_executor_says_how_to_get_it(tmp_path: Path) -> None:
+    symbolic_copy(tmp_path / "p", "chain-3")
+    study = write_study(tmp_path / "s.yaml", "study: noray\ninstances: [{file: p/chain-3.mrg}]\nmethods: [{name: O}]\n")
+    code = ("import sys; sys.modules['ray'] = None\nfrom mrgc.cli import main\n"
+            f"sys.exit(main(['bench', 'run', {str(study)!r}, '--db', {str(tmp_path / 'r.db')!r}, '--executor', 'ray']))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 4 and "pip install 'mrgc[ray]'" in out.stderr and "Traceback" not in out.stderr
+
+
+# ---------------------------------------------------------------- reports
+def golden_db(tmp_path: Path) -> Path:
+    db = tmp_path / "golden.db"
+    conn = sqlite3.connect(db)
+    conn.executescript((GOLDEN / "runs.sql").read_text(encoding="utf-8"))
+    conn.close()
+    return db
+
+
+@pytest.mark.parametrize("fmt, name", [("markdown", "report.md"), ("wide", "report-wide.md"), ("csv", "report.csv")])
+def test_reports_of_a_fixed_database_are_golden(tmp_path: Path, fmt: str, name: str) -> None:
+    db = golden_db(tmp_path)
+    out = subprocess.run([*MRGC, "bench", "report", "--db", str(db), "--format", fmt], capture_output=True,
+                         text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    golden = GOLDEN / name
+    if os.environ.get("MRGC_UPDATE_GOLDEN") == "1":
+        golden.write_text(out.stdout, encoding="utf-8")
+    assert out.stdout == golden.read_text(encoding="utf-8"), f"{name} changed; regenerate with MRGC_UPDATE_GOLDEN=1"
+
+
+def test_report_numbers_are_means_and_standard_errors_of_the_solved_runs(tmp_path: Path) -> None:
+    import math
+
+    from mrgc.bench import aggregate
+
+    with ResultsDB(str(golden_db(tmp_path)), readonly=True) as db:
+        runs = list(db.runs())
+        for row in aggregate(runs):
+            mine = [r for r in runs if (r["instance_set"], r["method"]) == (row.instance_set, row.method)]
+            solved = [float(r["planning_seconds"]) for r in mine if r["success"]]
+            assert row.runs == len(mine) and row.solved == len(solved)
+            assert all(r["valid"] for r in mine if r["success"] and r["plan_status"] == "solved")
+            if len(solved) >= 2:
+                mean = sum(solved) / len(solved)
+                se = math.sqrt(sum((x - mean) ** 2 for x in solved) / (len(solved) - 1) / len(solved))
+                assert row.time.mean == pytest.approx(mean) and row.time.se == pytest.approx(se)
+
+
+def test_figures_of_a_fixed_database(tmp_path: Path) -> None:
+    db = golden_db(tmp_path)
+    out = subprocess.run([*MRGC, "bench", "report", "--db", str(db), "--figures", str(tmp_path / "fig")],
+                         capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    written = sorted(p.name for p in (tmp_path / "fig").iterdir())
+    assert written == ["golden-cactus.png", "golden-success.png", "golden-time-ecdf.png"]
+    for p in (tmp_path / "fig").iterdir():
+        assert p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and p.stat().st_size > 5000
+
+
+def test_report_errors_are_one_line_with_exit_code_2(tmp_path: Path) -> None:
+    (tmp_path / "notes.txt").write_text("hello")
+    for db in (tmp_path / "none.db", tmp_path / "notes.txt"):
+        out = subprocess.run([*MRGC, "bench", "report", "--db", str(db)], capture_output=True, text=True, timeout=60)
+        assert out.returncode == 2 and out.stderr.startswith("error[E603]") and "Traceback" not in out.stderr

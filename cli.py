@@ -413,6 +413,10 @@ def build_parser() -> argparse.ArgumentParser:
     from mrgc.render.command import add_commands as add_render_commands
 
     add_render_commands(sub)  # render, graph
+
+    from mrgc.bench.command import add_bench_parser
+
+    add_bench_parser(sub)  # bench run, bench report
     return parser
 
 

@@ -39,9 +39,9 @@ file, that mrgc prints exactly the `.out` text for it, and that this page is cur
 | --- | --- |
 | 0 | success (`check`: every file is fine; `fmt --check`: every file is canonical) |
 | 1 | infeasible: no task skeleton exists under the facts (`plan`, `compile`; the reasons are printed and, for `plan`, in the plan's `why`); `fmt --check`: some file would be reformatted; `validate`: the plan is invalid |
-| 2 | input error: a bad `.mrg` file (any `E0xx`–`E2xx` code below), a bad plan file (`E5xx`) or a bad command line (`E000`) |
+| 2 | input error: a bad `.mrg` file (any `E0xx`–`E2xx` code below), a bad plan file (`E5xx`), a bad study file or results database (`E6xx`, `mrgc bench`) or a bad command line (`E000`) |
 | 3 | time limit reached before an answer |
-| 4 | a needed backend (solver or geometry library) is not installed |
+| 4 | a needed backend (solver or geometry library) is not installed; `bench run --executor ray` without Ray |
 | 5 | `plan`: every skeleton was tried and none could be grounded into a plan the validator accepts (the grounding-failure summary says why) |
 | 70 | internal error (`E070`): a bug in mrgc |
 | 130 | interrupted (Ctrl-C, SIGINT): `plan` prints what its search had (best plan, statistics, reasons) and writes no plan file |
@@ -82,6 +82,18 @@ SPECIAL = {
              "'pick_grasp'"),
     "E503": ("mrgc validate domains/packaging/pa5.mrg old.json",
              "error[E503]: old.json: schema 'mrgc-plan/0' is not supported (this mrgc reads 'mrgc-plan/1')"),
+    "E600": ("mrgc bench run study.yaml",
+             "study.yaml:4:2: error[E600]: study is not YAML: expected <block end>, but found "
+             "'<block mapping start>'\n 4 |  methods: []\n   |  ^"),
+    "E601": ("mrgc bench run study.yaml",
+             "study.yaml:6:18: error[E601]: a method: unknown key 'planer' (did you mean 'planner'?) (known: name, "
+             "planner, compile, backend, encoding, options, limits, only)\n 6 |   - {name: Ours, planer: mcts}\n"
+             "   |                  ^^^^^^"),
+    "E602": ("mrgc bench run study.yaml",
+             "study.yaml:3:5: error[E602]: instance file 'no-such.mrg' not found (looked for /home/me/no-such.mrg)"
+             "\n 3 |   - file: no-such.mrg\n   |     ^^^^^^^^^^^^^^^^^"),
+    "E603": ("mrgc bench report --db notes.txt",
+             "error[E603]: 'notes.txt' is not a results database: file is not a database"),
     "E001": ("mrgc check no-such.mrg", "error[E001]: cannot read 'no-such.mrg': No such file or directory"),
     "E002": ("mrgc check huge.mrg   # a file over 8 MiB",
              "huge.mrg:1:1: error[E002]: 'huge.mrg' is 9437184 bytes; the limit is 8388608 bytes"),

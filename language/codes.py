@@ -87,6 +87,10 @@ CLI_CODES: dict[str, str] = {
     "E501": "plan file is not JSON",
     "E502": "plan does not follow the plan schema",
     "E503": "unsupported plan schema version",
+    "E600": "study file cannot be read or is not YAML",
+    "E601": "study does not follow the study schema",
+    "E602": "study instance not found or not generated",
+    "E603": "results database cannot be used",
 }
 
 #: what each code means and how to fix it (docs/errors.md is generated from this and the golden files)
@@ -110,6 +114,17 @@ HELP: dict[str, str] = {
     "missing, has the wrong type, or holds an unknown value; the message names the first such field.",
     "E503": "The plan's `schema` names another plan format version than the one this mrgc reads "
     "(`mrgc-plan/1`); plan again, or validate with the mrgc that wrote it.",
+    "E600": "`mrgc bench run STUDY`: the study file does not exist, is not UTF-8 text, is over 1 MiB, or is "
+    "not YAML; the message gives the line and column where reading stopped.",
+    "E601": "The study is YAML but breaks the study schema (docs/bench.md): an unknown or missing key, a value "
+    "of the wrong type, a seed range that is not `a..b`, a method option `mrgc plan`/`mrgc compile` does not "
+    "have, an unknown backend or encoding. Every such error is reported at once, located in the study.",
+    "E602": "An instance entry yields no usable problem file: a `file:` that does not exist, a `glob:` that "
+    "matches no `.mrg` file, a `generate:` call `mrgc generate` rejects, or two instances with the same "
+    "name or content. (An instance file that exists but does not check reports its own diagnostics.)",
+    "E603": "`--db PATH` is not a results database of this mrgc (another SQLite file, another file, a newer "
+    "schema), does not exist (`bench report`), is being written by another `mrgc bench run`, or a method's "
+    "definition changed under the same name since its runs were recorded (give it a new name).",
     "E001": "The file does not exist, is a folder, or cannot be read.",
     "E002": "Files above the size limit (8 MiB) are refused before parsing, so a huge input cannot stall mrgc.",
     "E003": "The file holds bytes that are not UTF-8 text, or a NUL byte: probably not a `.mrg` file.",

@@ -173,8 +173,13 @@ class LatticePlanner:
 
     def _overlaps(self, part: np.ndarray, obstacle: np.ndarray) -> tuple[int, int, np.ndarray] | None:
         """Where the convex polygon ``part`` (base frame), turned to each heading and put at a cell centre,
-        meets the convex polygon ``obstacle`` (touching counts): separating axes, vectorised over headings
-        and the cells of the block that can overlap."""
+        meets the convex polygon ``obstacle`` (touching counts).
+
+        Separating axes: the two meet iff on every edge normal n of either polygon their projections
+        overlap, i.e. n·c lies in an interval [L, U] for the cell centre c.  Each interval is a slab of
+        the plane, so for a column of cells (x fixed) the centres that meet the obstacle are those whose y
+        lies in one interval: vectorised over headings, axes and columns, then compared with the rows.
+        """
         reach = float(np.max(np.hypot(part[:, 0], part[:, 1])))
         lo, hi = obstacle.min(axis=0) - reach, obstacle.max(axis=0) + reach
         i0 = max(0, math.ceil((lo[0] - self.xmin) / self.cell - 0.5))
@@ -188,21 +193,22 @@ class LatticePlanner:
         c, s = np.cos(self.headings), np.sin(self.headings)
         rot = np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2)  # (H, 2, 2)
         turned = np.einsum("hab,kb->hka", rot, part)  # (H, K, 2): the part's vertices at each heading
-        mask = np.ones((self.yaws, len(xs), len(ys)), dtype=bool)
+        axes = np.concatenate([np.broadcast_to(_normals(obstacle), (self.yaws, *_normals(obstacle).shape)),
+                               np.einsum("hab,kb->hka", rot, _normals(part))], axis=1)  # (H, A, 2)
+        p_proj = np.einsum("hka,hna->hnk", turned, axes)
+        o_proj = np.einsum("ka,hna->hnk", obstacle, axes)
         eps = 1e-9
-        # the obstacle's edge normals do not turn with the heading
-        for n in _normals(obstacle):
-            shift = n[0] * xs[:, None] + n[1] * ys[None, :]
-            p_proj, o_proj = turned @ n, obstacle @ n  # (H, K), (M,)
-            mask &= shift >= (o_proj.min() - eps - p_proj.max(-1))[:, None, None]
-            mask &= shift <= (o_proj.max() + eps - p_proj.min(-1))[:, None, None]
-        # the part's edge normals turn with it
-        for normals in np.einsum("hab,kb->kha", rot, _normals(part)):  # (H, 2) per edge
-            shift = normals[:, 0, None, None] * xs[:, None] + normals[:, 1, None, None] * ys[None, :]
-            p_proj = np.einsum("hka,ha->hk", turned, normals)
-            o_proj = obstacle @ normals.T  # (M, H)
-            mask &= shift >= (o_proj.min(0) - eps - p_proj.max(-1))[:, None, None]
-            mask &= shift <= (o_proj.max(0) + eps - p_proj.min(-1))[:, None, None]
+        low = (o_proj.min(-1) - p_proj.max(-1) - eps)[..., None]  # (H, A, 1): bounds on n·c
+        high = (o_proj.max(-1) - p_proj.min(-1) + eps)[..., None]
+        nx, ny = axes[..., 0, None], axes[..., 1, None]
+        t = nx * xs  # (H, A, columns)
+        vertical = np.abs(ny) < 1e-12
+        safe = np.where(vertical, 1.0, ny)
+        y1, y2 = (low - t) / safe, (high - t) / safe
+        inside = (t >= low) & (t <= high)  # for an axis along x: the whole column or none of it
+        y_lo = np.where(vertical, np.where(inside, -np.inf, np.inf), np.minimum(y1, y2)).max(axis=1)
+        y_hi = np.where(vertical, np.where(inside, np.inf, -np.inf), np.maximum(y1, y2)).min(axis=1)
+        mask = (ys >= y_lo[..., None]) & (ys <= y_hi[..., None])  # (H, columns, rows)
         return (i0, j0, mask) if mask.any() else None
 
     def occupancy(self, parts: Sequence[Placed], obstacles: Sequence[tuple[Hashable, Body, np.ndarray]]

@@ -19,6 +19,7 @@ query, so the same queries in the same order give the same answers.
 from __future__ import annotations
 
 import enum
+import hashlib
 from dataclasses import dataclass, field
 from typing import Iterable, Sequence
 
@@ -78,6 +79,7 @@ class Grounder:
         self._planar: dict[str, PlanarRobot] = {}
         self._grids: dict[str, DiscGrid] = {}
         self._lattices: dict[str, LatticePlanner] = {}
+        self._paths: dict[tuple[object, ...], Answer] = {}
         # planar robots wait at their start pose (as the validator assumes): obstacles for the others
         self.parked: dict[str, str] = {}
         for spec in scene.robots:
@@ -290,9 +292,21 @@ class Grounder:
         at the same time sweep), searched on the robot's lattice
         (:mod:`mrgc.geometry.lattice`: deterministic, complete at the lattice's resolution) and checked
         state by state at the validator's resolution; hopeless queries are refused at once by an
-        inscribed-disc grid test."""
+        inscribed-disc grid test.  Answers are cached: the same query (same obstacles at the same poses)
+        gets the same answer, and the search never asks twice."""
+        movers = sorted({a for a in avoid if not holding or a != holding[0]})
+        digest = hashlib.sha1()
+        for part in (np.asarray(start, dtype=float), np.asarray(goal, dtype=float),
+                     *(self.poses[a] for a in movers), *(t for _, t in busy)):
+            digest.update(np.ascontiguousarray(part).tobytes())
+        key = (robot, holding, tuple(movers), tuple(id(shape) for shape, _ in busy), digest.digest())
+        if key not in self._paths:
+            self._paths[key] = self._base_path(robot, start, goal, holding, movers, busy)
+        return self._paths[key]
+
+    def _base_path(self, robot: str, start: np.ndarray, goal: np.ndarray, holding: tuple[str, str] | None,
+                   movers: list[str], busy: Sequence[tuple[CollisionShape, np.ndarray]]) -> Answer:
         others = [name for r, name in self.parked.items() if r != robot]
-        movers = [a for a in avoid if not holding or a != holding[0]]
         against = ("fixed", *others, *movers)
         ignore = (holding[0],) if holding else ()
         if robot not in self._grids:

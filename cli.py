@@ -17,10 +17,10 @@ from typing import TYPE_CHECKING, Callable, Sequence
 
 from mrgc import __version__
 from mrgc.errors import Diagnostic, InputError, MrgcError
+from mrgc.limits import count, number
 
 if TYPE_CHECKING:
     from mrgc.language.loader import MrgFile
-    from mrgc.language.model import Problem
 
 EXIT_OK = 0
 EXIT_NO_PLAN = 1
@@ -41,11 +41,12 @@ class _Parser(argparse.ArgumentParser):
 
 
 def _report(exc: InputError) -> None:
+    from mrgc.language.files import read_regular
+
     for d in exc.diagnostics:  # errors raised past the loader (geometry) carry no source text: read it
         if d.span is not None and d.span.file not in exc.sources and os.path.isfile(d.span.file):
             try:
-                with open(d.span.file, encoding="utf-8") as fh:
-                    exc.sources[d.span.file] = fh.read()
+                exc.sources[d.span.file] = read_regular(d.span.file, 8 << 20).decode("utf-8")
             except (OSError, UnicodeDecodeError):
                 pass
     print(exc.render(), file=sys.stderr)
@@ -70,7 +71,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     status = EXIT_OK
     for path in args.files:
         try:
-            mf = parse_file(path)
+            mf = parse_file(path, **_outside(args))
         except InputError as exc:
             _report(exc)
             status = EXIT_INPUT
@@ -115,38 +116,82 @@ def cmd_fmt(args: argparse.Namespace) -> int:
                 status = status or EXIT_NO_PLAN
         elif args.write:
             if pretty != text:
-                tmp = path + ".mrgc-tmp"
-                with open(tmp, "w", encoding="utf-8") as fh:
-                    fh.write(pretty)
-                os.replace(tmp, path)
+                write_text(path, pretty, option="fmt --write")
                 print(f"{path}: reformatted")
         else:
             sys.stdout.write(pretty)
     return status
 
 
-def _load_problem(path: str, name: str | None) -> "Problem":
+def _load(args: argparse.Namespace) -> "MrgFile":
+    """The checked file of a command's FILE argument, with its ``--allow-outside`` folders."""
     from mrgc.language.loader import parse_file
 
-    return parse_file(path).problem(name)
+    return parse_file(args.file, **_outside(args))
+
+
+def _outside(args: argparse.Namespace) -> dict[str, tuple[str, ...]]:
+    """``parse_file``'s ``allow_outside`` keyword from ``--allow-outside`` (none when not given)."""
+    folders = getattr(args, "allow_outside", None)
+    return {"allow_outside": tuple(folders)} if folders else {}
+
+
+def _inputs(mf: "MrgFile") -> list[str]:
+    """Every file a command reads for ``mf``: .mrg files (the problem, its domain, includes), the meshes
+    its shapes name, and the URDFs of its robot kinds (an output may be none of them)."""
+    from mrgc.language.model import Mesh
+
+    files = list(mf.files)
+    for p in mf.problems:
+        for obj in (*p.movable, *p.fixed, *p.regions):
+            if isinstance(obj.shape, Mesh):
+                files.append(obj.shape.path)
+        for kind in p.domain.robot_kinds:
+            if kind.urdf is not None:
+                base = os.path.dirname(os.path.abspath(kind.source)) if kind.source else ""
+                files.append(os.path.join(base, kind.urdf))
+    return files
+
+
+def write_text(path: str, text: str, inputs: Sequence[str] = (), option: str = "-o") -> None:
+    """Write a command's output file safely (see :mod:`mrgc.outputs`)."""
+    from mrgc import outputs
+
+    outputs.write_text(path, text, inputs, option=option)
+
+
+def check_output(path: str | None, inputs: Sequence[str] = (), option: str = "-o") -> None:
+    """Refuse an unusable output path before any work is done (see :mod:`mrgc.outputs`)."""
+    if path is not None:
+        from mrgc import outputs
+
+        outputs.check_output(path, inputs, option=option)
 
 
 def cmd_compile(args: argparse.Namespace) -> int:
     import json
 
+    from mrgc import outputs, signals
+    from mrgc.backends.registry import backend_class
     from mrgc.planner.skeletons import compile_problem, export_model, problem_facts
 
-    problem = _load_problem(args.file, args.problem)
-    if args.skeletons < 1:
-        raise InputError([Diagnostic("E000", "--skeletons must be at least 1")])
-    facts, facts_seconds = problem_facts(problem, seed=args.seed)  # once, for the skeletons and the export
-    result = compile_problem(problem, backend=args.backend, encoding=args.encoding, skeletons=args.skeletons,
-                             max_makespan=args.max_makespan, time_limit=args.time_limit, facts=facts,
-                             seed=args.seed)
+    mf = _load(args)
+    problem = mf.problem(args.problem)
+    if args.emit:  # before any solving: a path the solver cannot write, or a format it does not write
+        check_output(args.emit, _inputs(mf), option="--emit")
+        backend_class(args.backend).check_export(args.emit)
+    with signals.activity(f"computing the facts of {problem.name} (phase 1)"):
+        facts, facts_seconds = problem_facts(problem, seed=args.seed)  # once, for the skeletons and the export
+    with signals.activity(f"generating skeletons of {problem.name} with {args.backend}"):
+        result = compile_problem(problem, backend=args.backend, encoding=args.encoding, skeletons=args.skeletons,
+                                 max_makespan=args.max_makespan, time_limit=args.time_limit, facts=facts,
+                                 seed=args.seed)
     result.stats["facts_seconds"] = round(facts_seconds, 6)
     if args.emit:
         horizon = result.skeletons[0].makespan if result.skeletons else None
-        export_model(problem, args.emit, backend=args.backend, encoding=args.encoding, horizon=horizon, facts=facts)
+        with signals.activity(f"writing the model to {args.emit}"), \
+                outputs.atomic_path(args.emit, _inputs(mf), option="--emit") as tmp:
+            export_model(problem, tmp, backend=args.backend, encoding=args.encoding, horizon=horizon, facts=facts)
     if args.format == "json":
         print(json.dumps(result.to_json(), indent=2))
     else:
@@ -173,29 +218,40 @@ def cmd_compile(args: argparse.Namespace) -> int:
 def cmd_facts(args: argparse.Namespace) -> int:
     import json
 
-    from mrgc.language.edit import facts_document
-    from mrgc.language.loader import parse_file
-    from mrgc.planner.phase1 import compute_problem_facts
+    from mrgc import signals
+    from mrgc.planner.phase1 import compute_problem_facts, facts_file
 
-    mf = parse_file(args.file)
+    mf = _load(args)
     problem = mf.problem(args.problem)
-    result = compute_problem_facts(problem, seed=args.seed, workers=args.workers)
-    header = (f"facts of problem {problem.name} computed by mrgc {__version__} (seed {args.seed}) from "
-              f"{os.path.basename(args.file)}: {len(result.facts)} facts in {result.stats['seconds']:.2f} s")
-    text = facts_document(mf.syntax, problem.name, problem.domain.name, problem.domain.source, result.facts,
-                          args.file, args.output, header)
+    check_output(args.output, _inputs(mf))
+    with signals.activity(f"computing the facts of {problem.name} (phase 1)"):
+        result = compute_problem_facts(problem, seed=args.seed, workers=args.workers)
+    doc = facts_file(mf, problem, result.facts, args.seed, __version__, args.output)
     if args.output:
-        tmp = args.output + ".mrgc-tmp"
-        with open(tmp, "w", encoding="utf-8") as fh:
-            fh.write(text)
-        os.replace(tmp, args.output)
-        print(f"{args.output}: {len(result.facts)} facts ({result.stats['seconds']:.2f} s, "
-              f"{int(result.stats['ik_solves'])} IK solves, {int(result.stats['workers'])} workers)")
-        if args.stats:
-            print(json.dumps(result.stats, indent=2))
+        for asset, data in doc.assets.items():  # local meshes and URDFs the output refers to, copied beside it
+            _write_asset(asset, data, _inputs(mf))
+        write_text(args.output, doc.text, _inputs(mf))
+        print(f"{args.output}: {len(result.facts)} facts ({int(result.stats['ik_solves'])} IK solves, "
+              f"{int(result.stats['workers'])} workers"
+              + (f"; {len(doc.assets)} mesh/URDF files copied beside it" if doc.assets else "") + ")")
     else:
-        sys.stdout.write(text)
+        sys.stdout.write(doc.text)
+    if args.stats:
+        print(json.dumps(result.stats, indent=2), file=sys.stdout if args.output else sys.stderr)
     return EXIT_OK
+
+
+def _write_asset(path: str, data: bytes, inputs: Sequence[str]) -> None:
+    from mrgc import outputs
+
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    try:
+        with open(path, "rb") as fh:
+            if fh.read(len(data) + 1) == data:
+                return  # already there (a previous run)
+    except OSError:
+        pass
+    outputs.write_bytes(path, data, inputs)
 
 
 def _progress(message: str) -> "contextlib.AbstractContextManager[object]":
@@ -208,35 +264,33 @@ def _progress(message: str) -> "contextlib.AbstractContextManager[object]":
 
 
 def cmd_plan(args: argparse.Namespace) -> int:
+    from mrgc import signals
     from mrgc.planner.outcome import EXIT_CODES, PlanStatus
     from mrgc.planner.baselines import plan_with
     from mrgc.planner.plan import file_sha256
 
-    if args.skeletons < 1 or not args.time_limit > 0 or args.time_limit == float("inf") or (
-            args.max_makespan is not None and args.max_makespan < 1):
-        raise InputError([Diagnostic("E000", "--skeletons and --max-makespan must be at least 1, "
-                                     "--time-limit positive and finite")])
-    problem = _load_problem(args.file, args.problem)
+    mf = _load(args)
+    problem = mf.problem(args.problem)
+    check_output(args.output, _inputs(mf))
     log = (lambda line: print(line, file=sys.stderr, flush=True)) if args.verbose else None
-    with _progress(f"planning {problem.name} (phase 1, then the tree search; at most {args.time_limit:g} s)"):
+    with _progress(f"planning {problem.name} (phase 1, then the tree search; at most {args.time_limit:g} s)"), \
+            signals.activity(f"planning {problem.name}"):
         plan = plan_with(args.planner, problem, args.file, file_sha256(args.file), __version__, backend=args.backend,
                          encoding=args.encoding, seed=args.seed, time_limit=args.time_limit, c=args.c,
                          alpha=args.alpha, skeletons=args.skeletons, max_makespan=args.max_makespan,
                          anytime=args.anytime, log=log)
     status = PlanStatus(plan.status)
-    out = sys.stderr if not args.output or status is PlanStatus.INTERRUPTED else sys.stdout
-    if status is not PlanStatus.INTERRUPTED:  # an interrupted run writes no result, only what it had
+    # a signal ends the run as interrupted even where the search did not see it (never a verdict, never a file)
+    interrupted = status is PlanStatus.INTERRUPTED or signals.received() is not None
+    out = sys.stderr if not args.output or interrupted else sys.stdout
+    if not interrupted:  # an interrupted run writes no result, only what it had
         text = plan.dumps()
         if args.output:
-            tmp = args.output + ".mrgc-tmp"
-            with open(tmp, "w", encoding="utf-8") as fh:
-                fh.write(text)
-            os.replace(tmp, args.output)
+            write_text(args.output, text, _inputs(mf))
         else:
             sys.stdout.write(text)
     else:
-        print(f"mrgc: {'terminated (SIGTERM)' if _SIGNALLED else 'interrupted'}; no plan file written. "
-              "The search so far:", file=out)
+        print(f"mrgc: {signals.describe()}; no plan file written. The search so far:", file=out)
     for line in plan.summary():
         print(line, file=out)
     st = plan.stats
@@ -247,18 +301,17 @@ def cmd_plan(args: argparse.Namespace) -> int:
     if plan.validation:
         print(f"  validated: {plan.validation['plans_checked']} complete plan(s) replayed by the validator, "
               f"the returned one valid", file=out)
-    if status is PlanStatus.INTERRUPTED and _SIGNALLED:
-        return EXIT_TERMINATED
+    if interrupted:
+        return signals.exit_code()
     return EXIT_CODES[status]
 
 
 def cmd_validate(args: argparse.Namespace) -> int:
     import json
 
-    from mrgc.language.loader import parse_file
     from mrgc.planner.validate import load_plan, validate
 
-    mf = parse_file(args.file)
+    mf = _load(args)
     plan = load_plan(args.plan)
     name = args.problem
     if name is None and len(mf.problems) > 1 and any(p.name == plan["problem"] for p in mf.problems):
@@ -281,22 +334,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
     if not args.output:
         sys.stdout.write(text)
         return EXIT_OK
-    if os.path.exists(args.output) and os.path.samefile(args.output, domain_path(args.kind)):
-        raise InputError([Diagnostic("E000", f"will not overwrite the domain the generator reads: {args.output}")])
-    folder = os.path.dirname(os.path.abspath(args.output))
-    import tempfile
-
-    tmp = None
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=".mrgc-generate-", suffix=".tmp", dir=folder)
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
-        os.replace(tmp, args.output)
-    except OSError as exc:
-        raise InputError([Diagnostic("E000", f"cannot write {args.output}: {exc.strerror or exc}")]) from None
-    finally:
-        if tmp is not None and os.path.exists(tmp):
-            os.unlink(tmp)
+    write_text(args.output, text, [domain_path(args.kind)])
     print(f"{args.output}: {args.kind} problem written")
     return EXIT_OK
 
@@ -318,14 +356,19 @@ def cmd_backends(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def threading_main() -> bool:
-    """Whether this is the main thread (only it may install signal handlers)."""
-    import threading
-
-    return threading.current_thread() is threading.main_thread()
-
-
 # ---------------------------------------------------------------- wiring
+def add_seed(p: argparse.ArgumentParser, metavar: str | None = None) -> None:
+    """``--seed`` (bounded, see mrgc.limits)."""
+    p.add_argument("--seed", type=count("--seed"), default=0, metavar=metavar)
+
+
+def add_allow_outside(p: argparse.ArgumentParser) -> None:
+    """``--allow-outside PATH``: a folder tree meshes and URDFs may come from besides the problem's own."""
+    p.add_argument("--allow-outside", action="append", metavar="PATH",
+                   help="also read mesh and URDF files under this folder (default: only the problem file's "
+                        "folder tree and pybullet_data; repeatable)")
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="mrgc", description="Multi-robot geometric task-and-motion planning compiler and solver.")
     parser.add_argument("--version", action="version", version=f"mrgc {__version__}")
@@ -334,6 +377,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("check", help="parse and check .mrg files, reporting every error at once")
     p.add_argument("files", nargs="+", metavar="FILE")
     p.add_argument("-q", "--quiet", action="store_true", help="print nothing for files that are fine")
+    add_allow_outside(p)
     p.set_defaults(func=cmd_check)
 
     p = sub.add_parser("fmt", help="print a .mrg file in canonical form")
@@ -347,9 +391,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("file", metavar="FILE")
     p.add_argument("-o", "--output", metavar="OUT", help="write here (default: standard output)")
     p.add_argument("--problem", help="which problem of the file (default: its only one)")
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--workers", type=int, default=None, help="processes (default: one per robot, at most one per core)")
+    add_seed(p)
+    p.add_argument("--workers", type=count("--workers"), default=None,
+                   help="processes (default: one per robot; capped at one per robot and one per core)")
     p.add_argument("--stats", action="store_true", help="also print timing statistics as JSON")
+    add_allow_outside(p)
     p.set_defaults(func=cmd_facts)
 
     p = sub.add_parser("compile", help="build the task graph and generate task skeletons with a solver backend")
@@ -358,11 +404,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--backend", default="cpsat", help="mip | smt | pysmt | cpsat (default cpsat; see mrgc backends)")
     p.add_argument("--encoding", default="time-of-move",
                    help="paper | disaggregated | time-of-move (default time-of-move)")
-    p.add_argument("--skeletons", type=int, default=1, metavar="K", help="how many skeletons (default 1)")
-    p.add_argument("--max-makespan", type=int, default=None, metavar="T",
-                   help="horizon limit (default: the number of objects in the task graph)")
-    p.add_argument("--time-limit", type=float, default=None, metavar="S", help="seconds for the whole search")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--skeletons", type=count("--skeletons"), default=1, metavar="K",
+                   help="how many skeletons (default 1)")
+    p.add_argument("--max-makespan", type=count("--max-makespan"), default=None, metavar="T",
+                   help="horizon limit (default and cap: the number of objects in the task graph)")
+    p.add_argument("--time-limit", type=number("--time-limit", positive=True), default=None, metavar="S",
+                   help="seconds for the whole search")
+    add_seed(p)
+    add_allow_outside(p)
     p.add_argument("--emit", metavar="PATH", help="also write the model: .lp/.mps (mip), .smt2 (smt), .pbtxt (cpsat)")
     p.add_argument("--format", choices=["text", "json"], default="text")
     p.set_defaults(func=cmd_compile)
@@ -375,16 +424,19 @@ def build_parser() -> argparse.ArgumentParser:
                    help="mcts (the paper's method, default) | ap1 (its baseline Ap1; docs/baselines.md)")
     p.add_argument("--backend", default="cpsat")
     p.add_argument("--encoding", default="time-of-move")
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--time-limit", type=float, default=60.0, metavar="S")
-    p.add_argument("--skeletons", type=int, default=5, metavar="K", help="skeletons per generator call (default 5)")
-    p.add_argument("--max-makespan", type=int, default=None, metavar="T")
-    p.add_argument("-c", type=float, default=1.0, help="PUCT exploration constant (default 1)")
-    p.add_argument("--alpha", type=float, default=1.0, help="reward weight of fewer moved objects (default 1)")
+    add_seed(p)
+    p.add_argument("--time-limit", type=number("--time-limit", positive=True), default=60.0, metavar="S")
+    p.add_argument("--skeletons", type=count("--skeletons"), default=5, metavar="K",
+                   help="skeletons per generator call (default 5)")
+    p.add_argument("--max-makespan", type=count("--max-makespan"), default=None, metavar="T")
+    p.add_argument("-c", type=number("-c"), default=1.0, help="PUCT exploration constant (default 1)")
+    p.add_argument("--alpha", type=number("--alpha"), default=1.0,
+                   help="reward weight of fewer moved objects (default 1)")
     p.add_argument("--anytime", action="store_true",
                    help="keep searching after the first plan until the time limit; return the best "
                         "(makespan, then objects moved)")
     p.add_argument("-v", "--verbose", action="store_true", help="print a search log line per grounded skeleton")
+    add_allow_outside(p)
     p.set_defaults(func=cmd_plan)
 
     p = sub.add_parser("validate", help="independently re-check a plan: replay it in pybullet, check every step")
@@ -392,6 +444,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("plan", metavar="PLAN", help="the plan JSON (mrgc plan -o PLAN)")
     p.add_argument("--problem", help="which problem of the file (default: the one the plan names, else its only one)")
     p.add_argument("--format", choices=["text", "json"], default="text")
+    add_allow_outside(p)
     p.set_defaults(func=cmd_validate)
 
     p = sub.add_parser("generate", help="write a random problem: packaging (arms, table, bins) or box-moving (rooms)")
@@ -402,7 +455,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--others", type=int, default=None, metavar="K", help="other objects (default 2)")
     p.add_argument("--preset", metavar="NAME", help="a suite of the paper: pa5, pa7, pa10, pa18 (--robots 2-6) "
                    "(packaging), bo8 (box-moving); fixes the counts (docs/generators.md)")
-    p.add_argument("--seed", type=int, default=0, metavar="S")
+    add_seed(p, "S")
     p.add_argument("-o", "--output", metavar="FILE", help="write here (default: standard output)")
     p.set_defaults(func=cmd_generate)
 
@@ -420,55 +473,60 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-EXIT_TERMINATED = 143
-
-
-class Terminated(KeyboardInterrupt):
-    """SIGTERM, raised where the process is (like Ctrl-C) so that every command stops the same way."""
-
-
-_SIGNALLED: list[int] = []  # SIGTERM seen (a search that stops on it reports "interrupted")
-
-
-def _on_sigterm(signum: int, frame: object) -> None:
-    _SIGNALLED.append(signum)
-    raise Terminated()
-
-
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run the CLI; returns the exit code (the console script exits with it)."""
-    import signal
+    """Run the CLI; returns the exit code (the console script exits with it).
+
+    SIGINT and SIGTERM follow the one policy of :mod:`mrgc.signals` while a command runs (exit 130 / 143,
+    workers killed, nothing written); Python's defaults are restored when ``main`` returns.
+    """
+    from mrgc import signals
 
     parser = build_parser()
+    signals.reset()
+    signals.install()
     try:
-        if threading_main():
-            signal.signal(signal.SIGTERM, _on_sigterm)
         args = parser.parse_args(argv)
         if not getattr(args, "func", None):
             parser.print_help()
             return EXIT_INPUT
         func: Callable[[argparse.Namespace], int] = args.func
-        return func(args)
+        code = func(args)
+        if signals.received() is not None and code not in signals.EXIT_CODES.values():
+            # something swallowed the signal's exception: the signal still ends the run
+            print(f"mrgc: {signals.describe()}", file=sys.stderr)
+            return signals.exit_code()
+        return code
     except SystemExit as exc:  # argparse --help / --version / usage errors
         return exc.code if isinstance(exc.code, int) else EXIT_INPUT
+    except KeyboardInterrupt as exc:  # SIGINT, or SIGTERM (signals.Terminated)
+        print(f"mrgc: {signals.describe(exc)}; nothing written", file=sys.stderr)
+        return signals.exit_code(signal_of(exc))
     except InputError as exc:
         _report(exc)
         return exc.exit_code
     except MrgcError as exc:
         print(f"mrgc: error: {exc}", file=sys.stderr)
         return exc.exit_code
-    except Terminated:
-        print("mrgc: terminated (SIGTERM)", file=sys.stderr)
-        return EXIT_TERMINATED
-    except KeyboardInterrupt:
-        print("mrgc: interrupted", file=sys.stderr)
-        return EXIT_INTERRUPTED
     except BrokenPipeError:
         return EXIT_OK
     except Exception as exc:  # noqa: BLE001 - the promise is: never a traceback
         print(f"mrgc: internal error[E070]: {type(exc).__name__}: {exc} "
               "(please report this with the input that caused it)", file=sys.stderr)
         return EXIT_INTERNAL
+    finally:
+        signals.uninstall()
+
+
+def signal_of(exc: BaseException) -> int:
+    """The signal an interrupt exception stands for (the first received, else by its type)."""
+    import signal
+
+    from mrgc import signals
+
+    got = signals.received()
+    if got is not None:
+        return got
+    return signal.SIGTERM if isinstance(exc, signals.Terminated) else signal.SIGINT
 
 
 if __name__ == "__main__":  # pragma: no cover

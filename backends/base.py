@@ -11,7 +11,7 @@ from typing import ClassVar, Sequence
 from mrgc.compiler.encodings import ENCODINGS
 from mrgc.compiler.ir import Feature, Row, SkeletonModel, Solution, Status
 from mrgc.compiler.lowering import lower
-from mrgc.errors import Diagnostic, InputError
+from mrgc.errors import Diagnostic, InputError, MrgcError
 
 
 @dataclass(frozen=True)
@@ -86,16 +86,31 @@ class Backend(ABC):
         return Solution(sol.status, (), (), seconds, sol.message)
 
     def export(self, path: str) -> None:
+        """Write the loaded model to ``path`` in the format its extension names (one of ``info.exports``).
+
+        The path is checked before the solver library sees it (some crash on a missing folder), and the
+        file must exist and be non-empty afterwards (some report failure only by a return value).
+        """
         if self.model is None:
             raise RuntimeError("export before load")
+        self.check_export(path)
+        folder = os.path.dirname(os.path.abspath(path))
+        if not os.path.isdir(folder):
+            raise InputError([Diagnostic("E006", f"cannot write {path}: folder {folder} does not exist")])
+        self._export(path)
+        if not os.path.isfile(path) or os.path.getsize(path) == 0:
+            raise MrgcError(f"backend '{self.name}' wrote nothing to {path}")
+
+    @classmethod
+    def check_export(cls, path: str) -> None:
+        """InputError E300 when this backend cannot write files of ``path``'s extension."""
         ext = os.path.splitext(path)[1].lstrip(".").lower()
-        if ext not in self.info.exports:
+        if ext not in cls.info.exports:
             from mrgc.backends.registry import feature_table
 
-            raise InputError([Diagnostic("E300", f"backend '{self.name}' cannot write .{ext} files "
-                                         f"(it writes: {', '.join('.' + e for e in self.info.exports) or 'none'})",
+            raise InputError([Diagnostic("E300", f"backend '{cls.info.name}' cannot write .{ext} files "
+                                         f"(it writes: {', '.join('.' + e for e in cls.info.exports) or 'none'})",
                                          notes=tuple(feature_table().splitlines()))])
-        self._export(path)
 
     @abstractmethod
     def _load(self, model: SkeletonModel) -> None: ...

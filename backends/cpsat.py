@@ -11,7 +11,8 @@ from typing import Any, Sequence
 
 from mrgc.backends.base import Backend, BackendInfo
 from mrgc.compiler.ir import Feature, Row, SkeletonModel, Solution, Status
-from mrgc.errors import MissingBackendError
+from mrgc.errors import MissingBackendError, MrgcError
+from mrgc.signals import stop_on_signal
 
 
 def _cp_model() -> Any:
@@ -70,7 +71,8 @@ class CpSatBackend(Backend):
         solver.parameters.catch_sigint_signal = False
         if time_limit is not None:
             solver.parameters.max_time_in_seconds = max(0.001, float(time_limit))
-        status = solver.Solve(self.m)
+        with stop_on_signal(solver.StopSearch):  # Ctrl-C / SIGTERM stop the search at once (mrgc.signals)
+            status = solver.Solve(self.m)
         if status in (cp.OPTIMAL, cp.FEASIBLE):
             values = tuple(int(solver.Value(x)) for x in self.x)
             if status == cp.OPTIMAL:
@@ -83,4 +85,5 @@ class CpSatBackend(Backend):
         return Solution(Status.ERROR, message=f"CP-SAT: {solver.StatusName(status)}")
 
     def _export(self, path: str) -> None:
-        self.m.ExportToFile(path)
+        if not self.m.ExportToFile(path):
+            raise MrgcError(f"CP-SAT could not write {path}")

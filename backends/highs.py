@@ -13,6 +13,7 @@ from typing import Any, Sequence
 from mrgc.backends.base import Backend, BackendInfo
 from mrgc.compiler.ir import Row, SkeletonModel, Solution, Status
 from mrgc.errors import MissingBackendError
+from mrgc.signals import stop_on_signal
 
 INF = float("inf")
 
@@ -99,7 +100,9 @@ class HighsBackend(Backend):
     def _solve(self, time_limit: float | None) -> Solution:
         hs = _highspy()
         self.h.setOptionValue("time_limit", float(time_limit) if time_limit is not None else INF)
-        self.h.run()
+        self.h.HandleUserInterrupt = True  # lets cancelSolve stop the run: Ctrl-C / SIGTERM (mrgc.signals)
+        with stop_on_signal(self.h.cancelSolve):
+            self.h.run()
         status = self.h.getModelStatus()
         S = hs.HighsModelStatus
         if status == S.kModelEmpty:  # no variables: only constant rows, which hold or not

@@ -14,6 +14,7 @@ from typing import Any, Sequence
 from mrgc.backends.base import Backend, BackendInfo
 from mrgc.compiler.ir import Feature, Row, SkeletonModel, Solution, Status, Terms
 from mrgc.errors import MissingBackendError
+from mrgc.signals import stop_on_signal
 
 
 def _pysmt() -> Any:
@@ -43,6 +44,8 @@ class PysmtBackend(Backend):
         mgr = self.mgr = self.env.formula_manager
         INT, BOOL = pysmt.typing.INT, pysmt.typing.BOOL
         self.solver = self.env.factory.Solver(name=self.solver_name, random_seed=int(self.seed))
+        if hasattr(self.solver, "z3"):  # z3's own SIGINT handler would swallow Ctrl-C (see _stop)
+            self.solver.z3.set("ctrl_c", False)
         self.x = [mgr.Symbol(v.name, BOOL if v.is_bool else INT) for v in model.vars]
         self.is_bool = [v.is_bool for v in model.vars]
         for x, v in zip(self.x, model.vars):
@@ -96,7 +99,8 @@ class PysmtBackend(Backend):
                     if hasattr(self.solver, "z3"):  # the z3 wrapper takes a per-check timeout
                         self.solver.z3.set("timeout", max(1, int(left * 1000)))
                 try:
-                    sat = self.solver.solve()
+                    with stop_on_signal(self._stop):
+                        sat = self.solver.solve()
                 except pysmt.exceptions.SolverReturnedUnknownResultError:
                     return self._timed_out(best)
                 if not sat:
@@ -109,6 +113,11 @@ class PysmtBackend(Backend):
         if best is None:
             return Solution(Status.INFEASIBLE)
         return Solution(Status.OPTIMAL, best)
+
+    def _stop(self) -> None:
+        """Interrupt a running check (Ctrl-C / SIGTERM, mrgc.signals); only the z3 wrapper can."""
+        if hasattr(self.solver, "z3"):
+            self.solver.z3.ctx.interrupt()
 
     def _objective_terms(self) -> Terms:
         assert self.model is not None

@@ -15,6 +15,7 @@ from typing import Any, Sequence
 from mrgc.backends.base import Backend, BackendInfo
 from mrgc.compiler.ir import Feature, Row, SkeletonModel, Solution, Status, Terms
 from mrgc.errors import MissingBackendError
+from mrgc.signals import stop_on_signal
 
 
 def _z3() -> Any:
@@ -92,8 +93,12 @@ class Z3Backend(Backend):
             watchdog = threading.Timer(time_limit + 0.05, self.ctx.interrupt)
             watchdog.daemon = True
             watchdog.start()
+        # z3's own SIGINT handler would swallow Ctrl-C (check() returns unknown: a wrong "time limit"
+        # verdict): mrgc.signals stops the check through the context instead
+        self.opt.set("ctrl_c", False)
         try:
-            res = self.opt.check()
+            with stop_on_signal(self.ctx.interrupt):
+                res = self.opt.check()
         finally:
             if watchdog is not None:
                 watchdog.cancel()

@@ -47,7 +47,10 @@ class SkeletonGenerator:
         self.graph = prune(graph)
         self.encoding = encoding
         self.make_solver = make_solver
-        self.limit = max_makespan if max_makespan is not None else max(1, len(graph.objects))
+        # a skeleton moves each object at most once and at least one per step: no makespan exceeds the
+        # number of objects, so a larger limit changes nothing but the size of time-indexed models
+        complete = max(1, len(graph.objects))
+        self.limit = min(max_makespan, complete) if max_makespan is not None else complete
         robots = max(1, len(graph.robots))
         self.horizon = max(1, math.ceil(len(graph.must_move) / robots))  # each step moves <= |R| objects
         self.found: list[frozenset[int]] = []

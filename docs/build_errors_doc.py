@@ -44,8 +44,24 @@ file, that mrgc prints exactly the `.out` text for it, and that this page is cur
 | 4 | a needed backend (solver or geometry library) is not installed; `bench run --executor ray` without Ray |
 | 5 | `plan`: every skeleton was tried and none could be grounded into a plan the validator accepts (the grounding-failure summary says why) |
 | 70 | internal error (`E070`): a bug in mrgc |
-| 130 | interrupted (Ctrl-C, SIGINT): `plan` prints what its search had (best plan, statistics, reasons) and writes no plan file |
+| 130 | interrupted (Ctrl-C, SIGINT): the command stops, says what it was doing, and writes nothing (no output file is created or changed); `plan` also prints what its search had (best plan, statistics, reasons) |
 | 143 | terminated (SIGTERM): as 130 |
+
+### Signals
+
+One policy for every command (`signals.py`; details in docs/cli.md):
+
+- **SIGINT** (Ctrl-C) exits with **130**, **SIGTERM** with **143**; the last line on standard error says
+  which and what was running, e.g. `mrgc: terminated (SIGTERM) while computing the facts of pa10 (phase 1);
+  nothing written`.
+- Worker processes (phase 1 runs one per robot) are killed and reaped before mrgc exits; they ignore
+  Ctrl-C themselves and die with mrgc even if it is killed with SIGKILL. No worker outlives the command.
+- Nothing is written as a result: an output file is only renamed into place when no signal was
+  received; its temp file is removed.
+- A signal during a solver call stops the solver at once (CP-SAT `StopSearch`, HiGHS `cancelSolve`, z3
+  `interrupt`); the solvers' own Ctrl-C handlers are switched off (CP-SAT `catch_sigint_signal = false`,
+  z3 `ctrl_c = false`) so a signal never turns into a solver verdict: an interrupted run never reports
+  "no plan" (1), a time limit (3) or a plan with exit code 0.
 
 ## Codes
 """
@@ -53,6 +69,11 @@ file, that mrgc prints exactly the `.out` text for it, and that this page is cur
 SPECIAL = {
     "E000": ("mrgc check --frobnicate x.mrg", "usage: mrgc check [-h] [-q] FILE [FILE ...]\n"
              "mrgc: error[E000]: unrecognized arguments: --frobnicate"),
+    "E005": ("mrgc facts domains/packaging/pa5.mrg -o domains/packaging/domain.mrg",
+             "error[E005]: -o domains/packaging/domain.mrg: is an input of this command; writing it would destroy "
+             "the input: choose another output file"),
+    "E006": ("mrgc compile domains/symbolic/chain-3.mrg --backend mip --emit missing-dir/m.lp",
+             "error[E006]: --emit missing-dir/m.lp: folder missing-dir does not exist"),
     "E070": ("(any input that trips a bug)", "mrgc: internal error[E070]: KeyError: 'x' "
              "(please report this with the input that caused it)"),
     "E300": ("mrgc compile domains/symbolic/chain-3.mrg --backend mip --emit model.smt2",
@@ -72,6 +93,8 @@ SPECIAL = {
              "panda_grasptarget)"),
     "E402": ("mrgc facts domains/symbolic/chain-3.mrg",
              "domains/symbolic/chain-3.mrg:25:3: error[E402]: problem 'chain-3' is symbolic: it has no geometry"),
+    "E403": ("mrgc facts p.mrg   # o1 is (mesh \"bad.obj\"), whose line 3 reads 'v nan 0 0'",
+             "bad.obj:3:1: error[E403]: mesh file 'bad.obj': coordinate 'nan' is not a finite number within 10000"),
     "E500": ("mrgc validate domains/packaging/pa5.mrg no-such.json",
              "error[E500]: cannot read plan 'no-such.json': No such file or directory"),
     "E501": ("mrgc validate domains/packaging/pa5.mrg truncated.json",

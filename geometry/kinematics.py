@@ -25,16 +25,17 @@ from __future__ import annotations
 import functools
 import math
 import os
-import struct
 import xml.etree.ElementTree as ET
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Iterator
 
 import numpy as np
 
 from mrgc.errors import Diagnostic, InputError, Span
-from mrgc.geometry import transforms as tf
 from mrgc.geometry.bullet import check_urdf, data_path, pybullet_box_distance, pybullet_fk, pybullet_ik
+from mrgc.geometry.meshes import checked_vertices, read_mesh
+from mrgc.geometry.urdf import MAX_LENGTH, Urdf, UrdfError, mesh_path, parse_urdf, scalar, urdf_error, vec
+from mrgc.geometry.urdf import origin as urdf_origin
 from mrgc.language.model import RobotKind
 
 __all__ = ["E_LINK", "E_URDF", "Collision", "Joint", "Link", "RobotModel", "load_robot_model", "model_for_kind",
@@ -178,126 +179,70 @@ class RobotModel:
 
 # ----------------------------------------------------------------------------------------- loading
 
-def resolve_urdf(urdf: str, base_dir: str, span: Span | None = None) -> str:
-    """The absolute path of ``urdf``: relative to ``base_dir`` (the .mrg file's folder) if it exists
-    there, else relative to pybullet_data; :class:`~mrgc.errors.InputError` E400 when neither exists."""
-    candidates = [urdf] if os.path.isabs(urdf) else [os.path.join(base_dir, urdf), os.path.join(data_path(), urdf)]
+def resolve_urdf(urdf: str, base_dir: str, span: Span | None = None, roots: tuple[str, ...] = ()) -> str:
+    """The real path of ``urdf``: relative to ``base_dir`` (the declaring .mrg file's folder) if it exists
+    there, else relative to pybullet_data (never the current folder); InputError E400 when neither exists,
+    E236 when ``roots`` is given and the file found is outside them and pybullet_data."""
+    from mrgc.language.loader import inside, urdf_candidates
+
+    candidates = [c for c, _ in urdf_candidates(urdf, base_dir)]
     for c in candidates:
         if os.path.isfile(c):
-            return os.path.realpath(c)
+            real = os.path.realpath(c)
+            if roots and not inside(real, roots + (os.path.realpath(data_path()),)):
+                raise InputError([Diagnostic("E236", f"robot URDF {urdf!r} is outside the folder tree of the "
+                                             f"problem and pybullet_data; pass --allow-outside FOLDER to allow it",
+                                             span)])
+            return real
     looked = " or ".join(repr(c) for c in candidates)
     raise InputError([Diagnostic(E_URDF, f"robot URDF {urdf!r} not found (looked for {looked})", span)])
 
 
-def load_robot_model(urdf: str, base_dir: str, end_effector: str, *, span: Span | None = None) -> RobotModel:
+def load_robot_model(urdf: str, base_dir: str, end_effector: str, *, span: Span | None = None,
+                     roots: tuple[str, ...] = ()) -> RobotModel:
     """Read the robot of ``urdf`` (resolved by :func:`resolve_urdf`) with ``end_effector`` as its tool link.
 
-    Raises :class:`~mrgc.errors.InputError` with E400 when the URDF is missing, malformed or refused by
-    pybullet, E401 when it has no link named ``end_effector``.  Cached per (resolved path, end effector).
+    Raises :class:`~mrgc.errors.InputError` with E400 when the URDF is missing, malformed (located at its
+    line, see :mod:`mrgc.geometry.urdf`) or refused by pybullet, E401 when it has no link named
+    ``end_effector``, E403 for a bad mesh file, E236 for a file outside ``roots`` (when given).  Cached per
+    (resolved path, end effector, roots).
     """
-    path = resolve_urdf(urdf, base_dir, span)
+    path = resolve_urdf(urdf, base_dir, span, roots)
+    note = f"robot kind declared at {span}" if span is not None else None
     try:
-        names = _parse_urdf(path).order
-    except (ET.ParseError, ValueError, KeyError) as exc:
-        raise InputError([Diagnostic(E_URDF, f"robot URDF {path!r} is malformed: {exc}", span)]) from None
+        names = parse_urdf(path).order
+        model = _build_model(path, end_effector, tuple(roots)) if end_effector in names else None
+    except InputError as exc:
+        if note is not None:
+            exc.diagnostics = tuple(replace(d, notes=d.notes + (note,)) for d in exc.diagnostics)
+        raise
     refused = check_urdf(path)  # pybullet must accept the file too: it is the reference and replays plans
     if refused is not None:
         raise InputError([Diagnostic(E_URDF, f"pybullet cannot load robot URDF {path!r}: {refused}", span)])
-    if end_effector not in names:
+    if model is None:
         raise InputError([Diagnostic(
             E_LINK, f"end-effector link {end_effector!r} is not a link of {path!r} (links: {', '.join(names)})",
             span)])
-    try:
-        return _build_model(path, end_effector)
-    except ValueError as exc:
-        raise InputError([Diagnostic(E_URDF, f"robot URDF {path!r}: {exc}", span)]) from None
+    return model
 
 
 def model_for_kind(kind: RobotKind, base_dir: str) -> RobotModel:
-    """The model of a robot kind of a geometric domain (``base_dir``: folder of the file declaring it)."""
+    """The model of a robot kind of a geometric domain (``base_dir``: folder of the file declaring it;
+    the kind's ``roots`` confine its URDF and meshes)."""
     if kind.urdf is None or kind.end_effector is None:
         what = ":urdf" if kind.urdf is None else ":end-effector"
         raise InputError([Diagnostic(E_URDF, f"robot kind {kind.name!r} has no {what}", kind.span)])
-    return load_robot_model(kind.urdf, base_dir, kind.end_effector, span=kind.span)
+    return load_robot_model(kind.urdf, base_dir, kind.end_effector, span=kind.span, roots=kind.roots)
 
 
-# The URDF itself is read with the standard library rather than through pybullet's getJointInfo, whose
-# parentFrameOrn is expressed in the parent's centre-of-mass frame and comes back with the rotation inverted
-# (bullet3 issues #3253, #4231); pybullet still loads every file, as the reference and as a validity check.
-
-@dataclass(frozen=True)
-class _UrdfJoint:
-    name: str
-    kind: str
-    parent: str
-    child: str
-    origin: np.ndarray
-    axis: np.ndarray
-    lower: float
-    upper: float
-    velocity: float
-
-
-@dataclass(frozen=True)
-class _Urdf:
-    name: str
-    order: tuple[str, ...]  # links, root first, parents before children
-    joint_of: dict[str, _UrdfJoint]  # child link -> the joint attaching it
-    links: dict[str, ET.Element]
-
-
-def _vec(text: str | None, default: tuple[float, ...]) -> tuple[float, ...]:
-    if text is None:
-        return default
-    vals = tuple(float(x) for x in text.split())
-    if len(vals) != len(default):
-        raise ValueError(f"expected {len(default)} numbers, got {text!r}")
-    return vals
-
-
-def _origin(el: ET.Element | None) -> np.ndarray:
-    if el is None:
-        return np.eye(4)
-    return tf.from_xyz_rpy(_vec(el.get("xyz"), (0.0, 0.0, 0.0)), _vec(el.get("rpy"), (0.0, 0.0, 0.0)))
-
+# The URDF itself is read with the standard library (geometry/urdf.py) rather than through pybullet's
+# getJointInfo, whose parentFrameOrn is expressed in the parent's centre-of-mass frame and comes back with
+# the rotation inverted (bullet3 issues #3253, #4231); pybullet still loads every file, as the reference and
+# as a validity check.
 
 @functools.lru_cache(maxsize=None)
-def _parse_urdf(path: str) -> _Urdf:
-    root = ET.parse(path).getroot()
-    links = {el.attrib["name"]: el for el in root.findall("link")}
-    joint_of: dict[str, _UrdfJoint] = {}
-    children: dict[str, list[str]] = {}
-    for el in root.findall("joint"):
-        kind = el.attrib["type"]
-        parent, child = el.find("parent"), el.find("child")
-        if parent is None or child is None:
-            raise ValueError(f"joint {el.get('name')!r} lacks its parent or child")
-        axis = np.array(_vec(el.find("axis").get("xyz") if el.find("axis") is not None else None, (1.0, 0.0, 0.0)))
-        lim = el.find("limit")
-        lo = float(lim.get("lower", 0.0)) if lim is not None else 0.0
-        hi = float(lim.get("upper", 0.0)) if lim is not None else 0.0
-        vel = float(lim.get("velocity", 0.0)) if lim is not None else 0.0
-        if kind == "continuous" or (kind == "revolute" and lo >= hi):
-            lo, hi = -math.pi, math.pi
-        j = _UrdfJoint(el.attrib["name"], kind, parent.attrib["link"], child.attrib["link"], _origin(el.find("origin")),
-                       axis / np.linalg.norm(axis) if np.linalg.norm(axis) > 0 else axis, lo, hi, vel)
-        joint_of[j.child] = j
-        children.setdefault(j.parent, []).append(j.child)
-    roots = [name for name in links if name not in joint_of]
-    if len(roots) != 1:
-        raise ValueError(f"expected one root link, found {roots}")
-    order: list[str] = []
-    stack = [roots[0]]
-    while stack:  # depth first, children in document order
-        name = stack.pop()
-        order.append(name)
-        stack.extend(reversed(children.get(name, [])))
-    return _Urdf(root.get("name", ""), tuple(order), joint_of, links)
-
-
-@functools.lru_cache(maxsize=None)
-def _build_model(path: str, end_effector: str) -> RobotModel:
-    urdf = _parse_urdf(path)
+def _build_model(path: str, end_effector: str, roots: tuple[str, ...] = ()) -> RobotModel:
+    urdf = parse_urdf(path)
     index = {name: i for i, name in enumerate(urdf.order)}
     ee = index[end_effector]
     chain_names: list[str] = []
@@ -307,8 +252,8 @@ def _build_model(path: str, end_effector: str) -> RobotModel:
         if j.kind in ("revolute", "continuous", "prismatic"):
             chain_names.append(k_name)
         elif j.kind != "fixed":
-            raise ValueError(f"joint {j.name!r} between the base and {end_effector!r} is {j.kind}, "
-                             f"not revolute, continuous, prismatic or fixed")
+            raise urdf_error(path, f"joint {j.name!r} between the base and {end_effector!r} is {j.kind}, "
+                                   f"not revolute, continuous, prismatic or fixed", j.line)
         k_name = j.parent
     chain_names.reverse()
 
@@ -328,7 +273,7 @@ def _build_model(path: str, end_effector: str) -> RobotModel:
             frozen = hi  # a gripper finger: open
         elif chain_index < 0 and kind == "revolute":
             frozen = float(min(max(0.0, lo), hi))
-        collisions = tuple(_collisions(urdf.links[name], path))
+        collisions = tuple(_collisions(urdf, urdf.links[name], roots))
         pts = [(c.origin[:3, :3] @ c.vertices.T).T + c.origin[:3, 3] for c in collisions if len(c.vertices)]
         links.append(Link(
             name=name, index=k, parent=parent, joint=jname, joint_kind=kind, origin=_ro(origin), axis=_ro(axis),
@@ -386,49 +331,40 @@ def _ro(a: np.ndarray) -> np.ndarray:
 
 # ------------------------------------------------------------------------------ collision geometry
 
-def _collisions(link: ET.Element, urdf: str) -> Iterator[Collision]:
+def _collisions(urdf: Urdf, link: ET.Element, roots: tuple[str, ...]) -> Iterator[Collision]:
+    data = os.path.realpath(data_path()) if roots else None
     for col in link.findall("collision"):
         geom = col.find("geometry")
         shape = geom[0] if geom is not None and len(geom) else None
         if shape is None:
             continue
-        origin = _ro(_origin(col.find("origin")))
-        faces = np.zeros((0, 3), dtype=np.int64)
-        mesh_path = None
-        if shape.tag == "mesh":
-            size = _vec(shape.get("scale"), (1.0, 1.0, 1.0))
-            mesh_path = _mesh_path(shape.get("filename", ""), urdf)
-            verts, faces = read_mesh(mesh_path) if mesh_path else (np.zeros((0, 3)), faces)
-            verts = verts * np.asarray(size)
-        elif shape.tag == "box":
-            size = _vec(shape.get("size"), (0.0, 0.0, 0.0))
-            verts = np.array([[x, y, z] for x in (-.5, .5) for y in (-.5, .5) for z in (-.5, .5)]) * size
-        elif shape.tag == "sphere":
-            size = (float(shape.get("radius", 0.0)),)
-            verts = _sphere_points(size[0])
-        elif shape.tag in ("cylinder", "capsule"):
-            size = (float(shape.get("radius", 0.0)), float(shape.get("length", 0.0)))
-            verts = _ring_points(size[0], size[1], capsule=shape.tag == "capsule")
-        else:  # planes and unknown shapes carry no points
-            size, verts = (), np.zeros((0, 3))
-        faces.setflags(write=False)
-        yield Collision(kind=shape.tag, origin=origin, size=tuple(size), mesh_path=mesh_path, vertices=_ro(verts),
+        line = urdf.line(shape)
+        try:
+            org = col.find("origin")
+            origin = _ro(urdf_origin(org, urdf.line(org) if org is not None else urdf.line(col)))
+            faces = np.zeros((0, 3), dtype=np.int64)
+            mesh_file = None
+            if shape.tag == "mesh":
+                size = vec(shape.get("scale"), (1.0, 1.0, 1.0), line, MAX_LENGTH, "mesh scale")
+                mesh_file = mesh_path(shape.get("filename", ""), urdf.path, line, roots, data)
+                _, faces = read_mesh(mesh_file)
+                verts = checked_vertices(mesh_file, size)
+            elif shape.tag == "box":
+                size = vec(shape.get("size"), (0.0, 0.0, 0.0), line, MAX_LENGTH, "box size")
+                verts = np.array([[x, y, z] for x in (-.5, .5) for y in (-.5, .5) for z in (-.5, .5)]) * size
+            elif shape.tag == "sphere":
+                size = (scalar(shape.get("radius"), 0.0, line, "radius", MAX_LENGTH),)
+                verts = _sphere_points(size[0])
+            elif shape.tag in ("cylinder", "capsule"):
+                size = (scalar(shape.get("radius"), 0.0, line, "radius", MAX_LENGTH),
+                        scalar(shape.get("length"), 0.0, line, "length", MAX_LENGTH))
+                verts = _ring_points(size[0], size[1], capsule=shape.tag == "capsule")
+            else:  # planes and unknown shapes carry no points
+                size, verts = (), np.zeros((0, 3))
+        except UrdfError as exc:
+            raise urdf_error(urdf.path, str(exc), exc.line) from None
+        yield Collision(kind=shape.tag, origin=origin, size=tuple(size), mesh_path=mesh_file, vertices=_ro(verts),
                         faces=faces)
-
-
-def _mesh_path(filename: str, urdf: str) -> str | None:
-    """A mesh file named in a URDF: ``package://`` and ``file://`` stripped, relative to the URDF's folder
-    (also without the package name), as pybullet resolves it; None when no file is there."""
-    here = os.path.dirname(urdf)
-    rel = filename
-    for prefix in ("package://", "file://"):
-        if rel.startswith(prefix):
-            rel = rel[len(prefix):]
-    for cand in (rel, os.path.join(here, rel), os.path.join(here, rel.split("/", 1)[-1]),
-                 os.path.join(here, os.pardir, rel)):
-        if rel and os.path.isfile(cand):
-            return os.path.realpath(cand)
-    return None
 
 
 def _ring_points(radius: float, length: float, capsule: bool, segments: int = 16) -> np.ndarray:
@@ -444,40 +380,3 @@ def _sphere_points(radius: float) -> np.ndarray:
     d = np.array([[x, y, z] for x in (-1, 0, 1) for y in (-1, 0, 1) for z in (-1, 0, 1) if (x, y, z) != (0, 0, 0)],
                  dtype=float)
     return radius * d / np.linalg.norm(d, axis=1, keepdims=True)
-
-
-@functools.lru_cache(maxsize=256)
-def read_mesh(path: str) -> tuple[np.ndarray, np.ndarray]:
-    """Vertices (V, 3) and triangles (F, 3) of an OBJ (``v``/``f`` lines) or STL file, unscaled."""
-    if path.lower().endswith(".stl"):
-        return _read_stl(path)
-    verts: list[list[float]] = []
-    faces: list[tuple[int, int, int]] = []
-    with open(path, encoding="utf-8", errors="replace") as fh:
-        for line in fh:
-            if line.startswith("v "):
-                verts.append([float(x) for x in line.split()[1:4]])
-            elif line.startswith("f "):
-                idx = [int(tok.split("/")[0]) for tok in line.split()[1:]]
-                idx = [i - 1 if i > 0 else len(verts) + i for i in idx]
-                faces.extend((idx[0], idx[i], idx[i + 1]) for i in range(1, len(idx) - 1))
-    v = np.array(verts, dtype=float).reshape(-1, 3)
-    f = np.array(faces, dtype=np.int64).reshape(-1, 3)
-    v.setflags(write=False)
-    f.setflags(write=False)
-    return v, f
-
-
-def _read_stl(path: str) -> tuple[np.ndarray, np.ndarray]:
-    with open(path, "rb") as fh:
-        data = fh.read()
-    if len(data) >= 84:
-        (count,) = struct.unpack_from("<I", data, 80)
-        if 84 + 50 * count == len(data):
-            rec = np.frombuffer(data, dtype=np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")]),
-                                count=count, offset=84)
-            tri = rec["v"].astype(float).reshape(-1, 3)
-            return tri, np.arange(len(tri)).reshape(-1, 3)
-    tri = np.array([[float(x) for x in line.split()[1:4]] for line in data.decode(errors="replace").splitlines()
-                    if line.strip().startswith("vertex")]).reshape(-1, 3)
-    return tri, np.arange(len(tri) - len(tri) % 3).reshape(-1, 3)

@@ -20,12 +20,9 @@ and ``in-region M Re`` from the initial poses.  Everything is deterministic for 
 
 from __future__ import annotations
 
-import os
 import time
 import zlib
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
-from multiprocessing import get_context
 
 import numpy as np
 
@@ -37,6 +34,7 @@ from mrgc.geometry.kinematics import model_for_kind
 from mrgc.geometry.scene import SceneSpec, half_extents, inside
 from mrgc.geometry.transforms import translation
 from mrgc.language.model import Box, Fact
+from mrgc.workers import map_in_workers, worker_count
 
 APPROACH_SAMPLES = 5  # configurations sampled from pre-grasp to grasp for the swept volume
 LIFT = 6e-3  # placements float this much above the region floor: touching counts as colliding, and the
@@ -274,20 +272,17 @@ def _robot_worker(args: tuple[SceneSpec, str, int]) -> RobotFacts:
 
 
 def compute_facts(scene: SceneSpec, seed: int = 0, workers: int | None = None) -> FactsResult:
-    """Every fact of ``scene`` (see the module docstring); ``workers`` processes (default: one per robot,
-    at most the number of cores; 1 runs everything in this process)."""
+    """Every fact of ``scene`` (see the module docstring); ``workers`` processes (default: one per robot;
+    capped at one per robot and one per usable core; 1 runs everything in this process; see
+    :mod:`mrgc.workers` for what happens to them on an error or a signal)."""
     t0 = time.perf_counter()
     robots = [r.name for r in scene.robots]
-    n = workers if workers is not None else min(len(robots), os.cpu_count() or 1)
+    n = worker_count(workers, len(robots))
     jobs = [(scene, r, seed) for r in robots]
     for spec in scene.robots:  # load every arm model here: errors surface once, and forked workers share them
         if spec.kind.base != "planar":
             model_for_kind(spec.kind, spec.base_dir)
-    if n > 1 and len(robots) > 1:
-        with ProcessPoolExecutor(max_workers=n, mp_context=get_context("fork")) as pool:
-            per_robot = list(pool.map(_robot_worker, jobs))
-    else:
-        per_robot = [_robot_worker(j) for j in jobs]
+    per_robot = map_in_workers(_robot_worker, jobs, n)
     t_robots = time.perf_counter() - t0
     facts: set[Fact] = set()
     for rf in per_robot:

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from mrgc.errors import Diagnostic, InputError
+from mrgc.geometry.meshes import checked_vertices
 from mrgc.geometry.transforms import from_pose
 from mrgc.language.model import Box, Cylinder, GraspSpec, Mesh, Problem, RobotKind, Shape, Sphere
 
@@ -69,6 +70,8 @@ def scene_from_problem(problem: Problem) -> SceneSpec:
     if problem.symbolic:
         raise InputError([Diagnostic("E402", f"problem '{problem.name}' is symbolic: it has no geometry",
                                      problem.span)])
+    for shape in _mesh_shapes(problem):  # bad mesh files fail here, located, before any worker starts
+        mesh_vertices(shape)
     kinds = {k.name: k for k in problem.domain.robot_kinds}
     robots = []
     for r in problem.robots:
@@ -89,6 +92,12 @@ def scene_from_problem(problem: Problem) -> SceneSpec:
     )
 
 
+def _mesh_shapes(problem: Problem) -> list[Mesh]:
+    shapes = [o.shape for o in (*problem.movable, *problem.fixed, *problem.regions)]
+    shapes += [k.footprint for k in problem.domain.robot_kinds]
+    return [s for s in shapes if isinstance(s, Mesh)]
+
+
 def half_extents(shape: Shape) -> np.ndarray:
     """Half sizes of the shape's bounding box in its own frame."""
     if isinstance(shape, Box):
@@ -106,14 +115,9 @@ def mesh_half_extents(mesh: Mesh) -> np.ndarray:
 
 
 def mesh_vertices(mesh: Mesh) -> np.ndarray:
-    """The vertices of an OBJ mesh file (``v x y z`` lines), scaled."""
-    pts = []
-    with open(mesh.path, encoding="utf-8", errors="replace") as fh:
-        for line in fh:
-            if line.startswith("v "):
-                x, y, z = line.split()[1:4]
-                pts.append((float(x), float(y), float(z)))
-    return np.array(pts) * mesh.scale if pts else np.zeros((1, 3))
+    """The vertices of a mesh shape's file (OBJ or STL, checked by :mod:`mrgc.geometry.meshes`), scaled."""
+    pts = checked_vertices(mesh.path, mesh.scale)
+    return pts if len(pts) else np.zeros((1, 3))
 
 
 def outline(shape: Shape) -> np.ndarray:

@@ -62,6 +62,8 @@ class Checker:
         self.file = file
         self.diags: list[Diagnostic] = []
         self.props = PropReader(self.diags, file)
+        # names of each sort, for suggestions: built once per name table, not once per misspelt name
+        self._sorted_names: dict[str, tuple[dict[str, tuple[str, Span]], frozenset[str]]] = {}
 
     def err(self, code: str, message: str, span: Span) -> None:
         self.diags.append(Diagnostic(code, message, span))
@@ -307,8 +309,11 @@ class Checker:
                 return False
             return True
         if name not in sort_of:
-            same = [n for n, (s, _) in sort_of.items() if s == want]
-            self.err(code, f"undeclared {noun} '{name}'{did_you_mean(name, same)}", span)
+            cached = self._sorted_names.get(want)
+            if cached is None or cached[0] is not sort_of:
+                cached = (sort_of, frozenset(n for n, (s, _) in sort_of.items() if s == want))
+                self._sorted_names[want] = cached
+            self.err(code, f"undeclared {noun} '{name}'{did_you_mean(name, cached[1])}", span)
             return False
         have = sort_of[name][0]
         if have != want:

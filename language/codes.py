@@ -46,6 +46,7 @@ CODES: dict[str, str] = {
     "E233": "include leaves the problem's folder tree",
     "E234": "included file not found",
     "E235": "unknown requirement",
+    "E236": "geometry file outside the problem's folder tree",
     # grasps
     "E240": "unknown axis",
     "E241": "grasp axes not perpendicular",
@@ -61,6 +62,7 @@ CODES: dict[str, str] = {
     "E256": "unknown shape",
     "E257": "unknown base type",
     "E258": "mesh file not found",
+    "E259": "number out of range",
     # symbolic vs geometric
     "E260": "robot of a geometric problem lacks a kind",
     "E261": "symbolic problem mixes in geometry",
@@ -75,6 +77,8 @@ WARNINGS = frozenset(c for c in CODES if c.startswith("W"))
 #: codes the CLI itself uses (not produced by the front end)
 CLI_CODES: dict[str, str] = {
     "E000": "bad command line",
+    "E005": "output file is an input of the command",
+    "E006": "output file cannot be written",
     "E070": "internal error",
     "E300": "backend cannot export this format",
     "E301": "unknown backend",
@@ -83,6 +87,7 @@ CLI_CODES: dict[str, str] = {
     "E400": "robot URDF not found or unreadable",
     "E401": "end-effector link not in the URDF",
     "E402": "geometry asked of a symbolic problem",
+    "E403": "mesh file unreadable or invalid",
     "E500": "plan file cannot be read",
     "E501": "plan file is not JSON",
     "E502": "plan does not follow the plan schema",
@@ -96,6 +101,12 @@ CLI_CODES: dict[str, str] = {
 #: what each code means and how to fix it (docs/errors.md is generated from this and the golden files)
 HELP: dict[str, str] = {
     "E000": "The command line is wrong (unknown option, missing argument). `mrgc COMMAND --help` shows usage.",
+    "E005": "An output path (`-o`, `--emit`) names a file the command reads: the problem file, its domain, "
+    "an include, a mesh or a URDF (also through a symlink or a hard link). Writing it would destroy the input; "
+    "choose another output file.",
+    "E006": "An output path that cannot be written: a folder, a FIFO or device, a file under a folder that "
+    "does not exist or is not writable. Checked before any work is done. Outputs are written to a temp file "
+    "in the target's folder and renamed over it (docs/cli.md).",
     "E070": "A bug in mrgc. The message names the Python exception; please report it with the input.",
     "E300": "`--emit` names a file type the backend does not write (mip: .lp .mps; smt: .smt2; cpsat: "
     ".pbtxt). The message is followed by the backend × feature table.",
@@ -105,6 +116,9 @@ HELP: dict[str, str] = {
     "E400": "A robot kind's `:urdf` names no readable URDF (looked up beside the .mrg file, then in "
     "pybullet_data), or pybullet refuses the file.",
     "E401": "A robot kind's `:end-effector` is not a link of its URDF; the message lists the links.",
+    "E403": "A mesh file (of a `(mesh ...)` shape or of a URDF link) that cannot be used: not a regular file, "
+    "too large, a coordinate that is not a finite number or beyond 10 km (after scaling), a face naming a "
+    "vertex that does not exist. The message gives the file and line.",
     "E402": "`mrgc facts` (or another geometric command) was run on a symbolic problem, which has no geometry.",
     "E500": "`mrgc validate FILE PLAN`: the plan file does not exist, is a folder, is not UTF-8 text or cannot "
     "be read.",
@@ -163,6 +177,10 @@ HELP: dict[str, str] = {
     "E233": "An include path that resolves outside the folder of the file being checked.",
     "E234": "An include path that names no file.",
     "E235": "A requirement flag that mrgc does not know.",
+    "E236": "A mesh file of a shape, or a robot kind's `:urdf`, that lies outside the folder tree of the file "
+    "being checked (URDFs may also come from pybullet_data). Like includes, geometry files are confined so a "
+    "problem file cannot make mrgc read arbitrary files; `--allow-outside FOLDER` allows a folder. The mesh "
+    "files a URDF names are confined the same way when the geometry is loaded.",
     "E240": "A grasp's `:approach` and `:fingers` are axis words of the object frame: `+x -x +y -y +z -z` "
     "(`x` means `+x`).",
     "E241": "A grasp's approach axis and finger axis must be perpendicular (the fingers close across the "
@@ -185,6 +203,8 @@ HELP: dict[str, str] = {
     "E256": "Shapes are `box`, `cylinder`, `sphere` and `mesh`.",
     "E257": "A robot kind's `:base` is `fixed` or `planar`.",
     "E258": "A mesh file that does not exist (paths are relative to the declaring file).",
+    "E259": "A number beyond 10,000 in magnitude (metres, radians: larger values are unit mistakes and "
+    "overflow the geometry), or a size below 1 micrometre.",
     "E260": "In a geometric problem every robot needs a `:kind` from the domain.",
     "E261": "A problem whose movable objects have no shapes is symbolic; it may not give shapes, poses, "
     "robot bases or handover positions to anything.",

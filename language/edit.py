@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Iterable
+from typing import Callable, Iterable
 
 from mrgc.language import ast
 from mrgc.language.model import Fact
@@ -52,13 +52,41 @@ def _strip(node: object) -> object:
     return replace(node, **changes)  # type: ignore[type-var]
 
 
+#: ``relocate(path, what, declaring_file)`` -> the path to write instead; ``what`` is ``mesh``, ``urdf``
+#: or ``include``; ``declaring_file`` the file the path was written in (it is relative to its folder)
+Relocate = Callable[[str, str, str], str]
+
+
+def relocate_paths(node: object, relocate: Relocate, declaring_file: str) -> object:
+    """``node`` with every file path it names (a ``:urdf`` string, a ``(mesh "file")`` shape, an
+    ``(:include "file")``) replaced by ``relocate(path, what, declaring_file)``."""
+    from dataclasses import fields, is_dataclass, replace
+
+    if isinstance(node, tuple):
+        return tuple(relocate_paths(n, relocate, declaring_file) for n in node)
+    if isinstance(node, ast.Include):
+        return replace(node, path=relocate(node.path, "include", declaring_file))
+    if isinstance(node, ast.Property) and node.key == "urdf" and isinstance(node.value, ast.String):
+        return replace(node, value=replace(node.value, value=relocate(node.value.value, "urdf", declaring_file)))
+    if (isinstance(node, ast.ListValue) and len(node.items) >= 2 and isinstance(node.items[0], ast.Symbol)
+            and node.items[0].name == "mesh" and isinstance(node.items[1], ast.String)):
+        path = replace(node.items[1], value=relocate(node.items[1].value, "mesh", declaring_file))
+        return replace(node, items=(node.items[0], path, *node.items[2:]))
+    if not is_dataclass(node) or isinstance(node, type):
+        return node
+    changes = {f.name: relocate_paths(getattr(node, f.name), relocate, declaring_file) for f in fields(node)
+               if isinstance(getattr(node, f.name), tuple) or is_dataclass(getattr(node, f.name))}
+    return replace(node, **changes)  # type: ignore[type-var]
+
+
 def facts_document(source: ast.SourceFile, problem_name: str, domain_name: str, domain_file: str,
-                   facts: Iterable[Fact], source_path: str, out_path: str | None, header: str) -> str:
+                   facts: Iterable[Fact], source_path: str, out_path: str | None, header: str,
+                   relocate: Relocate | None = None) -> str:
     """The text ``mrgc facts`` writes: ``problem_name`` with its ``:init`` completed by ``facts``.
 
     The domain comes along when the source file defines it, or when the output is written to another
     folder than the source (then a copy of the domain definition replaces the problem's includes, so the
-    facts file stands on its own).
+    facts file stands on its own, and every file path it names is passed through ``relocate``).
     """
     import os
 
@@ -80,5 +108,8 @@ def facts_document(source: ast.SourceFile, problem_name: str, domain_name: str, 
     problem = with_init(problem, facts)
     if defs and not same_folder:
         problem = ast.ProblemDef(problem.name, tuple(s for s in problem.sections if not isinstance(s, ast.Include)))
+    if relocate is not None and not same_folder:
+        defs = [relocate_paths(d, relocate, source_path if own else domain_file) for d in defs]  # type: ignore[misc]
+        problem = relocate_paths(problem, relocate, source_path)  # type: ignore[assignment]
     tree = strip_spans(ast.SourceFile(tuple(defs) + (problem,)))
     return "".join(f"; {line}\n" for line in header.splitlines()) + format_source(tree)

@@ -4,17 +4,26 @@ A problem's domain is looked up (1) among the domains of its own file, (2) in ``
 (3) in the files named by ``(:include "path")`` (transitively).  Includes resolve relative to the including
 file and must stay inside the folder tree of the file being checked.  Any error raises
 :class:`~mrgc.errors.InputError` carrying *every* diagnostic found.
+
+Only regular files are read: a FIFO, a device or a socket is refused (E001) without opening it for
+reading, so a FIFO cannot block the command.  Geometry files are confined like includes: the mesh files of
+shapes and a robot kind's ``:urdf`` must lie in the folder tree of the file being checked, in
+pybullet_data (for a URDF), or under a folder given as ``allow_outside`` (``--allow-outside PATH``), else
+E236.  The same folders travel with each robot kind (:attr:`~mrgc.language.model.RobotKind.roots`) so
+the geometry layer confines the URDF's own mesh files the same way.
 """
 
 from __future__ import annotations
 
+import importlib.util
 import os
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from mrgc.errors import Diagnostic, InputError, Span
 from mrgc.language import ast
 from mrgc.language.check import Checker
-from mrgc.language.model import Domain, Problem
+from mrgc.language.files import FileTooLarge, read_regular
+from mrgc.language.model import Domain, Mesh, Problem
 from mrgc.language.parser import parse_text
 from mrgc.language.suggest import did_you_mean
 
@@ -33,6 +42,8 @@ class MrgFile:
     domains: tuple[Domain, ...]
     problems: tuple[Problem, ...]
     text: str = field(default="", repr=False, compare=False)
+    #: real paths of every .mrg file read: this one, its includes, the domain.mrg beside it
+    files: tuple[str, ...] = field(default=(), repr=False, compare=False)
 
     def problem(self, name: str | None = None) -> Problem:
         """The problem called ``name``, or the file's only problem when ``name`` is None."""
@@ -51,12 +62,10 @@ class MrgFile:
 def read_source(path: str) -> tuple[str | None, Diagnostic | None]:
     """The text of ``path``, or the E001/E002/E003 diagnostic saying why it cannot be used."""
     try:
-        size = os.path.getsize(path)
-        if size > MAX_BYTES:
-            return None, Diagnostic("E002", f"'{path}' is {size} bytes; the limit is {MAX_BYTES} bytes",
-                                    Span(path, 1, 1, 1, 2))
-        with open(path, "rb") as fh:
-            data = fh.read(MAX_BYTES + 1)
+        data = read_regular(path, MAX_BYTES)
+    except FileTooLarge as exc:
+        return None, Diagnostic("E002", f"'{path}' is {exc.size} bytes; the limit is {MAX_BYTES} bytes",
+                                Span(path, 1, 1, 1, 2))
     except OSError as exc:
         return None, Diagnostic("E001", f"cannot read '{path}': {exc.strerror or exc}")
     return decode(data, path)
@@ -104,6 +113,7 @@ class _Loader:
         self.trees: dict[str, ast.SourceFile | None] = {}
         self.domains: dict[str, list[Domain]] = {}  # file -> its checked domains
         self.includes: dict[str, list[str]] = {}  # file -> files it includes
+        self.files: list[str] = []  # real paths of the files read, in order
 
     def dir_of(self, path: str) -> str:
         """The folder relative paths in ``path`` resolve against (the root folder for in-memory text)."""
@@ -116,6 +126,7 @@ class _Loader:
             return self.trees[key]
         self.trees[key] = None
         if text is None:
+            self.files.append(key)
             text, diag = read_source(path)
             if diag is not None:
                 self.diags.append(diag)
@@ -215,14 +226,18 @@ def _includes(tree: ast.SourceFile) -> list[ast.Include]:
     return [s for d in tree.definitions for s in d.sections if isinstance(s, ast.Include)]
 
 
-def load(path: str, text: str | None = None, root_dir: str | None = None) -> MrgFile:
-    """Parse and check ``path`` (or ``text`` under that name); raise InputError with every diagnostic."""
+def load(path: str, text: str | None = None, root_dir: str | None = None,
+         allow_outside: tuple[str, ...] = ()) -> MrgFile:
+    """Parse and check ``path`` (or ``text`` under that name); raise InputError with every diagnostic.
+
+    ``allow_outside``: folders whose files (meshes, URDFs) may be used besides the file's own tree."""
     base = root_dir if root_dir is not None else (os.path.dirname(os.path.abspath(path)) if text is None else os.getcwd())
     loader = _Loader(base)
     tree = loader.parse(path, text)
     if tree is None:
         raise InputError(loader.diags, loader.sources)
     key = os.path.realpath(path) if text is None else path
+    roots = (loader.root_dir, *(os.path.realpath(p) for p in allow_outside))
     problems: list[Problem] = []
     if not tree.definitions:
         loader.diags.append(Diagnostic("E004", "the file defines no domain and no problem", Span(path, 1, 1, 1, 2)))
@@ -239,22 +254,88 @@ def load(path: str, text: str | None = None, root_dir: str | None = None) -> Mrg
         if domain is None:
             continue
         checker = Checker(path)
-        problems.append(checker.problem(pdef, domain))
+        problem = checker.problem(pdef, domain)
         loader.diags.extend(checker.diags)
+        loader.diags.extend(confinement(problem, roots))
+        problems.append(with_roots(problem, roots))
     if loader.diags:
         ordered = sorted(loader.diags, key=lambda d: (d.span is None, d.span or Span("", 0, 0, 0, 0)))
         raise InputError(_unique(ordered), loader.sources)
     domains = tuple(loader.domains.get(key, []))
-    return MrgFile(path, tree, domains, tuple(problems), loader.sources.get(path, ""))
+    return MrgFile(path, tree, domains, tuple(problems), loader.sources.get(path, ""), tuple(loader.files))
 
 
 def _unique(diags: list[Diagnostic]) -> list[Diagnostic]:
     return list(dict.fromkeys(diags))
 
 
-def parse_file(path: str | os.PathLike[str]) -> MrgFile:
-    """Read, parse and check a ``.mrg`` file and everything it includes."""
-    return load(os.fspath(path))
+# ---------------------------------------------------------------- where geometry files may come from
+def pybullet_data_dir() -> str | None:
+    """pybullet_data's folder, found without importing it (URDFs of robot kinds may come from there)."""
+    spec = importlib.util.find_spec("pybullet_data")
+    if spec is None or not spec.submodule_search_locations:
+        return None
+    return os.path.realpath(list(spec.submodule_search_locations)[0])
+
+
+def inside(path: str, roots: tuple[str, ...]) -> bool:
+    """Whether the real path of ``path`` lies in one of the folder trees ``roots`` (real paths)."""
+    real = os.path.realpath(path)
+    return any(os.path.commonpath([r, real]) == r for r in roots)
+
+
+def urdf_candidates(urdf: str, base_dir: str) -> list[tuple[str, bool]]:
+    """Where a ``:urdf`` path is looked for, in order, and whether each candidate is in pybullet_data:
+    relative to the declaring file's folder, then relative to pybullet_data (never the current folder)."""
+    if os.path.isabs(urdf):
+        return [(urdf, False)]
+    out = [(os.path.join(base_dir, urdf), False)]
+    data = pybullet_data_dir()
+    if data is not None:
+        out.append((os.path.join(data, urdf), True))
+    return out
+
+
+def confinement(problem: Problem, roots: tuple[str, ...]) -> list[Diagnostic]:
+    """E236 for each mesh file of a shape, and each robot kind's URDF, outside ``roots`` (URDFs may also
+    come from pybullet_data)."""
+    out = []
+    hint = "; pass --allow-outside FOLDER to allow it"
+    shown_roots = " or ".join(shown(r) for r in roots[:1])
+    for obj in (*problem.movable, *problem.fixed, *problem.regions):
+        if isinstance(obj.shape, Mesh) and not inside(obj.shape.path, roots):
+            out.append(Diagnostic("E236", f"mesh file '{obj.shape.path}' of '{obj.name}' is outside the folder "
+                                  f"tree of {shown_roots}{hint}", obj.span))
+    data = pybullet_data_dir()
+    for kind in problem.domain.robot_kinds:
+        if isinstance(kind.footprint, Mesh) and not inside(kind.footprint.path, roots):
+            out.append(Diagnostic("E236", f"mesh file '{kind.footprint.path}' of robot kind '{kind.name}' is "
+                                  f"outside the folder tree of {shown_roots}{hint}", kind.span))
+        if kind.urdf is None:
+            continue
+        base = os.path.dirname(os.path.abspath(kind.source)) if kind.source else roots[0]
+        for cand, in_data in urdf_candidates(kind.urdf, base):
+            if os.path.exists(cand):
+                if not in_data and not inside(cand, roots + ((data,) if data else ())):
+                    out.append(Diagnostic("E236", f"robot URDF '{kind.urdf}' of robot kind '{kind.name}' is "
+                                          f"outside the folder tree of {shown_roots} and pybullet_data{hint}",
+                                          kind.span))
+                break
+    return out
+
+
+def with_roots(problem: Problem, roots: tuple[str, ...]) -> Problem:
+    """``problem`` whose robot kinds carry the folders their URDF meshes may come from."""
+    if not problem.domain.robot_kinds:
+        return problem
+    kinds = tuple(replace(k, roots=roots) for k in problem.domain.robot_kinds)
+    return replace(problem, domain=replace(problem.domain, robot_kinds=kinds))
+
+
+def parse_file(path: str | os.PathLike[str], allow_outside: tuple[str, ...] = ()) -> MrgFile:
+    """Read, parse and check a ``.mrg`` file and everything it includes (``allow_outside``: folders whose
+    mesh and URDF files may be used besides the file's own folder tree)."""
+    return load(os.fspath(path), allow_outside=allow_outside)
 
 
 def parse_string(text: str, file: str = "<string>", base_dir: str | None = None) -> MrgFile:

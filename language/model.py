@@ -162,6 +162,9 @@ class RobotKind:
     gripper_opening: float = DEFAULT_GRIPPER_OPENING
     source: str = field(default="", compare=False)
     span: Span = _span()
+    #: folder trees the URDF's mesh files may come from besides pybullet_data (empty: anywhere); the
+    #: loader sets the problem file's tree and the ``--allow-outside`` folders
+    roots: tuple[str, ...] = field(default=(), compare=False)
 
 
 @dataclass(frozen=True)

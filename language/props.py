@@ -36,6 +36,12 @@ SCHEMAS: dict[str, dict[str, str]] = {
     "handover-points": {"position": "point"},
 }
 
+#: bound on every number of a property (coordinates, sizes, angles, joint values): 10 km or 10^4 rad
+#: keep the geometry's arithmetic exact enough and free of overflow (E259)
+MAX_MAGNITUDE = 1e4
+#: smallest positive size (1 micrometre): smaller shapes are a unit mistake and degenerate for collision
+MIN_LENGTH = 1e-6
+
 #: the properties that make a declaration geometric
 GEOMETRIC_PROPS = frozenset({"shape", "pose", "base", "position"})
 
@@ -86,12 +92,19 @@ class PropReader:
         if not math.isfinite(value.value):
             self.err("E251", f"{what} is not a finite number", value.span)
             return None
+        if abs(value.value) > MAX_MAGNITUDE:
+            self.err("E259", f"{what} is {_fmt(value.value)}, beyond the bound of {MAX_MAGNITUDE:g} "
+                             "(metres, radians)", value.span)
+            return None
         return value.value
 
     def _length(self, value: ast.Value, what: str) -> Optional[float]:
         x = self._number(value, what)
         if x is not None and x <= 0:
             self.err("E250", f"{what} must be positive, got {_fmt(x)}", value.span)
+            return None
+        if x is not None and x < MIN_LENGTH:
+            self.err("E259", f"{what} is {_fmt(x)}, below the smallest size of {MIN_LENGTH:g} m", value.span)
             return None
         return x
 

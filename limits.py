@@ -1,0 +1,75 @@
+"""The bounds of every number the command line takes, as argparse types.
+
+Each option's value is parsed and checked when the command line is read, so a bad number is a usage error
+(``error[E000]``, exit code 2) before any work starts: not finite (``nan``, ``inf``), not positive where a
+count or a duration is meant, or beyond a bound that keeps the solvers' own integer types and memory
+safe.  The bounds are data (:data:`BOUNDS`); docs/cli.md lists them.  Commands added later take their
+numbers through the same types (``type=limits.count("--runs", 1, 10_000)``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+from typing import Callable
+
+#: option -> (lowest, highest) accepted value; the reason for each bound is in docs/cli.md
+BOUNDS: dict[str, tuple[float, float]] = {
+    "--time-limit": (0.0, 1e6),  # seconds, > 0: about 11.6 days; z3 takes milliseconds in 32 bits
+    "--seed": (0, 2**31 - 1),  # CP-SAT's random_seed is a 32-bit signed integer
+    "--skeletons": (1, 10_000),
+    "--max-makespan": (1, 10_000),  # a skeleton moves each object at most once: makespan <= objects
+    "--workers": (1, 1_000_000),  # then capped at one per robot and one per usable core
+    "-c": (0.0, 1e6),
+    "--alpha": (0.0, 1e6),
+}
+
+
+def _int_text(text: str) -> int:
+    if len(text) > 40:  # int() of thousands of digits is slow and meaningless here
+        raise ValueError
+    return int(text)
+
+
+def count(option: str, lo: int | None = None, hi: int | None = None) -> Callable[[str], int]:
+    """An argparse type: an integer in [lo, hi] (default: ``BOUNDS[option]``)."""
+    blo, bhi = BOUNDS.get(option, (lo, hi))
+    low, high = int(lo if lo is not None else blo), int(hi if hi is not None else bhi)  # type: ignore[arg-type]
+
+    def parse(text: str) -> int:
+        try:
+            value = _int_text(text.strip())
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"must be a whole number from {low} to {high:,} (got {_shown(text)})") \
+                from None
+        if not low <= value <= high:
+            raise argparse.ArgumentTypeError(f"must be a whole number from {low} to {high:,} (got {value})")
+        return value
+
+    parse.__name__ = "integer"
+    return parse
+
+
+def number(option: str, lo: float | None = None, hi: float | None = None, *,
+           positive: bool = False) -> Callable[[str], float]:
+    """An argparse type: a finite float in [lo, hi] (default: ``BOUNDS[option]``); ``positive`` excludes
+    ``lo`` itself (a duration of 0 s is no duration)."""
+    blo, bhi = BOUNDS.get(option, (lo, hi))
+    low, high = float(lo if lo is not None else blo), float(hi if hi is not None else bhi)  # type: ignore[arg-type]
+    what = f"{'more than' if positive else 'from'} {low:g} {'and at most' if positive else 'to'} {high:g}"
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text.strip()) if len(text) <= 64 else float("nan")
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"must be a finite number {what} (got {_shown(text)})") from None
+        if not math.isfinite(value) or value > high or value < low or (positive and value <= low):
+            raise argparse.ArgumentTypeError(f"must be a finite number {what} (got {_shown(text)})")
+        return value
+
+    parse.__name__ = "number"
+    return parse
+
+
+def _shown(text: str) -> str:
+    return repr(text if len(text) <= 40 else text[:37] + "...")

@@ -105,6 +105,9 @@ SPECIAL = {
              "'pick_grasp'"),
     "E503": ("mrgc validate domains/packaging/pa5.mrg old.json",
              "error[E503]: old.json: schema 'mrgc-plan/0' is not supported (this mrgc reads 'mrgc-plan/1')"),
+    "E510": ("mrgc render domains/packaging/pa3-handover.mrg plan.json -o plan.gif   # a plan for another problem",
+             "error[E510]: plan.json: step 1: object 'o99' is not a movable object of the problem (problem "
+             "'pa3-handover')"),
     "E600": ("mrgc bench run study.yaml",
              "study.yaml:4:2: error[E600]: study is not YAML: expected <block end>, but found "
              "'<block mapping start>'\n 4 |  methods: []\n   |  ^"),

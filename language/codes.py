@@ -92,6 +92,7 @@ CLI_CODES: dict[str, str] = {
     "E501": "plan file is not JSON",
     "E502": "plan does not follow the plan schema",
     "E503": "unsupported plan schema version",
+    "E510": "plan does not fit the problem",
     "E600": "study file cannot be read or is not YAML",
     "E601": "study does not follow the study schema",
     "E602": "study instance not found or not generated",
@@ -128,6 +129,9 @@ HELP: dict[str, str] = {
     "missing, has the wrong type, or holds an unknown value; the message names the first such field.",
     "E503": "The plan's `schema` names another plan format version than the one this mrgc reads "
     "(`mrgc-plan/1`); plan again, or validate with the mrgc that wrote it.",
+    "E510": "`mrgc render FILE PLAN`: the plan names an object, robot, region or grasp the problem does not have, "
+    "a planar robot with a grasp it cannot use, or configurations of the wrong size: it was made for another "
+    "problem (or edited by hand). `mrgc validate FILE PLAN` lists every difference.",
     "E600": "`mrgc bench run STUDY`: the study file does not exist, is not UTF-8 text, is over 1 MiB, or is "
     "not YAML; the message gives the line and column where reading stopped.",
     "E601": "The study is YAML but breaks the study schema (docs/bench.md): an unknown or missing key, a value "

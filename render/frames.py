@@ -40,7 +40,7 @@ PHASES = ("to-pick", "pick", "to-handover", "handover", "to-place", "place", "ho
 KEY_PHASES = frozenset({"pick", "handover", "place"})
 ARM_SPEED = 4.0  # rad/s of the fastest joint
 BASE_SPEED = 1.5  # m/s of a planar base
-MIN_PHASE = 0.15  # s
+MIN_PHASE = 0.1  # s
 HANDOVER_PAUSE = 0.3  # s
 #: the code of a plan that does not fit its problem (names it lacks, configurations of the wrong size)
 E_PLAN_FIT = "E510"

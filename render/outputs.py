@@ -32,6 +32,8 @@ Progress = Callable[[int, int], None]  # (frames done, frames in all)
 ANIMATIONS = (".gif", ".mp4")
 #: robot poses used to frame a replay's camera: every k-th frame
 FRAMING_STRIDE = 4
+#: the HTML replay's first view is this much further away than the fitted picture's
+HTML_BACK_OFF = 1.35
 
 
 @dataclass(frozen=True)
@@ -175,7 +177,10 @@ def write_html(problem: Problem, plan: Mapping[str, Any] | None, path: str, opts
         timeline = build_timeline(world, plan, source)
         frames = timeline.frames(opts.fps)
         steps = timeline.steps
-    camera = frame_camera(world, frames, opts)
+    fitted = frame_camera(world, frames, opts)
+    # a browser window has any shape and a control bar: start further back than the fitted picture
+    camera = Camera(fitted.target + HTML_BACK_OFF * (fitted.eye - fitted.target), fitted.target, fitted.up,
+                    fitted.fov, fitted.near, fitted.far * HTML_BACK_OFF)
     t0 = time.perf_counter()
     size = write(world, frames, camera, opts.fps, path, progress)
     return {"frames": len(frames), "steps": steps, "draw_seconds": time.perf_counter() - t0, "bytes": size}

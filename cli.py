@@ -136,7 +136,7 @@ def _outside(args: argparse.Namespace) -> dict[str, tuple[str, ...]]:
     return {"allow_outside": tuple(folders)} if folders else {}
 
 
-def _inputs(mf: "MrgFile") -> list[str]:
+def inputs_of(mf: "MrgFile") -> list[str]:
     """Every file a command reads for ``mf``: .mrg files (the problem, its domain, includes), the meshes
     its shapes name, and the URDFs of its robot kinds (an output may be none of them)."""
     from mrgc.language.model import Mesh
@@ -178,7 +178,7 @@ def cmd_compile(args: argparse.Namespace) -> int:
     mf = _load(args)
     problem = mf.problem(args.problem)
     if args.emit:  # before any solving: a path the solver cannot write, or a format it does not write
-        check_output(args.emit, _inputs(mf), option="--emit")
+        check_output(args.emit, inputs_of(mf), option="--emit")
         backend_class(args.backend).check_export(args.emit)
     with signals.activity(f"computing the facts of {problem.name} (phase 1)"):
         facts, facts_seconds = problem_facts(problem, seed=args.seed)  # once, for the skeletons and the export
@@ -190,7 +190,7 @@ def cmd_compile(args: argparse.Namespace) -> int:
     if args.emit:
         horizon = result.skeletons[0].makespan if result.skeletons else None
         with signals.activity(f"writing the model to {args.emit}"), \
-                outputs.atomic_path(args.emit, _inputs(mf), option="--emit") as tmp:
+                outputs.atomic_path(args.emit, inputs_of(mf), option="--emit") as tmp:
             export_model(problem, tmp, backend=args.backend, encoding=args.encoding, horizon=horizon, facts=facts)
     if args.format == "json":
         print(json.dumps(result.to_json(), indent=2))
@@ -223,14 +223,14 @@ def cmd_facts(args: argparse.Namespace) -> int:
 
     mf = _load(args)
     problem = mf.problem(args.problem)
-    check_output(args.output, _inputs(mf))
+    check_output(args.output, inputs_of(mf))
     with signals.activity(f"computing the facts of {problem.name} (phase 1)"):
         result = compute_problem_facts(problem, seed=args.seed, workers=args.workers)
     doc = facts_file(mf, problem, result.facts, args.seed, __version__, args.output)
     if args.output:
         for asset, data in doc.assets.items():  # local meshes and URDFs the output refers to, copied beside it
-            _write_asset(asset, data, _inputs(mf))
-        write_text(args.output, doc.text, _inputs(mf))
+            _write_asset(asset, data, inputs_of(mf))
+        write_text(args.output, doc.text, inputs_of(mf))
         print(f"{args.output}: {len(result.facts)} facts ({int(result.stats['ik_solves'])} IK solves, "
               f"{int(result.stats['workers'])} workers"
               + (f"; {len(doc.assets)} mesh/URDF files copied beside it" if doc.assets else "") + ")")
@@ -271,7 +271,7 @@ def cmd_plan(args: argparse.Namespace) -> int:
 
     mf = _load(args)
     problem = mf.problem(args.problem)
-    check_output(args.output, _inputs(mf))
+    check_output(args.output, inputs_of(mf))
     log = (lambda line: print(line, file=sys.stderr, flush=True)) if args.verbose else None
     with _progress(f"planning {problem.name} (phase 1, then the tree search; at most {args.time_limit:g} s)"), \
             signals.activity(f"planning {problem.name}"):
@@ -286,7 +286,7 @@ def cmd_plan(args: argparse.Namespace) -> int:
     if not interrupted:  # an interrupted run writes no result, only what it had
         text = plan.dumps()
         if args.output:
-            write_text(args.output, text, _inputs(mf))
+            write_text(args.output, text, inputs_of(mf))
         else:
             sys.stdout.write(text)
     else:

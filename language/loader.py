@@ -177,7 +177,8 @@ class _Loader:
                 self.diags.append(Diagnostic("E232", f"include cycle: {chain}", inc.span))
                 continue
             if not os.path.isfile(real):
-                self.diags.append(Diagnostic("E234", f"included file '{inc.path}' not found (looked for {shown(target)})",
+                what = "is not a regular file" if os.path.exists(real) else "not found"
+                self.diags.append(Diagnostic("E234", f"included file '{inc.path}' {what} (looked for {shown(target)})",
                                              inc.span))
                 continue
             sub = self.parse(shown(target))

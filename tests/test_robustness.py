@@ -459,3 +459,104 @@ def test_cli_check_reports_every_file(capsys, tmp_path) -> None:
     rc, out, err = run_cli(capsys, "check", str(good), str(bad), str(tmp_path / "missing.mrg"))
     assert rc == 2
     assert "good.mrg: ok" in out and "E003" in err and "E001" in err
+
+
+# ---------------------------------------------------------------- URDF and mesh files (issue 9)
+def _fresh(folder: Path, name: str, data: str | bytes) -> str:
+    """A new file per example: the readers cache by path."""
+    path = folder / f"{len(list(folder.iterdir()))}-{name}"
+    path.write_bytes(data.encode("utf-8", "surrogatepass") if isinstance(data, str) else data)
+    return str(path)
+
+
+def _urdf_error(exc: InputError, path: str) -> None:
+    from mrgc.language.codes import CLI_CODES
+
+    codes = {d.code for d in exc.diagnostics}
+    assert codes and codes <= {"E400", "E403", "E236"} and codes <= set(CLI_CODES) | set(CODES), codes
+    assert all(d.message and "\n" not in d.message for d in exc.diagnostics)
+    assert all(d.span is not None and d.span.file == path for d in exc.diagnostics if d.code == "E400")
+
+
+links = st.lists(st.sampled_from(["a", "b", "c", "d", "e"]), min_size=1, max_size=5, unique=True)
+numbers = st.sampled_from(["0", "1", "-0.5", "nan", "inf", "-inf", "1e999", "1e300", "x", ""])
+
+
+@st.composite
+def urdf_texts(draw: st.DrawFn) -> str:
+    """URDFs with random links and joints: cycles, two parents, unknown links, bad numbers."""
+    names = draw(links)
+    joints = draw(st.lists(st.tuples(st.sampled_from(names + ["zz"]), st.sampled_from(names),
+                                     st.sampled_from(["revolute", "fixed", "prismatic", "continuous", "bogus"]),
+                                     numbers, numbers), max_size=6))
+    body = [f'<link name="{n}"><collision><geometry><box size="0.1 0.1 {draw(numbers)}"/></geometry></collision>'
+            f"</link>" for n in names]
+    for k, (parent, child, kind, x, lim) in enumerate(joints):
+        body.append(f'<joint name="j{k}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>'
+                    f'<origin xyz="{x} 0 0"/><axis xyz="0 0 1"/><limit lower="-1" upper="{lim}"/></joint>')
+    return '<robot name="r">\n' + "\n".join(body) + "\n</robot>\n"
+
+
+@SETTINGS
+@given(urdf_texts())
+def test_random_urdfs_are_read_or_refused_at_a_line(folder: Path, text: str) -> None:
+    from mrgc.geometry.urdf import parse_urdf
+
+    path = _fresh(folder, "r.urdf", text)
+    with time_limit(10):  # a joint cycle used to loop forever
+        try:
+            urdf = parse_urdf(path)
+        except InputError as exc:
+            _urdf_error(exc, path)
+            return
+    assert sorted(urdf.order) == sorted(urdf.links)  # every link once, each after its parent
+    for pos, name in enumerate(urdf.order[1:], 1):
+        assert urdf.order.index(urdf.joint_of[name].parent) < pos
+
+
+@SETTINGS
+@given(st.one_of(st.text(max_size=300), st.binary(max_size=300)))
+def test_arbitrary_urdf_bytes(folder: Path, data: str | bytes) -> None:
+    from mrgc.geometry.urdf import parse_urdf
+
+    path = _fresh(folder, "x.urdf", data)
+    with time_limit(10):
+        try:
+            parse_urdf(path)
+        except InputError as exc:
+            _urdf_error(exc, path)
+
+
+@SETTINGS
+@given(st.lists(st.one_of(st.tuples(st.just("v"), numbers, numbers, numbers).map(" ".join),
+                          st.tuples(st.just("f"), st.integers(-5, 8).map(str), st.integers(-5, 8).map(str),
+                                    st.integers(-5, 8).map(str)).map(" ".join),
+                          st.text(max_size=20)), max_size=20).map("\n".join))
+def test_random_meshes_are_finite_or_refused_at_a_line(folder: Path, text: str) -> None:
+    import numpy as np
+
+    from mrgc.geometry.meshes import MAX_COORD, read_mesh
+
+    path = _fresh(folder, "m.obj", text)
+    try:
+        v, f = read_mesh(path)
+    except InputError as exc:
+        assert [d.code for d in exc.diagnostics] == ["E403"] and exc.diagnostics[0].span is not None
+        return
+    assert np.isfinite(v).all() and (np.abs(v) <= MAX_COORD).all()
+    assert f.size == 0 or (f.min() >= 0 and f.max() < len(v))
+
+
+def test_a_fifo_include_does_not_block(tmp_path: Path) -> None:
+    import os
+
+    os.mkfifo(tmp_path / "dom.mrg")
+    (tmp_path / "p.mrg").write_text('(define (problem p) (:domain d) (:include "dom.mrg") (:robots r) (:movable o)'
+                                    ' (:regions a b) (:init (in-region o a)) (:goal (in-region o b)))\n',
+                                    encoding="utf-8")
+    with time_limit(10):
+        _, codes = try_load(parse_file, tmp_path / "p.mrg")
+    assert codes == {"E234", "E230"}  # the include is refused (not read), so the domain is missing too
+    with pytest.raises(InputError) as info:
+        parse_file(tmp_path / "p.mrg")
+    assert "'dom.mrg' is not a regular file" in info.value.render()

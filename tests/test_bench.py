@@ -172,7 +172,7 @@ def test_a_study_killed_mid_way_and_resumed_loses_no_finished_run_and_repeats_no
     study = write_study(tmp_path / "s.yaml", "study: resume\nseeds: 0..1\nlimits: {time: 30}\n"
                         "instances: [{glob: p/*.mrg, name: sym}]\nmethods: [{name: Ours}]\n")
     db = tmp_path / "r.db"
-    proc = subprocess.Popen([*MRGC, "bench", "run", str(study), "--db", str(db)], stdout=subprocess.PIPE,
+    proc = subprocess.Popen([*MRGC, "bench", "run", str(study), "--db", str(db), "--jobs", "2"], stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True)
     assert proc.stdout is not None
     seen = []
@@ -201,14 +201,18 @@ def test_a_study_killed_mid_way_and_resumed_loses_no_finished_run_and_repeats_no
 
 
 def test_a_run_past_its_wall_clock_limit_is_killed_as_a_group(tmp_path: Path) -> None:
+    """The runner's wall-clock limit (shorter than the planner's own) kills a run as a group: timeout; the
+    planner's own time limit ends a run by itself: time limit."""
     folder = packaging_copy(tmp_path / "g", "pa10")
-    study = write_study(tmp_path / "s.yaml", "study: hang\nlimits: {time: 600, wall: 2}\n"
-                        "instances: [{file: g/pa10.mrg}]\nmethods: [{name: Ours}]\n")
-    summary = run_study(str(study), str(tmp_path / "r.db"))
-    (r,) = rows(tmp_path / "r.db")
-    assert summary.outcomes == {"timeout": 1}
-    assert r["status"] == "timeout" and not r["success"] and 2 <= r["wall_seconds"] < 6  # type: ignore[operator]
-    assert r["signal"] == signal.SIGKILL and r["planning_seconds"] is None
+    study = write_study(tmp_path / "s.yaml", "study: hang\ninstances: [{file: g/pa10.mrg}]\nmethods:\n"
+                        "  - {name: Hang, limits: {time: 600, wall: 2}}\n  - {name: Short, limits: {time: 1}}\n")
+    summary = run_study(str(study), str(tmp_path / "r.db"), jobs=2)
+    hang, short = rows(tmp_path / "r.db")
+    assert summary.outcomes == {"timeout": 1, "time limit": 1}
+    assert hang["status"] == "timeout" and not hang["success"] and 2 <= hang["wall_seconds"] < 6  # type: ignore[operator]
+    assert hang["signal"] == signal.SIGKILL and hang["planning_seconds"] is None
+    assert short["status"] == "time limit" and short["exit_code"] == 3 and short["plan_status"] == "time limit"
+    assert short["planning_seconds"] >= 1 and not short["success"]  # type: ignore[operator]
     assert not leftover(str(folder))
 
 

@@ -95,6 +95,22 @@ def test_gif_has_a_frame_for_every_phase_of_every_step(plan_file: Path, tmp_path
     assert any(not np.array_equal(frames[0], f) for f in frames[1:]), "nothing moves"
 
 
+def test_drawing_in_worker_processes_gives_the_same_images(plan_file: Path, monkeypatch: pytest.MonkeyPatch
+                                                            ) -> None:
+    from mrgc.render import outputs
+
+    plan = json.loads(plan_file.read_text())
+    opts = outputs.Options(96, 72, 4.0)
+    world, _, frames, camera = outputs.replay_frames(parse_file(str(HANDOVER)).problem(None), plan, opts, "plan")
+    monkeypatch.setattr(outputs, "PARALLEL_FRAMES", len(frames) + 1)
+    alone, _ = outputs.draw(world, frames, camera, opts)
+    monkeypatch.setattr(outputs, "PARALLEL_FRAMES", 2)
+    monkeypatch.setattr("mrgc.workers.usable_cores", lambda: 2)
+    shared, _ = outputs.draw(world, frames, camera, opts)
+    assert len(alone) == len(shared) == len(frames)
+    assert all(np.array_equal(a, b) for a, b in zip(alone, shared))
+
+
 def test_held_objects_follow_the_grasp_and_land_on_the_place_pose(plan_file: Path) -> None:
     """Taking an object and putting it down do not make it jump (the plan was validated: the tool is at
     the grasp), and after the place the object is at its place_pose."""

@@ -22,7 +22,7 @@ MAY_IMPORT: dict[str, set[str]] = {
     "geometry": {"errors", "language", "workers"},
     "planner": {"errors", "language", "compiler", "backends", "geometry"},
     "generate": {"errors", "language"},
-    "render": {"errors", "language", "compiler", "backends", "geometry", "planner", "outputs"},
+    "render": {"errors", "language", "compiler", "backends", "geometry", "planner", "outputs", "workers"},
     "signals": set(),
     "workers": {"errors", "signals"},
     "outputs": {"errors", "signals"},

@@ -159,7 +159,11 @@ class WriterLock:
     def __enter__(self) -> "WriterLock":
         import fcntl
 
-        self.fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
+        try:
+            self.fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
+        except OSError as exc:
+            raise InputError([Diagnostic(E_DB, f"cannot write a results database at {self.path[:-5]}: "
+                                         f"{exc.strerror or exc}")]) from None
         try:
             fcntl.flock(self.fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:

@@ -19,7 +19,7 @@ from __future__ import annotations
 from typing import Any, Iterable, Iterator
 
 from mrgc.bench.execute import RawRun, RunTask, execute_run
-from mrgc.errors import MissingBackendError
+from mrgc.errors import Diagnostic, InputError, MissingBackendError
 
 
 def _run_remote(task: RunTask) -> RawRun:
@@ -44,7 +44,11 @@ class RayExecutor:
                 kwargs["address"] = address
             else:
                 kwargs["num_cpus"] = max(1, jobs)
-            ray.init(**kwargs)
+            try:
+                ray.init(**kwargs)
+            except Exception as exc:  # noqa: BLE001 - Ray raises several kinds for an unusable cluster
+                where = f"at {address}" if address is not None else "on this machine"
+                raise InputError([Diagnostic("E000", f"cannot start or reach Ray {where}: {exc}")]) from None
         self.pending: list[Any] = []
 
     def results(self, tasks: Iterable[RunTask]) -> Iterator[RawRun]:

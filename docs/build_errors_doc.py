@@ -108,6 +108,8 @@ SPECIAL = {
     "E510": ("mrgc render domains/packaging/pa3-handover.mrg plan.json -o plan.gif   # a plan for another problem",
              "error[E510]: plan.json: step 1: object 'o99' is not a movable object of the problem (problem "
              "'pa3-handover')"),
+    "E504": ("mrgc validate domains/packaging/pa5.mrg deep.json   # a plan nested 100,000 deep",
+             "deep.json:334:47: error[E504]: plan nests arrays and objects more than 32 deep (a plan needs 8)"),
     "E600": ("mrgc bench run study.yaml",
              "study.yaml:4:2: error[E600]: study is not YAML: expected <block end>, but found "
              "'<block mapping start>'\n 4 |  methods: []\n   |  ^"),

@@ -305,7 +305,8 @@ class ReplayScene:
     Built from a :class:`~mrgc.geometry.scene.SceneSpec`: each fixed-base robot is its URDF loaded with a
     fixed base at its base pose, its off-chain joints (a Panda's fingers) frozen as the kinematic model
     says (gripper open); each planar robot is a rigid body of its footprint shape; fixed and movable
-    objects are static collision bodies (``GEOM_BOX``, ``GEOM_CYLINDER``, ``GEOM_SPHERE``; meshes are
+    objects are static collision bodies (boxes as the convex hull of their 8 corners, because ``GEOM_BOX``'s
+    margin rounds edges and corners by up to about 1 mm; ``GEOM_CYLINDER``, ``GEOM_SPHERE``; meshes are
     ``GEOM_MESH``, which pybullet reduces to the convex hull of the file's vertices).  Robot meshes are the
     URDF's collision meshes as pybullet loads them (convex hulls too).  Distances are corrected for
     pybullet's margin around mesh shapes (:data:`MESH_MARGIN`; a link with any mesh shape counts as a mesh).
@@ -329,6 +330,7 @@ class ReplayScene:
         self.robots: dict[str, ReplayRobot] = {}
         self._owner: dict[int, str] = {}
         self._margin: dict[tuple[int, int], float] = {}  # (body, link) -> MESH_MARGIN for mesh shapes
+        self._shaped: dict[int, tuple[int, ...]] = {}  # body -> its links with collision shapes
         #: getClosestPoints calls made so far
         self.queries = 0
         try:
@@ -353,9 +355,10 @@ class ReplayScene:
     # ------------------------------------------------------------------ building
     def _shape(self, shape: Shape) -> int:
         pb, cid = self.pb, self.cid
-        if isinstance(shape, Box):
-            return int(pb.createCollisionShape(pb.GEOM_BOX, halfExtents=[shape.sx / 2, shape.sy / 2, shape.sz / 2],
-                                               physicsClientId=cid))
+        if isinstance(shape, Box):  # an 8-vertex hull: exact once MESH_MARGIN is added back (GEOM_BOX rounds)
+            h = (shape.sx / 2, shape.sy / 2, shape.sz / 2)
+            corners = [[x * h[0], y * h[1], z * h[2]] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]
+            return int(pb.createCollisionShape(pb.GEOM_MESH, vertices=corners, physicsClientId=cid))
         if isinstance(shape, Cylinder):
             return int(pb.createCollisionShape(pb.GEOM_CYLINDER, radius=shape.radius, height=shape.height,
                                                physicsClientId=cid))
@@ -374,7 +377,7 @@ class ReplayScene:
                                            physicsClientId=self.cid))
         self.bodies[name] = body
         self._owner[body] = name
-        if isinstance(shape, Mesh):
+        if isinstance(shape, (Mesh, Box)):
             self._margin[(body, -1)] = MESH_MARGIN
         if fixed:
             self.fixed.add(name)
@@ -424,6 +427,8 @@ class ReplayScene:
             raise ValueError(f"planar robot {name!r} has no footprint")
         body = int(self.pb.createMultiBody(baseMass=0, baseCollisionShapeIndex=self._shape(footprint),
                                            physicsClientId=self.cid))
+        if isinstance(footprint, (Mesh, Box)):
+            self._margin[(body, -1)] = MESH_MARGIN
         lift = tf.translation(0.0, 0.0, float(half_extents(footprint)[2]) + LIFT)
         self.robots[name] = ReplayRobot(
             name=name, body=body, planar=True, joints=(), lower=np.full(3, -math.inf), upper=np.full(3, math.inf),
@@ -452,8 +457,8 @@ class ReplayScene:
             pos, orn = tf.to_quaternion(base @ r.lift)
             self.pb.resetBasePositionAndOrientation(r.body, pos, orn, physicsClientId=self.cid)
             return
-        for j, v in zip(r.joints, q):
-            self.pb.resetJointState(r.body, j, float(v), physicsClientId=self.cid)
+        self.pb.resetJointStatesMultiDof(r.body, r.joints, [[float(v)] for v in q[: len(r.joints)]],
+                                         physicsClientId=self.cid)
 
     def set_fingers(self, robot: str, opening: float | None) -> None:
         """Open an arm's fingers ``opening`` metres apart (None: back to their frozen, fully open values)."""
@@ -473,6 +478,21 @@ class ReplayScene:
         return _pose(st[4], st[5])
 
     # ------------------------------------------------------------------ distances
+    def aabb(self, name: str) -> tuple[float, float, float, float, float, float]:
+        """The axis-aligned bounding box (min x, y, z, max x, y, z) of body ``name``'s collision shapes as
+        they stand now, all links of a robot together (pybullet's, margins included)."""
+        r = self.robots.get(name)
+        body = r.body if r is not None else self.bodies[name]
+        links = self._shaped.get(body)
+        if links is None:  # the links that have collision shapes (a link without one has no box)
+            links = self._shaped[body] = tuple(
+                link for link in (tuple(r.links) if r is not None else (-1,))
+                if self.pb.getCollisionShapeData(body, link, physicsClientId=self.cid)) or (-1,)
+        boxes = [self.pb.getAABB(body, link, physicsClientId=self.cid) for link in links]
+        lo = [min(b[0][k] for b in boxes) for k in range(3)]
+        hi = [max(b[1][k] for b in boxes) for k in range(3)]
+        return (lo[0], lo[1], lo[2], hi[0], hi[1], hi[2])
+
     def closest(self, a: str, b: str, max_distance: float = 0.0) -> Closest | None:
         """The deepest pair of points of bodies ``a`` and ``b`` (robots or objects) closer than
         ``max_distance`` (None when there is none), after the base-link rule of the class docstring."""

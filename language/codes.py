@@ -93,6 +93,7 @@ CLI_CODES: dict[str, str] = {
     "E502": "plan does not follow the plan schema",
     "E503": "unsupported plan schema version",
     "E510": "plan does not fit the problem",
+    "E504": "plan file beyond a reading limit",
     "E600": "study file cannot be read or is not YAML",
     "E601": "study does not follow the study schema",
     "E602": "study instance not found or not generated",
@@ -132,6 +133,10 @@ HELP: dict[str, str] = {
     "E510": "`mrgc render FILE PLAN`: the plan names an object, robot, region or grasp the problem does not have, "
     "a planar robot with a grasp it cannot use, or configurations of the wrong size: it was made for another "
     "problem (or edited by hand). `mrgc validate FILE PLAN` lists every difference.",
+    "E504": "The plan file is larger than 32 MiB, nests arrays and objects more than 32 deep, holds an integer "
+    "of more than 20 digits or a number beyond double precision (such as `1e999`). Checked before or while the "
+    "JSON is parsed, so no plan can exhaust memory or recursion; a plan written by `mrgc plan` stays far "
+    "within these limits.",
     "E600": "`mrgc bench run STUDY`: the study file does not exist, is not UTF-8 text, is over 1 MiB, or is "
     "not YAML; the message gives the line and column where reading stopped.",
     "E601": "The study is YAML but breaks the study schema (docs/bench.md): an unknown or missing key, a value "

@@ -5,6 +5,10 @@ handover-and-place occupying two robots) or waits.  Geometric plans carry the pl
 moved object and the robots' configurations: for an arm, the approach configurations of its pick and of
 its place (pre-grasp first), and at a handover both robots' exchange configurations; for a planar robot,
 its SE(2) paths.  Symbolic plans carry no geometry.
+
+A geometric plan states its :class:`MotionModel`: which motions it holds, and so which motions the
+validator requires and how it reads a motion the plan leaves out (docs/validator.md).  This module writes
+plans; :mod:`mrgc.planner.plan_reader` reads them back (limits, JSON Schema, typed actions).
 """
 
 from __future__ import annotations
@@ -17,6 +21,60 @@ from typing import Any
 from mrgc.planner.outcome import PlanStatus, Why
 
 SCHEMA = "mrgc-plan/1"
+
+#: ``motion_model.arms`` -> what an arm's motions in the plan are
+ARM_MODELS: dict[str, str] = {
+    "configurations": "the paper's packaging model: pick and place approaches (pre-grasp to grasp) and the "
+                      "handover configurations; a transfer holding the object is a straight joint-space move "
+                      "unless the plan gives its path; empty-handed transit is not modelled",
+    "full": "every motion is a path: to-pick, to-handover, taker-to-handover, to-place, home, giver-home, "
+            "besides the approaches and handover configurations",
+}
+#: ``motion_model.planar`` -> what a planar robot's motions in the plan are
+PLANAR_MODELS: dict[str, str] = {
+    "paths": "every motion is an SE(2) path: to-pick, to-place, home",
+}
+
+
+@dataclass(frozen=True)
+class MotionModel:
+    """Which motions a geometric plan holds.
+
+    ``arms`` and ``planar`` name entries of :data:`ARM_MODELS` and :data:`PLANAR_MODELS`;
+    ``approach_configurations`` is how many configurations each pick and place approach holds (pre-grasp
+    first, grasp last, in joint space), ``approach_back_off`` how far (m) the pre-grasp stands back from the
+    grasp along the approach axis; ``resolution`` the largest motion (rad per joint; m or rad for a planar
+    base) between two states at which the planner checked its motions.
+    """
+
+    arms: str = "configurations"
+    planar: str = "paths"
+    approach_configurations: int = 5
+    approach_back_off: float = 0.08
+    resolution: float = 0.01
+
+    def to_json(self) -> dict[str, Any]:
+        return {"arms": self.arms, "planar": self.planar,
+                "approach": {"configurations": self.approach_configurations, "back_off": self.approach_back_off},
+                "resolution": self.resolution}
+
+    @classmethod
+    def from_json(cls, data: dict[str, Any]) -> "MotionModel":
+        """The model of a schema-checked ``motion_model`` object."""
+        approach = data["approach"]
+        return cls(data["arms"], data["planar"], approach["configurations"], float(approach["back_off"]),
+                   float(data["resolution"]))
+
+
+def planner_motion_model(arms: str = "configurations") -> MotionModel:
+    """The motion model of the plans ``mrgc plan`` writes: approaches of the geometry layer's
+    ``APPROACH_SAMPLES`` configurations backed off by the grasp specification's ``APPROACH``, planar paths
+    checked every ``PATH_RESOLUTION``."""
+    from mrgc.geometry.grasps import APPROACH
+    from mrgc.geometry.grounding import PATH_RESOLUTION
+    from mrgc.geometry.predicates import APPROACH_SAMPLES
+
+    return MotionModel(arms, "paths", APPROACH_SAMPLES, APPROACH, PATH_RESOLUTION)
 
 
 @dataclass
@@ -77,6 +135,8 @@ class Plan:
     why: Why | None = None
     #: the independent validator's verdict on the returned plan (geometric plans)
     validation: dict[str, Any] | None = None
+    #: the motions a geometric plan holds (None: :func:`planner_motion_model`); symbolic plans have none
+    motion_model: MotionModel | None = None
 
     @property
     def makespan(self) -> int:
@@ -99,6 +159,7 @@ class Plan:
             "seed": self.seed,
             "status": str(PlanStatus(self.status)),
             "symbolic": self.symbolic,
+            **({} if self.symbolic else {"motion_model": (self.motion_model or planner_motion_model()).to_json()}),
             "makespan": self.makespan if self.steps else None,
             "motion_cost": self.motion_cost if self.steps else None,
             "steps": [{"index": i, "actions": [a.to_json() for a in step],

@@ -1,4 +1,5 @@
-"""Test-suite wiring: make the independent skeleton oracle importable as ``skeleton_oracle``.
+"""Test-suite wiring: make the sibling helper modules importable: the independent skeleton oracle
+(``skeleton_oracle``) and the validator's valid plans (``validator_plans``).
 
 Tests run with ``--import-mode=importlib`` and no ``tests/__init__.py``, so sibling helper modules are not
 on the import path; conftest runs first and registers the oracle once for every test module.
@@ -10,9 +11,10 @@ import importlib.util
 import sys
 from pathlib import Path
 
-if "skeleton_oracle" not in sys.modules:
-    _spec = importlib.util.spec_from_file_location("skeleton_oracle", Path(__file__).with_name("skeleton_oracle.py"))
-    assert _spec is not None and _spec.loader is not None
-    _module = importlib.util.module_from_spec(_spec)
-    sys.modules["skeleton_oracle"] = _module
-    _spec.loader.exec_module(_module)
+for _name in ("skeleton_oracle", "validator_plans"):
+    if _name not in sys.modules:
+        _spec = importlib.util.spec_from_file_location(_name, Path(__file__).with_name(f"{_name}.py"))
+        assert _spec is not None and _spec.loader is not None
+        _module = importlib.util.module_from_spec(_spec)
+        sys.modules[_name] = _module
+        _spec.loader.exec_module(_module)

@@ -1,8 +1,9 @@
 """The independent plan validator: valid plans pass; every kind of broken plan is rejected in one clear line.
 
-Geometric plans for pa3-handover are built here with the geometry layer's grounding service (tests may use
-it; the validator itself may not) and then mutated; symbolic plans for chain-3 are written by hand from
-the file's own comment (its three feasible action sets).
+Valid geometric plans come from tests/validator_plans.py (pa3-handover, built with the geometry layer's
+grounding service and IK, and a planar room); symbolic plans for chain-3 are written by hand from the
+file's own comment (its three feasible action sets).  Each doctored plan of issue 9 is a named test here;
+tests/test_validator_fuzz.py edits the same plans at random.
 """
 
 from __future__ import annotations
@@ -18,74 +19,42 @@ from typing import Any, Callable
 import numpy as np
 import pytest
 
+import validator_plans as vp
 from mrgc import cli
 from mrgc.errors import InputError
 from mrgc.geometry.grounding import Grounder
 from mrgc.geometry.ik import solve_ik_many
 from mrgc.geometry.grasps import grasp_transform
-from mrgc.geometry.scene import scene_from_problem
 from mrgc.geometry.transforms import translation
 from mrgc.language.loader import parse_file
-from mrgc.planner.plan import Plan, PlannedAction, file_sha256
+from mrgc.planner.plan import PlannedAction
 from mrgc.planner.validate import ValidationReport, load_plan, validate
 
-ROOT = Path(__file__).resolve().parent.parent
-PA3 = str(ROOT / "domains" / "packaging" / "pa3-handover.mrg")
+ROOT = vp.ROOT
+PA3 = vp.PA3
 CHAIN3 = str(ROOT / "domains" / "symbolic" / "chain-3.mrg")
-
-
-def _l(a: Any) -> list[list[float]]:
-    return [[float(v) for v in row] for row in np.atleast_2d(a)]
-
-
-def _plan(problem: Any, path: str, steps: list[list[PlannedAction]], symbolic: bool = False) -> dict[str, Any]:
-    plan = Plan(problem.name, path, file_sha256(path), "0.1.0", "cpsat", "time-of-move", 0, "solved", steps,
-                symbolic=symbolic, stats={"robots": [r.name for r in problem.robots]})
-    return json.loads(plan.dumps())  # as a file holds it
+_l, _line, _plan, _action = vp.rows, vp.line, vp.as_file, vp.action
 
 
 # ------------------------------------------------------------------------------------- pa3-handover
 @pytest.fixture(scope="module")
 def pa3() -> Any:
-    return parse_file(PA3).problem(None)
+    return vp.pa3()
 
 
 @pytest.fixture(scope="module")
 def grounder(pa3: Any) -> Grounder:
-    return Grounder(scene_from_problem(pa3), seed=0)
+    return vp.grounder()
 
 
-def _handover(g: Grounder, avoid: list[str]) -> PlannedAction:
-    """r1 picks o1 from the top, hands it to r2 at h1 (r2 grasps side-x+), r2 puts it into bin-b."""
-    pick = g.pick("r1", "o1", "top", avoid=avoid)
-    hand = g.handover("o1", "h1", "r1", "top", "r2", "side-x+", avoid=avoid)
-    spot = g.placement("o1", "bin-b", avoid=avoid)
-    assert pick.ok and hand.ok and spot.ok and spot.pose is not None
-    place = g.place("r2", "o1", "side-x+", spot.pose, avoid=avoid)
-    assert place.ok
-    return PlannedAction("o1", "bin-b", "r1", "r2", "top", "side-x+", place_pose=_l(spot.pose), handover_point="h1",
-                         configs={"pick": _l(pick.configs), "handover": _l(hand.configs), "place": _l(place.configs)})
+@pytest.fixture
+def one_step() -> dict[str, Any]:
+    return vp.one_step()
 
 
-@pytest.fixture(scope="module")
-def one_step(pa3: Any) -> dict[str, Any]:
-    g = Grounder(scene_from_problem(pa3), seed=0)
-    return _plan(pa3, PA3, [[_handover(g, ["o2", "o3"])]])
-
-
-@pytest.fixture(scope="module")
-def two_steps(pa3: Any) -> dict[str, Any]:
-    """Step 1: r1 moves o2 within start (top); step 2: the handover of o1 into bin-b."""
-    g = Grounder(scene_from_problem(pa3), seed=0)
-    pick = g.pick("r1", "o2", "top", avoid=["o1", "o3"])
-    spot = g.placement("o2", "start", avoid=["o1", "o3"])
-    assert pick.ok and spot.ok and spot.pose is not None
-    place = g.place("r1", "o2", "top", spot.pose, avoid=["o1", "o3"])
-    assert place.ok
-    first = PlannedAction("o2", "start", "r1", "r1", "top", "top", place_pose=_l(spot.pose),
-                          configs={"pick": _l(pick.configs), "place": _l(place.configs)})
-    g.move("o2", spot.pose)
-    return _plan(pa3, PA3, [[first], [_handover(g, ["o2", "o3"])]])
+@pytest.fixture
+def two_steps() -> dict[str, Any]:
+    return vp.two_steps()
 
 
 def _codes(report: ValidationReport) -> set[str]:
@@ -98,10 +67,6 @@ def test_hand_built_plans_are_valid(pa3: Any, one_step: dict[str, Any], two_step
         assert report.ok, report.lines()
         assert report.lines()[0].startswith("valid: plan for pa3-handover")
         assert report.stats["configurations"] > 40 and report.stats["distance_queries"] > 100
-
-
-def _action(plan: dict[str, Any], step: int, k: int = 0) -> dict[str, Any]:
-    return plan["steps"][step - 1]["actions"][k]  # type: ignore[no-any-return]
 
 
 def _drop_last_step(p: dict[str, Any]) -> None:
@@ -239,13 +204,155 @@ def test_paths_are_checked_and_must_connect(pa3: Any, one_step: dict[str, Any]) 
     a = _action(plan, 1)
     home = [0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785]
     pre = a["configs"]["pick"][0]
-    a["paths"] = {"to-pick": [home, [(x + y) / 2 for x, y in zip(home, pre)], pre]}
+    a["paths"]["to-pick"] = [home, [(x + y) / 2 for x, y in zip(home, pre)], pre]
     assert validate(pa3, plan, PA3).ok
     a["paths"]["to-pick"] = a["paths"]["to-pick"][:-1]
-    a["paths"]["fly"] = [home]
     lines = validate(pa3, plan, PA3).lines()
     assert any("path 'to-pick' (moving o1) ends" in x and "away from the first pick configuration" in x for x in lines)
-    assert any("unknown path 'fly'" in x for x in lines)
+    a["paths"]["fly"] = [home]  # a path the schema does not know: the plan cannot be checked (E502)
+    with pytest.raises(InputError) as err:
+        validate(pa3, plan, PA3)
+    assert "plan.steps[0].actions[0].paths has an unknown field 'fly'" in err.value.diagnostics[0].message
+
+
+# ------------------------------------------------------------------------------------- issue 9's doctored plans
+def _cli(tmp_path: Path, problem_path: str, plan: dict[str, Any], capsys: pytest.CaptureFixture[str]
+         ) -> tuple[int, list[str]]:
+    """``mrgc validate`` on ``plan``: exit code and output lines (one per violation, then the verdict)."""
+    path = tmp_path / "doctored.json"
+    path.write_text(json.dumps(plan), encoding="utf-8")
+    rc = cli.main(["validate", problem_path, str(path)])
+    cap = capsys.readouterr()
+    assert "Traceback" not in cap.err
+    return rc, cap.out.splitlines()
+
+
+def _rejected(rc: int, lines: list[str], code: str, *fragments: str) -> None:
+    assert rc == 1 and lines[-1].startswith("invalid: "), lines
+    hits = [x for x in lines if x.endswith(f"[{code}]")]
+    assert any(all(f in x for f in fragments) for x in hits), lines
+
+
+def test_doctored_every_planar_path_deleted(room: tuple[str, Any, dict[str, Any]], tmp_path: Path,
+                                            capsys: pytest.CaptureFixture[str]) -> None:
+    path, _, plan = room
+    assert _cli(tmp_path, path, plan, capsys)[0] == 0
+    del _action(plan, 1)["paths"]
+    rc, lines = _cli(tmp_path, path, plan, capsys)
+    for name in ("to-pick", "to-place", "home"):
+        _rejected(rc, lines, "missing", f"r1: the action moving b has no '{name}' path, which the motion model "
+                                        f"(planar 'paths') requires")
+
+
+def test_doctored_only_the_to_place_path_deleted(room: tuple[str, Any, dict[str, Any]], tmp_path: Path,
+                                                 capsys: pytest.CaptureFixture[str]) -> None:
+    path, _, plan = room
+    del _action(plan, 1)["paths"]["to-place"]
+    rc, lines = _cli(tmp_path, path, plan, capsys)
+    _rejected(rc, lines, "missing", "has no 'to-place' path")
+    assert len(lines) == 2, lines
+
+
+def test_doctored_approach_cut_to_the_grasp(one_step: dict[str, Any], tmp_path: Path,
+                                            capsys: pytest.CaptureFixture[str]) -> None:
+    a = _action(one_step, 1)
+    a["configs"]["pick"] = a["configs"]["pick"][-1:]
+    a["paths"]["to-handover"][0] = a["configs"]["pick"][0]
+    rc, lines = _cli(tmp_path, PA3, one_step, capsys)
+    _rejected(rc, lines, "approach", "step 1: r1: the pick approach of r1 (moving o1) holds 1 configuration; the "
+                                     "motion model's approaches hold 5, pre-grasp first")
+    _rejected(rc, lines, "approach", "the first pick configuration of r1 puts the tool 80.0 mm")
+
+
+def test_doctored_approach_through_the_object(one_step: dict[str, Any], grounder: Grounder, tmp_path: Path,
+                                              capsys: pytest.CaptureFixture[str]) -> None:
+    """The middle approach configuration puts the tool at the grasp depth 31 mm along the finger axis: a
+    finger drives through o1 before the contact segment (configurations 4 to 5), where o1 is not exempt."""
+    a = _action(one_step, 1)
+    qs = a["configs"]["pick"]
+    grasp = vp.tool_at(grounder, "o1", "top", grounder.poses["o1"])
+    qs[2] = [float(v) for v in vp.ik(grounder, "r1", grasp @ translation(0, 0.031, 0), np.array(qs[2]))]
+    rc, lines = _cli(tmp_path, PA3, one_step, capsys)
+    _rejected(rc, lines, "collision-robot-object", "step 1: r1: pick: ", " of r1 (", " of 5) and o1 overlap by")
+    hits = [x for x in lines if "[collision-robot-object]" in x and "and o1 overlap" in x]
+    assert all("configurations 4 and 5" not in x for x in hits), hits
+
+
+def test_doctored_object_released_in_the_air(one_step: dict[str, Any], grounder: Grounder, tmp_path: Path,
+                                             capsys: pytest.CaptureFixture[str]) -> None:
+    """o1 released 12 cm above bin-b's floor, its place approach recomputed to match: only support fails."""
+    a = _action(one_step, 1)
+    pose = translation(0, 0, 0.12) @ np.array(a["place_pose"])
+    a["place_pose"] = _l(pose)
+    old = np.array(a["configs"]["place"])
+    pre = vp.ik(grounder, "r2", vp.tool_at(grounder, "o1", "side-x+", pose, 0.08), old[0])
+    at = vp.ik(grounder, "r2", vp.tool_at(grounder, "o1", "side-x+", pose), old[-1])
+    a["configs"]["place"] = _line(pre, at)
+    rc, lines = _cli(tmp_path, PA3, one_step, capsys)
+    _rejected(rc, lines, "floating", "step 1: o1: o1 is released at (", "resting on nothing: its lowest point is "
+                                     "126.0 mm above the floor of bin-b, and nothing is within 10 mm under it")
+    assert len(lines) == 2, lines
+
+
+def test_doctored_unknown_robot_waiting(two_steps: dict[str, Any], tmp_path: Path,
+                                        capsys: pytest.CaptureFixture[str]) -> None:
+    two_steps["steps"][0]["waiting"].append("r9")
+    rc, lines = _cli(tmp_path, PA3, two_steps, capsys)
+    _rejected(rc, lines, "unknown-name", "step 1: r9: no robot 'r9' (waiting)")
+    two_steps["steps"][0]["waiting"] = []
+    rc, lines = _cli(tmp_path, PA3, two_steps, capsys)
+    _rejected(rc, lines, "waiting", "step 1: r2: r2 is in no action of the step and not listed as waiting")
+
+
+def test_doctored_unknown_fields_are_refused(two_steps: dict[str, Any], tmp_path: Path,
+                                             capsys: pytest.CaptureFixture[str]) -> None:
+    """An unknown field may carry meaning the validator cannot check: the plan is refused as bad input
+    (exit 2, E502 naming the field), like a plan missing a field."""
+    _action(two_steps, 2)["configs"]["retreat"] = [[0.0] * 7]
+    path = tmp_path / "doctored.json"
+    path.write_text(json.dumps(two_steps), encoding="utf-8")
+    assert cli.main(["validate", PA3, str(path)]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and "error[E502]" in err[0] and "plan.steps[1].actions[0].configs has an unknown field " \
+        "'retreat'" in err[0], err
+
+
+def test_doctored_transfer_left_out_is_a_straight_move(one_step: dict[str, Any], tmp_path: Path,
+                                                        capsys: pytest.CaptureFixture[str]) -> None:
+    """Without its to-handover path, r1 carries o1 from the grasp to the exchange in a straight joint-space
+    line (the paper's packaging model), through its neighbour o3."""
+    del _action(one_step, 1)["paths"]
+    rc, lines = _cli(tmp_path, PA3, one_step, capsys)
+    _rejected(rc, lines, "collision-object-object", "to-handover: o1 held by r1 (between straight to-handover "
+                                                    "transfer configurations 1 and 2 of 2) and o3 overlap by")
+
+
+def test_a_transfer_path_is_checked(one_step: dict[str, Any], grounder: Grounder, tmp_path: Path,
+                                    capsys: pytest.CaptureFixture[str]) -> None:
+    """A given transfer path is followed: lifted only 5 cm before it turns, o1 sweeps through o3."""
+    a = _action(one_step, 1)
+    path = a["paths"]["to-handover"]
+    a["paths"]["to-handover"] = path[:2] + path[-1:]
+    rc, lines = _cli(tmp_path, PA3, one_step, capsys)
+    _rejected(rc, lines, "collision-object-object", "to-handover: o1 held by r1 (between to-handover path "
+                                                    "configurations 2 and 3 of 3) and o3 overlap by")
+
+
+def test_the_motion_model_must_be_one_the_validator_checks(one_step: dict[str, Any]) -> None:
+    one_step["motion_model"]["approach"] = {"configurations": 2, "back_off": 0.01}
+    lines = validate(vp.pa3(), one_step, PA3).lines()
+    assert "the motion model's approach back-off is 0.01 m; the grasp specification's pre-grasp stands 0.08 m back " \
+           "[motion-model]" in lines, lines
+    assert any("the motion model's approaches hold 2 configurations; at least 5 are needed" in x for x in lines)
+
+
+def test_full_motions_require_every_path(one_step: dict[str, Any]) -> None:
+    one_step["motion_model"]["arms"] = "full"
+    lines = validate(vp.pa3(), one_step, PA3).lines()
+    for name in ("to-pick", "taker-to-handover", "to-place", "home", "giver-home"):
+        assert any(f"has no '{name}' path, which the motion model (arms 'full') requires [missing]" in x
+                   for x in lines), lines
+    assert not any("'to-handover' path" in x for x in lines)
 
 
 # ------------------------------------------------------------------------------------- the CLI
@@ -309,6 +416,23 @@ MALFORMED: dict[str, tuple[Callable[[str], str | bytes] | None, str, str]] = {
     "wrong schema": (_edit(_set("schema", "mrgc-plan/7")), "E503",
                      "schema 'mrgc-plan/7' is not supported (this mrgc reads 'mrgc-plan/1')"),
     "missing file": (None, "E500", "No such file or directory"),
+    # issue 9: unknown fields, limits checked before the JSON parser can explode
+    "unknown field": (_edit(lambda p: _action(p, 1).__setitem__("teleport", True)), "E502",
+                      "plan.steps[0].actions[0] has an unknown field 'teleport'"),
+    "unknown top-level field": (_edit(_set("trust_me", 1)), "E502", "plan has an unknown field 'trust_me'"),
+    "motion model missing": (_edit(lambda p: p.pop("motion_model")), "E502", "plan lacks 'motion_model'"),
+    "unknown motion model": (_edit(lambda p: p["motion_model"].__setitem__("arms", "teleport")), "E502",
+                             "plan.motion_model.arms should be one of"),
+    "nested 100k deep": (lambda t: t.replace('"stats": {', '"stats": {"x": ' + "[" * 100_000 + "]" * 100_000 + ", ", 1),
+                         "E504", "plan nests arrays and objects more than 32 deep"),
+    "400-digit integer": (lambda t: t.replace('"seed": 0', '"seed": ' + "9" * 400), "E504",
+                          "plan holds an integer of 400 digits (at most 20)"),
+    "400-digit integer in a configuration": (_edit(lambda p: _action(p, 1)["configs"]["pick"][0].__setitem__(0, int("9" * 400))),
+                                             "E504", "an integer of 400 digits"),
+    "beyond double precision": (lambda t: t.replace('"seed": 0', '"seed": 1e999'), "E504",
+                                "the number 1e999 lies beyond double precision"),
+    "key twice": (lambda t: t.replace('"seed": 0', '"seed": 0, "seed": 1'), "E501",
+                  "the key 'seed' appears twice in one object"),
 }
 
 
@@ -357,7 +481,7 @@ def test_the_validator_imports_no_planner_search_or_grounding() -> None:
     banned = {"mrgc.planner.ground", "mrgc.planner.mcts", "mrgc.planner.search", "mrgc.geometry.grounding",
               "mrgc.geometry.predicates", "mrgc.geometry.path_predicates", "mrgc.geometry.collision",
               "mrgc.geometry.motion", "mrgc.geometry.ik", "mrgc.geometry.fk", "mrgc.geometry.arm", "mrgc.compiler"}
-    for name in ("validate.py", "replay.py"):
+    for name in ("validate.py", "replay.py", "replay_actions.py", "sampling.py", "plan_reader.py"):
         tree = ast.parse((ROOT / "planner" / name).read_text(encoding="utf-8"))
         for node in ast.walk(tree):
             if isinstance(node, ast.ImportFrom) and node.module:
@@ -469,39 +593,10 @@ def test_symbolic_cli(tmp_path: Path, chain3: Any, capsys: pytest.CaptureFixture
 
 
 # ------------------------------------------------------------------------------------- planar robots
-ROOM = """(define (domain movers)
-  (:requirements :planar-base)
-  (:robot-kind mover :base planar :footprint (box 0.5 0.4 0.3) :carry (0.45 0 0.2 0))
-  (:grasps side-x+ side-x- side-y+ side-y-))
-(define (problem room)
-  (:domain movers)
-  (:robots (r1 :kind mover :base (-1 0 0 0)) (r2 :kind mover :base (-1 -1.5 0 0)))
-  (:fixed (wall :shape (box 0.1 1 0.5) :pose (0 1.2 0.25 0)))
-  (:regions (start :shape (box 1 1 0.5) :pose (0 0 0.25 0)) (goal :shape (box 1 1 0.5) :pose (1.5 0 0.25 0)))
-  (:movable (b :shape (box 0.3 0.3 0.3) :pose (0 0 0.15 0)))
-  (:goal (in-region b goal)))
-"""
-
-
-def _line(a: Any, b: Any, n: int = 5) -> list[list[float]]:
-    return _l(np.linspace(np.asarray(a, dtype=float), np.asarray(b, dtype=float), n))
-
-
-@pytest.fixture(scope="module")
+@pytest.fixture
 def room(tmp_path_factory: pytest.TempPathFactory) -> tuple[str, Any, dict[str, Any]]:
     """r1 drives from (-1, 0) to the box's -x side, carries it east into the goal region, and drives back."""
-    path = tmp_path_factory.mktemp("room") / "room.mrg"
-    path.write_text(ROOM, encoding="utf-8")
-    problem = parse_file(str(path)).problem(None)
-    # the planar model (geometry/planar.py): facing the grasped face, the front 5 cm from it; the base origin
-    # 0.25 (half length) + 0.05 + 0.15 (half the box) = 0.45 m from the box's centre
-    q_pick, place = [-0.45, 0.0, 0.0], translation(1.7, 0.0, 0.151)
-    q_place = [1.25, 0.0, 0.0]
-    act = PlannedAction("b", "goal", "r1", "r1", "side-x-", "side-x-", place_pose=_l(place),
-                        configs={"pick": [q_pick], "place": [q_place]},
-                        paths={"to-pick": _line([-1, 0, 0], q_pick), "to-place": _line(q_pick, q_place, 20),
-                               "home": _line(q_place, [-1, 0, 0], 30)})
-    return str(path), problem, _plan(problem, str(path), [[act]])
+    return vp.room(str(tmp_path_factory.getbasetemp()))
 
 
 def test_a_planar_plan_is_valid_and_its_mutations_are_not(room: tuple[str, Any, dict[str, Any]]) -> None:

@@ -157,4 +157,5 @@ def prune(graph: TaskGraph) -> TaskGraph:
         block_pick=tuple(graph.block_pick[i] for i in keep),
         block_place=tuple(graph.block_place[i] for i in keep),
         single_handover_point=graph.single_handover_point,
+        strict_place=graph.strict_place,
     )

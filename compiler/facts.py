@@ -33,6 +33,9 @@ class FactBase:
     occludes_place: dict[tuple[str, str, str, str], tuple[str, ...]] = field(default_factory=dict)  # (M2, Re, g, R)
     #: handovers that can happen at once (the number of handover points); None: no limit (symbolic)
     handover_capacity: int | None = None
+    #: robots that drive to their placements (planar bases): their place obstacles lie on the path and must
+    #: be gone before the step starts, not moved in the same step
+    drivers: frozenset[str] = frozenset()
 
     @classmethod
     def from_problem(cls, problem: Problem, facts: Iterable[Fact] | None = None) -> "FactBase":
@@ -44,11 +47,14 @@ class FactBase:
             goal=problem.goal_regions,
             facts=problem.init if facts is None else facts,
             handover_capacity=None if problem.symbolic else len(problem.handover_points),
+            drivers=[r.name for r in problem.robots
+                     if r.kind is not None and problem.domain.kind(r.kind).base == "planar"],
         )
 
     @classmethod
     def from_facts(cls, robots: Iterable[str], objects: Iterable[str], grasps: dict[str, tuple[str, ...]],
-                   goal: dict[str, str], facts: Iterable[Fact], handover_capacity: int | None = None) -> "FactBase":
+                   goal: dict[str, str], facts: Iterable[Fact], handover_capacity: int | None = None,
+                   drivers: Iterable[str] = ()) -> "FactBase":
         region: dict[str, str] = {}
         pick: set[tuple[str, str, str]] = set()
         place: set[tuple[str, str, str, str]] = set()
@@ -86,4 +92,5 @@ class FactBase:
             occludes_pick={k: tuple(sorted(v, key=rank)) for k, v in occ_pick.items()},
             occludes_place={k: tuple(sorted(v, key=rank)) for k, v in occ_place.items()},
             handover_capacity=handover_capacity,
+            drivers=frozenset(drivers),
         )

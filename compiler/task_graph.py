@@ -65,6 +65,9 @@ class TaskGraph:
     #: the number of handover points when it is one: then at most one handover per step (beyond the paper:
     #: two objects cannot be passed at the same point at once); None: no limit
     single_handover_point: bool = False
+    #: robots whose place obstacles must move strictly earlier (they drive through them; beyond the paper,
+    #: whose place obstacles may move in the same step: right for arms, which pick before they place)
+    strict_place: frozenset[str] = frozenset()
 
     @cached_property
     def _by_object(self) -> dict[str, list[int]]:
@@ -132,6 +135,7 @@ def build_task_graph(facts: FactBase, must_move: Iterable[str], moved: Iterable[
         block_pick=tuple(block_pick),
         block_place=tuple(block_place),
         single_handover_point=facts.handover_capacity == 1,
+        strict_place=facts.drivers,
     )
 
 

@@ -9,7 +9,8 @@ The definitions (DESIGN.md section 5, the paper's "Key Component 1"):
 
 - each action moves exactly one object; every object moves at most once; every object of M* moves;
 - a pick obstacle of a selected action moves at a strictly earlier step, a place obstacle at the same step
-  or earlier; every obstacle of a selected action moves;
+  or earlier (strictly earlier when the placing robot is in ``strict_place``: it drives through it);
+  every obstacle of a selected action moves;
 - an object outside M* moves only if it obstructs a selected action;
 - a robot does at most one action per step, and a handover occupies both of its robots;
 - no step is empty;
@@ -30,11 +31,16 @@ from mrgc.compiler.task_graph import Action, TaskGraph
 
 # ------------------------------------------------------------------ helpers on the graph's data
 def _obstacles(graph: TaskGraph) -> dict[Action, tuple[frozenset[str], frozenset[str]]]:
-    """action -> (pick obstacles, place obstacles), straight from the graph's edge lists."""
+    """action -> (strictly-earlier obstacles, same-step-or-earlier obstacles), from the graph's edge lists:
+    pick obstacles, and place obstacles of robots in ``graph.strict_place`` (robots that drive through
+    them), are strict; other place obstacles are not."""
     out: dict[Action, tuple[frozenset[str], frozenset[str]]] = {}
     for i, a in enumerate(graph.actions):
         pick, place = out.get(a, (frozenset(), frozenset()))
-        out[a] = (pick | frozenset(graph.block_pick[i]), place | frozenset(graph.block_place[i]))
+        if a.place_robot in graph.strict_place:
+            out[a] = (pick | frozenset(graph.block_pick[i]) | frozenset(graph.block_place[i]), place)
+        else:
+            out[a] = (pick | frozenset(graph.block_pick[i]), place | frozenset(graph.block_place[i]))
     return out
 
 

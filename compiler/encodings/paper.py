@@ -89,7 +89,9 @@ class PaperEncoding(Encoding):
 
 
 def _obstacles(graph: TaskGraph, a: int) -> list[tuple[str, bool]]:
-    """(obstacle, strict) for action a: pick obstacles strictly before, place obstacles no later."""
+    """(obstacle, strict) for action a: pick obstacles strictly before, place obstacles no later (strictly
+    before too when the placing robot drives through them: ``graph.strict_place``)."""
     out = [(o, True) for o in graph.block_pick[a]]
-    out += [(o, False) for o in graph.block_place[a] if o not in graph.block_pick[a]]
+    strict = graph.actions[a].place_robot in graph.strict_place
+    out += [(o, strict) for o in graph.block_place[a] if o not in graph.block_pick[a]]
     return out

@@ -22,6 +22,22 @@ from mrgc.bench.execute import RawRun, RunTask, execute_run
 from mrgc.errors import Diagnostic, InputError, MissingBackendError
 
 
+def _check_reachable(address: str) -> None:
+    """A ``HOST:PORT`` address that refuses a TCP connection is a one-line error at once (Ray itself
+    retries for minutes in native code, deaf to Ctrl-C); other forms (``auto``, ``ray://``) go to Ray."""
+    import re
+    import socket
+
+    m = re.fullmatch(r"\[?([^\]/]+?)\]?:(\d+)", address)
+    if m is None:
+        return
+    try:
+        socket.create_connection((m.group(1), int(m.group(2))), timeout=5).close()
+    except OSError as exc:
+        raise InputError([Diagnostic("E000", f"--address {address}: no Ray cluster answers there "
+                                     f"({exc.strerror or exc})")]) from None
+
+
 def _run_remote(task: RunTask) -> RawRun:
     return execute_run(task, remote=True)
 
@@ -41,6 +57,7 @@ class RayExecutor:
         if self.owns:
             kwargs: dict[str, Any] = {"include_dashboard": False, "log_to_driver": False}
             if address is not None:
+                _check_reachable(address)
                 kwargs["address"] = address
             else:
                 kwargs["num_cpus"] = max(1, jobs)

@@ -379,3 +379,12 @@ def test_report_errors_are_one_line_with_exit_code_2(tmp_path: Path) -> None:
     for db in (tmp_path / "none.db", tmp_path / "notes.txt"):
         out = subprocess.run([*MRGC, "bench", "report", "--db", str(db)], capture_output=True, text=True, timeout=60)
         assert out.returncode == 2 and out.stderr.startswith("error[E603]") and "Traceback" not in out.stderr
+
+
+def test_a_ray_address_nobody_answers_is_one_line(tmp_path: Path) -> None:
+    symbolic_copy(tmp_path / "p", "chain-3")
+    study = write_study(tmp_path / "s.yaml", "study: far\ninstances: [{file: p/chain-3.mrg}]\nmethods: [{name: O}]\n")
+    out = subprocess.run([*MRGC, "bench", "run", str(study), "--db", str(tmp_path / "r.db"), "--executor", "ray",
+                          "--address", "127.0.0.1:1"], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 2 and "error[E000]: --address 127.0.0.1:1: no Ray cluster answers there" in out.stderr
+    assert rows(tmp_path / "r.db") == []

@@ -40,6 +40,8 @@ def add_bench_parser(sub: Any) -> None:
                    help="markdown (default): a row per instance set and method; wide: the paper's layout; "
                         "csv: the same numbers; runs: every run as CSV")
     q.add_argument("--figures", default=None, metavar="DIR", help="also write PNG figures here (matplotlib)")
+    q.add_argument("--planner-arena", default=None, metavar="OUT.db",
+                   help="also write the runs as an OMPL benchmark database (Planner Arena reads it)")
     q.set_defaults(func=cmd_report)
 
 
@@ -93,4 +95,9 @@ def cmd_report(args: argparse.Namespace) -> int:
 
             for path in write_figures(db, args.figures, args.study):
                 print(f"figure written: {path}", file=sys.stderr)
+        if args.planner_arena:
+            from mrgc.bench.arena import export_planner_arena
+
+            n = export_planner_arena(db, args.planner_arena, args.study)
+            print(f"{args.planner_arena}: {n} runs as an OMPL benchmark database (Planner Arena)", file=sys.stderr)
     return 0

@@ -388,3 +388,25 @@ def test_a_ray_address_nobody_answers_is_one_line(tmp_path: Path) -> None:
                           "--address", "127.0.0.1:1"], capture_output=True, text=True, timeout=120)
     assert out.returncode == 2 and "error[E000]: --address 127.0.0.1:1: no Ray cluster answers there" in out.stderr
     assert rows(tmp_path / "r.db") == []
+
+
+def test_planner_arena_export_has_ompl_s_tables(tmp_path: Path) -> None:
+    db, out = golden_db(tmp_path), tmp_path / "arena.db"
+    done = subprocess.run([*MRGC, "bench", "report", "--db", str(db), "--planner-arena", str(out)],
+                          capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0, done.stderr
+    conn = sqlite3.connect(out)
+    tables = {r[0] for r in conn.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
+    assert {"experiments", "plannerConfigs", "enums", "runs", "progress"} <= tables
+    with ResultsDB(str(db), readonly=True) as results:
+        mine = list(results.runs())
+    assert conn.execute("SELECT COUNT(*) FROM runs").fetchone()[0] == len(mine)
+    experiments = [r[0] for r in conn.execute("SELECT name FROM experiments ORDER BY id")]
+    assert experiments == ["golden: chain-3", "golden: symbolic", "golden: pa3-handover"]
+    solved = conn.execute("SELECT p.name, SUM(r.solved) FROM runs r JOIN plannerConfigs p ON p.id = r.plannerid "
+                          "GROUP BY p.name").fetchall()
+    assert dict(solved) == {m: sum(r["success"] for r in mine if r["method"] == m) for m in {r["method"] for r in mine}}
+    status = dict(conn.execute("SELECT value, description FROM enums WHERE name = 'status'").fetchall())
+    for (code,) in conn.execute("SELECT status FROM runs"):
+        assert status[code] in {s.value for s in RunStatus}
+    assert all(v.startswith("mrgc ") for (v,) in conn.execute("SELECT version FROM experiments"))

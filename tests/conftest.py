@@ -1,5 +1,6 @@
 """Test-suite wiring: make the sibling helper modules importable: the independent skeleton oracle
-(``skeleton_oracle``) and the validator's valid plans (``validator_plans``).
+(``skeleton_oracle``), the validator's valid plans (``validator_plans``) and a headless Chromium driver
+(``headless_chromium``).
 
 Tests run with ``--import-mode=importlib`` and no ``tests/__init__.py``, so sibling helper modules are not
 on the import path; conftest runs first and registers the oracle once for every test module.
@@ -11,7 +12,7 @@ import importlib.util
 import sys
 from pathlib import Path
 
-for _name in ("skeleton_oracle", "validator_plans"):
+for _name in ("skeleton_oracle", "validator_plans", "headless_chromium"):
     if _name not in sys.modules:
         _spec = importlib.util.spec_from_file_location(_name, Path(__file__).with_name(f"{_name}.py"))
         assert _spec is not None and _spec.loader is not None

@@ -18,6 +18,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from PIL import Image
 
+from headless_chromium import colour_share, screenshot_when
 from mrgc import cli
 from mrgc.language.loader import parse_file
 from mrgc.render.camera import PRESETS
@@ -27,24 +28,6 @@ from mrgc.render.palette import GOAL_REGION, ROBOT_COLOURS, byte_colour
 from mrgc.render.world import World
 
 ROOT = Path(__file__).resolve().parent.parent
-
-
-def _helper(name: str):  # type: ignore[no-untyped-def]
-    """A sibling helper module of tests/ (no tests/__init__.py, importlib import mode)."""
-    import importlib.util
-    import sys
-
-    if name not in sys.modules:
-        spec = importlib.util.spec_from_file_location(name, Path(__file__).with_name(f"{name}.py"))
-        assert spec is not None and spec.loader is not None
-        module = importlib.util.module_from_spec(spec)
-        sys.modules[name] = module
-        spec.loader.exec_module(module)
-    return sys.modules[name]
-
-
-colour_share = _helper("headless_chromium").colour_share
-screenshot_when = _helper("headless_chromium").screenshot_when
 HANDOVER = ROOT / "domains" / "packaging" / "pa3-handover.mrg"
 SMALL = ["--size", "160x120", "--fps", "4"]
 

@@ -10,7 +10,8 @@ The Python API that ``mrgc bench run`` / ``mrgc bench report`` wrap:
 - :class:`ResultsDB`: the database; ``runs()`` yields the recorded rows (columns of :class:`RunResult`,
   status a :class:`RunStatus`).
 - :func:`render` (``markdown``, ``wide``, ``csv``, ``runs``) and :func:`aggregate` → :class:`Row` for the
-  tables; :func:`write_figures` (matplotlib) for the figures.
+  tables; :func:`write_figures` (matplotlib) for the figures; :func:`export_planner_arena` for OMPL's
+  benchmark database format (Planner Arena).
 
 Example::
 
@@ -28,6 +29,7 @@ import importlib
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
+    from mrgc.bench.arena import export_planner_arena
     from mrgc.bench.db import ResultsDB
     from mrgc.bench.figures import write_figures
     from mrgc.bench.outcome import RunResult, RunStatus
@@ -38,7 +40,7 @@ if TYPE_CHECKING:
 #: public name -> the module defining it (loaded on first use: ``mrgc`` builds its parser with
 #: :mod:`mrgc.bench.command`, and that must not load the rest of the package)
 _API = {
-    "ResultsDB": "db", "write_figures": "figures", "RunResult": "outcome", "RunStatus": "outcome",
+    "ResultsDB": "db", "export_planner_arena": "arena", "write_figures": "figures", "RunResult": "outcome", "RunStatus": "outcome",
     "Row": "report", "aggregate": "report", "render": "report", "DEFAULT_DB": "run", "StudySummary": "run",
     "run_study": "run", "InstanceSpec": "study", "Limits": "study", "Method": "study", "Study": "study",
     "load_study": "study", "parse_study": "study",
@@ -63,6 +65,7 @@ __all__ = [
     "Study",
     "StudySummary",
     "aggregate",
+    "export_planner_arena",
     "load_study",
     "parse_study",
     "render",

@@ -410,3 +410,11 @@ def test_planner_arena_export_has_ompl_s_tables(tmp_path: Path) -> None:
     for (code,) in conn.execute("SELECT status FROM runs"):
         assert status[code] in {s.value for s in RunStatus}
     assert all(v.startswith("mrgc ") for (v,) in conn.execute("SELECT version FROM experiments"))
+
+
+def test_the_python_api_names_resolve_and_importing_it_loads_no_heavy_library() -> None:
+    code = ("import sys, mrgc.bench as b\n"
+            "names = [getattr(b, n) for n in b.__all__]\n"
+            "print(sorted(m for m in ('ray', 'matplotlib', 'pybullet', 'ortools') if m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60, check=True)
+    assert out.stdout.strip() == "[]"

@@ -73,7 +73,8 @@ def _record(server: Any, world: World, frames: list[Frame], camera: Camera, fps:
     for robot, q in first.configs.items():
         for part, pose in world.robots[robot].part_poses(q, first.fingers.get(robot)):
             handles[part.name] = _add(scene, f"/robots/{part.name}", part, pose)
-    top = camera.target + np.array([0.0, 0.0, 1.0]) * 0.5 * float(np.linalg.norm(camera.eye - camera.target)) * 0.4
+    # the caption floats above the middle of the scene, a fifth of the viewing distance up
+    top = camera.target + np.array([0.0, 0.0, 0.2 * float(np.linalg.norm(camera.eye - camera.target))])
     label = scene.add_label("/caption", first.caption, position=tuple(float(v) for v in top),
                             anchor="bottom-center", font_screen_scale=1.2)
     serializer = server.get_scene_serializer()

@@ -97,18 +97,30 @@ class _Track:
     exempt_from: float = 2.0
 
 
+class _Stop(Exception):
+    """The first violation is known and no more are wanted."""
+
+
 def replay(problem: Problem, model: MotionModel, steps: Sequence[Sequence[Action]], usable: set[int],
-           stats: dict[str, Any]) -> list[Violation]:
+           stats: dict[str, Any], first_only: bool = False) -> list[Violation]:
     """The geometric violations of a plan whose actions (``usable``: ids of the name-checked ones) are
     ``steps``, under motion model ``model``; fills ``stats`` with the configurations and distance queries
-    checked."""
+    checked.  ``first_only``: stop at the end of the first phase or check that finds a violation (a
+    referee that only needs to know whether the plan is valid)."""
     scene, rs = _world(problem)
     queries = rs.queries
     r = _Replayer(scene, rs, model)
-    r.check_model()
-    for t, step in enumerate(steps, 1):
-        r.run_step(t, [r.parse(t, a) for a in step if id(a) in usable])
-    r.goals()
+    r.first_only = first_only
+    try:
+        r.check_model()
+        r.stop_if_found()
+        for t, step in enumerate(steps, 1):
+            acts = [r.parse(t, a) for a in step if id(a) in usable]
+            r.stop_if_found()
+            r.run_step(t, acts)
+        r.goals()
+    except _Stop:
+        r.flush()
     stats["configurations"] = r.samples
     stats["distance_queries"] = rs.queries - queries
     return r.out
@@ -142,6 +154,7 @@ class _Replayer(ActionReader):
         self.samples = 0
         self.budget_spent = False
         self._worst: dict[tuple[Any, ...], tuple[float, str, str]] = {}
+        self.first_only = False
         self._boxes: dict[str, tuple[float, ...]] = {}  # bounding boxes (min x y z, max x y z) of the bodies of the phase being swept
         self._placements_state()
         self.support = {o: self._supports(o) for o in self.movable}  # what each object rests on
@@ -207,7 +220,7 @@ class _Replayer(ActionReader):
         placed = [a for a in acts if a.place_pose is not None]
         self._placements(t, placed)
         self._rests(t, placed)
-        self._flush()
+        self.flush()
 
     # ------------------------------------------------------------------ sweeping a phase
     def _sweep(self, t: int, phase: str, tracks: list[_Track], static: list[str], present: list[str]) -> None:
@@ -260,6 +273,14 @@ class _Replayer(ActionReader):
                     self._pair(t, phase, tr, states[i], tracks[j], states[j])
                 for r in static:
                     self._pair(t, phase, tr, states[i], _Track(r, np.zeros((1, 1)), "home"), "at home")
+            if self.first_only and self._worst:
+                break
+        self.stop_if_found()
+
+    def stop_if_found(self) -> None:
+        """With ``first_only``, end the replay once a violation is known."""
+        if self.first_only and (self.out or self._worst):
+            raise _Stop
 
     def _closest(self, a: str, b: str) -> Any:
         """pybullet's deepest overlap of ``a`` and ``b``, None when they do not overlap (at once when their
@@ -319,7 +340,7 @@ class _Replayer(ActionReader):
         msg = f"{phase}: {side(da, c.link_a)} and {side(db, c.link_b)} overlap by {-c.distance * 1e3:.1f} mm"
         self._worst[key] = (c.distance, a, msg)
 
-    def _flush(self) -> None:
+    def flush(self) -> None:
         for (t, _, kind, _, _), (_, subject, msg) in self._worst.items():
             self._v(t, subject, f"collision-{kind}", msg)
         self._worst.clear()

@@ -32,7 +32,7 @@ LIMIT_TOL = 1e-6  # rad or m beyond a joint limit
 JOINT_TOL = 1e-3  # rad: path ends vs the configurations they connect
 WORLD = 1e4  # m: planar base coordinates beyond this are outside the world
 MIN_APPROACH_CONFIGURATIONS = 5  # an approach of fewer would make its contact segment longer than a quarter
-CONTACT_SLACK = 1.25  # the contact segment may start this much farther than its equal share of the back-off
+CONTACT_SLACK = 2.0  # the contact segment may start this much farther than its equal share of the back-off
 
 #: path name -> (robot role, grasp role held on the way or None, where it starts, where it ends); a place is
 #: ``home`` or (configs phase, index), ``transfer`` meaning where the object was taken (the last pick

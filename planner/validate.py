@@ -88,11 +88,13 @@ class ValidationReport:
 
 
 # ------------------------------------------------------------------------------------------ validating
-def validate(problem: Problem, plan: Any, problem_path: str | None = None) -> ValidationReport:
+def validate(problem: Problem, plan: Any, problem_path: str | None = None, first_only: bool = False
+             ) -> ValidationReport:
     """Check ``plan`` against ``problem``, read from ``problem_path`` (whose sha256 must match the plan's;
     None skips that comparison).  ``plan`` is a :class:`~mrgc.planner.plan_reader.PlanFile`, parsed plan
     JSON (as :func:`load_plan` returns it) or a :class:`~mrgc.planner.plan.Plan`; InputError when it breaks
-    the schema."""
+    the schema.  ``first_only``: the geometric replay stops at the first phase that finds a violation (the
+    verdict is the same; the report lists fewer violations), for a referee inside a search."""
     doc = read_plan(plan)
     out: list[Violation] = []
     steps = [s.actions for s in doc.steps]
@@ -116,13 +118,11 @@ def validate(problem: Problem, plan: Any, problem_path: str | None = None) -> Va
                 where = f"in {final[obj]!r}" if obj in final else "nowhere known"
                 out.append(Violation(None, obj, "goal", f"goal (in-region {obj} {region}) does not hold at the "
                                                         f"end: {obj} is {where}"))
-    elif doc.symbolic:
-        pass  # [plan-kind]: a symbolic plan carries no geometry to replay
-    else:
+    elif not doc.symbolic and not (first_only and out):  # a symbolic plan carries no geometry to replay
         from mrgc.planner.replay import replay
 
         assert doc.motion_model is not None  # the schema requires it of geometric plans
-        out.extend(replay(problem, doc.motion_model, steps, usable, stats))
+        out.extend(replay(problem, doc.motion_model, steps, usable, stats, first_only=first_only))
     return ValidationReport(not out, out, stats)
 
 

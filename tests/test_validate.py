@@ -18,6 +18,8 @@ from typing import Any, Callable
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import validator_plans as vp
 from mrgc import cli
@@ -355,6 +357,17 @@ def test_full_motions_require_every_path(one_step: dict[str, Any]) -> None:
     assert not any("'to-handover' path" in x for x in lines)
 
 
+def test_the_documented_motion_model_is_the_planners() -> None:
+    import re
+
+    from mrgc.planner.plan import planner_motion_model
+
+    text = (ROOT / "docs" / "validator.md").read_text(encoding="utf-8")
+    block = re.search(r"```json\n(\"motion_model\": .*?)```", text, re.S)
+    assert block is not None
+    assert json.loads("{" + block.group(1) + "}")["motion_model"] == planner_motion_model().to_json()
+
+
 # ------------------------------------------------------------------------------------- the CLI
 def test_cli_valid_and_invalid(tmp_path: Path, two_steps: dict[str, Any], capsys: pytest.CaptureFixture[str]) -> None:
     good = tmp_path / "good.json"
@@ -516,6 +529,47 @@ def test_replay_scene_distances_and_kinematics(pa3: Any, grounder: Grounder, tmp
         rs.set_config("r1", arm.home)
         assert rs.closest("r1", "table") is None  # its base link stands on the table: ignored
         assert rs.closest("r1", "r2", 10.0) is not None
+
+
+@given(gap=st.floats(0.0005, 0.03), diagonal=st.booleans())
+@settings(max_examples=25, deadline=None, derandomize=True)
+def test_replay_boxes_are_exact_at_edges(gap: float, diagonal: bool) -> None:
+    """Boxes are 8-vertex hulls in the replay world: their distances are exact at edges and corners too,
+    where GEOM_BOX's rounded margin read up to 1.1 mm wrong (docs/geometry.md)."""
+    from mrgc.geometry.bullet import ReplayScene
+    from mrgc.geometry.scene import SceneSpec
+    from mrgc.language.model import Box
+
+    with ReplayScene(SceneSpec("edges", (), (), (), (), {}, {}, {}, {})) as rs:
+        rs.add_object("a", Box(0.1, 0.1, 0.1), np.eye(4))
+        # edge to edge across the diagonal of x-y, or corner to corner across the body diagonal
+        d = np.array([0.1, 0.1, 0.0 if not diagonal else 0.1]) + gap * np.array([1, 1, int(diagonal)])
+        rs.add_object("b", Box(0.1, 0.1, 0.1), translation(*d))
+        exact = gap * (np.sqrt(3) if diagonal else np.sqrt(2))
+        c = rs.closest("a", "b", 0.1)
+        assert c is not None and abs(c.distance - exact) < 5e-5, (c, exact)
+
+
+@given(st.lists(st.lists(st.floats(-3, 3), min_size=3, max_size=3), min_size=2, max_size=40),
+       st.sampled_from([0.01, 0.003]), st.booleans())
+@settings(max_examples=60, deadline=None, derandomize=True)
+def test_samples_are_never_farther_apart_than_the_resolution(configs: list[list[float]], resolution: float,
+                                                             planar: bool) -> None:
+    """Between two consecutive samples of a motion no coordinate moves more than the resolution, whether the
+    motion has few configurations (every one sampled) or many (equal steps along its length)."""
+    from mrgc.planner.sampling import config_at, deltas, sample_count, sample_times
+
+    qs = np.array(configs)
+    times = sample_times(qs, planar, resolution)
+    assert times[0] == 0.0 and times[-1] == 1.0 and np.all(np.diff(times) > 0)
+    assert len(times) <= sample_count(qs, planar, resolution)
+    m = len(qs)
+    for s0, s1 in zip(times[:-1], times[1:]):
+        # every point of the polyline between the two samples: the configurations in between and the ends
+        inner = [k / (m - 1) for k in range(m) if s0 < k / (m - 1) < s1]
+        pts = np.array([config_at(qs, float(s), planar) for s in [s0, *inner, s1]])
+        travel = float(np.abs(deltas(pts, planar)).max(axis=1).sum())
+        assert travel <= resolution + 1e-9, (s0, s1, travel)
 
 
 # ------------------------------------------------------------------------------------- symbolic: chain-3

@@ -290,7 +290,7 @@ def _describe(e: Any) -> str:
     """One line for a jsonschema ValidationError, naming the field."""
     at, kw, arg, value = _where(e.absolute_path), e.validator, e.validator_value, e.instance
     if kw == "type":
-        types = arg if isinstance(arg, list) else [arg]
+        types = [str(t) for t in (arg if isinstance(arg, list) else [arg])]
         return f"{at} should be {' or '.join(_ARTICLE.get(t, t) for t in types)}, not {_show(value)}"
     if kw == "required":
         missing = [k for k in arg if isinstance(value, dict) and k not in value]

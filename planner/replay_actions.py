@@ -402,7 +402,7 @@ class ActionReader:
 
     def path_end(self, act: ActionGeometry, ref: str | tuple[str, int]) -> tuple[np.ndarray, str] | None:
         """The configuration a path end refers to, and its name in words (None: not in the plan)."""
-        if ref == "home":
+        if isinstance(ref, str):  # home
             return None
         phase, k = ref
         if phase == "transfer":

@@ -41,9 +41,13 @@ from typing import Any
 
 from mrgc.language.model import Problem
 from mrgc.planner.plan import file_sha256
-from mrgc.planner.plan_reader import (  # noqa: F401  (the reader's entry points, as the CLI imports them)
+from mrgc.planner.plan_reader import (
     E_JSON, E_LIMIT, E_READ, E_SCHEMA, E_VERSION, Action, PlanFile, check_schema, load_plan, read_plan,
     schema_errors)
+
+#: the reader's entry points are re-exported here, where the CLI and the tests import them
+__all__ = ["E_JSON", "E_LIMIT", "E_READ", "E_SCHEMA", "E_VERSION", "ValidationReport", "Violation", "check_schema",
+           "load_plan", "schema_errors", "validate"]
 
 
 @dataclass(frozen=True)

@@ -296,6 +296,28 @@ def test_doctored_object_released_in_the_air(one_step: dict[str, Any], grounder:
     assert len(lines) == 2, lines
 
 
+def test_an_object_may_rest_on_another_until_that_one_moves(grounder: Grounder) -> None:
+    """Step 1 stacks o2 on o1 (supported by a movable object: valid); step 2 takes o1 from under it: o2
+    would fall, so the plan is invalid (besides the hand that now meets o2 on its way to o1)."""
+    g = vp.grounder()
+    pick = g.pick("r1", "o2", "top", avoid=["o1", "o3"])
+    assert pick.ok and pick.configs is not None
+    on_o1 = translation(0, 0, 0.12 + 0.006) @ g.poses["o1"]
+    place = g.place("r1", "o2", "top", on_o1)
+    assert place.ok and place.configs is not None
+    up = vp.lifted(g, "r1", "o2", "top", g.poses["o2"], pick.configs[-1])
+    down = vp.lifted(g, "r1", "o2", "top", on_o1, place.configs[0])[::-1]
+    stack = PlannedAction("o2", "start", "r1", "r1", "top", "top", place_pose=_l(on_o1),
+                          configs={"pick": _l(pick.configs), "place": _l(place.configs)},
+                          paths={"to-place": _l([pick.configs[-1], *up, *down, place.configs[0]])})
+    g.move("o2", on_o1)
+    hand = vp.handover(g, ["o3"])
+    report = validate(vp.pa3(), _plan(vp.pa3(), PA3, [[stack], [hand]]), PA3)
+    assert not any(v.step == 1 for v in report.violations), report.lines()
+    assert "step 2: o2: o2 rested on o1, which the step moves away: nothing holds it up now [floating]" \
+        in report.lines(), report.lines()
+
+
 def test_doctored_unknown_robot_waiting(two_steps: dict[str, Any], tmp_path: Path,
                                         capsys: pytest.CaptureFixture[str]) -> None:
     two_steps["steps"][0]["waiting"].append("r9")

@@ -104,7 +104,7 @@ def lifted(g: Grounder, robot: str, obj: str, grasp: str, pose: np.ndarray, q: n
     return out
 
 
-def _handover(g: Grounder, avoid: list[str]) -> PlannedAction:
+def handover(g: Grounder, avoid: list[str]) -> PlannedAction:
     """r1 picks o1 from the top, lifts it and hands it to r2 at h1 (r2 grasps side-x+), r2 puts it into
     bin-b (straight from the exchange)."""
     pick = g.pick("r1", "o1", "top", avoid=avoid)
@@ -123,7 +123,7 @@ def _handover(g: Grounder, avoid: list[str]) -> PlannedAction:
 @lru_cache(maxsize=1)
 def _one_step() -> str:
     g = grounder()
-    return json.dumps(as_file(pa3(), PA3, [[_handover(g, ["o2", "o3"])]]))
+    return json.dumps(as_file(pa3(), PA3, [[handover(g, ["o2", "o3"])]]))
 
 
 @lru_cache(maxsize=1)
@@ -141,7 +141,7 @@ def _two_steps() -> str:
                           configs={"pick": rows(pick.configs), "place": rows(place.configs)},
                           paths={"to-place": rows([pick.configs[-1], *up, *down, place.configs[0]])})
     g.move("o2", spot.pose)
-    return json.dumps(as_file(pa3(), PA3, [[first], [_handover(g, ["o2", "o3"])]]))
+    return json.dumps(as_file(pa3(), PA3, [[first], [handover(g, ["o2", "o3"])]]))
 
 
 def one_step() -> dict[str, Any]:

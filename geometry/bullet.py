@@ -447,7 +447,7 @@ class ReplayScene:
             pos, orn = tf.to_quaternion(np.asarray(pose, dtype=float))
         self.pb.resetBasePositionAndOrientation(self.bodies[name], pos, orn, physicsClientId=self.cid)
 
-    def set_config(self, robot: str, q: Sequence[float]) -> None:
+    def set_config(self, robot: str, q: Sequence[float] | np.ndarray) -> None:
         """Put ``robot`` at configuration ``q`` (joint values of the chain; planar: x, y, yaw in radians)."""
         r = self.robots[robot]
         if r.planar:

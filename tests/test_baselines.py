@@ -42,7 +42,7 @@ def moved(plan: dict[str, Any]) -> list[str]:
 # ---------------------------------------------------------------- geometric
 def test_ap1_solves_a_packaging_problem_and_mrgc_validate_accepts_its_plan(tmp_path: Path) -> None:
     out = tmp_path / "plan.json"
-    assert cli.main(["plan", str(PLACE_OBSTACLE), "--planner", "ap1", "--time-limit", "120", "-o", str(out)]) == 0
+    assert cli.main(["plan", str(PLACE_OBSTACLE), "--planner", "ap1", "--time-limit", "60", "-o", str(out)]) == 0
     doc = json.loads(out.read_text(encoding="utf-8"))
     assert doc["status"] == "solved" and doc["validation"]["valid"] and doc["stats"]["planner"] == "ap1"
     objects = moved(doc)

@@ -139,17 +139,17 @@ def _outside(args: argparse.Namespace) -> dict[str, tuple[str, ...]]:
 def inputs_of(mf: "MrgFile") -> list[str]:
     """Every file a command reads for ``mf``: .mrg files (the problem, its domain, includes), the meshes
     its shapes name, and the URDFs of its robot kinds (an output may be none of them)."""
+    from mrgc.language.loader import urdf_candidates
     from mrgc.language.model import Mesh
 
     files = list(mf.files)
     for p in mf.problems:
-        for obj in (*p.movable, *p.fixed, *p.regions):
-            if isinstance(obj.shape, Mesh):
-                files.append(obj.shape.path)
+        shapes = [o.shape for o in (*p.movable, *p.fixed, *p.regions)] + [k.footprint for k in p.domain.robot_kinds]
+        files.extend(s.path for s in shapes if isinstance(s, Mesh))
         for kind in p.domain.robot_kinds:
             if kind.urdf is not None:
                 base = os.path.dirname(os.path.abspath(kind.source)) if kind.source else ""
-                files.append(os.path.join(base, kind.urdf))
+                files.extend(c for c, _ in urdf_candidates(kind.urdf, base))
     return files
 
 

@@ -108,7 +108,9 @@ def _unraisable(info: "sys.UnraisableHookArgs") -> None:
 
 
 def reset() -> None:
-    """Forget received signals and activities (a new command in the same process)."""
+    """Forget received signals and activities (a new command in the same process; main thread only)."""
+    if threading.current_thread() is not threading.main_thread():
+        return
     _S.received.clear()
     _S.doing.clear()
     _S.what = ""

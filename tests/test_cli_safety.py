@@ -31,9 +31,27 @@ MRGC = [sys.executable, "-m", "mrgc.cli"]
 
 
 def run(*argv: str | Path, cwd: Path | None = None, timeout: float = 120) -> subprocess.CompletedProcess[str]:
+    """``mrgc ARGV`` in a new process (where blocking, processes or signals are at stake)."""
     proc = subprocess.run([*MRGC, *map(str, argv)], capture_output=True, text=True, timeout=timeout, cwd=cwd)
     assert "Traceback" not in proc.stderr and "internal error" not in proc.stderr, proc.stderr[-2000:]
     return proc
+
+
+@pytest.fixture()
+def mrgc(capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch):  # type: ignore[no-untyped-def]
+    """``mrgc ARGV`` in this process (``cli.main``), run from ``cwd``: as ``run`` but without the start-up."""
+
+    def call(*argv: str | Path, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
+        capsys.readouterr()
+        with monkeypatch.context() as m:
+            if cwd is not None:
+                m.chdir(cwd)
+            code = cli.main([str(a) for a in argv])
+        out, err = capsys.readouterr()
+        assert "Traceback" not in err and "internal error" not in err, err[-2000:]
+        return subprocess.CompletedProcess(list(argv), code, out, err)
+
+    return call
 
 
 def error_lines(stderr: str) -> list[str]:
@@ -75,7 +93,7 @@ MULTI = """; two problems and a comment that must survive
 
 @pytest.mark.parametrize("case", ["plan-self", "plan-domain", "plan-hard-link", "plan-symlink", "facts-domain",
                                   "facts-multi", "plan-include"])
-def test_an_output_that_is_an_input_is_refused(tmp_path: Path, symbolic: Path, case: str) -> None:
+def test_an_output_that_is_an_input_is_refused(tmp_path: Path, symbolic: Path, case: str, mrgc) -> None:  # type: ignore[no-untyped-def]
     folder = symbolic
     if case == "plan-self":
         argv = ["plan", "chain-3.mrg", "-o", "chain-3.mrg"]
@@ -102,7 +120,7 @@ def test_an_output_that_is_an_input_is_refused(tmp_path: Path, symbolic: Path, c
                                       encoding="utf-8")
         argv = ["plan", "p.mrg", "--problem", "p1", "-o", "sub/dom.mrg"]
     before = snapshot(folder)
-    proc = run(*argv, cwd=folder)
+    proc = mrgc(*argv, cwd=folder)
     assert proc.returncode == 2, proc.stderr
     assert len(error_lines(proc.stderr)) == 1 and "error[E005]" in proc.stderr
     assert snapshot(folder) == before  # nothing lost, nothing added
@@ -123,35 +141,35 @@ def test_an_output_that_cannot_be_written_is_refused_before_any_work(symbolic: P
 
 
 # ------------------------------------------------------------------ how outputs are written
-def test_outputs_keep_mode_and_write_through_symlinks_and_hard_links(symbolic: Path) -> None:
+def test_outputs_keep_mode_and_write_through_symlinks_and_hard_links(symbolic: Path, mrgc) -> None:  # type: ignore[no-untyped-def]
     target = symbolic / "plan.json"
     target.write_text("old", encoding="utf-8")
     os.chmod(target, 0o640)
-    assert run("plan", symbolic / "chain-3.mrg", "-o", target).returncode == 0
+    assert mrgc("plan", symbolic / "chain-3.mrg", "-o", target).returncode == 0
     assert stat.S_IMODE(target.stat().st_mode) == 0o640 and target.read_text(encoding="utf-8").startswith("{")
 
     real = symbolic / "real.json"
     real.write_text("old", encoding="utf-8")
     link = symbolic / "link.json"
     link.symlink_to(real)
-    assert run("plan", symbolic / "chain-3.mrg", "-o", link).returncode == 0
+    assert mrgc("plan", symbolic / "chain-3.mrg", "-o", link).returncode == 0
     assert link.is_symlink() and real.read_text(encoding="utf-8").startswith("{")  # the link's file is updated
 
     other_name = symbolic / "other-name.json"
     os.link(real, other_name)
-    assert run("fmt", "--write", symbolic / "chain-3.mrg").returncode == 0  # fmt --write: same helper
+    assert mrgc("fmt", "--write", symbolic / "chain-3.mrg").returncode == 0  # fmt --write: same helper
     before = real.stat().st_ino
-    assert run("plan", symbolic / "chain-3.mrg", "--seed", "1", "-o", other_name).returncode == 0
+    assert mrgc("plan", symbolic / "chain-3.mrg", "--seed", "1", "-o", other_name).returncode == 0
     assert real.stat().st_ino == before and real.read_bytes() == other_name.read_bytes()
     assert '"seed": 1' in real.read_text(encoding="utf-8")  # both names see the new content
     assert not temp_files(symbolic)
 
 
-def test_a_planted_symlink_at_the_old_temp_name_is_not_followed(symbolic: Path, tmp_path_factory) -> None:
+def test_a_planted_symlink_at_the_old_temp_name_is_not_followed(symbolic: Path, tmp_path_factory, mrgc) -> None:  # type: ignore[no-untyped-def]
     victim = tmp_path_factory.mktemp("victim") / "precious.txt"
     victim.write_text("precious", encoding="utf-8")
     (symbolic / "plan.json.mrgc-tmp").symlink_to(victim)
-    assert run("plan", symbolic / "chain-3.mrg", "-o", symbolic / "plan.json").returncode == 0
+    assert mrgc("plan", symbolic / "chain-3.mrg", "-o", symbolic / "plan.json").returncode == 0
     assert victim.read_text(encoding="utf-8") == "precious"
     assert (symbolic / "plan.json").read_text(encoding="utf-8").startswith("{")
 
@@ -200,20 +218,20 @@ def test_nothing_is_written_after_a_signal(tmp_path: Path) -> None:
 # ------------------------------------------------------------------ model exports
 @pytest.mark.parametrize(("backend", "emit"), [("mip", "missing-dir/m.lp"), ("cpsat", "missing-dir/x.pbtxt"),
                                                ("smt", "missing-dir/m.smt2")])
-def test_emit_into_a_missing_folder_is_a_usage_error(symbolic: Path, backend: str, emit: str) -> None:
-    proc = run("compile", "chain-3.mrg", "--backend", backend, "--emit", emit, cwd=symbolic)
+def test_emit_into_a_missing_folder_is_a_usage_error(symbolic: Path, backend: str, emit: str, mrgc) -> None:  # type: ignore[no-untyped-def]
+    proc = mrgc("compile", "chain-3.mrg", "--backend", backend, "--emit", emit, cwd=symbolic)
     assert proc.returncode == 2 and "error[E006]" in proc.stderr and "model written" not in proc.stdout
 
 
 @pytest.mark.parametrize(("backend", "emit"), [("mip", "m.lp"), ("cpsat", "m.pbtxt"), ("smt", "m.smt2")])
-def test_emit_writes_a_model(symbolic: Path, backend: str, emit: str) -> None:
-    proc = run("compile", "chain-3.mrg", "--backend", backend, "--emit", emit, cwd=symbolic)
+def test_emit_writes_a_model(symbolic: Path, backend: str, emit: str, mrgc) -> None:  # type: ignore[no-untyped-def]
+    proc = mrgc("compile", "chain-3.mrg", "--backend", backend, "--emit", emit, cwd=symbolic)
     assert proc.returncode == 0 and f"model written to {emit}" in proc.stdout
     assert (symbolic / emit).stat().st_size > 0 and not temp_files(symbolic)
 
 
-def test_an_export_format_the_backend_lacks_fails_before_solving(symbolic: Path) -> None:
-    proc = run("compile", "chain-3.mrg", "--backend", "cpsat", "--emit", "m.lp", cwd=symbolic)
+def test_an_export_format_the_backend_lacks_fails_before_solving(symbolic: Path, mrgc) -> None:  # type: ignore[no-untyped-def]
+    proc = mrgc("compile", "chain-3.mrg", "--backend", "cpsat", "--emit", "m.lp", cwd=symbolic)
     assert proc.returncode == 2 and "error[E300]" in proc.stderr and "skeleton" not in proc.stdout
 
 
@@ -360,9 +378,9 @@ def big_symbolic(n: int) -> str:
 
 
 @pytest.mark.parametrize("command", ["compile", "plan"])
-def test_a_symbolic_search_out_of_time_says_time_limit(tmp_path: Path, command: str) -> None:
+def test_a_symbolic_search_out_of_time_says_time_limit(tmp_path: Path, command: str, mrgc) -> None:  # type: ignore[no-untyped-def]
     (tmp_path / "big.mrg").write_text(big_symbolic(80), encoding="utf-8")
-    proc = run(command, "big.mrg", "--encoding", "paper", "--time-limit", "0.2", cwd=tmp_path)
+    proc = mrgc(command, "big.mrg", "--encoding", "paper", "--time-limit", "0.2", cwd=tmp_path)
     assert proc.returncode == 3, proc.stdout + proc.stderr
     assert "time limit" in proc.stdout + proc.stderr
 
@@ -436,9 +454,9 @@ def test_bad_urdfs_are_located(tmp_path: Path, edit, line: int, words: str) -> N
                                                     ("v 0 0 0\nv 1e999 0 0\n", 2, "not a finite number"),
                                                     ("v 0 0 0\nf 1 2 3\n", 2, "vertices"),
                                                     ("v 0 0 0\nv 0 zz 0\n", 2, "not a number")])
-def test_bad_meshes_are_located(tmp_path: Path, obj: str, line: int, words: str) -> None:
+def test_bad_meshes_are_located(tmp_path: Path, obj: str, line: int, words: str, mrgc) -> None:  # type: ignore[no-untyped-def]
     folder = arm_folder(tmp_path, obj=obj)
-    proc = run("facts", "p.mrg", cwd=folder)
+    proc = mrgc("facts", "p.mrg", cwd=folder)
     assert proc.returncode == 2
     first = error_lines(proc.stderr)[0]
     assert re.match(rf".*robots/meshes/link\.obj:{line}:1: error\[E403\]", first) and words in first, first
@@ -462,7 +480,7 @@ def test_urdf_meshes_resolve_beside_the_urdf_never_the_current_folder(tmp_path: 
     assert float(abs(upper.points).max()) == pytest.approx(0.3)
 
 
-def test_geometry_files_are_confined_to_the_problems_tree(tmp_path: Path) -> None:
+def test_geometry_files_are_confined_to_the_problems_tree(tmp_path: Path, mrgc) -> None:  # type: ignore[no-untyped-def]
     outside = tmp_path / "outside"
     outside.mkdir()
     (outside / "block.obj").write_text("v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nv 0 0 0.1\n", encoding="utf-8")
@@ -472,24 +490,24 @@ def test_geometry_files_are_confined_to_the_problems_tree(tmp_path: Path) -> Non
         "(o3 :shape (box 0.05 0.05 0.1)", '(o3 :shape (mesh "../outside/block.obj")')
     (folder / "p.mrg").write_text(text, encoding="utf-8")
     (folder / "domain.mrg").write_text((PACKAGING / "domain.mrg").read_text(encoding="utf-8"), encoding="utf-8")
-    proc = run("check", "p.mrg", cwd=folder)
+    proc = mrgc("check", "p.mrg", cwd=folder)
     assert proc.returncode == 2 and "error[E236]" in proc.stderr and "block.obj" in proc.stderr
-    assert run("check", "p.mrg", "--allow-outside", outside, cwd=folder).returncode == 0
+    assert mrgc("check", "p.mrg", "--allow-outside", outside, cwd=folder).returncode == 0
     (folder / "domain.mrg").write_text((PACKAGING / "domain.mrg").read_text(encoding="utf-8")
                                        .replace('"franka_panda/panda.urdf"', '"/etc/passwd"'), encoding="utf-8")
-    proc = run("facts", "p.mrg", "--allow-outside", outside, cwd=folder)
+    proc = mrgc("facts", "p.mrg", "--allow-outside", outside, cwd=folder)
     assert proc.returncode == 2 and re.search(r"domain\.mrg:\d+:\d+: error\[E236\]: robot URDF '/etc/passwd'",
                                               proc.stderr)
 
 
-def test_huge_sizes_and_poses_are_refused_without_numpy_warnings(tmp_path: Path) -> None:
+def test_huge_sizes_and_poses_are_refused_without_numpy_warnings(tmp_path: Path, mrgc) -> None:  # type: ignore[no-untyped-def]
     folder = tmp_path
     (folder / "domain.mrg").write_bytes((PACKAGING / "domain.mrg").read_bytes())
     text = (PACKAGING / "pa-basic.mrg").read_text(encoding="utf-8")
     (folder / "p.mrg").write_text(text.replace("(box 1.6 1.4 0.05)", "(box 1e300 1.4 0.05)")
                                   .replace("(0 -0.05 0.05 0)", "(0 -0.05 1e300 0)"), encoding="utf-8")
     for command in ("check", "facts"):
-        proc = run(command, "p.mrg", cwd=folder)
+        proc = mrgc(command, "p.mrg", cwd=folder)
         assert proc.returncode == 2 and proc.stderr.count("error[E259]") == 2, proc.stderr
         assert "Warning" not in proc.stderr
 
@@ -540,7 +558,7 @@ TINY = """(define (problem tiny)
 """
 
 
-def test_facts_are_byte_reproducible_and_stand_on_their_own_elsewhere(tmp_path: Path) -> None:
+def test_facts_are_byte_reproducible_and_stand_on_their_own_elsewhere(tmp_path: Path, mrgc) -> None:  # type: ignore[no-untyped-def]
     src = tmp_path / "src"
     (src / "meshes").mkdir(parents=True)
     (src / "domain.mrg").write_bytes((PACKAGING / "domain.mrg").read_bytes())
@@ -551,13 +569,13 @@ def test_facts_are_byte_reproducible_and_stand_on_their_own_elsewhere(tmp_path: 
                                               + "".join(f"f {f}\n" for f in faces), encoding="utf-8")
     other = tmp_path / "other-dir"
     other.mkdir()
-    first = run("facts", "p.mrg", "-o", other / "x.mrg", "--workers", "1", cwd=src)
+    first = mrgc("facts", "p.mrg", "-o", other / "x.mrg", "--workers", "1", cwd=src)
     assert first.returncode == 0, first.stderr
     text = (other / "x.mrg").read_text(encoding="utf-8")
     assert not re.search(r"\d s\b|seconds", text.splitlines()[0])  # no wall time in the header
     assert '(mesh "x.files/meshes/block.obj")' in text and (other / "x.files" / "meshes" / "block.obj").is_file()
-    second = run("facts", "p.mrg", "-o", other / "x.mrg", "--workers", "1", "--stats", cwd=src)
+    second = mrgc("facts", "p.mrg", "-o", other / "x.mrg", "--workers", "1", "--stats", cwd=src)
     assert second.returncode == 0 and '"seconds"' in second.stdout  # timing only with --stats
     assert (other / "x.mrg").read_text(encoding="utf-8") == text
-    check = run("check", other / "x.mrg", cwd=tmp_path)  # from another folder, too
+    check = mrgc("check", other / "x.mrg", cwd=tmp_path)  # from another folder, too
     assert check.returncode == 0 and "ok" in check.stdout, check.stderr

@@ -27,7 +27,7 @@ import numpy as np
 
 from mrgc.geometry.arm import Arm
 from mrgc.geometry.collision import CollisionShape, CollisionWorld, collision_shape
-from mrgc.geometry.grasps import finger_opening, fits, grasp_transform, pregrasp_transform
+from mrgc.geometry.grasps import APPROACH, finger_opening, fits, grasp_transform, pregrasp_transform
 from mrgc.geometry.ik import solve_ik_many
 from mrgc.geometry.lattice import LatticePlanner, box_corners
 from mrgc.geometry.motion import MAX_CHECKS, plan_joint_path
@@ -39,8 +39,14 @@ from mrgc.language.model import Box, Shape
 
 Volume = list[tuple[CollisionShape, np.ndarray]]  # shapes at world transforms
 
-#: largest step (m of translation, rad of turn) between checked states of a planar path: the validator's
+#: largest step (m of translation, rad of turn) between checked states of a planar path, and largest joint
+#: motion (rad) between the configurations of an arm's transfer: the validator's
 PATH_RESOLUTION = 0.01
+#: how far a transfer raises the tool straight up before it moves off (m): the approach's back-off
+TRANSFER_LIFT = 0.08
+#: an approach's last segment starts at most this many equal shares of the back-off from the grasp (the
+#: validator allows 2)
+CONTACT_START = 1.5
 
 
 class Status(str, enum.Enum):
@@ -80,6 +86,8 @@ class Grounder:
         self._grids: dict[str, DiscGrid] = {}
         self._lattices: dict[str, LatticePlanner] = {}
         self._paths: dict[tuple[object, ...], Answer] = {}
+        self._vol_world = _PieceWorld()
+        self._moving_world = _PieceWorld()
         # planar robots wait at their start pose (as the validator assumes): obstacles for the others
         self.parked: dict[str, str] = {}
         for spec in scene.robots:
@@ -89,6 +97,24 @@ class Grounder:
                 self.parked[spec.name] = f"@{spec.name}"
                 self.world.add(f"@{spec.name}", shape, pose, "robots")
         self.queries = 0
+        #: arms wait at home while others move (the validator's rule): each arm's links at home, group
+        #: ``home:<arm>``, an obstacle to the other arms' motions
+        self.homes: tuple[str, ...] = ()
+
+    def _arm_homes(self) -> tuple[str, ...]:
+        """Put every arm's links at home into the world (once) and name their groups."""
+        if not self.homes:
+            for spec in self.scene.robots:
+                if not is_planar(spec):
+                    arm = self.arm(spec.name)
+                    for i, (shape, t) in enumerate(self.arm_volume(spec.name, arm.home[None])):
+                        self.world.add(f"@{spec.name}:{i}", shape, t, f"home:{spec.name}")
+            self.homes = tuple(f"home:{s.name}" for s in self.scene.robots if not is_planar(s))
+        return self.homes
+
+    def _others_home(self, robot: str) -> tuple[str, ...]:
+        """The groups of the other arms at home."""
+        return tuple(h for h in self._arm_homes() if h != f"home:{robot}")
 
     # ------------------------------------------------------------ state
     def arm(self, robot: str) -> Arm:
@@ -152,20 +178,21 @@ class Grounder:
 
     # ------------------------------------------------------------ placements
     def placement(self, obj: str, region: str, avoid: Iterable[str] = (), volume: Volume | None = None,
-                  samples: int = 200, key: str = "", skip: int = 0) -> Answer:
+                  samples: int = 200, key: str = "", skip: int = 0, packed: bool = False) -> Answer:
         """A pose of ``obj`` entirely inside ``region`` that hits no fixed object, none of ``avoid`` (at their
         current poses) and nothing of ``volume``: phase 1's lattice first, then random positions and the four
-        yaws; ``skip`` passes over that many valid candidates (to get another one on a retry)."""
+        yaws; ``skip`` passes over that many valid candidates (to get another one on a retry).
+
+        ``packed`` (a bin that several objects share): first a grid over the region at the four yaws,
+        corners and walls first, so that each object leaves the largest free space in the middle for the
+        ones placed before it (the reverse search places the last object first); the middle-first lattice
+        scatters them and leaves no room for a third or fourth."""
         body, reg = self.scene.body(obj), self.scene.body(region)
         if not isinstance(reg.shape, Box):
             return Answer(Status.NO_PLACEMENT)
         rng = np.random.default_rng(seed_for("placement", obj, region, key, seed=self.seed))
         h_o, h_r = half_extents(body.shape), half_extents(reg.shape)
-        vol_world = None
-        if volume:
-            vol_world = CollisionWorld()
-            for i, (shape, t) in enumerate(volume):
-                vol_world.add(f"v{i}", shape, t, "volume")
+        vol_world = self._volume_world(volume) if volume else None
         avoid = tuple(a for a in avoid if a != obj)
         shape = self.shape(obj)
         # first the 3 × 3 lattice phase 1 uses (so a placement the facts relied on is tried first), then
@@ -173,9 +200,12 @@ class Grounder:
         room = np.maximum(h_r[:2] - h_o[:2], 0) * 0.9
         lattice = sorted(((a, b) for a in (-1.0, 0.0, 1.0) for b in (-1.0, 0.0, 1.0)),
                          key=lambda ab: (ab[0] ** 2 + ab[1] ** 2, ab))
-        for k in range(len(lattice) + samples):
-            if k < len(lattice):
-                yaw, (x, y) = 0.0, (lattice[k][0] * room[0], lattice[k][1] * room[1])
+        fixed: list[tuple[float, float, float]] = [(0.0, a * room[0], b * room[1]) for a, b in lattice]
+        if packed:
+            fixed = _packing_grid(h_r[:2] - min(h_o[0], h_o[1])) + fixed
+        for k in range(len(fixed) + samples):
+            if k < len(fixed):
+                yaw, x, y = fixed[k]
             else:
                 yaw = (np.pi / 2) * (k % 4)
                 x, y = rng.uniform(-1, 1, 2) * np.maximum(h_r[:2] - min(h_o[0], h_o[1]), 0)
@@ -198,9 +228,19 @@ class Grounder:
             return Answer(Status.OK, pose=pose)
         return Answer(Status.NO_PLACEMENT)
 
+    def _volume_world(self, volume: Volume) -> CollisionWorld:
+        """A collision world holding ``volume`` (group "volume") for placements (V_fut), kept between calls:
+        see :class:`_PieceWorld`."""
+        return self._vol_world.holding(volume)
+
+    def _busy_world(self, volume: Volume) -> CollisionWorld:
+        """The same for what other robots of a step sweep meanwhile (another world: both are used at once)."""
+        return self._moving_world.holding(volume)
+
     # ------------------------------------------------------------ arm configurations
     def _approach(self, robot: str, obj: str, grasp: str, pose: np.ndarray, key: str,
-                  avoid: Iterable[str], attempts: int = 8, approach: bool = True, held: bool = False) -> Answer:
+                  avoid: Iterable[str], attempts: int = 8, approach: bool = True, held: bool = False,
+                  busy: Volume = ()) -> Answer:
         spec = self.scene.grasp_specs.get(grasp)
         arm = self.arm(robot)
         if spec is None or not fits(spec, self.scene.body(obj).shape, arm.spec.kind):
@@ -209,6 +249,7 @@ class Grounder:
         avoid = tuple(a for a in avoid if a != obj)
         blockers: set[str] = set()
         status = Status.NO_IK
+        moving = self._busy_world(busy) if busy else None
         for attempt in range(attempts):
             seed = seed_for(robot, obj, grasp, key, str(attempt), seed=self.seed)
             q = solve_ik_many(arm.model, arm.ee_target(pose @ g_t)[None], seed, q_init=arm.home)[0]
@@ -223,6 +264,11 @@ class Grounder:
                     continue
                 s = np.linspace(0.0, 1.0, APPROACH_SAMPLES)[:, None]
                 configs = pre.q[None] * (1 - s) + q.q[None] * s
+                # pre-grasp and grasp from different IK branches swing the tool off the approach line: the
+                # contact segment must start near the grasp (the validator's rule, with a margin)
+                near = arm.tool_world(configs[-2][None])[0][:3, 3]
+                if np.linalg.norm(near - (pose @ g_t)[:3, 3]) > CONTACT_START * APPROACH / (APPROACH_SAMPLES - 1):
+                    continue
             else:
                 configs = np.asarray(q.q)[None]
             # checked on a 4× finer interpolation than the configurations kept (the validator's resolution),
@@ -230,7 +276,8 @@ class Grounder:
             volume = self.arm_volume(robot, refine(configs), holding=(obj, grasp) if held else None,
                                      grasp=(obj, grasp))
             self.queries += 1
-            if self.world.probe_collides(volume, against="fixed", ignore=() if held else (obj,)):
+            if self.world.probe_collides(volume, against=("fixed", *self._others_home(robot)),
+                                         ignore=() if held else (obj,)):
                 status = Status.COLLISION
                 continue
             hit = self.world.probe_hits(volume, against=avoid) if avoid else set()
@@ -238,25 +285,30 @@ class Grounder:
                 blockers |= hit
                 status = Status.COLLISION
                 continue
+            if moving is not None and moving.probe_collides(volume, against="volume"):
+                status = Status.COLLISION  # another robot of the step moves there meanwhile: another IK seed
+                continue
             return Answer(Status.OK, pose=pose, configs=configs)
         return Answer(status, blockers=blockers)
 
-    def pick(self, robot: str, obj: str, grasp: str, avoid: Iterable[str] = ()) -> Answer:
+    def pick(self, robot: str, obj: str, grasp: str, avoid: Iterable[str] = (), busy: Volume = ()) -> Answer:
         """Approach configurations for ``robot`` to grasp ``obj`` (at its current pose) with ``grasp``,
-        free of fixed objects and of ``avoid``; ``blockers`` names the avoided objects that were in the way."""
-        return self._approach(robot, obj, grasp, self.poses[obj], "pick", avoid)
+        free of fixed objects, of ``avoid`` and of ``busy`` (what other robots sweep meanwhile); ``blockers``
+        names the avoided objects that were in the way."""
+        return self._approach(robot, obj, grasp, self.poses[obj], "pick", avoid, busy=busy)
 
-    def place(self, robot: str, obj: str, grasp: str, pose: np.ndarray, avoid: Iterable[str] = ()) -> Answer:
+    def place(self, robot: str, obj: str, grasp: str, pose: np.ndarray, avoid: Iterable[str] = (),
+              busy: Volume = ()) -> Answer:
         """Approach configurations for ``robot`` holding ``obj`` with ``grasp`` to put it at ``pose``."""
-        return self._approach(robot, obj, grasp, pose, "place", avoid, held=True)
+        return self._approach(robot, obj, grasp, pose, "place", avoid, held=True, busy=busy)
 
     def handover(self, obj: str, point: str, giver: str, g1: str, taker: str, g2: str,
-                 avoid: Iterable[str] = ()) -> Answer:
+                 avoid: Iterable[str] = (), busy: Volume = ()) -> Answer:
         """Both arms' configurations holding ``obj`` at handover point ``point`` (configs: giver, taker)."""
         pose = translation(*self.scene.handover_points[point])
         # as in phase 1, a handover is checked at the exchange configurations (no approach)
-        a = self._approach(giver, obj, g1, pose, f"handover:{point}", avoid, approach=False)
-        b = self._approach(taker, obj, g2, pose, f"handover:{point}", avoid, approach=False)
+        a = self._approach(giver, obj, g1, pose, f"handover:{point}", avoid, approach=False, busy=busy)
+        b = self._approach(taker, obj, g2, pose, f"handover:{point}", avoid, approach=False, busy=busy)
         if not (a.ok and b.ok):
             return Answer(a.status if not a.ok else b.status, blockers=a.blockers | b.blockers)
         assert a.configs is not None and b.configs is not None
@@ -269,21 +321,86 @@ class Grounder:
 
     # ------------------------------------------------------------ paths
     def arm_path(self, robot: str, start: np.ndarray, goal: np.ndarray, holding: tuple[str, str] | None = None,
-                 avoid: Iterable[str] = (), max_checks: int = MAX_CHECKS) -> Answer:
+                 avoid: Iterable[str] = (), max_checks: int = MAX_CHECKS, resolution: float = 0.05,
+                 busy: Volume = ()) -> Answer:
         """A joint-space path (RRTConnect, at most ``max_checks`` validity checks: no clock decides) free of
-        fixed objects and ``avoid`` (and of the held object's collisions with them)."""
+        fixed objects, ``avoid`` and ``busy`` (and of the held object's collisions with them)."""
         arm = self.arm(robot)
-        against = ("fixed", *[a for a in avoid if not holding or a != holding[0]])
+        against = ("fixed", *self._others_home(robot), *[a for a in avoid if not holding or a != holding[0]])
         ignore = (holding[0],) if holding else ()
+        moving = self._busy_world(busy) if busy else None
 
         def valid(q: np.ndarray) -> bool:
             self.queries += 1
-            return not self.world.probe_collides(self.arm_volume(robot, q[None], holding), against=against,
-                                                 ignore=ignore)
+            volume = self.arm_volume(robot, q[None], holding)
+            if moving is not None and moving.probe_collides(volume, against="volume"):
+                return False
+            return not self.world.probe_collides(volume, against=against, ignore=ignore)
 
         res = plan_joint_path(arm.model.lower, arm.model.upper, start, goal, valid, max_checks=max_checks,
-                              seed=seed_for(robot, "arm-path", seed=self.seed))
+                              seed=seed_for(robot, "arm-path", seed=self.seed), resolution=resolution)
         return Answer(Status.OK if res.solved else Status.NO_PATH, path=list(res.path))
+
+    def transfer(self, robot: str, obj: str, grasp: str, start: np.ndarray, goal: np.ndarray,
+                 avoid: Iterable[str] = (), lift: bool = False, busy: Volume = ()) -> Answer:
+        """How ``robot`` carries ``obj`` (held with ``grasp``) from configuration ``start`` to ``goal``: when
+        ``lift`` (``start`` grasps the object where it rests), first straight up by :data:`TRANSFER_LIFT`
+        (tool poses every centimetre, each by IK from the one before); then the straight joint-space line
+        (the validator's reading of a plan that gives no transfer) or, when that line collides, an
+        RRTConnect path (a budget of checks, seeded from the query).  Free of fixed objects, of the other arms
+        at home, of ``avoid`` and of ``busy`` (what other robots sweep meanwhile).
+        ``path`` is every configuration, ``start`` first, no joint moving more than
+        :data:`PATH_RESOLUTION` between two; ``blockers`` the avoided objects in the way."""
+        held = (obj, grasp)
+        others = tuple(a for a in avoid if a != obj)
+        against = ("fixed", *self._others_home(robot), *others)
+        back = np.asarray(start, dtype=float)[None]
+        moving = self._busy_world(busy) if busy else None
+
+        def hits(configs: np.ndarray, holding: tuple[str, str] | None = held) -> set[str] | None:
+            """None when free, else the avoided objects hit (empty: a fixed one or a moving robot)."""
+            self.queries += 1
+            volume = self.arm_volume(robot, configs, holding=holding, grasp=held)
+            if moving is not None and moving.probe_collides(volume, against="volume"):
+                return set()
+            if not self.world.probe_collides(volume, against=against, ignore=(obj,)):
+                return None
+            return self.world.probe_hits(volume, against=others, ignore=(obj,)) if others else set()
+
+        if lift:
+            up = self._lift(robot, back[0])
+            if up is None:
+                return Answer(Status.NO_IK)
+            first = joint_line(up[:2], PATH_RESOLUTION)  # the object leaves what it rests on: arm alone
+            back = joint_line(up, PATH_RESOLUTION)
+            blocked = hits(first, holding=None)
+            if blocked is None:
+                blocked = hits(back[len(first) - 1:])
+            if blocked is not None:
+                return Answer(Status.COLLISION, blockers=blocked)
+        line = joint_line(np.stack([back[-1], np.asarray(goal, dtype=float)]), PATH_RESOLUTION)
+        blocked = hits(line)
+        if blocked is None:
+            return Answer(Status.OK, path=[*back, *line[1:]])
+        planned = self.arm_path(robot, back[-1], np.asarray(goal, dtype=float), holding=held, avoid=others,
+                                resolution=PATH_RESOLUTION, busy=busy)
+        if not planned.ok:
+            return Answer(Status.NO_PATH, blockers=blocked)
+        return Answer(Status.OK, path=[*back, *planned.path[1:]])
+
+    def _lift(self, robot: str, q: np.ndarray) -> np.ndarray | None:
+        """Configurations raising the tool straight up from its pose at ``q`` by :data:`TRANSFER_LIFT` (one per
+        centimetre, each solved from the one before; None when one fails or jumps)."""
+        arm = self.arm(robot)
+        tool = arm.tool_world(q[None])[0]
+        out = [q]
+        for dz in np.arange(1, round(TRANSFER_LIFT / 0.01) + 1) * 0.01:
+            target = arm.ee_target(translation(0.0, 0.0, float(dz)) @ tool)
+            ik = solve_ik_many(arm.model, target[None], 0, q_init=out[-1], restarts=0)[0]
+            if not ik.solved or float(np.abs(ik.q - out[-1]).max()) > 0.2:
+                return None
+            out.append(ik.q)
+        return np.array(out)
 
     def base_path(self, robot: str, start: np.ndarray, goal: np.ndarray, holding: tuple[str, str] | None = None,
                   avoid: Iterable[str] = (), busy: Sequence[tuple[CollisionShape, np.ndarray]] = ()) -> Answer:
@@ -347,6 +464,50 @@ class Grounder:
         res = lattice.plan(occupied, np.asarray(start, dtype=float), np.asarray(goal, dtype=float), valid,
                            PATH_RESOLUTION, PATH_RESOLUTION)
         return Answer(Status.OK if res.solved else Status.NO_PATH, path=list(res.path))
+
+
+class _PieceWorld:
+    """A collision world holding a volume (group "volume"), kept between calls: pieces already in it (the
+    same tuple objects: the reverse search's volumes grow by concatenation) stay, the others are added or
+    removed, so a query pays only for what is new.  Booleans asked of it do not depend on the order the
+    pieces came in."""
+
+    def __init__(self) -> None:
+        self.world = CollisionWorld()
+        self.pieces: dict[int, tuple[CollisionShape, np.ndarray]] = {}
+
+    def holding(self, volume: Volume | Sequence[tuple[CollisionShape, np.ndarray]]) -> CollisionWorld:
+        want = {id(piece): piece for piece in volume}
+        for key in [k for k in self.pieces if k not in want]:
+            self.world.remove(f"v{key}")
+            del self.pieces[key]
+        for key, piece in want.items():
+            if key not in self.pieces:
+                self.world.add(f"v{key}", piece[0], piece[1], "volume")
+                self.pieces[key] = piece  # held, so that its id is not reused while it is in the world
+        return self.world
+
+
+def _packing_grid(room: np.ndarray, cells: int = 15) -> list[tuple[float, float, float]]:
+    """(yaw, x, y) over ``[-room, room]`` (region frame) on a grid of at most ``cells`` per side (at least 1 cm
+    apart), the four yaws at each point, points nearest a corner first."""
+    room = np.maximum(room, 0.0)
+    axes = [np.linspace(-r, r, max(1, min(cells, int(2 * r / 0.01) + 1))) for r in room]
+    scale = np.maximum(room, 1e-9)
+    points = sorted(((float(x), float(y)) for x in axes[0] for y in axes[1]),
+                    key=lambda p: (-round(abs(p[0]) / scale[0] + abs(p[1]) / scale[1], 9), p))
+    return [(k * np.pi / 2, x, y) for x, y in points for k in range(4)]
+
+
+def joint_line(configs: np.ndarray, step: float) -> np.ndarray:
+    """The configurations of the straight joint-space motion through ``configs`` (C, dof), first and last
+    included, no joint moving more than ``step`` between two."""
+    out = [configs[:1]]
+    for a, b in zip(configs[:-1], configs[1:]):
+        n = max(1, int(np.ceil(float(np.abs(b - a).max()) / step - 1e-9)))
+        s = np.arange(1, n + 1)[:, None] / n
+        out.append(a[None] * (1 - s) + b[None] * s)
+    return np.concatenate(out)
 
 
 def _swept_hulls(volume: Sequence[tuple[CollisionShape, np.ndarray]], chunk: int = 8) -> list[np.ndarray]:

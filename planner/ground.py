@@ -4,7 +4,10 @@ Steps are grounded from the last to the first.  At step t, placements avoid the 
 that are never moved (M_out), the objects moved later (M_fut, still at their initial poses at t), the
 objects moved in the same step, and the future volume V_fut (everything later grounded steps sweep,
 including objects at their final placements).  Pick, handover and place configurations avoid the same
-objects; robots of one step must not collide with each other.  If step t fails, it is retried allowing
+objects; robots of one step must not collide with each other: each action's motions (approaches,
+exchanges, transfers, base paths) keep clear of everything the step's actions grounded before it sweep in
+the same phase (conservative: it ignores when they pass), and the phases are then compared sample by
+sample as the validator replays them.  If step t fails, it is retried allowing
 collisions with M_out: on success grounding stops and returns the grounded suffix S' and M* = the goal
 objects not moved in S' plus the M_out objects that obstruct S'; otherwise it fails.
 """
@@ -111,10 +114,10 @@ class ReverseGrounder:
         placed: dict[str, np.ndarray] = {}  # objects of this step already placed by its earlier actions
         for a in step:
             avoid_a = sorted((avoid | same) - {a.obj})
-            # what the other robots of the step sweep in each phase (planar robots drive around it)
+            # what the other robots of the step sweep in each phase: this action's motions keep clear of it
             busy: dict[str, Volume] = {}
             for robot, phases in motions.items():
-                if robot != a.pick_robot:
+                if robot not in (a.pick_robot, a.place_robot):
                     for phase, samples in phases.items():
                         busy.setdefault(phase, []).extend(p for vol in samples for p in vol)
             action = self._action(a, avoid_a, v_fut + step_volume, f"{key}:{a.obj}", placed, busy)
@@ -158,6 +161,12 @@ class ReverseGrounder:
             out[action.pick_robot]["handover"] = [g.arm_volume(action.pick_robot, giver[None], (obj, action.pick_grasp))]
             out.setdefault(action.place_robot, {})["handover"] = [
                 g.arm_volume(action.place_robot, taker[None], (obj, action.place_grasp))]
+        # the holding transfers (every configuration: they are already at the validator's resolution)
+        for phase, robot, grasp in (("to-handover", action.pick_robot, action.pick_grasp),
+                                    ("to-place", action.place_robot, action.place_grasp)):
+            if phase in action.paths:
+                out.setdefault(robot, {})[phase] = [g.arm_volume(robot, np.array(q)[None], holding=(obj, grasp))
+                                                    for q in action.paths[phase]]
         out.setdefault(action.place_robot, {})["place"] = [
             g.arm_volume(action.place_robot, q[None], (obj, action.place_grasp))
             for q in refine(np.array(action.configs["place"]))]
@@ -168,32 +177,51 @@ class ReverseGrounder:
                 busy: dict[str, Volume] | None = None) -> PlannedAction | Failure:
         if self.g.is_planar(a.pick_robot):
             return self._drive(a, avoid, v_fut, key, placed or {}, busy or {})
-        g = self.g
-        pick = g.pick(a.pick_robot, a.obj, a.pick_grasp, avoid=avoid)
+        g, busy = self.g, busy or {}
+        pick = g.pick(a.pick_robot, a.obj, a.pick_grasp, avoid=avoid, busy=busy.get("pick", []))
         if not pick.ok:
             return _failed(f"pick by {a.pick_robot}", pick)
         planned = PlannedAction(a.obj, a.region, a.pick_robot, a.place_robot, a.pick_grasp, a.place_grasp)
         planned.configs["pick"] = _configs(pick.configs)
+        assert pick.configs is not None
+        start, lift = pick.configs[-1], True  # the place transfer starts at the grasp
         if a.handover:
-            hand = self._handover(a, avoid)
+            hand = self._handover(a, avoid, busy.get("handover", []))
             if isinstance(hand, Failure):
                 return hand
             point, answer = hand
             assert answer.configs is not None
             planned.handover_point = point
             planned.configs["handover"] = _configs(answer.configs)
+            giver = g.transfer(a.pick_robot, a.obj, a.pick_grasp, pick.configs[-1], answer.configs[0], avoid,
+                               lift=True, busy=busy.get("to-handover", []))
+            if not giver.ok:
+                return _failed(f"carry to the handover by {a.pick_robot}", giver)
+            planned.paths["to-handover"] = _configs(np.array(giver.path))
+            start, lift = answer.configs[1], False  # the taker's transfer starts at the exchange
         last: Failure | None = None
         for k in range(PLACEMENT_TRIES):
-            spot = g.placement(a.obj, a.region, avoid=avoid, volume=v_fut, key=key, skip=k)
+            # goal bins are shared by several objects: packed from the corners; elsewhere (moving an obstacle
+            # aside) the middle of the region first, nearest the arms that reach it
+            spot = g.placement(a.obj, a.region, avoid=avoid, volume=v_fut, key=key, skip=k,
+                               packed=self.goal.get(a.obj) == a.region)
             if not spot.ok:
                 return last or Failure(0, "", f"placement: no free pose of {a.obj} in {a.region}")
             assert spot.pose is not None
-            place = g.place(a.place_robot, a.obj, a.place_grasp, spot.pose, avoid=avoid)
-            if place.ok:
-                planned.place_pose = _matrix(spot.pose)
-                planned.configs["place"] = _configs(place.configs)
-                return planned
-            last = _failed(f"place by {a.place_robot}", place)
+            place = g.place(a.place_robot, a.obj, a.place_grasp, spot.pose, avoid=avoid, busy=busy.get("place", []))
+            if not place.ok:
+                last = _failed(f"place by {a.place_robot}", place)
+                continue
+            assert place.configs is not None
+            carry = g.transfer(a.place_robot, a.obj, a.place_grasp, start, place.configs[0], avoid, lift=lift,
+                               busy=busy.get("to-place", []))
+            if not carry.ok:
+                last = _failed(f"carry to the placement by {a.place_robot}", carry)
+                continue
+            planned.place_pose = _matrix(spot.pose)
+            planned.configs["place"] = _configs(place.configs)
+            planned.paths["to-place"] = _configs(np.array(carry.path))
+            return planned
         assert last is not None
         return last
 
@@ -213,7 +241,8 @@ class ReverseGrounder:
         shape = g.scene.body(a.obj).shape
         home = to_se2(g.scene.robot(robot).base)
         q_pick = pr.grasp_base(g.poses[a.obj], shape, a.pick_grasp)
-        to_pick = g.base_path(robot, home, q_pick, avoid=avoid, busy=busy.get("to-pick", []))
+        # the drive to the pick keeps clear of the object too: the robot stops in front of it
+        to_pick = g.base_path(robot, home, q_pick, avoid=[*avoid, a.obj], busy=busy.get("to-pick", []))
         if not to_pick.ok:
             return _failed("drive to the pick", to_pick)
         last: Failure | None = None
@@ -249,12 +278,13 @@ class ReverseGrounder:
         assert last is not None
         return last
 
-    def _handover(self, a: Action, avoid: list[str]) -> tuple[str, Answer] | Failure:
+    def _handover(self, a: Action, avoid: list[str], busy: Volume) -> tuple[str, Answer] | Failure:
         failure = Failure(0, "", f"handover: no handover point usable for {a.obj}")
         for point in self.g.scene.handover_of.get(a.obj, ()):
             if point not in self.g.scene.handover_points:
                 continue
-            ans = self.g.handover(a.obj, point, a.pick_robot, a.pick_grasp, a.place_robot, a.place_grasp, avoid=avoid)
+            ans = self.g.handover(a.obj, point, a.pick_robot, a.pick_grasp, a.place_robot, a.place_grasp, avoid=avoid,
+                                  busy=busy)
             if ans.ok:
                 return point, ans
             failure = _failed(f"handover at {point}", ans)

@@ -164,7 +164,7 @@ def _referee(problem: Problem, problem_file: str, plan: Plan, result: Grounding,
                      plan.encoding, plan.seed, PlanStatus.SOLVED, [s.actions for s in result.steps],
                      symbolic=False, stats={"robots": [r.name for r in problem.robots]})
     t0 = time.perf_counter()
-    report = validate(problem, candidate.to_json(), problem_file)
+    report = validate(problem, candidate.to_json(), problem_file, first_only=True)  # the verdict, fast
     seconds = time.perf_counter() - t0
     verdicts["seconds"] = verdicts.get("seconds", 0.0) + seconds
     verdicts["checked"] = verdicts.get("checked", 0) + 1

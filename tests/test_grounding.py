@@ -66,6 +66,50 @@ def test_handover_and_place(pa3: Grounder) -> None:
     assert pa3.place("r1", "o1", "top", target.pose).status is Status.NO_IK
 
 
+def test_transfer_lifts_then_carries_to_the_pre_place(pa3: Grounder) -> None:
+    """The held object's transfer starts at the grasp, rises 8 cm straight up, ends at the pre-place, moves no
+    joint more than 1 cm-rad between configurations, and (past its first centimetre, where the object
+    leaves the table it rests on) keeps the arm and the object clear of the table."""
+    pick = pa3.pick("r1", "o1", "top", avoid=["o2", "o3"])
+    hand = pa3.handover("o1", "h1", "r1", "top", "r2", "side-x+")
+    assert pick.ok and pick.configs is not None and hand.ok and hand.configs is not None
+    carry = pa3.transfer("r1", "o1", "top", pick.configs[-1], hand.configs[0], avoid=["o2", "o3"], lift=True)
+    assert carry.ok
+    path = np.array(carry.path)
+    assert np.allclose(path[0], pick.configs[-1]) and np.allclose(path[-1], hand.configs[0])
+    assert np.abs(np.diff(path, axis=0)).max() <= 0.01 + 1e-9
+    arm = pa3.arm("r1")
+    z = arm.tool_world(path)[:, 2, 3]
+    rise = next(i for i, h in enumerate(z) if h >= z[0] + 0.08 - 1e-4)
+    tools = arm.tool_world(path[:rise + 1])[:, :2, 3]
+    assert np.abs(tools - tools[0]).max() < 2e-3  # straight up
+    start = next(i for i, h in enumerate(z) if h >= z[0] + 0.01 - 1e-4)
+    volume = pa3.arm_volume("r1", path[start:], holding=("o1", "top"))
+    assert pa3.hits(volume, among="fixed", ignore=["o1"]) == set()
+    assert pa3.hits(volume, among=["o2", "o3"]) == set()
+
+
+def test_transfer_names_what_blocks_it(pa3: Grounder) -> None:
+    pick = pa3.pick("r1", "o1", "top")
+    assert pick.ok and pick.configs is not None
+    # an object put right above o1 is in the way of the lift
+    pa3.move("o2", pa3.poses["o1"] @ translation(0, 0, 0.15))
+    blocked = pa3.transfer("r1", "o1", "top", pick.configs[-1], pick.configs[0], avoid=["o2"], lift=True)
+    assert blocked.status is Status.COLLISION and blocked.blockers == {"o2"}
+
+
+def test_packed_placements_fill_a_bin_from_its_corners(pa3: Grounder) -> None:
+    bin_b = pa3.scene.body("bin-b")
+    first = pa3.placement("o1", "bin-b", packed=True)
+    assert first.ok and first.pose is not None
+    local = np.linalg.inv(bin_b.pose) @ first.pose
+    centre = pa3.placement("o1", "bin-b")
+    assert centre.ok and centre.pose is not None
+    assert np.allclose(centre.pose[:2, 3], bin_b.pose[:2, 3])  # the default starts in the middle
+    assert abs(local[0, 3]) > 0.01 and abs(local[1, 3]) > 0.01  # packed starts in a corner
+    assert inside(bin_b, pa3.scene.body("o1").shape, first.pose)
+
+
 def test_arm_path_and_its_volume(pa3: Grounder) -> None:
     arm = pa3.arm("r1")
     pick = pa3.pick("r1", "o1", "top")

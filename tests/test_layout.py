@@ -48,6 +48,7 @@ HEAVY = {
     "matplotlib": "render/gantt.py",
     "viser": "render/html.py",
     "ray": "bench/ray_executor.py",
+    "jsonschema": "planner/plan_reader.py",
 }
 #: heavy libraries a second module may import too: pybullet's renderer draws the pictures
 ALSO_HEAVY = {"render/raster.py": {"pybullet"}, "bench/figures.py": {"matplotlib"}}

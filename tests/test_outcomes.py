@@ -165,17 +165,21 @@ class ScriptedGrounder:
     def is_planar(self, robot: str) -> bool:
         return False
 
-    def pick(self, robot: str, obj: str, grasp: str, avoid: Any = ()) -> Answer:
+    def pick(self, robot: str, obj: str, grasp: str, avoid: Any = (), busy: Any = ()) -> Answer:
         hit = self.blocked_by.get(obj, set()) & set(avoid)
         if hit:
             return Answer(Status.COLLISION, blockers=hit)
         return Answer(Status.OK, configs=np.array([[0.0], [1.0]]))
 
-    def place(self, robot: str, obj: str, grasp: str, pose: np.ndarray, avoid: Any = ()) -> Answer:
+    def place(self, robot: str, obj: str, grasp: str, pose: np.ndarray, avoid: Any = (), busy: Any = ()) -> Answer:
         return Answer(Status.OK, configs=np.array([[1.0], [0.0]]))
 
+    def transfer(self, robot: str, obj: str, grasp: str, start: np.ndarray, goal: np.ndarray, avoid: Any = (),
+                 lift: bool = False, busy: Any = ()) -> Answer:
+        return Answer(Status.OK, path=[np.asarray(start), np.asarray(goal)])
+
     def placement(self, obj: str, region: str, avoid: Any = (), volume: Any = None, key: str = "",
-                  skip: int = 0) -> Answer:
+                  skip: int = 0, packed: bool = False) -> Answer:
         return Answer(Status.OK, pose=np.eye(4))
 
     def arm_volume(self, robot: str, configs: np.ndarray, holding: Any = None, grasp: Any = None) -> list[Any]:

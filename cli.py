@@ -278,7 +278,7 @@ def cmd_plan(args: argparse.Namespace) -> int:
         plan = plan_with(args.planner, problem, args.file, file_sha256(args.file), __version__, backend=args.backend,
                          encoding=args.encoding, seed=args.seed, time_limit=args.time_limit, c=args.c,
                          alpha=args.alpha, skeletons=args.skeletons, max_makespan=args.max_makespan,
-                         anytime=args.anytime, log=log)
+                         anytime=args.anytime, log=log, motions=args.motions)
     status = PlanStatus(plan.status)
     # a signal ends the run as interrupted even where the search did not see it (never a verdict, never a file)
     interrupted = status is PlanStatus.INTERRUPTED or signals.received() is not None
@@ -435,6 +435,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--anytime", action="store_true",
                    help="keep searching after the first plan until the time limit; return the best "
                         "(makespan, then objects moved)")
+    p.add_argument("--motions", choices=["configurations", "full"], default="configurations",
+                   help="arms' motion model: configurations (the paper's packaging model: approaches, exchanges, "
+                        "transfers; default) or full (every motion planned as a path; docs/validator.md)")
     p.add_argument("-v", "--verbose", action="store_true", help="print a search log line per grounded skeleton")
     add_allow_outside(p)
     p.set_defaults(func=cmd_plan)

@@ -388,6 +388,35 @@ class Grounder:
             return Answer(Status.NO_PATH, blockers=blocked)
         return Answer(Status.OK, path=[*back, *planned.path[1:]])
 
+    def transit(self, robot: str, start: np.ndarray, goal: np.ndarray, avoid: Iterable[str] = (),
+                busy: Volume = (), via: np.ndarray | None = None) -> Answer:
+        """An empty-handed motion of ``robot`` (fingers fully open, as the validator replays it) from
+        ``start`` to ``goal``: along ``via`` first when given (configurations, ``start`` first, joined by
+        straight joint-space lines: a release backing off along its approach), then the straight line or, when
+        that collides, an RRTConnect path.  Free of fixed objects, of the other arms at home, of ``avoid`` and
+        of ``busy``; ``path`` as for :meth:`transfer`."""
+        against = ("fixed", *self._others_home(robot), *avoid)
+        moving = self._busy_world(busy) if busy else None
+
+        def free(configs: np.ndarray) -> bool:
+            self.queries += 1
+            volume = self.arm_volume(robot, configs)
+            if moving is not None and moving.probe_collides(volume, against="volume"):
+                return False
+            return not self.world.probe_collides(volume, against=against)
+
+        back = joint_line(np.asarray(via if via is not None else [start], dtype=float), PATH_RESOLUTION)
+        if not free(back):
+            return Answer(Status.COLLISION)
+        line = joint_line(np.stack([back[-1], np.asarray(goal, dtype=float)]), PATH_RESOLUTION)
+        if free(line):
+            return Answer(Status.OK, path=[*back, *line[1:]])
+        planned = self.arm_path(robot, back[-1], np.asarray(goal, dtype=float), avoid=tuple(avoid),
+                                resolution=PATH_RESOLUTION, busy=busy)
+        if not planned.ok:
+            return Answer(Status.NO_PATH)
+        return Answer(Status.OK, path=[*back, *planned.path[1:]])
+
     def _lift(self, robot: str, q: np.ndarray) -> np.ndarray | None:
         """Configurations raising the tool straight up from its pose at ``q`` by :data:`TRANSFER_LIFT` (one per
         centimetre, each solved from the one before; None when one fails or jumps)."""

@@ -30,6 +30,8 @@ from mrgc.planner.outcome import Failure
 from mrgc.planner.plan import PlannedAction
 
 PLACEMENT_TRIES = 6  # placements sampled per place before the step gives up
+#: paths replayed in another path's phase (the validator's execution model): name -> phase
+PATH_PHASE = {"taker-to-handover": "to-handover", "giver-home": "home"}
 
 
 class Outcome(str, enum.Enum):
@@ -70,9 +72,12 @@ def _configs(c: np.ndarray | None) -> list[list[float]]:
 class ReverseGrounder:
     """Grounds skeletons on a scene (see the module docstring)."""
 
-    def __init__(self, grounder: Grounder, goal: dict[str, str]) -> None:
+    def __init__(self, grounder: Grounder, goal: dict[str, str], full: bool = False) -> None:
         self.g = grounder
         self.goal = goal
+        #: arms' empty-handed motions planned too (``mrgc plan --motions full``): home -> pre-grasp, release
+        #: -> home, and for a handover the taker's way to the exchange and the giver's way home
+        self.full = full
         self.movable = [b.name for b in grounder.scene.movable]
 
     def ground(self, skeleton: Skeleton, suffix: list[GroundedStep], key: str = "") -> Grounding:
@@ -161,12 +166,16 @@ class ReverseGrounder:
             out[action.pick_robot]["handover"] = [g.arm_volume(action.pick_robot, giver[None], (obj, action.pick_grasp))]
             out.setdefault(action.place_robot, {})["handover"] = [
                 g.arm_volume(action.place_robot, taker[None], (obj, action.place_grasp))]
-        # the holding transfers (every configuration: they are already at the validator's resolution)
+        # the paths (every configuration: they are already at the validator's resolution); holding the
+        # object on the transfers, empty-handed (fingers fully open) otherwise
         for phase, robot, grasp in (("to-handover", action.pick_robot, action.pick_grasp),
-                                    ("to-place", action.place_robot, action.place_grasp)):
+                                    ("to-place", action.place_robot, action.place_grasp),
+                                    ("to-pick", action.pick_robot, None), ("taker-to-handover", action.place_robot, None),
+                                    ("home", action.place_robot, None), ("giver-home", action.pick_robot, None)):
             if phase in action.paths:
-                out.setdefault(robot, {})[phase] = [g.arm_volume(robot, np.array(q)[None], holding=(obj, grasp))
-                                                    for q in action.paths[phase]]
+                held = (obj, grasp) if grasp is not None else None
+                out.setdefault(robot, {})[PATH_PHASE.get(phase, phase)] = [
+                    g.arm_volume(robot, np.array(q)[None], holding=held) for q in action.paths[phase]]
         out.setdefault(action.place_robot, {})["place"] = [
             g.arm_volume(action.place_robot, q[None], (obj, action.place_grasp))
             for q in refine(np.array(action.configs["place"]))]
@@ -221,9 +230,53 @@ class ReverseGrounder:
             planned.place_pose = _matrix(spot.pose)
             planned.configs["place"] = _configs(place.configs)
             planned.paths["to-place"] = _configs(np.array(carry.path))
+            if self.full:
+                transits = self._transits(a, planned, avoid, busy, {**(placed or {}), a.obj: spot.pose})
+                if isinstance(transits, Failure):
+                    last = transits
+                    continue
             return planned
         assert last is not None
         return last
+
+    def _transits(self, a: Action, planned: PlannedAction, avoid: list[str], busy: dict[str, Volume],
+                  new: dict[str, np.ndarray]) -> None | Failure:
+        """An arm action's empty-handed motions (``full``), into ``planned.paths``: home to the pre-grasp
+        (the object to pick in the way too), the taker home to the exchange; then, with every object of the
+        step at its new pose (``new``, the validator's home phase), back off along the place approach and go
+        home, and the giver home from the exchange."""
+        g = self.g
+        pick, place = np.array(planned.configs["pick"]), np.array(planned.configs["place"])
+        asks: list[tuple[str, str, np.ndarray, np.ndarray, list[str], np.ndarray | None]] = [
+            ("to-pick", a.pick_robot, g.arm(a.pick_robot).home, pick[0], [*avoid, a.obj], None)]
+        after = sorted({*avoid, *new})
+        if a.handover:
+            giver, taker = np.array(planned.configs["handover"])
+            asks.append(("taker-to-handover", a.place_robot, g.arm(a.place_robot).home, taker, avoid, None))
+            asks.append(("giver-home", a.pick_robot, giver, g.arm(a.pick_robot).home, after, None))
+        asks.append(("home", a.place_robot, place[-1], g.arm(a.place_robot).home, after, place[::-1]))
+        # the giver's motions share the validator's phases with the taker's: each keeps clear of the other's
+        mine: dict[str, Volume] = {}
+        if "to-handover" in planned.paths:
+            mine["to-handover"] = g.arm_volume(a.pick_robot, np.array(planned.paths["to-handover"]),
+                                               holding=(a.obj, a.pick_grasp))
+        initial = {o: g.poses[o] for o in new}
+        try:
+            for name, robot, start, goal, obstacles, via in asks:
+                phase = PATH_PHASE.get(name, name)
+                if phase == "home":
+                    for o, pose in new.items():
+                        g.move(o, pose)
+                ans = g.transit(robot, start, goal, avoid=obstacles, busy=busy.get(phase, []) + mine.get(phase, []),
+                                via=via)
+                if not ans.ok:
+                    return _failed(f"{name} of {robot}", ans)
+                planned.paths[name] = _configs(np.array(ans.path))
+                mine.setdefault(phase, []).extend(g.arm_volume(robot, np.array(ans.path)))
+        finally:
+            for o, pose in initial.items():
+                g.move(o, pose)
+        return None
 
     def _drive(self, a: Action, avoid: list[str], v_fut: Volume, key: str,
                placed: dict[str, np.ndarray], busy: dict[str, Volume]) -> PlannedAction | Failure:

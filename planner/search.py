@@ -25,20 +25,28 @@ from mrgc.language.model import Problem
 from mrgc.planner.ground import GroundedStep, Grounding, Outcome, ReverseGrounder, moved_objects
 from mrgc.planner.mcts import MCTS
 from mrgc.planner.outcome import BlockingCycle, Failure, PlanStatus, Why
-from mrgc.planner.plan import Plan, PlannedAction
+from mrgc.planner.plan import Plan, PlannedAction, planner_motion_model
 from mrgc.planner.skeletons import DEFAULT_BACKEND, DEFAULT_ENCODING, SkeletonSource, must_move, problem_facts
 
 #: a search log line sink (``mrgc plan --verbose`` prints them)
 Log = Callable[[str], None]
 
 
+#: the arms' motion models ``plan_problem`` can plan (docs/validator.md)
+MOTIONS = ("configurations", "full")
+
+
 def plan_problem(problem: Problem, problem_file: str, sha256: str, version: str, backend: str = DEFAULT_BACKEND,
                  encoding: str = DEFAULT_ENCODING, seed: int = 0, time_limit: float = 60.0, c: float = 1.0,
                  alpha: float = 1.0, skeletons: int = 5, max_makespan: int | None = None, anytime: bool = False,
-                 log: Log | None = None, max_iterations: int = 10_000) -> Plan:
+                 log: Log | None = None, max_iterations: int = 10_000, motions: str = "configurations") -> Plan:
     """Plan ``problem`` (see the module docstring).  ``anytime`` keeps searching after the first plan until
     the time limit (or the end of the tree) and returns the best by (makespan, objects moved); ``log`` gets
-    one line per grounded skeleton."""
+    one line per grounded skeleton.  ``motions``: ``configurations`` (the paper's packaging model: arms'
+    approaches, exchanges and the held object's transfers) or ``full`` (arms' empty-handed motions too, as
+    paths; docs/validator.md)."""
+    if motions not in MOTIONS:
+        raise ValueError(f"motions is one of {', '.join(MOTIONS)}, not {motions!r}")
     t0 = time.perf_counter()
     deadline = t0 + time_limit
     say: Log = log or (lambda line: None)
@@ -46,6 +54,7 @@ def plan_problem(problem: Problem, problem_file: str, sha256: str, version: str,
     base = FactBase.from_problem(problem, facts)
     plan = Plan(problem.name, problem_file, sha256, version, backend, encoding, seed, PlanStatus.EXHAUSTED,
                 symbolic=problem.symbolic)
+    plan.motion_model = None if problem.symbolic else planner_motion_model(motions)
     why = Why()
     plan.why = why
     stats: dict[str, Any] = {"robots": [r.name for r in problem.robots], "facts": len(facts),
@@ -91,7 +100,7 @@ def plan_problem(problem: Problem, problem_file: str, sha256: str, version: str,
     else:
         scene = scene_from_problem(problem)
         grounder = Grounder(scene, seed=seed)
-        reverse = ReverseGrounder(grounder, problem.goal_regions)
+        reverse = ReverseGrounder(grounder, problem.goal_regions, full=motions == "full")
         count = [0]
         validation: dict[str, Any] = {}
 

@@ -44,6 +44,8 @@ Volume = list[tuple[CollisionShape, np.ndarray]]  # shapes at world transforms
 PATH_RESOLUTION = 0.01
 #: how far a transfer raises the tool straight up before it moves off (m): the approach's back-off
 TRANSFER_LIFT = 0.08
+#: pairs of exchange configurations tried for a handover before the two arms are said to collide
+HANDOVER_PAIRS = 6
 #: an approach's last segment starts at most this many equal shares of the back-off from the grasp (the
 #: validator allows 2)
 CONTACT_START = 1.5
@@ -252,7 +254,11 @@ class Grounder:
         moving = self._busy_world(busy) if busy else None
         for attempt in range(attempts):
             seed = seed_for(robot, obj, grasp, key, str(attempt), seed=self.seed)
-            q = solve_ik_many(arm.model, arm.ee_target(pose @ g_t)[None], seed, q_init=arm.home)[0]
+            # the first attempt starts from home (the solution nearest it); the others from a start drawn from
+            # their seed, or every attempt would converge to that same solution again
+            start = arm.home if attempt == 0 else np.random.default_rng(seed).uniform(arm.model.lower,
+                                                                                       arm.model.upper)
+            q = solve_ik_many(arm.model, arm.ee_target(pose @ g_t)[None], seed, q_init=start)[0]
             if not q.solved:
                 if q.status.value == "unreachable":
                     return Answer(Status.NO_IK)  # provably out of reach: no other seed helps
@@ -306,18 +312,21 @@ class Grounder:
                  avoid: Iterable[str] = (), busy: Volume = ()) -> Answer:
         """Both arms' configurations holding ``obj`` at handover point ``point`` (configs: giver, taker)."""
         pose = translation(*self.scene.handover_points[point])
-        # as in phase 1, a handover is checked at the exchange configurations (no approach)
-        a = self._approach(giver, obj, g1, pose, f"handover:{point}", avoid, approach=False, busy=busy)
-        b = self._approach(taker, obj, g2, pose, f"handover:{point}", avoid, approach=False, busy=busy)
-        if not (a.ok and b.ok):
-            return Answer(a.status if not a.ok else b.status, blockers=a.blockers | b.blockers)
-        assert a.configs is not None and b.configs is not None
-        world = CollisionWorld()
-        for i, (shape, t) in enumerate(self.arm_volume(taker, b.configs[-1:], grasp=(obj, g2))):
-            world.add(f"t{i}", shape, t, "taker")
-        if world.probe_collides(self.arm_volume(giver, a.configs[-1:], grasp=(obj, g1)), against="taker"):
-            return Answer(Status.COLLISION)
-        return Answer(Status.OK, pose=pose, configs=np.stack([a.configs[-1], b.configs[-1]]))
+        # as in phase 1, a handover is checked at the exchange configurations (no approach); IK solutions of
+        # the two arms are drawn in pairs (other seeds) until a pair does not collide
+        for attempt in range(HANDOVER_PAIRS):
+            key = f"handover:{point}" + (f":{attempt}" if attempt else "")
+            a = self._approach(giver, obj, g1, pose, key, avoid, approach=False, busy=busy)
+            b = self._approach(taker, obj, g2, pose, key, avoid, approach=False, busy=busy)
+            if not (a.ok and b.ok):
+                return Answer(a.status if not a.ok else b.status, blockers=a.blockers | b.blockers)
+            assert a.configs is not None and b.configs is not None
+            world = CollisionWorld()
+            for i, (shape, t) in enumerate(self.arm_volume(taker, b.configs[-1:], grasp=(obj, g2))):
+                world.add(f"t{i}", shape, t, "taker")
+            if not world.probe_collides(self.arm_volume(giver, a.configs[-1:], grasp=(obj, g1)), against="taker"):
+                return Answer(Status.OK, pose=pose, configs=np.stack([a.configs[-1], b.configs[-1]]))
+        return Answer(Status.COLLISION)
 
     # ------------------------------------------------------------ paths
     def arm_path(self, robot: str, start: np.ndarray, goal: np.ndarray, holding: tuple[str, str] | None = None,

@@ -55,28 +55,26 @@ def _report(exc: InputError) -> None:
         print(f"{n} errors", file=sys.stderr)
 
 
-def _warn(mf: "MrgFile") -> None:
-    """Print the warnings of a checked file's problems (grasps no robot can open wide enough for)."""
-    from mrgc.geometry.grasps import grasp_warnings
-
-    for p in mf.problems:
-        for d in grasp_warnings(p):
-            print(d.render(mf.text if d.span is not None and d.span.file == mf.path else None), file=sys.stderr)
+def _warn(path: str, text: str, warnings: Sequence[Diagnostic]) -> None:
+    """Print the warnings about a checked file (``path``, whose ``text`` shows the source lines)."""
+    for d in warnings:
+        print(d.render(text if d.span is not None and d.span.file == path else None), file=sys.stderr)
 
 
 # ---------------------------------------------------------------- commands
 def cmd_check(args: argparse.Namespace) -> int:
-    from mrgc.language.loader import parse_file
+    from mrgc.api import check
 
     status = EXIT_OK
     for path in args.files:
         try:
-            mf = parse_file(path, **_outside(args))
+            report = check(path, allow_outside=getattr(args, "allow_outside", None) or ())
         except InputError as exc:
             _report(exc)
             status = EXIT_INPUT
             continue
-        _warn(mf)
+        mf = report.file
+        _warn(mf.path, mf.text, report.warnings)
         parts = [f"{len(mf.domains)} domain{'s' * (len(mf.domains) != 1)}"]
         for p in mf.problems:
             kind = "symbolic" if p.symbolic else "geometric"
@@ -94,8 +92,8 @@ def cmd_fmt(args: argparse.Namespace) -> int:
     from mrgc.language.parser import parse_text
     from mrgc.language.printer import format_source
 
-    if not (args.check or args.write) and len(args.files) != 1:
-        raise InputError([Diagnostic("E000", "fmt prints one file; use --check or --write for several")])
+    if not (args.check or args.write or args.diff) and len(args.files) != 1:
+        raise InputError([Diagnostic("E000", "fmt prints one file; use --check, --diff or --write for several")])
     status = EXIT_OK
     for path in args.files:
         text, diag = read_source(path)
@@ -110,10 +108,12 @@ def cmd_fmt(args: argparse.Namespace) -> int:
             continue
         assert text is not None and not isinstance(tree, Diagnostic)
         pretty = format_source(tree, text)
-        if args.check:
+        if args.check or args.diff:
             if pretty != text:
-                print(f"{path}: would reformat", file=sys.stderr)
-                status = status or EXIT_NO_PLAN
+                sys.stdout.write(_unified_diff(path, text, pretty))
+                if args.check:
+                    print(f"{path}: would reformat", file=sys.stderr)
+                    status = status or EXIT_NO_PLAN
         elif args.write:
             if pretty != text:
                 write_text(path, pretty, option="fmt --write")
@@ -121,6 +121,20 @@ def cmd_fmt(args: argparse.Namespace) -> int:
         else:
             sys.stdout.write(pretty)
     return status
+
+
+def _unified_diff(path: str, text: str, pretty: str) -> str:
+    """What ``fmt --diff`` / ``--check`` print: a unified diff from ``text`` to its canonical form, ``patch
+    -p0`` applicable (every line ends with a newline; a missing final newline is shown as patch does)."""
+    import difflib
+
+    def lines(s: str) -> list[str]:
+        out = s.splitlines(keepends=True)
+        if out and not out[-1].endswith("\n"):
+            out[-1] += "\n\\ No newline at end of file\n"
+        return out
+
+    return "".join(difflib.unified_diff(lines(text), lines(pretty), fromfile=path, tofile=path))
 
 
 def _load(args: argparse.Namespace) -> "MrgFile":
@@ -171,27 +185,34 @@ def check_output(path: str | None, inputs: Sequence[str] = (), option: str = "-o
 def cmd_compile(args: argparse.Namespace) -> int:
     import json
 
-    from mrgc import outputs, signals
+    from mrgc import api, outputs, signals
     from mrgc.backends.registry import backend_class
-    from mrgc.planner.skeletons import compile_problem, export_model, problem_facts
+    from mrgc.planner.skeletons import needs_facts
 
     mf = _load(args)
     problem = mf.problem(args.problem)
     if args.emit:  # before any solving: a path the solver cannot write, or a format it does not write
         check_output(args.emit, inputs_of(mf), option="--emit")
         backend_class(args.backend).check_export(args.emit)
-    with signals.activity(f"computing the facts of {problem.name} (phase 1)"):
-        facts, facts_seconds = problem_facts(problem, seed=args.seed)  # once, for the skeletons and the export
+    facts = None
+    if needs_facts(problem):  # phase 1 once, for the skeletons and the export
+        with signals.activity(f"computing the facts of {problem.name} (phase 1)"):
+            found = api.compute_facts(problem, seed=args.seed)
+        _warn(mf.path, mf.text, found.warnings)
+        facts, facts_seconds = found.facts, float(found.stats["seconds"])
     with signals.activity(f"generating skeletons of {problem.name} with {args.backend}"):
-        result = compile_problem(problem, backend=args.backend, encoding=args.encoding, skeletons=args.skeletons,
-                                 max_makespan=args.max_makespan, time_limit=args.time_limit, facts=facts,
-                                 seed=args.seed)
-    result.stats["facts_seconds"] = round(facts_seconds, 6)
+        result = api.compile(problem, backend=args.backend, encoding=args.encoding, skeletons=args.skeletons,
+                             max_makespan=args.max_makespan, time_limit=args.time_limit, facts=facts, seed=args.seed)
+    if facts is not None:
+        result.stats["facts_seconds"] = round(facts_seconds, 6)
     if args.emit:
-        horizon = result.skeletons[0].makespan if result.skeletons else None
+        horizon = args.horizon if args.horizon is not None else (
+            result.skeletons[0].makespan if result.skeletons else None)
         with signals.activity(f"writing the model to {args.emit}"), \
                 outputs.atomic_path(args.emit, inputs_of(mf), option="--emit") as tmp:
-            export_model(problem, tmp, backend=args.backend, encoding=args.encoding, horizon=horizon, facts=facts)
+            horizon = api.export_model(problem, tmp, backend=args.backend, encoding=args.encoding, horizon=horizon,
+                                       max_makespan=args.max_makespan, facts=facts, seed=args.seed)
+        result.stats["emitted_horizon"] = horizon
     if args.format == "json":
         print(json.dumps(result.to_json(), indent=2))
     else:
@@ -209,7 +230,7 @@ def cmd_compile(args: argparse.Namespace) -> int:
         for reason in result.reasons:
             print(f"  reason: {reason}")
         if args.emit:
-            print(f"model written to {args.emit}")
+            print(f"model written to {args.emit} (horizon {result.stats['emitted_horizon']})")
     if result.skeletons:
         return EXIT_OK
     return {"infeasible": EXIT_NO_PLAN, "time limit": EXIT_TIME_LIMIT}.get(result.status, EXIT_INTERNAL)
@@ -219,13 +240,15 @@ def cmd_facts(args: argparse.Namespace) -> int:
     import json
 
     from mrgc import signals
-    from mrgc.planner.phase1 import compute_problem_facts, facts_file
+    from mrgc.api import compute_facts
+    from mrgc.planner.phase1 import facts_file
 
     mf = _load(args)
     problem = mf.problem(args.problem)
     check_output(args.output, inputs_of(mf))
     with signals.activity(f"computing the facts of {problem.name} (phase 1)"):
-        result = compute_problem_facts(problem, seed=args.seed, workers=args.workers)
+        result = compute_facts(problem, seed=args.seed, workers=args.workers)
+    _warn(mf.path, mf.text, result.warnings)
     doc = facts_file(mf, problem, result.facts, args.seed, __version__, args.output)
     if args.output:
         for asset, data in doc.assets.items():  # local meshes and URDFs the output refers to, copied beside it
@@ -264,10 +287,8 @@ def _progress(message: str) -> "contextlib.AbstractContextManager[object]":
 
 
 def cmd_plan(args: argparse.Namespace) -> int:
-    from mrgc import signals
+    from mrgc import api, signals
     from mrgc.planner.outcome import EXIT_CODES, PlanStatus
-    from mrgc.planner.baselines import plan_with
-    from mrgc.planner.plan import file_sha256
 
     mf = _load(args)
     problem = mf.problem(args.problem)
@@ -275,10 +296,9 @@ def cmd_plan(args: argparse.Namespace) -> int:
     log = (lambda line: print(line, file=sys.stderr, flush=True)) if args.verbose else None
     with _progress(f"planning {problem.name} (phase 1, then the tree search; at most {args.time_limit:g} s)"), \
             signals.activity(f"planning {problem.name}"):
-        plan = plan_with(args.planner, problem, args.file, file_sha256(args.file), __version__, backend=args.backend,
-                         encoding=args.encoding, seed=args.seed, time_limit=args.time_limit, c=args.c,
-                         alpha=args.alpha, skeletons=args.skeletons, max_makespan=args.max_makespan,
-                         anytime=args.anytime, log=log, motions=args.motions)
+        plan = api.plan(problem, planner=args.planner, backend=args.backend, encoding=args.encoding, seed=args.seed,
+                        time_limit=args.time_limit, log=log, c=args.c, alpha=args.alpha, skeletons=args.skeletons,
+                        max_makespan=args.max_makespan, anytime=args.anytime, motions=args.motions)
     status = PlanStatus(plan.status)
     # a signal ends the run as interrupted even where the search did not see it (never a verdict, never a file)
     interrupted = status is PlanStatus.INTERRUPTED or signals.received() is not None
@@ -309,14 +329,11 @@ def cmd_plan(args: argparse.Namespace) -> int:
 def cmd_validate(args: argparse.Namespace) -> int:
     import json
 
-    from mrgc.planner.validate import load_plan, validate
+    from mrgc.api import validate
+    from mrgc.planner.validate import load_plan
 
-    mf = _load(args)
-    plan = load_plan(args.plan)
-    name = args.problem
-    if name is None and len(mf.problems) > 1 and any(p.name == plan["problem"] for p in mf.problems):
-        name = plan["problem"]  # a file of several problems: the one the plan names
-    report = validate(mf.problem(name), plan, args.file)
+    report = validate(args.file, load_plan(args.plan), name=args.problem,
+                      allow_outside=getattr(args, "allow_outside", None) or ())
     if args.format == "json":
         print(json.dumps(report.to_json(), indent=2))
     else:
@@ -342,15 +359,16 @@ def cmd_generate(args: argparse.Namespace) -> int:
 def cmd_backends(args: argparse.Namespace) -> int:
     import json
 
-    from mrgc.backends.registry import describe, feature_table
+    from mrgc.api import backends
+    from mrgc.backends.registry import feature_table
 
-    rows = describe()
+    rows = backends()
     if args.format == "json":
-        print(json.dumps(rows, indent=2))
+        print(json.dumps([r.to_json() for r in rows], indent=2))
         return EXIT_OK
     for r in rows:
-        state = f"installed ({r['library']} {r['version']})" if r["installed"] else f"missing: pip install {r['library']}"
-        print(f"{r['name']:6} {r['title']}: {state}; encodings: {', '.join(r['encodings'])}")
+        state = f"installed ({r.library} {r.version})" if r.installed else f"missing: pip install {r.library}"
+        print(f"{r.name:6} {r.title}: {state}; encodings: {', '.join(r.encodings)}")
     print()
     print(feature_table())
     return EXIT_OK
@@ -383,7 +401,11 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("fmt", help="print a .mrg file in canonical form")
     p.add_argument("files", nargs="+", metavar="FILE")
     mode = p.add_mutually_exclusive_group()
-    mode.add_argument("--check", action="store_true", help="exit 1 if a file is not canonically formatted")
+    mode.add_argument("--check", action="store_true",
+                      help="exit 1 if a file is not canonically formatted, printing the unified diff to its "
+                           "canonical form")
+    mode.add_argument("--diff", action="store_true",
+                      help="print the unified diff of each file to its canonical form (exit 0)")
     mode.add_argument("--write", action="store_true", help="rewrite files in place")
     p.set_defaults(func=cmd_fmt)
 
@@ -413,6 +435,9 @@ def build_parser() -> argparse.ArgumentParser:
     add_seed(p)
     add_allow_outside(p)
     p.add_argument("--emit", metavar="PATH", help="also write the model: .lp/.mps (mip), .smt2 (smt), .pbtxt (cpsat)")
+    p.add_argument("--horizon", type=count("--horizon"), default=None, metavar="T",
+                   help="the model --emit writes: horizon T (paper, disaggregated: exactly T steps; time-of-move: "
+                        "at most T); default: the first skeleton's makespan, else the horizon limit")
     p.add_argument("--format", choices=["text", "json"], default="text")
     p.set_defaults(func=cmd_compile)
 

@@ -19,6 +19,7 @@ BOUNDS: dict[str, tuple[float, float]] = {
     "--seed": (0, 2**31 - 1),  # CP-SAT's random_seed is a 32-bit signed integer
     "--skeletons": (1, 10_000),
     "--max-makespan": (1, 10_000),  # a skeleton moves each object at most once: makespan <= objects
+    "--horizon": (1, 10_000),  # the exported model's horizon: as --max-makespan
     "--workers": (1, 1_000_000),  # then capped at one per robot and one per usable core
     "-c": (0.0, 1e6),
     "--alpha": (0.0, 1e6),

@@ -8,6 +8,7 @@ from __future__ import annotations
 import importlib
 import importlib.metadata
 import importlib.util
+from dataclasses import dataclass
 from typing import Any
 
 from mrgc.backends.base import Backend, BackendInfo
@@ -75,6 +76,34 @@ def describe() -> list[dict[str, Any]]:
             "exports": list(info.exports),
         })
     return rows
+
+
+@dataclass(frozen=True)
+class BackendRecord:
+    """A registered solver backend: its name (for ``backend=``), what it is, whether its library is
+    installed (and which version), the model features it translates natively (the others are rewritten to
+    rows), the encodings it runs and the model files it writes (extensions)."""
+
+    name: str
+    title: str
+    installed: bool
+    library: str
+    version: str
+    features: tuple[str, ...] = ()
+    encodings: tuple[str, ...] = ()
+    exports: tuple[str, ...] = ()
+
+    def to_json(self) -> dict[str, Any]:
+        return {"name": self.name, "title": self.title, "installed": self.installed, "library": self.library,
+                "version": self.version, "features": list(self.features), "encodings": list(self.encodings),
+                "exports": list(self.exports)}
+
+
+def records() -> list[BackendRecord]:
+    """Every registered backend (the built-in ones, then plug-ins of the ``mrgc.backends`` entry-point
+    group), in registry order; looking them up imports no solver library."""
+    return [BackendRecord(r["name"], r["title"], r["installed"], r["library"], r["version"], tuple(r["features"]),
+                          tuple(r["encodings"]), tuple(r["exports"])) for r in describe()]
 
 
 def feature_table() -> str:

@@ -3,7 +3,8 @@
 Bools are z3 Bools; integers are bounded z3 Ints; a row is a linear (in)equality; a conditional row is
 ``Implies(And(literals), row)``; at-most-one is ``AtMost``; a lexicographic objective is z3's native
 ``lex`` priority.  ``--emit model.smt2`` writes ``Optimize.sexpr()``: SMT-LIB2 with z3's ``(minimize)``
-extension.
+extension, as a script z3 runs (``z3 model.smt2``, ``z3.Optimize().from_file``): the seed as SMT-LIB's
+``:random-seed``, then ``(check-sat)`` and ``(get-objectives)`` (:func:`smt2_script`).
 """
 
 from __future__ import annotations
@@ -119,4 +120,26 @@ class Z3Backend(Backend):
 
     def _export(self, path: str) -> None:
         with open(path, "w", encoding="utf-8") as fh:
-            fh.write(self.opt.sexpr())
+            fh.write(smt2_script(self.opt.sexpr(), self.seed))
+
+
+def smt2_script(sexpr: str, seed: int) -> str:
+    """``Optimize.sexpr()`` as a script z3 loads and runs: its ``opt.random_seed`` option (which z3's own
+    parser rejects: no such parameter of module ``opt``) becomes SMT-LIB's ``:random-seed``, and it ends
+    with ``(check-sat)`` and ``(get-objectives)``."""
+    lines = sexpr.splitlines()
+    out: list[str] = []
+    skip_comment = False
+    for line in lines:
+        if line.startswith("(set-option :opt.random_seed"):
+            out.append(f"(set-option :random-seed {int(seed)})")
+            skip_comment = True
+            continue
+        if skip_comment and line.startswith(";"):
+            skip_comment = False
+            continue
+        skip_comment = False
+        out.append(line)
+    while out and out[-1].strip() in ("", "(check-sat)", "(get-objectives)"):
+        out.pop()
+    return "\n".join(out + ["(check-sat)", "(get-objectives)"]) + "\n"

@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from mrgc.errors import Diagnostic
 from mrgc.geometry.arm import Arm
 from mrgc.geometry.collision import CollisionWorld
 from mrgc.geometry.grasps import finger_opening, fits, grasp_transform, pregrasp_transform
@@ -56,10 +57,12 @@ class RobotFacts:
 
 @dataclass
 class FactsResult:
-    """All facts of a scene (sorted, deterministic) and statistics."""
+    """All facts of a scene (sorted, deterministic) and statistics; ``warnings`` about the problem's layout
+    (W271, W272: docs/errors.md) when :func:`mrgc.compute_facts` ran the layout checks."""
 
     facts: list[Fact]
     stats: dict[str, float]
+    warnings: tuple[Diagnostic, ...] = ()
 
 
 def seed_for(*parts: str, seed: int = 0) -> int:

@@ -14,6 +14,7 @@ from mrgc.language.model import (
     BUILTIN_GRASPS,
     DEFAULT_GRASP_DEPTH,
     DEFAULT_GRIPPER_OPENING,
+    PREDICATE_WORDS,
     PREDICATES,
     REQUIREMENTS,
     Domain,
@@ -28,7 +29,7 @@ from mrgc.language.model import (
     RobotKind,
 )
 from mrgc.language.props import GEOMETRIC_PROPS, PropReader
-from mrgc.language.suggest import did_you_mean
+from mrgc.language.suggest import by_meaning, did_you_mean
 
 #: sort -> (code for an undeclared name, how the sort is named in messages)
 SORTS: dict[str, tuple[str, str]] = {
@@ -162,6 +163,7 @@ class Checker:
             gripper_opening=vals.get("gripper-opening") or DEFAULT_GRIPPER_OPENING,  # type: ignore[arg-type]
             source=self.file,
             span=k.span,
+            home_span=table["home"].value.span if "home" in table else k.span,
         )
 
     # ------------------------------------------------------------ problems
@@ -285,7 +287,8 @@ class Checker:
     def _atom(self, atom: ast.Atom, sort_of: dict[str, tuple[str, Span]], grasps: set[str]) -> Fact | None:
         sig = PREDICATES.get(atom.predicate)
         if sig is None:
-            self.err("E220", f"unknown predicate '{atom.predicate}'{did_you_mean(atom.predicate, PREDICATES)}", atom.span)
+            hint = by_meaning(atom.predicate, PREDICATES, PREDICATE_WORDS)
+            self.err("E220", f"unknown predicate '{atom.predicate}'{hint}", atom.span)
             return None
         if len(atom.args) != len(sig):
             self.err(

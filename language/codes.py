@@ -17,6 +17,7 @@ CODES: dict[str, str] = {
     "E101": "unexpected token",
     "E102": "unexpected end of file",
     "E103": "unknown section",
+    "E104": "unclosed parenthesis",
     # names
     "E200": "duplicate name",
     "E201": "duplicate section",
@@ -67,8 +68,15 @@ CODES: dict[str, str] = {
     "E260": "robot of a geometric problem lacks a kind",
     "E261": "symbolic problem mixes in geometry",
     "E262": "geometric declaration lacks its shape or pose",
+    # the start layout of a geometric problem (geometry/layout.py)
+    "E263": "home configuration of the wrong length",
+    "E264": "movable objects overlap at the start",
+    "E265": "movable object overlaps a fixed object at the start",
+    "E266": "robot overlaps an object at the start",
     # warnings (the file is accepted)
     "W270": "grasp wider than the gripper",
+    "W271": "object in no region",
+    "W272": "region outside every robot's workspace",
 }
 
 #: codes that are warnings: reported, but the input is accepted (exit code 0)
@@ -154,8 +162,13 @@ HELP: dict[str, str] = {
     "E004": "The file holds no `(define ...)` form (it is empty or only comments).",
     "E100": "A character or word that cannot start any token here, or a string with no closing quote.",
     "E101": "A token where the grammar expects something else; the message lists what may come here.",
-    "E102": "The file ends inside a form: usually a missing `)`.",
+    "E102": "The file ends inside a form: a `(` is never closed. The error points at the `(` most likely left "
+    "open (the innermost one followed by a line indented no deeper than it, else the innermost one); the note "
+    "says where the file ends.",
     "E103": "A section keyword that does not exist at this place; the message suggests the closest one.",
+    "E104": "A `(` is not closed before the next form starts (a section such as `(:goal`, or the next "
+    "`(define`): a missing `)`. The error points at the `(` left open, chosen as for E102; the note says where "
+    "the parser stopped and what it expected there.",
     "E200": "Two declarations share a name. Robots, fixed and movable objects, regions and handover points "
     "share one namespace per problem; grasps and robot kinds one per domain.",
     "E201": "A section such as `:goal`, `:init` or `:robots` appears twice in one definition.",
@@ -199,6 +212,24 @@ HELP: dict[str, str] = {
     "E243": "In a domain with robot kinds every grasp needs geometry: a bare name must be a built-in grasp "
     "(top, top-x, side-x+, side-x-, side-y+, side-y-), any other grasp is declared as "
     "`(NAME :approach AXIS :fingers AXIS)`. Domains without robot kinds (symbolic) accept any name.",
+    "E263": "A robot kind's `:home` needs one value (radians, metres for a prismatic joint) per joint of its arm: the "
+    "URDF's revolute, continuous and prismatic joints from the base link to the `:end-effector` link (7 for "
+    "the Franka Panda; finger joints are not part of it). Checked by `mrgc check` when the URDF can be read "
+    "(otherwise `mrgc facts` reports E400/E401).",
+    "E264": "Two movable objects interpenetrate (by more than 1 mm) at their start poses. Objects may touch "
+    "(stand side by side or on each other); move one of them.",
+    "E265": "A movable object interpenetrates a fixed object (by more than 1 mm) at its start pose, e.g. sinks "
+    "into the table or stands inside a wall. An object resting on a surface only touches it.",
+    "E266": "A robot at its start overlaps (by more than 1 mm) a movable or fixed object: a planar robot's "
+    "`:footprint` at its `:base` pose (also another planar robot's footprint), found by `mrgc check`; an arm's "
+    "links at its `:home` configuration, found by `mrgc facts` (and `mrgc plan`), which read the arm's meshes.",
+    "W271": "A warning, not an error: a movable object lies in no region at its start pose (no region holds it "
+    "entirely, so `in-region` holds for none). A goal object can still be moved into its goal region; any other "
+    "object can never move, so if it obstructs something, that goal cannot be reached.",
+    "W272": "A warning, not an error: a region is farther from the shoulder of every arm than the arm can "
+    "reach (the reach bound of its URDF), so nothing can be placed in it or picked from it. Reported by "
+    "`mrgc facts` (and `mrgc plan`), which read the arms' models; problems with a planar robot never get it "
+    "(planar robots drive).",
     "W270": "A warning, not an error: the object is wider along the grasp's finger axis (plus the 1 cm "
     "clearance) than a robot kind's `:gripper-opening`, so robots of that kind get no facts for this "
     "(object, grasp). `mrgc check` exits 0.",

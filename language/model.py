@@ -25,6 +25,19 @@ PREDICATES: dict[str, tuple[str, ...]] = {
     "enable-goal-handover": ("movable", "grasp", "grasp", "robot", "robot"),
 }
 
+#: words users write for a predicate -> the predicates they mean (E220's "did you mean"; a word that is a
+#: part of predicate names, like ``reachable``, needs no entry: every predicate holding it is suggested)
+PREDICATE_WORDS: dict[str, tuple[str, ...]] = {
+    "handover": ("enable-goal-handover",), "hand-over": ("enable-goal-handover",),
+    "handoff": ("enable-goal-handover",), "can-handover": ("enable-goal-handover",),
+    "in": ("in-region",), "at": ("in-region",), "on": ("in-region",), "inside": ("in-region",),
+    "pick": ("reachable-pick",), "can-pick": ("reachable-pick",), "graspable": ("reachable-pick",),
+    "place": ("reachable-place",), "can-place": ("reachable-place",), "placeable": ("reachable-place",),
+    "blocks": ("occludes-pick", "occludes-goal-place"), "obstructs": ("occludes-pick", "occludes-goal-place"),
+    "blocks-pick": ("occludes-pick",), "blocks-place": ("occludes-goal-place",),
+    "occludes-place": ("occludes-goal-place",),
+}
+
 #: requirement flags a domain may declare (informational; see docs/language.md)
 REQUIREMENTS: tuple[str, ...] = ("handover", "planar-base", "symbolic")
 
@@ -165,6 +178,8 @@ class RobotKind:
     #: folder trees the URDF's mesh files may come from besides pybullet_data (empty: anywhere); the
     #: loader sets the problem file's tree and the ``--allow-outside`` folders
     roots: tuple[str, ...] = field(default=(), compare=False)
+    #: where ``:home`` is written (the layout checks point there)
+    home_span: Span = _span()
 
 
 @dataclass(frozen=True)

@@ -16,6 +16,7 @@ from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput
 
 from mrgc.errors import Diagnostic, Span
 from mrgc.language import ast
+from mrgc.language.parens import paren_at, unclosed_paren
 from mrgc.language.suggest import did_you_mean
 
 GRAMMAR = Path(__file__).with_name("grammar.lark")
@@ -250,6 +251,35 @@ def _section_literals(names: set[str] | frozenset[str]) -> list[str]:
 
 
 def _syntax_diagnostic(exc: UnexpectedInput, text: str, file: str) -> Diagnostic:
+    """The diagnostic of a syntax error; one a missing ``)`` explains is reported at the ``(`` left open
+    (E102 at the end of the file, E104 before the next form: :mod:`mrgc.language.parens`)."""
+    found = _first_syntax_diagnostic(exc, text, file)
+    if isinstance(exc, UnexpectedToken) and (found.code == "E102" or (
+            found.code == "E101" and exc.token.type not in _NAMED and str(exc.token) != ")")):
+        end = len(text) if exc.token.type == "$END" else (exc.token.start_pos or 0)
+        paren = unclosed_paren(text, end)
+        if paren is not None:
+            span = Span(file, paren.line, paren.column, paren.line, paren.column + 1 + len(paren.word))
+            what = f"'({paren.word}'" if paren.word else "'('"
+            if found.code == "E102":
+                return Diagnostic("E102", f"{what} is never closed: the file ends inside it", span,
+                                  notes=(f"the file ends at {found.span}",))
+            assert found.span is not None
+            return Diagnostic("E104", f"{what} is not closed before {_form_at(text, end)} on line "
+                                      f"{found.span.line}", span, notes=(f"at {found.span}: {found.message}",))
+    return found
+
+
+def _form_at(text: str, offset: int) -> str:
+    """How to name what starts at ``offset``: ``'(:goal'`` for a form whose ``(`` is there or just before."""
+    before = text[:offset].rstrip()
+    start = len(before) - 1 if before.endswith("(") else offset
+    if text.startswith("(", start):
+        return f"'({paren_at(text, start).word}'"
+    return f"'{text[start:].split(None, 1)[0][:40]}'" if text[start:].strip() else "the end"
+
+
+def _first_syntax_diagnostic(exc: UnexpectedInput, text: str, file: str) -> Diagnostic:
     line = getattr(exc, "line", 1) or 1
     col = getattr(exc, "column", 1) or 1
     if isinstance(exc, UnexpectedToken):

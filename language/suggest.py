@@ -106,3 +106,27 @@ def did_you_mean(word: str, candidates: Iterable[str]) -> str:
     # difflib's ratio of 0.6 needs the shorter of the two at least 0.43 times the longer
     match = difflib.get_close_matches(word, sorted(pool.scan(word, 2 * len(word))), n=1, cutoff=0.6)
     return f" (did you mean '{match[0]}'?)" if match else ""
+
+
+def by_meaning(word: str, candidates: Iterable[str], synonyms: dict[str, tuple[str, ...]] | None = None) -> str:
+    """`` (did you mean 'x'?)`` (or ``'x' or 'y'``) by what ``word`` means, else by spelling (:func:`did_you_mean`).
+
+    Meaning: ``synonyms`` maps words users write to the candidates they stand for (``handover`` →
+    ``enable-goal-handover``); otherwise the candidates whose hyphen-separated parts include every part of
+    ``word`` (``reachable`` → ``reachable-pick`` or ``reachable-place``, ``goal-place`` →
+    ``occludes-goal-place``).  Case and ``_`` versus ``-`` do not matter.
+    """
+    names = sorted(set(candidates))
+    key = word.lower().replace("_", "-")
+    found: list[str] = []
+    if synonyms and key in synonyms:
+        found = [c for c in synonyms[key] if c in names]
+    if not found and key not in names:
+        parts = [p for p in key.split("-") if p]
+        found = [c for c in names if parts and all(p in c.split("-") for p in parts)]
+    found = [c for c in found if c != word]
+    if found:
+        if len(found) == 1:
+            return f" (did you mean '{found[0]}'?)"
+        return " (did you mean " + " or ".join(f"'{c}'" for c in found[:3]) + "?)"
+    return did_you_mean(word, names)

@@ -137,6 +137,9 @@ class Plan:
     validation: dict[str, Any] | None = None
     #: the motions a geometric plan holds (None: :func:`planner_motion_model`); symbolic plans have none
     motion_model: MotionModel | None = None
+    #: the content digest of the checked problem (:func:`mrgc.language.digest.problem_digest`): the plan is
+    #: for any file holding this problem (its facts file too), whatever its bytes
+    problem_digest: str | None = None
 
     @property
     def makespan(self) -> int:
@@ -154,6 +157,7 @@ class Plan:
             "problem": self.problem,
             "problem_file": self.problem_file,
             "problem_sha256": self.problem_sha256,
+            **({"problem_digest": self.problem_digest} if self.problem_digest is not None else {}),
             "backend": self.backend,
             "encoding": self.encoding,
             "seed": self.seed,

@@ -106,6 +106,7 @@ class PlanFile:
     motion_cost: int | None
     steps: tuple[Step, ...]
     motion_model: MotionModel | None = None
+    problem_digest: str | None = None
 
 
 # ------------------------------------------------------------------------------------------ reading
@@ -336,7 +337,8 @@ def read_plan(data: Any, where: str = "plan") -> PlanFile:
         motion_cost=None if data["motion_cost"] is None else int(data["motion_cost"]),
         steps=tuple(Step(int(s["index"]), tuple(_action(a) for a in s["actions"]), tuple(s["waiting"]))
                     for s in data["steps"]),
-        motion_model=MotionModel.from_json(model) if model is not None else None)
+        motion_model=MotionModel.from_json(model) if model is not None else None,
+        problem_digest=data.get("problem_digest"))
 
 
 def _motion(qs: list[list[float]]) -> Motion:

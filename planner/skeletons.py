@@ -11,6 +11,7 @@ import time
 from dataclasses import dataclass, field
 from typing import Any, Iterable
 
+from mrgc.backends.base import Backend
 from mrgc.backends.registry import backend_class
 from mrgc.compiler.diagnose import explain_infeasible
 from mrgc.compiler.encodings import get_encoding
@@ -79,9 +80,11 @@ def problem_facts(problem: Problem, facts: Iterable[Fact] | None = None, seed: i
 class SkeletonSource:
     """Skeletons for one (M*, already moved) request, from a chosen backend and encoding; resumable."""
 
-    def __init__(self, facts: FactBase, must: Iterable[str], moved: Iterable[str] = (), backend: str = DEFAULT_BACKEND,
-                 encoding: str = DEFAULT_ENCODING, max_makespan: int | None = None, seed: int = 0) -> None:
-        cls = backend_class(backend)
+    def __init__(self, facts: FactBase, must: Iterable[str], moved: Iterable[str] = (),
+                 backend: str | type[Backend] = DEFAULT_BACKEND, encoding: str = DEFAULT_ENCODING,
+                 max_makespan: int | None = None, seed: int = 0) -> None:
+        cls = backend if isinstance(backend, type) else backend_class(backend)
+        backend = cls.info.name
         self.backend, self.encoding = backend, encoding
         try:
             enc = get_encoding(encoding)
@@ -101,10 +104,12 @@ class SkeletonSource:
         return self.generator.next(k, time_limit)
 
 
-def compile_problem(problem: Problem, backend: str = DEFAULT_BACKEND, encoding: str = DEFAULT_ENCODING,
-                    skeletons: int = 1, max_makespan: int | None = None, time_limit: float | None = None,
-                    facts: Iterable[Fact] | None = None, seed: int = 0) -> CompileResult:
-    """The first ``skeletons`` skeletons of ``problem`` (facts default to its ``:init``)."""
+def compile_problem(problem: Problem, backend: str | type[Backend] = DEFAULT_BACKEND,
+                    encoding: str = DEFAULT_ENCODING, skeletons: int = 1, max_makespan: int | None = None,
+                    time_limit: float | None = None, facts: Iterable[Fact] | None = None,
+                    seed: int = 0) -> CompileResult:
+    """The first ``skeletons`` skeletons of ``problem`` (facts default to its ``:init``); ``backend`` is a
+    registered name or a :class:`~mrgc.backends.base.Backend` subclass."""
     fact_list, facts_seconds = problem_facts(problem, facts, seed)
     base = FactBase.from_problem(problem, fact_list)
     source = SkeletonSource(base, must_move(problem, fact_list), (), backend, encoding, max_makespan, seed)
@@ -129,17 +134,22 @@ def compile_problem(problem: Problem, backend: str = DEFAULT_BACKEND, encoding: 
     else:
         status = "optimal"
     reasons = list(source.reasons) or ([batch.message] if batch.message else [])
-    return CompileResult(problem.name, backend, encoding, status, batch.skeletons, reasons, stats)
+    return CompileResult(problem.name, source.backend, encoding, status, batch.skeletons, reasons, stats)
 
 
-def export_model(problem: Problem, path: str, backend: str = DEFAULT_BACKEND, encoding: str = DEFAULT_ENCODING,
-                 horizon: int | None = None, facts: Iterable[Fact] | None = None) -> None:
-    """Write the skeleton model (horizon ``horizon``; default the first one searched) to ``path``."""
+def export_model(problem: Problem, path: str, backend: str | type[Backend] = DEFAULT_BACKEND,
+                 encoding: str = DEFAULT_ENCODING, horizon: int | None = None, facts: Iterable[Fact] | None = None,
+                 max_makespan: int | None = None) -> int:
+    """Write the skeleton model of horizon ``horizon`` to ``path`` and return the horizon written (default:
+    the horizon limit, ``max_makespan`` capped at the number of objects of the task graph).  The model holds
+    no cuts: its optimum is the first skeleton of that horizon."""
     fact_list, _ = problem_facts(problem, facts)
     base = FactBase.from_problem(problem, fact_list)
-    source = SkeletonSource(base, must_move(problem, fact_list), (), backend, encoding)
+    source = SkeletonSource(base, must_move(problem, fact_list), (), backend, encoding, max_makespan)
     gen = source.generator
-    enc = gen.encoding.build(gen.graph, horizon or (gen.horizon if gen.encoding.horizon_loop else gen.limit))
-    solver = backend_class(backend)()
+    chosen = horizon or gen.limit
+    enc = gen.encoding.build(gen.graph, chosen)
+    solver = (backend if isinstance(backend, type) else backend_class(backend))()
     solver.load(enc.model)
     solver.export(path)
+    return chosen

@@ -14,9 +14,10 @@ reader's limits, not JSON, not following ``docs/plan.schema.json``, another sche
 
 Checks on every plan (codes in brackets):
 
-- the plan is for this problem: same name ``[problem]``, same file contents (sha256 of the problem file;
-  a mismatch is an error: the plan was made for other contents) ``[problem-changed]``, symbolic flag as
-  the problem's ``[plan-kind]``; status ``solved`` ``[status]``; ``makespan``/``motion_cost``/step
+- the plan is for this problem: same name ``[problem]``, same contents ``[problem-changed]`` (the plan's
+  ``problem_digest``, the checked problem's content digest of :mod:`mrgc.language.digest`, matches: the
+  file the plan was made from and its facts file both qualify; a plan without a digest compares the
+  sha256 of the problem file's bytes), symbolic flag as the problem's ``[plan-kind]``; status ``solved`` ``[status]``; ``makespan``/``motion_cost``/step
   indices agree with the steps ``[summary]``;
 - every name is declared (objects, regions, robots of actions and of ``waiting``, handover points), every
   grasp allowed for its object ``[unknown-name]``; the ``kind`` matches the robots, and a pick-and-place
@@ -134,15 +135,9 @@ def _header(problem: Problem, plan: PlanFile, problem_path: str | None, out: lis
     if plan.problem != problem.name:
         out.append(Violation(None, None, "problem", f"the plan is for problem {plan.problem!r}, "
                                                     f"not {problem.name!r}"))
-    if problem_path is not None:
-        try:
-            digest = file_sha256(problem_path)
-        except OSError as exc:
-            digest = f"unreadable ({exc.strerror})"
-        if digest != plan.problem_sha256:
-            out.append(Violation(None, None, "problem-changed",
-                                 f"the problem file changed since the plan was made: sha256 "
-                                 f"{plan.problem_sha256[:12]}... in the plan, {digest[:12]}... now"))
+    changed = _changed(problem, plan, problem_path)
+    if changed:
+        out.append(Violation(None, None, "problem-changed", changed))
     if plan.symbolic != problem.symbolic:
         what = ("a symbolic plan for a geometric problem (it carries no geometry to check)" if plan.symbolic
                 else "a geometric plan for a symbolic problem")
@@ -159,6 +154,33 @@ def _header(problem: Problem, plan: PlanFile, problem_path: str | None, out: lis
     for i, s in enumerate(plan.steps, 1):
         if not s.actions:
             out.append(Violation(i, None, "summary", "the step is empty"))
+
+
+def _changed(problem: Problem, plan: PlanFile, problem_path: str | None) -> str:
+    """Why the plan is not for this problem's content ("" when it is): the plan's ``problem_digest`` (or a
+    ``problem_sha256`` that is a content digest) matches the checked problem's, or its ``problem_sha256``
+    matches the bytes of ``problem_path``; a plan without a digest and no path to compare is accepted."""
+    from mrgc.language.digest import problem_digest
+
+    recorded = {plan.problem_sha256, plan.problem_digest} - {None}
+    file_digest = "(no file given)"
+    if problem_path is not None:
+        try:
+            file_digest = file_sha256(problem_path)
+        except OSError as exc:
+            file_digest = f"unreadable ({exc.strerror})"
+        if file_digest in recorded:
+            return ""
+    elif plan.problem_digest is None:
+        return ""
+    content = problem_digest(problem)
+    if content in recorded:
+        return ""
+    if plan.problem_digest is not None:
+        return (f"the plan was made for other problem contents: problem digest {plan.problem_digest[:12]}... in "
+                f"the plan, {content[:12]}... now")
+    return (f"the problem file changed since the plan was made: sha256 {plan.problem_sha256[:12]}... in the plan, "
+            f"{file_digest[:12]}... now")
 
 
 def _names(problem: Problem, plan: PlanFile, out: list[Violation]) -> set[int]:

@@ -1,7 +1,6 @@
 (set-option :opt.priority lex)
 ; select how to prioritize objectives: 'lex' (lexicographic), 'pareto', 'box'
-(set-option :opt.random_seed 0)
-; random seed for the smt solver
+(set-option :random-seed 0)
 (declare-fun |tau(o1)| () Int)
 (declare-fun |tau(o2)| () Int)
 (declare-fun |tau(o3)| () Int)
@@ -114,3 +113,4 @@
    (ite |y(o2,start,r1,r1,top,top)| 1 0)
    (ite |y(o3,start,r2,r2,side,side)| 1 0)))
 (check-sat)
+(get-objectives)

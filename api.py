@@ -1,0 +1,250 @@
+"""The public Python API: what every ``mrgc`` command runs (the CLI only parses arguments and prints).
+
+Every function takes a checked :class:`~mrgc.language.model.Problem` (from :func:`parse_file` /
+:func:`parse_string`) or the path of a ``.mrg`` file (``name`` picks a problem of a file holding several;
+``allow_outside`` are the folders, besides the file's own tree, its meshes and URDFs may come from).
+Bad input raises :class:`~mrgc.errors.InputError` carrying located diagnostics; outcomes (infeasible, a
+time limit, an invalid plan) are values: a status on the result.  Nothing here asks for file hashes or
+version strings: plans record them themselves.  docs/api.md documents each function with examples (a test
+runs them).
+
+Heavy libraries (solvers, geometry) load only when a function needs them; importing this module is cheap.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, Callable, Iterable, Mapping, Sequence, Union
+
+from mrgc.errors import Diagnostic, InputError
+
+if TYPE_CHECKING:
+    from mrgc.backends.base import Backend
+    from mrgc.backends.registry import BackendRecord
+    from mrgc.geometry.predicates import FactsResult
+    from mrgc.language.loader import MrgFile
+    from mrgc.language.model import Fact, Problem
+    from mrgc.planner.plan import Plan
+    from mrgc.planner.skeletons import CompileResult
+    from mrgc.planner.validate import ValidationReport
+
+#: a problem as the API takes it: checked, or the path of its ``.mrg`` file
+ProblemSource = Union["Problem", str, "os.PathLike[str]"]
+#: a backend as the API takes it: a registered name (``mrgc backends``) or a Backend subclass (a plug-in
+#: under test, not registered)
+BackendSpec = Union[str, "type[Backend]"]
+
+DEFAULT_BACKEND = "cpsat"
+DEFAULT_ENCODING = "time-of-move"
+
+
+# ---------------------------------------------------------------- reading problems
+@dataclass(frozen=True)
+class CheckReport:
+    """A checked file (``file``) and the warnings about it (``W###``: accepted, but part of it will not be
+    used, e.g. an object in no region); errors are raised instead."""
+
+    file: "MrgFile"
+    warnings: tuple[Diagnostic, ...] = ()
+
+
+def check(path: str | os.PathLike[str], *, allow_outside: Sequence[str] = ()) -> CheckReport:
+    """What ``mrgc check`` does for one file: parse and check it (every error at once, as InputError), then
+    the layout checks of its geometric problems that need no robot model beyond the URDF files
+    (docs/errors.md: overlapping objects, a robot's footprint on an object, a ``:home`` of the wrong length,
+    objects in no region, regions no robot reaches)."""
+    from mrgc.language.loader import parse_file
+
+    mf = parse_file(path, allow_outside=tuple(allow_outside))
+    warnings: list[Diagnostic] = []
+    errors: list[Diagnostic] = []
+    for p in mf.problems:
+        for d in _layout(p, False):
+            (warnings if d.severity == "warning" else errors).append(d)
+    if errors:
+        raise InputError(errors, {mf.path: mf.text})
+    return CheckReport(mf, tuple(warnings))
+
+
+def load_problem(source: ProblemSource, *, name: str | None = None,
+                 allow_outside: Sequence[str] = ()) -> "Problem":
+    """The checked problem ``source`` stands for: itself, or problem ``name`` (default: the only one) of the
+    file at that path."""
+    return _resolve(source, name, allow_outside)[0]
+
+
+def _resolve(source: ProblemSource, name: str | None, allow_outside: Sequence[str]) -> tuple["Problem", str | None]:
+    """(problem, the path of the file it was read from, when it was read from an existing file)."""
+    from mrgc.language.model import Problem
+
+    if isinstance(source, Problem):
+        if name is not None and name != source.name:
+            raise InputError([Diagnostic("E230", f"the problem given is '{source.name}', not '{name}'")])
+        return source, source.source if source.source and os.path.isfile(source.source) else None
+    from mrgc.language.loader import parse_file
+
+    path = os.fspath(source)
+    return parse_file(path, allow_outside=tuple(allow_outside)).problem(name), path
+
+
+def _layout(problem: "Problem", robots: bool) -> list[Diagnostic]:
+    """The layout diagnostics of a geometric problem (none for a symbolic one): those ``check`` reports, or
+    (``robots``) those that need the robots' models (docs/errors.md, E263-E266, W270-W272)."""
+    if problem.symbolic:
+        return []
+    from mrgc.geometry import layout
+
+    return layout.robot_diagnostics(problem) if robots else layout.layout_diagnostics(problem)
+
+
+def _checked_layout(problem: "Problem", robots: bool = True) -> list[Diagnostic]:
+    """InputError when the layout of a geometric problem has errors (of ``check``'s checks, and with
+    ``robots`` of those needing the robots' models too); else the warnings of the robot-model checks."""
+    errors = [d for d in _layout(problem, False) if d.severity != "warning"]
+    found = _layout(problem, True) if robots and not errors else []
+    errors += [d for d in found if d.severity != "warning"]
+    if errors:
+        raise InputError(errors)
+    return found
+
+
+# ---------------------------------------------------------------- phase 1
+def compute_facts(source: ProblemSource, *, name: str | None = None, seed: int = 0, workers: int | None = None,
+                  allow_outside: Sequence[str] = ()) -> "FactsResult":
+    """Phase 1: every geometric fact of a geometric problem (``.facts``, sorted) and timing statistics
+    (``.stats``); ``workers`` processes (default one per robot).  InputError E402 for a symbolic problem."""
+    from mrgc.planner.phase1 import compute_problem_facts
+
+    problem = load_problem(source, name=name, allow_outside=allow_outside)
+    warnings = _checked_layout(problem, robots=True)
+    result = compute_problem_facts(problem, seed=seed, workers=workers)
+    result.warnings = tuple(warnings)
+    return result
+
+
+# ---------------------------------------------------------------- skeletons
+def compile(source: ProblemSource, *, name: str | None = None, backend: BackendSpec = DEFAULT_BACKEND,  # noqa: A001
+            encoding: str = DEFAULT_ENCODING, skeletons: int = 1, max_makespan: int | None = None,
+            time_limit: float | None = None, facts: Iterable["Fact"] | None = None, seed: int = 0,
+            allow_outside: Sequence[str] = ()) -> "CompileResult":
+    """The first ``skeletons`` task skeletons of a problem in (makespan, objects moved) order, with a status
+    (``optimal``, ``infeasible``, ``time limit``, ``error``), the compiler's reasons when there is none, and
+    statistics (``stats``: task-graph size, solver calls, seconds per phase).  ``facts`` default to the
+    problem's ``:init``, or phase 1 run now for a geometric problem without them."""
+    from mrgc.planner.skeletons import compile_problem, needs_facts, problem_facts
+
+    problem = load_problem(source, name=name, allow_outside=allow_outside)
+    _checked_layout(problem, robots=facts is None and needs_facts(problem))
+    fact_list, facts_seconds = problem_facts(problem, facts, seed=seed)
+    result = compile_problem(problem, backend=backend, encoding=encoding, skeletons=skeletons,  # type: ignore[arg-type]
+                             max_makespan=max_makespan, time_limit=time_limit, facts=fact_list, seed=seed)
+    result.stats["facts_seconds"] = round(facts_seconds, 6)
+    return result
+
+
+def export_model(source: ProblemSource, path: str | os.PathLike[str], *, name: str | None = None,
+                 backend: BackendSpec = DEFAULT_BACKEND, encoding: str = DEFAULT_ENCODING, horizon: int | None = None,
+                 max_makespan: int | None = None, facts: Iterable["Fact"] | None = None, seed: int = 0,
+                 allow_outside: Sequence[str] = ()) -> int:
+    """Write the skeleton model of a problem to ``path`` in the backend's format (its extension: ``.lp`` /
+    ``.mps`` for ``mip``, ``.smt2`` for ``smt``, ``.pbtxt`` for ``cpsat``) and return its horizon.
+
+    The model is the one the backend solves for the first skeleton, without cuts: its optimum is the first
+    skeleton's (makespan, objects moved).  ``horizon`` T chooses another: for the ``paper`` and
+    ``disaggregated`` encodings the model of skeletons of exactly T steps, for ``time-of-move`` of at most T
+    steps.  By default T is the makespan of the first skeleton (compiled now), or, when there is none, the
+    horizon limit (``max_makespan``, capped at the number of objects in the task graph).  docs/backends.md
+    says what each file holds and how to load it into its solver.
+    """
+    from mrgc.planner.skeletons import export_model as write_model, problem_facts
+
+    problem = load_problem(source, name=name, allow_outside=allow_outside)
+    if horizon is not None and horizon < 1:
+        raise InputError([Diagnostic("E000", f"the horizon is at least 1, not {horizon}")])
+    fact_list, _ = problem_facts(problem, facts, seed=seed)
+    if horizon is None:
+        result = compile(problem, backend=backend, encoding=encoding, max_makespan=max_makespan, facts=fact_list,
+                         seed=seed)
+        horizon = result.skeletons[0].makespan if result.skeletons else None  # none: the limit
+    return write_model(problem, os.fspath(path), backend=backend, encoding=encoding, horizon=horizon,  # type: ignore[arg-type]
+                       facts=fact_list, max_makespan=max_makespan)
+
+
+# ---------------------------------------------------------------- planning
+def plan(source: ProblemSource, *, name: str | None = None, planner: str = "mcts",
+         backend: str = DEFAULT_BACKEND, encoding: str = DEFAULT_ENCODING, seed: int = 0, time_limit: float = 60.0,
+         log: Callable[[str], None] | None = None, allow_outside: Sequence[str] = (), **options: Any) -> "Plan":
+    """Plan a problem end to end: phase 1 (unless the file holds its facts), task skeletons, then the
+    planner's search; a geometric plan counts only once the independent validator accepted it.
+
+    Returns a :class:`~mrgc.planner.plan.Plan`: ``status`` (:class:`~mrgc.planner.outcome.PlanStatus`:
+    solved, infeasible, exhausted, time limit, interrupted), ``why`` (the reasons behind it), ``steps``,
+    ``stats`` and ``dumps()`` (the plan JSON, docs/plan.schema.json).  ``planner`` is ``mcts`` (the paper's
+    method) or ``ap1`` (its baseline, docs/baselines.md); ``options`` are the planner's own (``mcts``:
+    ``c``, ``alpha``, ``skeletons``, ``max_makespan``, ``anytime``, ``max_iterations``, ``motions``); ``log``
+    gets one line per grounded skeleton.  The plan records the problem's content digest, so it validates
+    against any file holding the same problem (its facts file too).
+    """
+    from mrgc import __version__
+    from mrgc.language.digest import problem_digest
+    from mrgc.planner.baselines import plan_with
+    from mrgc.planner.plan import file_sha256
+
+    problem, path = _resolve(source, name, allow_outside)
+    _checked_layout(problem)
+    digest = problem_digest(problem)
+    problem_file = path if path is not None else (problem.source or "<string>")
+    sha256 = file_sha256(path) if path is not None else digest
+    result = plan_with(planner, problem, problem_file, sha256, __version__, backend=backend, encoding=encoding,
+                       seed=seed, time_limit=time_limit, log=log, **options)
+    result.problem_digest = digest
+    return result
+
+
+def validate(source: ProblemSource, plan: "Plan | Mapping[str, Any] | str | os.PathLike[str]", *,
+             name: str | None = None, allow_outside: Sequence[str] = ()) -> "ValidationReport":
+    """Independently re-check ``plan`` (a :class:`~mrgc.planner.plan.Plan`, parsed plan JSON, or the path of
+    a plan file) against a problem: a :class:`~mrgc.planner.validate.ValidationReport` whose ``ok`` is the
+    verdict and whose ``violations`` list every way the plan fails (docs/validator.md).  A plan file that
+    cannot be used at all raises InputError (E500-E504).  A file holding several problems is read for the
+    one the plan names (unless ``name`` says otherwise).  The plan must be for the same problem contents:
+    the file it was made from or its facts file are both accepted."""
+    from mrgc.planner.validate import load_plan, validate as run
+
+    doc: Any = plan
+    if isinstance(plan, (str, os.PathLike)):
+        doc = load_plan(os.fspath(plan))
+    if isinstance(source, (str, os.PathLike)):
+        from mrgc.language.loader import parse_file
+
+        path: str | None = os.fspath(source)
+        mf = parse_file(os.fspath(source), allow_outside=tuple(allow_outside))
+        wanted = _plan_problem(doc)
+        if name is None and len(mf.problems) > 1 and any(p.name == wanted for p in mf.problems):
+            name = wanted
+        problem = mf.problem(name)
+    else:
+        problem, path = _resolve(source, name, allow_outside)
+    return run(problem, doc, path)  # no layout checks: the validator's geometry is pybullet's alone (no coal)
+
+
+def _plan_problem(doc: Any) -> str | None:
+    if isinstance(doc, Mapping):
+        value = doc.get("problem")
+        return value if isinstance(value, str) else None
+    return getattr(doc, "problem", None)
+
+
+# ---------------------------------------------------------------- backends
+def backends() -> "list[BackendRecord]":
+    """Every registered backend (the built-in ones, then plug-ins of the ``mrgc.backends`` entry-point
+    group) as :class:`~mrgc.backends.registry.BackendRecord` values, in registry order; looking them up
+    imports no solver library.  (``mrgc.backends()`` calls this.)"""
+    from mrgc.backends.registry import records
+
+    return records()
+
+
+__all__ = ["BackendSpec", "CheckReport", "ProblemSource", "backends", "check", "compile",
+           "compute_facts", "export_model", "load_problem", "plan", "validate"]

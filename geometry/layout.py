@@ -1,0 +1,264 @@
+"""Layout checks of a geometric problem: start states that cannot be, and parts that will never be used.
+
+Each finding is a located :class:`~mrgc.errors.Diagnostic` (docs/errors.md).  Two tiers:
+
+**Without robot models** (``mrgc check``, and every command before it works on a problem):
+
+- ``E263`` a robot kind's ``:home`` does not have one value per joint of its arm (the URDF's revolute,
+  continuous and prismatic joints from the base to the end-effector link: 7 for the Panda).  The URDF is
+  read (its XML only, no meshes); a URDF that cannot be found or read is left to ``mrgc facts`` (E400/E401);
+- ``E264`` two movable objects overlap at their start poses;
+- ``E265`` a movable object overlaps a fixed object at its start pose;
+- ``E266`` a planar robot's footprint at its start pose overlaps a movable object, a fixed object or
+  another robot's footprint;
+- ``W270`` (:func:`mrgc.geometry.grasps.grasp_warnings`) a grasp no gripper opens wide enough for;
+- ``W271`` a movable object lies in no region at its start pose (``in-region`` holds for none): unless it
+  is a goal object it can never move, so an obstacle in no region makes its goals unreachable.
+
+**With robot models** (``mrgc facts`` and the commands that run phase 1, ``plan``):
+
+- ``E266`` an arm at its home configuration overlaps a movable object or a fixed object (the base link,
+  bolted in place, is left out, as everywhere in the geometry layer).  Arms overlapping each other at home
+  are not checked: the grounding keeps every motion clear of the other arms at home, so such arms only
+  narrow what can be planned;
+- ``W272`` a region lies outside the workspace of every robot: farther from each arm's shoulder than its
+  reach bound (:attr:`~mrgc.geometry.kinematics.RobotModel.reach`).  Planar robots drive, so a problem with
+  one has no such warning.
+
+Overlap means a penetration deeper than :data:`TOLERANCE` (signed distance, coal): shapes that touch, as
+an object standing on a table or two boxes side by side, do not overlap.  The overlaps are errors because
+no plan can start from them (the validator would reject every plan at its first step); objects in no
+region and unreachable regions are warnings because the problem may still be solvable without them.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Iterable
+
+from mrgc.errors import Diagnostic, InputError, Span
+from mrgc.geometry.collision import CollisionWorld
+from mrgc.geometry.transforms import from_pose
+from mrgc.language.model import FixedObject, Mesh, MovableObject, Problem, RobotKind
+
+#: penetration depth (m) above which two shapes overlap
+TOLERANCE = 1e-3
+
+
+def layout_diagnostics(problem: Problem) -> list[Diagnostic]:
+    """The layout diagnostics of ``problem`` that need no robot model (none for a symbolic one), in
+    declaration order within each check; :func:`robot_diagnostics` has the others."""
+    if problem.symbolic:
+        return []
+    from mrgc.geometry.grasps import grasp_warnings
+
+    out = home_diagnostics(problem)
+    out += overlap_diagnostics(problem)
+    out += grasp_warnings(problem)
+    out += region_diagnostics(problem)
+    return out
+
+
+# ---------------------------------------------------------------------------------------------- :home
+def arm_joints(kind: RobotKind) -> tuple[str, ...] | None:
+    """The joints of ``kind``'s arm from its base to its end-effector link, read from the URDF; None when
+    the kind has no URDF or it cannot be found or read (``mrgc facts`` reports that)."""
+    if kind.urdf is None or kind.end_effector is None:
+        return None
+    from mrgc.geometry.kinematics import resolve_urdf
+    from mrgc.geometry.urdf import parse_urdf
+
+    base = os.path.dirname(os.path.abspath(kind.source)) if kind.source else os.getcwd()
+    try:
+        urdf = parse_urdf(resolve_urdf(kind.urdf, base, kind.span, kind.roots))
+    except InputError:
+        return None
+    if kind.end_effector not in urdf.order:
+        return None
+    chain = []
+    link = kind.end_effector
+    while link in urdf.joint_of:
+        joint = urdf.joint_of[link]
+        if joint.kind in ("revolute", "continuous", "prismatic"):
+            chain.append(joint.name)
+        link = joint.parent
+    return tuple(reversed(chain))
+
+
+def home_diagnostics(problem: Problem) -> list[Diagnostic]:
+    """E263 for each robot kind used by the problem whose ``:home`` length differs from its arm's joints."""
+    used = {r.kind for r in problem.robots}
+    out = []
+    for kind in problem.domain.robot_kinds:
+        if kind.name not in used or kind.base != "fixed" or not kind.home:
+            continue
+        joints = arm_joints(kind)
+        if joints is None or len(joints) == len(kind.home):
+            continue
+        shown = ", ".join(joints) if len(joints) <= 4 else f"{joints[0]}, ..., {joints[-1]}"
+        out.append(Diagnostic(
+            "E263", f"robot kind '{kind.name}': :home has {len(kind.home)} value{'s' * (len(kind.home) != 1)}, but "
+            f"the arm of '{kind.urdf}' has {len(joints)} joint{'s' * (len(joints) != 1)} from its base to "
+            f"'{kind.end_effector}' ({shown}): give one value per joint", kind.home_span))
+    return out
+
+
+# ---------------------------------------------------------------------------------------------- overlaps
+def overlap_diagnostics(problem: Problem) -> list[Diagnostic]:
+    """E264 (object-object), E265 (object-fixed) and E266 (planar footprint) overlaps at the start.  Mesh
+    shapes are left out: a mesh may be concave (a bin that holds objects), and its file is read by
+    ``mrgc facts``."""
+    from mrgc.geometry.planar import PlanarRobot
+    from mrgc.geometry.scene import RobotSpec
+
+    world = CollisionWorld()
+    spans = _spans(problem)
+    fixed = [o.name for o in _solids(problem.fixed)]
+    movable = [o.name for o in _solids(problem.movable)]
+    for group, decls in (("fixed", problem.fixed), ("movable", problem.movable)):
+        for o in _solids(decls):
+            assert o.shape is not None and o.pose is not None
+            world.add(o.name, o.shape, from_pose(o.pose), group)
+    kinds = {k.name: k for k in problem.domain.robot_kinds}
+    footprints = []
+    for r in problem.robots:
+        kind = kinds.get(r.kind or "")
+        if kind is None or kind.base != "planar" or kind.footprint is None or isinstance(kind.footprint, Mesh) \
+                or r.base is None:
+            continue
+        robot = PlanarRobot(RobotSpec(r.name, kind, from_pose(r.base)))
+        world.add(r.name, robot.footprint, robot.body_transform(robot.start), "robot")
+        footprints.append(r.name)
+    out: list[Diagnostic] = []
+    for i, name in enumerate(movable):
+        for other, depth in _overlaps(world, name, movable[:i]):
+            out.append(_overlap("E264", f"movable object '{name}' overlaps movable object '{other}'", depth,
+                                spans, name, other))
+        for other, depth in _overlaps(world, name, fixed):
+            out.append(_overlap("E265", f"movable object '{name}' overlaps fixed object '{other}'", depth,
+                                spans, name, other))
+    for i, name in enumerate(footprints):
+        for other, depth in _overlaps(world, name, [*movable, *fixed, *footprints[:i]]):
+            what = "robot" if other in footprints else "fixed object" if other in fixed else "movable object"
+            out.append(_overlap("E266", f"the footprint of robot '{name}' overlaps {what} '{other}'", depth, spans,
+                                name, other))
+    return out
+
+
+def _spans(problem: Problem) -> dict[str, Span]:
+    """Where each fixed object, movable object and robot is declared."""
+    out: dict[str, Span] = {f.name: f.span for f in problem.fixed}
+    out.update({m.name: m.span for m in problem.movable})
+    out.update({r.name: r.span for r in problem.robots})
+    return out
+
+
+def _solids(decls: Iterable[FixedObject | MovableObject]) -> list[FixedObject | MovableObject]:
+    """The declarations with a primitive shape and a pose (meshes are left out)."""
+    return [d for d in decls if d.shape is not None and d.pose is not None and not isinstance(d.shape, Mesh)]
+
+
+def _overlaps(world: CollisionWorld, name: str, against: Iterable[str]) -> list[tuple[str, float]]:
+    """(other, penetration depth) for each world object of ``against`` that ``name`` overlaps, in order."""
+    candidates = [a for a in against if a != name]
+    if not candidates:
+        return []
+    hits = world.colliding_with(name, against=candidates)
+    out = []
+    for other in candidates:
+        if other in hits:
+            depth = -world.distance(name, other)
+            if depth > TOLERANCE:
+                out.append((other, depth))
+    return out
+
+
+def _overlap(code: str, what: str, depth: float, spans: dict[str, Span], name: str, other: str) -> Diagnostic:
+    note = (f"'{other}' is declared at {spans[other]}",) if other in spans and spans[other].line else ()
+    return Diagnostic(code, f"{what} by {depth * 1000:.1f} mm at the start: no plan can start from here",
+                      spans.get(name), notes=note)
+
+
+# ---------------------------------------------------------------------------------------------- regions
+def region_diagnostics(problem: Problem) -> list[Diagnostic]:
+    """W271 for each movable object in no region at its start pose (as ``in-region`` of phase 1 reads
+    it; a mesh whose file cannot be read is left to ``mrgc facts``)."""
+    from mrgc.geometry.scene import Body, inside
+
+    regions = [Body(r.name, r.shape, from_pose(r.pose)) for r in problem.regions if r.shape and r.pose]
+    goal = problem.goal_regions
+    out = []
+    for m in problem.movable:
+        if m.shape is None or m.pose is None:
+            continue
+        try:
+            if any(inside(region, m.shape, from_pose(m.pose)) for region in regions):
+                continue
+        except InputError:
+            continue
+        use = ("it is a goal object, so it can still be moved into its goal region" if m.name in goal
+               else "it can never move, so if it is in the way its goals cannot be reached")
+        out.append(Diagnostic("W271", f"movable object '{m.name}' lies in no region at its start pose (a region "
+                                      f"must hold it entirely): {use}", m.span, severity="warning"))
+    return out
+
+
+# ---------------------------------------------------------------------------------------------- robots
+def robot_diagnostics(problem: Problem) -> list[Diagnostic]:
+    """E266 for arms at home that overlap something, W272 for regions no robot reaches (none for a
+    symbolic problem)."""
+    if problem.symbolic:
+        return []
+    import numpy as np
+
+    from mrgc.geometry.arm import Arm
+    from mrgc.geometry.scene import half_extents, scene_from_problem
+
+    scene = scene_from_problem(problem)
+    arms = [Arm(spec) for spec in scene.robots if spec.kind.base == "fixed"]
+    spans = _spans(problem)
+    world = CollisionWorld()
+    for body in scene.fixed:
+        world.add(body.name, body.shape, body.pose, "fixed")
+    for body in scene.movable:
+        world.add(body.name, body.shape, body.pose, "movable")
+    links: dict[str, list[str]] = {}
+    for arm in arms:
+        shapes, index = arm.probes
+        transforms = arm.link_transforms(arm.home[None])[0]
+        links[arm.name] = []
+        for shape, k, t in zip(shapes, index, transforms):
+            key = f"{arm.name}/{arm.model.links[k].name}"
+            world.add(key, shape, t, f"robot:{arm.name}")
+            links[arm.name].append(key)
+    out: list[Diagnostic] = []
+    objects = [*world.names("movable"), *world.names("fixed")]
+    for arm in arms:
+        found: dict[str, tuple[float, str]] = {}
+        for key in links[arm.name]:
+            for other, depth in _overlaps(world, key, objects):
+                if depth > found.get(other, (0.0, ""))[0]:
+                    found[other] = (depth, key.split("/")[1])
+        for target, (depth, link) in found.items():
+            what = "movable object" if target in world.names("movable") else "fixed object"
+            out.append(_overlap("E266", f"robot '{arm.name}' ({link}) at its home configuration overlaps {what} "
+                                        f"'{target}'", depth, spans, arm.name, target))
+    if arms and len(arms) == len(scene.robots):
+        shoulders = [(arm.base @ np.append(arm.model.shoulder, 1.0))[:3] for arm in arms]
+        region_spans = {r.name: r.span for r in problem.regions}
+        for region in scene.regions:
+            inv = np.linalg.inv(region.pose)
+            half = half_extents(region.shape)
+            far = True
+            for arm, shoulder in zip(arms, shoulders):
+                local = inv[:3, :3] @ shoulder + inv[:3, 3]
+                gap = float(np.linalg.norm(np.maximum(np.abs(local) - half, 0.0)))
+                if gap <= arm.model.reach:
+                    far = False
+                    break
+            if far:
+                out.append(Diagnostic(
+                    "W272", f"region '{region.name}' lies outside the workspace of every robot (farther from each "
+                            f"arm's shoulder than its reach): nothing can be placed in it or picked from it",
+                    region_spans.get(region.name), severity="warning"))
+    return out

@@ -44,7 +44,9 @@ class PysmtBackend(Backend):
         mgr = self.mgr = self.env.formula_manager
         INT, BOOL = pysmt.typing.INT, pysmt.typing.BOOL
         self.solver = self.env.factory.Solver(name=self.solver_name, random_seed=int(self.seed))
-        if hasattr(self.solver, "z3"):  # z3's own SIGINT handler would swallow Ctrl-C (see _stop)
+        if hasattr(self.solver, "z3"):
+            self._private_context()
+            # z3's own SIGINT handler would swallow Ctrl-C (see _stop)
             self.solver.z3.set("ctrl_c", False)
         self.x = [mgr.Symbol(v.name, BOOL if v.is_bool else INT) for v in model.vars]
         self.is_bool = [v.is_bool for v in model.vars]
@@ -56,6 +58,20 @@ class PysmtBackend(Backend):
             lits = [self.x[v] if val else mgr.Not(self.x[v]) for v, val in cr.when]
             self.solver.add_assertion(mgr.Implies(mgr.And(lits), self._row(cr.row)))
         self.objective = self._sum(model.objectives[0]) if model.objectives else mgr.Int(0)
+
+    def _private_context(self) -> None:
+        """Move the z3 wrapper into a z3 context of its own.  pysmt builds every z3 solver in z3's global
+        context, whose terms from earlier solves change the search: the same model and seed gave another
+        optimum on the first solve of a process than on later ones (found by the conformance kit's
+        determinism check, mrgc.testing.conformance)."""
+        from pysmt.solvers import z3 as wrapper
+
+        ctx = wrapper.z3.Context()
+        logic = str(self.solver.logic)
+        self.solver.z3 = (wrapper.z3.SolverFor(logic, ctx=ctx) if logic in wrapper.Z3Solver.SOLVERFOR_LOGIC_NAMES
+                          else wrapper.z3.Solver(ctx=ctx))
+        self.solver.options(self.solver)  # the random seed, on the new solver
+        self.solver.converter = wrapper.Z3Converter(self.env, z3_ctx=ctx)
 
     def _sum(self, terms: Terms) -> Any:
         mgr = self.mgr

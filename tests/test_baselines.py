@@ -2,7 +2,7 @@
 
 Geometric: Ap1 solves a shipped packaging problem whose goal place is obstructed, and ``mrgc validate``
 accepts the plan it writes.  Symbolic: on random small problems Ap1's answer agrees with the brute-force
-oracle of tests/skeleton_oracle.py (a plan exactly when some action set has a schedule), every plan moves
+oracle of mrgc.testing.oracle (a plan exactly when some action set has a schedule), every plan moves
 each object at most once and is accepted by the validator, and the same seed gives the same plan.
 Statuses: infeasible (with the facts' reason), exhausted (the search ran to its end), time limit.
 """
@@ -22,8 +22,7 @@ from mrgc.planner.baselines import PLANNERS, plan_with
 from mrgc.planner.outcome import PlanStatus
 from mrgc.planner.plan import Plan
 from mrgc.planner.validate import validate
-
-import skeleton_oracle as oracle  # noqa: E402 - registered by tests/conftest.py
+from mrgc.testing import oracle
 
 ROOT = Path(__file__).resolve().parent.parent
 SYMBOLIC = ROOT / "domains" / "symbolic"

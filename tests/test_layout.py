@@ -28,7 +28,9 @@ MAY_IMPORT: dict[str, set[str]] = {
     "outputs": {"errors", "signals"},
     "limits": {"errors"},
     "cli": {"*"},
-    "api": {"*"},  # the public API the CLI wraps: it calls into every layer, nothing imports it but cli and __init__
+    "api": {"*"},
+    # test helpers for users and plug-ins: the conformance kit compiles through planner/skeletons.py
+    "testing": {"errors", "language", "compiler", "backends", "planner", "signals"},  # the public API the CLI wraps: it calls into every layer, nothing imports it but cli and __init__
     "bench": {"*"},  # studies drive the command line: bench imports everything, nothing imports bench but cli
     "__init__": {"*"},
 }
@@ -131,5 +133,20 @@ def test_heavy_libraries_are_imported_lazily(path: Path) -> None:
 def test_importing_mrgc_loads_no_heavy_library() -> None:
     code = ("import sys, mrgc, mrgc.cli, mrgc.language; "
             "print(sorted(m for m in %r if m in sys.modules))" % sorted(HEAVY))
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]"
+
+
+def test_the_skeleton_oracle_shares_no_code_with_the_compiler() -> None:
+    """mrgc.testing.oracle reads the task graph's data types and nothing else of mrgc.compiler."""
+    mrgc_imports = {m for m, _ in imports(ROOT / "testing" / "oracle.py") if m.startswith("mrgc.")}
+    assert mrgc_imports == {"mrgc.compiler.task_graph", "mrgc.language.model"}
+    source = (ROOT / "testing" / "oracle.py").read_text(encoding="utf-8")
+    assert "from mrgc.compiler.task_graph import Action, TaskGraph\n" in source
+
+
+def test_importing_mrgc_testing_loads_neither_hypothesis_nor_a_solver() -> None:
+    code = ("import sys, mrgc.testing, mrgc.testing.oracle, mrgc.testing.conformance; "
+            "print(sorted(m for m in %r if m in sys.modules))" % sorted([*HEAVY, "hypothesis"]))
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]"

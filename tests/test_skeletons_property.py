@@ -1,8 +1,9 @@
-"""Skeleton generation against an independent brute-force oracle (tests/skeleton_oracle.py).
+"""Skeleton generation against an independent brute-force oracle (mrgc.testing.oracle).
 
-Random small symbolic problems (2-3 robots, 2-5 objects, 2-3 regions, grasps top/side, random reachability,
-occlusion and handover facts, 1-2 goal objects) are written as .mrg text and parsed.  For every backend x
-encoding the first K skeleton keys (makespan, moved) must equal the oracle's, every skeleton must satisfy
+Random small symbolic problems (mrgc.testing.strategies: 2-3 robots, 2-5 objects, 2-3 regions, grasps
+top/side, random reachability, occlusion and handover facts, 1-2 goal objects, half of them drawn
+feasible) are written as .mrg text and parsed; the oracle must agree with the strategy's feasibility.  For
+every backend x encoding the first K skeleton keys (makespan, moved) must equal the oracle's, every skeleton must satisfy
 the model's definitions, and the action sets of one run must be pairwise distinct; Alg. 1 must build the
 same graph as the oracle's own reading of it.  A second property asks what the planner asks during search:
 other M*, objects of a grounded suffix excluded, a horizon limit, skeletons fetched a few at a time.  The
@@ -24,90 +25,39 @@ from mrgc.compiler.facts import FactBase
 from mrgc.compiler.task_graph import Action, build_task_graph
 from mrgc.language.model import Problem
 from mrgc.planner.skeletons import SkeletonSource, compile_problem, must_move
-
-
-import skeleton_oracle as oracle  # noqa: E402 - registered by tests/conftest.py
+from mrgc.testing import oracle
+from mrgc.testing.strategies import SymbolicCase, symbolic_problems
 
 BACKENDS = ["mip", "smt", "pysmt", "cpsat"]
 ENCODINGS = ["paper", "disaggregated", "time-of-move"]
 K = 4
-GRASPS = ("top", "side")
 SYMBOLIC = Path(__file__).resolve().parent.parent / "domains" / "symbolic"
 
 DOMAIN = "(define (domain abstract) (:requirements :handover :symbolic) (:grasps top side))\n"
 
 
 # ---------------------------------------------------------------- problem generation
-@st.composite
-def problems(draw: Any) -> str:
-    """The text of a random small symbolic problem (with its domain)."""
-    robots = [f"r{i}" for i in range(1, draw(st.integers(2, 3)) + 1)]
-    objects = [f"o{i}" for i in range(1, draw(st.integers(2, 5)) + 1)]
-    regions = ["ra", "rb", "rc"][: draw(st.integers(2, 3))]
-    region = {o: draw(st.sampled_from(regions)) for o in objects}
-    goal_objs = draw(st.lists(st.sampled_from(objects), min_size=1, max_size=2, unique=True))
-    goal: dict[str, str] = {}
-    for k, o in enumerate(goal_objs):
-        # the first goal is never already satisfied (so M* is not empty); the second may be, which puts a
-        # goal object outside M* (it then moves only as an obstacle, back into its goal region)
-        choices = [r for r in regions if r != region[o]] if k == 0 else regions
-        goal[o] = draw(st.sampled_from(choices))
-    target = {o: goal.get(o, region[o]) for o in objects}
-
-    density = draw(st.sampled_from([35, 50, 70]))  # percent of the reachability facts that hold
-
-    def some(candidates: list[tuple[str, ...]], dense: bool, cap: int = 4) -> list[tuple[str, ...]]:
-        if not candidates:
-            return []
-        if dense:
-            flags = draw(st.lists(st.integers(0, 99), min_size=len(candidates), max_size=len(candidates)))
-            return [c for c, f in zip(candidates, flags) if f < density]
-        return sorted(draw(st.sets(st.sampled_from(candidates), max_size=cap)))
-
-    facts: list[tuple[str, ...]] = [("in-region", o, region[o]) for o in objects]
-    facts += [("reachable-pick", *c) for c in some([(o, g, r) for o in objects for g in GRASPS for r in robots], True)]
-    facts += [("reachable-place", *c)
-              for c in some([(o, target[o], g, r) for o in objects for g in GRASPS for r in robots], True)]
-    facts += [("reachable-place", *c)  # decoys: places in regions that are nobody's target
-              for c in some([(o, re, g, r) for o in objects for re in regions if re != target[o]
-                             for g in GRASPS for r in robots], False, 2)]
-    facts += [("occludes-pick", *c)
-              for c in some([(m1, m2, g, r) for m1 in objects for m2 in objects if m1 != m2
-                             for g in GRASPS for r in robots], False, 8)]
-    facts += [("occludes-goal-place", *c)
-              for c in some([(m1, m2, goal[m2], g, r) for m1 in objects for m2 in goal if m1 != m2
-                             for g in GRASPS for r in robots], False, 4)]
-    facts += [("enable-goal-handover", *c)
-              for c in some([(m, g1, g2, r1, r2) for m in objects for g1 in GRASPS for g2 in GRASPS
-                             for r1 in robots for r2 in robots if r1 != r2], False, 6)]
-    init = "\n    ".join(f"({' '.join(f)})" for f in dict.fromkeys(facts))
-    goals = " ".join(f"(in-region {o} {r})" for o, r in goal.items())
-    return (DOMAIN + "(define (problem random)\n  (:domain abstract)\n"
-            f"  (:robots {' '.join(robots)})\n  (:movable {' '.join(objects)})\n  (:regions {' '.join(regions)})\n"
-            f"  (:init\n    {init})\n  (:goal (and {goals})))\n")
+def problems() -> Any:
+    """Random small symbolic problems from mrgc.testing.strategies, half of them drawn feasible."""
+    return symbolic_problems(feasible=0.5)
 
 
 def reference_graph(problem: Problem, must: Sequence[str] | None = None, moved: Sequence[str] = ()) -> Any:
     """Alg. 1 by the oracle, from the problem's raw facts (no mrgc.compiler code)."""
-    facts = [(f.predicate, *f.args) for f in problem.init]
-    region = {f.args[0]: f.args[1] for f in problem.init if f.predicate == "in-region"}
-    if must is None:
-        must = [o for o, r in problem.goal_regions.items() if region.get(o) != r]
-    return oracle.reference_task_graph([r.name for r in problem.robots],
-                                       {m.name: tuple(GRASPS) for m in problem.movable},
-                                       problem.goal_regions, region, facts, must, moved)
+    return oracle.problem_graph(problem, must, moved)
 
 
 # ---------------------------------------------------------------- the property
 @settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
 @given(problems())
-def test_every_backend_and_encoding_matches_the_brute_force_oracle(text: str) -> None:
-    problem = parse_string(text).problem()
+def test_every_backend_and_encoding_matches_the_brute_force_oracle(case: SymbolicCase) -> None:
+    problem, text = case.problem(), case.text
     ref = reference_graph(problem)
     graph = build_task_graph(FactBase.from_problem(problem), must_move(problem))
     assert oracle.graph_signature(graph) == oracle.graph_signature(ref), "Alg. 1 differs from the reference"
 
     sets = oracle.feasible_action_sets(ref)
+    assert bool(sets) == case.feasible, "the strategy's feasibility planting does not hold"
     expected = sorted((m, len(s)) for s, m in sets.items())[:K]
     event(f"{min(len(sets), K)}{'+' if len(sets) > K else ''} feasible action sets")
     event(f"first makespan {expected[0][0] if expected else '-'}, {len(ref.actions) // 5 * 5}+ actions")
@@ -142,10 +92,10 @@ def test_every_backend_and_encoding_matches_the_brute_force_oracle(text: str) ->
 
 @settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
 @given(problems(), st.data())
-def test_resumed_requests_with_moved_objects_and_a_horizon_limit(text: str, data: Any) -> None:
+def test_resumed_requests_with_moved_objects_and_a_horizon_limit(case: SymbolicCase, data: Any) -> None:
     """What the planner asks during search: skeletons for some M*, with the grounded suffix's objects
     excluded, a horizon limit, fetched a few at a time (the generator keeps its cuts between calls)."""
-    problem = parse_string(text).problem()
+    problem, text = case.problem(), case.text
     objects = [m.name for m in problem.movable]
     moved = data.draw(st.lists(st.sampled_from(objects), unique=True, max_size=2), label="moved")
     extra = data.draw(st.lists(st.sampled_from(objects), unique=True, max_size=1), label="extra M*")

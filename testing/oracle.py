@@ -1,9 +1,8 @@
 """An independent reference for task skeletons, written only from the model's definitions.
 
 It shares no code with ``mrgc.compiler``: ``Action`` and ``TaskGraph`` are used as plain input data (their
-fields), nothing else.  Test files load this module by path (tests/ is not a package):
-
-    spec = importlib.util.spec_from_file_location("skeleton_oracle", Path(__file__).with_name("skeleton_oracle.py"))
+fields), nothing else; ``tests/test_layout.py`` keeps it so.  Use it to check a skeleton generator (the
+project's own tests do, for every backend and encoding) or a domain of your own (docs/testing.md).
 
 The definitions (DESIGN.md section 5, the paper's "Key Component 1"):
 
@@ -18,15 +17,19 @@ The definitions (DESIGN.md section 5, the paper's "Key Component 1"):
   of actions differ, and an action set's makespan is the smallest one any valid schedule of it has.
 
 Contents: :func:`check_skeleton` (violations of one skeleton), :func:`min_makespan` and
-:func:`feasible_action_sets` / :func:`oracle_keys` (brute force over action sets), and
-:func:`reference_task_graph` (Alg. 1 of the paper on raw fact tuples, returned as a ``TaskGraph``).
+:func:`feasible_action_sets` / :func:`oracle_keys` (brute force over action sets: exponential, for small
+problems), :func:`reference_task_graph` (Alg. 1 of the paper on raw fact tuples, returned as a
+``TaskGraph``) and :func:`problem_graph` (the same from a checked symbolic problem).
 """
 
 from __future__ import annotations
 
-from typing import Any, Iterable, Mapping, Sequence
+from typing import TYPE_CHECKING, Any, Iterable, Mapping, Sequence
 
 from mrgc.compiler.task_graph import Action, TaskGraph
+
+if TYPE_CHECKING:
+    from mrgc.language.model import Problem
 
 
 # ------------------------------------------------------------------ helpers on the graph's data
@@ -329,3 +332,15 @@ def graph_signature(graph: TaskGraph) -> tuple[frozenset[str], frozenset[str], f
         frozenset((a, frozenset(graph.block_pick[i]), frozenset(graph.block_place[i]))
                   for i, a in enumerate(graph.actions)),
     )
+
+
+def problem_graph(problem: "Problem", must_move: Sequence[str] | None = None, moved: Iterable[str] = ()) -> TaskGraph:
+    """:func:`reference_task_graph` of a checked problem's facts (its ``:init``): M* defaults to the goal
+    objects not already in their goal region; ``moved`` are the objects of a grounded suffix."""
+    facts = [(f.predicate, *f.args) for f in problem.init]
+    region = {f.args[0]: f.args[1] for f in problem.init if f.predicate == "in-region"}
+    if must_move is None:
+        must_move = [o for o, r in problem.goal_regions.items() if region.get(o) != r]
+    return reference_task_graph([r.name for r in problem.robots],
+                                {m.name: problem.grasps_of(m.name) for m in problem.movable},
+                                problem.goal_regions, region, facts, must_move, moved)

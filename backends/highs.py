@@ -122,4 +122,20 @@ class HighsBackend(Backend):
         return Solution(Status.ERROR, message=f"HiGHS: {self.h.modelStatusToString(status)}")
 
     def _export(self, path: str) -> None:
-        self.h.writeModel(path)
+        """``writeModel``; rows without terms (0 >= 1 says "infeasible") and models without variables are
+        written with a column ``zero`` fixed at 0 that those rows hold, since HiGHS writes neither (the file
+        would reload as an empty, feasible model)."""
+        assert self.model is not None
+        empty = [i for i, r in enumerate(self.model.rows) if not r.terms]
+        if not empty and self.model.vars:
+            self.h.writeModel(path)
+            return
+        h = _highspy().Highs()
+        h.setOptionValue("output_flag", False)
+        h.passModel(self.h.getModel())
+        h.addVar(0.0, 0.0)
+        zero = h.getNumCol() - 1
+        h.passColName(zero, "zero")
+        for i in empty:
+            h.changeCoeff(i, zero, 1.0)
+        h.writeModel(path)

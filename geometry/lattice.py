@@ -294,27 +294,32 @@ class LatticePlanner:
             front[g] = True
         dist[front] = 0
         open_ = free & ~front  # free states not reached yet
-        grown, plane = np.empty_like(front), np.empty_like(front)
+        grown, plane = np.zeros_like(front), np.zeros_like(front)
+        # the reached states lie in a window that grows by one cell a layer: work on it only
+        i0, i1 = min(g[1] for g in goals), max(g[1] for g in goals)
+        j0, j1 = min(g[2] for g in goals), max(g[2] for g in goals)
         d = 0
         while all(dist[s] < 0 for s in starts):
+            i0, i1, j0, j1 = max(i0 - 1, 0), min(i1 + 1, self.nx - 1), max(j0 - 1, 0), min(j1 + 1, self.ny - 1)
+            win = (slice(None), slice(i0, i1 + 1), slice(j0, j1 + 1))
+            f, p, g = front[win], plane[win], grown[win]
             # the 8 neighbours in the plane (x, then y of the x-grown layer), then one heading either way
-            np.copyto(plane, front)
-            plane[:, 1:, :] |= front[:, :-1, :]
-            plane[:, :-1, :] |= front[:, 1:, :]
-            np.copyto(grown, plane)
-            grown[:, :, 1:] |= plane[:, :, :-1]
-            grown[:, :, :-1] |= plane[:, :, 1:]
-            grown[1:] |= front[:-1]
-            grown[0] |= front[-1]
-            grown[:-1] |= front[1:]
-            grown[-1] |= front[0]
-            grown &= open_
-            new = np.flatnonzero(grown)
-            if new.size == 0:
+            np.copyto(p, f)
+            p[:, 1:, :] |= f[:, :-1, :]
+            p[:, :-1, :] |= f[:, 1:, :]
+            np.copyto(g, p)
+            g[:, :, 1:] |= p[:, :, :-1]
+            g[:, :, :-1] |= p[:, :, 1:]
+            g[1:] |= f[:-1]
+            g[0] |= f[-1]
+            g[:-1] |= f[1:]
+            g[-1] |= f[0]
+            g &= open_[win]
+            if not g.any():
                 return None
             d += 1
-            dist.flat[new] = d
-            open_.flat[new] = False
+            dist[win][g] = d
+            open_[win][g] = False
             front, grown = grown, front
         here = min((s for s in starts if dist[s] >= 0), key=lambda s: (dist[s], starts.index(s)))
         path = [here]

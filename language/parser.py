@@ -68,6 +68,8 @@ def _tok_span(file: str, tok: Token) -> Span:
 
 
 _NAMED = frozenset({"NAME", "KEYWORD", "NUMBER", "STRING", "AXIS"})
+#: tokens that are values: unexpected, they are a mistake of their own, not a sign of a missing ")"
+_VALUES = _NAMED - {"KEYWORD"}
 
 
 class _ToAst(Transformer[Token, Any]):
@@ -255,7 +257,7 @@ def _syntax_diagnostic(exc: UnexpectedInput, text: str, file: str) -> Diagnostic
     (E102 at the end of the file, E104 before the next form: :mod:`mrgc.language.parens`)."""
     found = _first_syntax_diagnostic(exc, text, file)
     if isinstance(exc, UnexpectedToken) and (found.code == "E102" or (
-            found.code == "E101" and exc.token.type not in _NAMED and str(exc.token) != ")")):
+            found.code == "E101" and exc.token.type not in _VALUES and str(exc.token) != ")")):
         end = len(text) if exc.token.type == "$END" else (exc.token.start_pos or 0)
         paren = unclosed_paren(text, end)
         if paren is not None:

@@ -1,0 +1,156 @@
+"""The layout checks of geometric problems (geometry/layout.py, docs/errors.md E263-E266, W271, W272): each
+fires on the layout it names, located; none fires on the shipped problems or on generated ones; the
+commands that work on a problem refuse an impossible start before any work."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+import mrgc
+from mrgc import cli
+from mrgc.generate import generate
+from mrgc.geometry.layout import TOLERANCE, arm_joints, layout_diagnostics, robot_diagnostics
+
+ROOT = Path(__file__).resolve().parent.parent
+
+CELL = """(define (domain cell)
+  (:robot-kind panda :urdf "franka_panda/panda.urdf" :base fixed :end-effector "panda_hand"
+    :home (0 -0.785 0 -2.356 0 1.571 0.785))
+  (:grasps top))
+"""
+
+
+def cell(movable: str, regions: str = "(start :shape (box 0.4 0.4 0.3) :pose (0 0 0.15 0))",
+         fixed: str = "(table :shape (box 1.4 1.4 0.05) :pose (0 0 -0.025 0))", goal: str = "o1 start") -> str:
+    return CELL + f"""(define (problem p)
+  (:domain cell)
+  (:robots (r1 :kind panda :base (0 -0.6 0 90)))
+  (:fixed {fixed})
+  (:regions {regions})
+  (:movable {movable})
+  (:goal (in-region {goal})))
+"""
+
+
+def codes(text: str, robots: bool = False) -> list[tuple[str, int]]:
+    problem = mrgc.parse_string(text, "p.mrg").problem()
+    found = layout_diagnostics(problem) + (robot_diagnostics(problem) if robots else [])
+    return [(d.code, d.span.line if d.span else 0) for d in found]
+
+
+BOX = "(box 0.04 0.04 0.1)"
+
+
+def test_touching_is_not_overlapping() -> None:
+    """Side by side, on the table, on each other: nothing to report."""
+    text = cell(f"(o1 :shape {BOX} :pose (0 0 0.05 0)) (o2 :shape {BOX} :pose (0.04 0 0.05 0)) "
+                f"(o3 :shape {BOX} :pose (0 0 0.15 0))")
+    assert codes(text, robots=True) == []
+
+
+def test_objects_overlapping_each_other_or_the_table() -> None:
+    text = cell(f"(o1 :shape {BOX} :pose (0 0 0.05 0))\n (o2 :shape {BOX} :pose (0.035 0 0.05 0))\n"
+                f" (o3 :shape (cylinder 0.02 0.1) :pose (0.1 0.1 0.045 0))")
+    found = mrgc.parse_string(text, "p.mrg").problem()
+    diags = layout_diagnostics(found)
+    assert [(d.code, d.span.line) for d in diags] == [("E264", 11), ("E265", 12), ("W271", 12)]
+    assert "'o2' overlaps movable object 'o1' by 5.0 mm" in diags[0].message
+    assert "'o3' overlaps fixed object 'table' by 5.0 mm" in diags[1].message
+    assert diags[0].notes == ("'o1' is declared at p.mrg:10:14",)
+    shallow = cell(f"(o1 :shape {BOX} :pose (0 0 0.05 0)) (o2 :shape {BOX} :pose ({0.04 - TOLERANCE / 2} 0 0.05 0))")
+    assert codes(shallow) == []  # within the tolerance
+
+
+def test_a_planar_footprint_on_a_crate_or_a_wall() -> None:
+    text = (ROOT / "tests" / "golden" / "errors" / "E266.mrg").read_text(encoding="utf-8")
+    assert codes(text) == [("E266", 9)]
+    clear = text.replace(":base (0 0 0 0)", ":base (-0.5 0 0 0)")
+    assert codes(clear) == []
+    wall = clear.replace("(:regions", "(:fixed (wall :shape (box 0.1 2 0.5) :pose (-0.6 0 0.25 0)))\n  (:regions")
+    assert codes(wall) == [("E266", 9)]
+
+
+def test_home_length_against_the_arms_joints() -> None:
+    panda = mrgc.parse_string(cell(f"(o1 :shape {BOX} :pose (0 0 0.05 0))"), "p.mrg").problem()
+    assert arm_joints(panda.domain.robot_kinds[0]) == tuple(f"panda_joint{i}" for i in range(1, 8))
+    for values in ("(0 0 0 0 0 0)", "(0 0 0 0 0 0 0 0 0)"):
+        text = cell(f"(o1 :shape {BOX} :pose (0 0 0.05 0))").replace("(0 -0.785 0 -2.356 0 1.571 0.785)", values)
+        problem = mrgc.parse_string(text, "p.mrg").problem()
+        (diag,) = layout_diagnostics(problem)
+        assert diag.code == "E263" and (diag.span.line, diag.span.column) == (3, 11)
+        assert f":home has {values.count('0')} values, but the arm of 'franka_panda/panda.urdf' has 7 joints" \
+            in diag.message
+
+
+def test_an_unreadable_urdf_is_left_to_facts() -> None:
+    text = cell(f"(o1 :shape {BOX} :pose (0 0 0.05 0))").replace("franka_panda/panda.urdf", "nowhere.urdf") \
+        .replace("(0 -0.785 0 -2.356 0 1.571 0.785)", "(0 0)")
+    assert codes(text) == []
+
+
+def test_objects_in_no_region_are_warnings() -> None:
+    text = (ROOT / "tests" / "golden" / "errors" / "W271.mrg").read_text(encoding="utf-8")
+    diags = layout_diagnostics(mrgc.parse_string(text, "p.mrg").problem())
+    assert [(d.code, d.severity) for d in diags] == [("W271", "warning")] and "'o2'" in diags[0].message
+    goal_object = text.replace("(:goal (in-region o1 goal))", "(:goal (in-region o2 goal))")
+    (diag,) = layout_diagnostics(mrgc.parse_string(goal_object, "p.mrg").problem())
+    assert "it is a goal object" in diag.message
+
+
+def test_an_arm_at_home_inside_an_object_is_found_with_its_model() -> None:
+    """The Panda's links at home pass about 0.3-0.6 m above its base: a tall box there is hit."""
+    text = cell(f"(o1 :shape {BOX} :pose (0 0 0.05 0))\n (post :shape (box 0.1 0.1 0.6) :pose (0 -0.3 0.3 0))")
+    assert codes(text) == [("W270", 11), ("W271", 11)]  # no robot model: the post is too wide, in no region
+    found = codes(text, robots=True)
+    assert ("E266", 7) in found
+    problem = mrgc.parse_string(text, "p.mrg").problem()
+    (hit,) = [d for d in robot_diagnostics(problem) if d.code == "E266"]
+    assert "robot 'r1' (panda_" in hit.message and "at its home configuration overlaps movable object 'post'" \
+        in hit.message
+
+
+def test_regions_out_of_every_arms_reach() -> None:
+    text = cell(f"(o1 :shape {BOX} :pose (0 0 0.05 0))",
+                regions="(start :shape (box 0.4 0.4 0.3) :pose (0 0 0.15 0)) "
+                        "(far :shape (box 0.3 0.3 0.3) :pose (3 0 0.15 0))")
+    assert codes(text, robots=True) == [("W272", 9)]
+
+
+@pytest.mark.parametrize("path", sorted(p for p in (ROOT / "domains").glob("*/*.mrg") if p.name != "domain.mrg"),
+                         ids=lambda p: p.name)
+def test_the_shipped_problems_have_clean_layouts(path: Path) -> None:
+    for problem in mrgc.parse_file(path).problems:
+        found = layout_diagnostics(problem) + robot_diagnostics(problem)
+        assert [d.headline() for d in found if d.code != "W270"] == []
+
+
+@pytest.mark.parametrize(("kind", "robots"), [("packaging", 2), ("packaging", 3), ("box-moving", 2),
+                                              ("box-moving", 3)])
+def test_generated_problems_have_no_layout_errors(kind: str, robots: int) -> None:
+    for seed in range(4):
+        text = generate(kind, seed=seed, robots=robots)
+        problem = mrgc.parse_string(text, "gen.mrg", base_dir=str(ROOT / "domains" / kind)).problem()
+        found = layout_diagnostics(problem) + robot_diagnostics(problem)
+        assert [d.headline() for d in found if d.severity == "error"] == [], (kind, seed)
+
+
+def test_commands_refuse_an_impossible_start(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    path = tmp_path / "p.mrg"
+    path.write_text(cell(f"(o1 :shape {BOX} :pose (0 0 0.05 0)) (o2 :shape {BOX} :pose (0.02 0 0.05 0))"),
+                    encoding="utf-8")
+    for command in (["check"], ["facts"], ["compile"], ["plan", "--time-limit", "5"]):
+        assert cli.main([command[0], str(path), *command[1:]]) == 2, command
+        err = capsys.readouterr().err
+        assert f"{path}:10:" in err and "error[E264]" in err, (command, err)
+    with pytest.raises(mrgc.InputError) as exc:
+        mrgc.plan(path)
+    assert [d.code for d in exc.value.diagnostics] == ["E264"]
+
+
+def test_facts_reports_the_robot_model_warnings(capsys: pytest.CaptureFixture[str]) -> None:
+    golden = ROOT / "tests" / "golden" / "errors" / "W272.mrg"
+    result = mrgc.compute_facts(golden, workers=1)
+    assert [d.code for d in result.warnings] == ["W272"] and result.facts
+    assert mrgc.check(golden).warnings == ()  # check reads no robot model

@@ -2,6 +2,10 @@
 
     python benchmarks/planning.py --seeds 10
     python benchmarks/planning.py --problems pa5 pa10 --seeds 10
+    python benchmarks/planning.py --problems some/file.mrg other.mrg --seeds 3
+
+``--problems`` takes the names of shipped problems (the stems of domains/packaging/pa*.mrg and
+domains/box-moving/bo*.mrg) or paths of .mrg files (each holding one problem, symbolic or geometric).
 
 Each run is a fresh process (cold caches) calling the planner with one seed; the table gives the success
 rate (plans the validator accepts, re-checked in the child after planning), the median and max wall time of the planner (phase 1 included, interpreter start-up excluded), the
@@ -23,17 +27,25 @@ PROBLEMS = {p.stem: p for p in sorted((ROOT / "domains" / "packaging").glob("pa*
 
 CHILD = """
 import json, sys
-from mrgc import __version__, parse_file
-from mrgc.planner.plan import file_sha256
-from mrgc.planner.search import plan_problem
-from mrgc.planner.validate import validate
+import mrgc
 path, seed, limit = sys.argv[1], int(sys.argv[2]), float(sys.argv[3])
-problem = parse_file(path).problem()
-plan = plan_problem(problem, path, file_sha256(path), __version__, seed=seed, time_limit=limit)
-valid = plan.status == "solved" and validate(problem, plan.to_json(), path).ok  # re-checked here, not trusted
+plan = mrgc.plan(path, seed=seed, time_limit=limit)
+valid = plan.status == "solved" and mrgc.validate(path, plan).ok  # re-checked here, not trusted
 print(json.dumps({"status": str(plan.status), "valid": valid, "makespan": plan.makespan, "cost": plan.motion_cost,
                   **plan.stats}))
 """
+
+
+def problem_path(item: str) -> Path:
+    """A shipped problem's file by name, or the .mrg file ``item`` names; a one-line error (exit 2) else."""
+    if item in PROBLEMS:
+        return PROBLEMS[item]
+    path = Path(item)
+    if path.suffix == ".mrg" and path.is_file():
+        return path
+    what = "no such file" if path.suffix == ".mrg" else "not a shipped problem or a .mrg file"
+    print(f"planning.py: error: --problems {item}: {what} (shipped: {', '.join(PROBLEMS)})", file=sys.stderr)
+    raise SystemExit(2)
 
 
 def main() -> None:
@@ -42,12 +54,14 @@ def main() -> None:
     ap.add_argument("--seeds", type=int, default=10)
     ap.add_argument("--time-limit", type=float, default=120.0)
     args = ap.parse_args()
+    paths = [problem_path(item) for item in args.problems]  # every one checked before the first run
     print("| problem | solved | median (s) | max (s) | makespan | moved | facts % | skeletons % | grounding % |")
     print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
-    for name in args.problems:
+    for path in paths:
+        name = path.stem
         runs = []
         for seed in range(args.seeds):
-            out = subprocess.run([sys.executable, "-c", CHILD, str(PROBLEMS[name]), str(seed), str(args.time_limit)],
+            out = subprocess.run([sys.executable, "-c", CHILD, str(path), str(seed), str(args.time_limit)],
                                  capture_output=True, text=True)
             if out.returncode != 0:
                 print(f"{name} seed {seed}: crashed: {out.stderr.strip().splitlines()[-1:]}", file=sys.stderr)

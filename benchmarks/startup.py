@@ -1,0 +1,88 @@
+"""CLI start-up: wall time of ``mrgc --help``, ``mrgc check`` and ``mrgc compile`` on a symbolic file.
+
+    python benchmarks/startup.py                      # this checkout, 15 runs per command
+    python benchmarks/startup.py --root /tmp/old-checkout --root . --runs 15   # before / after
+
+Each run is a fresh interpreter running the CLI (``from mrgc.cli import main``) with the checkout at
+``--root`` first on the import path; with several roots their runs alternate, so a busy machine slows
+them alike.  Bytecode is cached (``PYTHONPYCACHEPREFIX`` in a temporary folder, warmed by one run of each
+command first), as in an installed package: without a cache every start compiles mrgc's sources again.
+The table gives, per checkout, the median and the least wall time of each command and the number of
+modules it imports (counted in an extra run).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+CHAIN3 = "domains/symbolic/chain-3.mrg"
+COMMANDS = {
+    "mrgc --help": ["--help"],
+    "mrgc check chain-3.mrg": ["check", CHAIN3],
+    "mrgc check pa5.mrg (geometric)": ["check", "domains/packaging/pa5.mrg"],
+    "mrgc compile chain-3.mrg (cpsat)": ["compile", CHAIN3],
+    "mrgc compile chain-3.mrg --backend mip": ["compile", CHAIN3, "--backend", "mip"],
+    "mrgc compile chain-3.mrg --backend smt": ["compile", CHAIN3, "--backend", "smt"],
+}
+RUNNER = ("import sys; sys.path.insert(0, sys.argv[1]); del sys.argv[1]; "
+          "from mrgc.cli import main; code = main(sys.argv[1:]); "
+          "print(len(sys.modules), file=sys.stderr) if __import__('os').environ.get('COUNT') else None; "
+          "sys.exit(code)")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--root", type=Path, action="append", help="a checkout to measure (repeatable; default: this one)")
+    ap.add_argument("--runs", type=int, default=15)
+    args = ap.parse_args()
+    roots = [r.resolve() for r in (args.root or [ROOT])]
+    with tempfile.TemporaryDirectory() as tmp:
+        links = []
+        for k, root in enumerate(roots):  # each checkout importable as `mrgc`, with its own bytecode cache
+            link = Path(tmp) / f"path{k}" / "mrgc"
+            link.parent.mkdir()
+            link.symlink_to(root)
+            links.append(link)
+        env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+
+        def run(k: int, argv: list[str], count: bool = False) -> tuple[float, str]:
+            t0 = time.perf_counter()
+            out = subprocess.run([sys.executable, "-c", RUNNER, str(links[k].parent), *argv], cwd=roots[k],
+                                 text=True, capture_output=True,
+                                 env={**env, "PYTHONPYCACHEPREFIX": str(Path(tmp) / f"pyc{k}"),
+                                      **({"COUNT": "1"} if count else {})})
+            seconds = time.perf_counter() - t0
+            if out.returncode != 0:
+                raise SystemExit(f"mrgc {' '.join(argv)} failed ({out.returncode}): {out.stderr.strip()[-300:]}")
+            return seconds, out.stderr
+
+        for k in range(len(roots)):  # warm the bytecode caches
+            for argv in COMMANDS.values():
+                run(k, argv)
+        print(f"{args.runs} runs per command and checkout, Python {sys.version.split()[0]}; median / least wall "
+              f"time in seconds (modules imported)")
+        print()
+        print("| command | " + " | ".join(str(r) for r in roots) + " |")
+        print("| --- |" + " --- |" * len(roots))
+        for name, argv in COMMANDS.items():
+            times: list[list[float]] = [[] for _ in roots]
+            for _ in range(args.runs):
+                for k in range(len(roots)):
+                    times[k].append(run(k, argv)[0])
+            cells = []
+            for k in range(len(roots)):
+                modules = run(k, argv, count=True)[1].strip().splitlines()[-1]
+                cells.append(f"{statistics.median(times[k]):.3f} / {min(times[k]):.3f} ({modules})")
+            print(f"| `{name}` | " + " | ".join(cells) + " |", flush=True)
+
+
+if __name__ == "__main__":
+    main()

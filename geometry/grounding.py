@@ -114,9 +114,10 @@ class Grounder:
             self.homes = tuple(f"home:{s.name}" for s in self.scene.robots if not is_planar(s))
         return self.homes
 
-    def _others_home(self, robot: str) -> tuple[str, ...]:
-        """The groups of the other arms at home."""
-        return tuple(h for h in self._arm_homes() if h != f"home:{robot}")
+    def _others_home(self, robot: str, partner: str | None = None) -> tuple[str, ...]:
+        """The groups of the other arms at home (but ``partner``, which moves with ``robot``: the other arm of
+        a handover, at the exchange or in transit)."""
+        return tuple(h for h in self._arm_homes() if h not in (f"home:{robot}", f"home:{partner}"))
 
     # ------------------------------------------------------------ state
     def arm(self, robot: str) -> Arm:
@@ -242,7 +243,7 @@ class Grounder:
     # ------------------------------------------------------------ arm configurations
     def _approach(self, robot: str, obj: str, grasp: str, pose: np.ndarray, key: str,
                   avoid: Iterable[str], attempts: int = 8, approach: bool = True, held: bool = False,
-                  busy: Volume = ()) -> Answer:
+                  busy: Volume = (), partner: str | None = None) -> Answer:
         spec = self.scene.grasp_specs.get(grasp)
         arm = self.arm(robot)
         if spec is None or not fits(spec, self.scene.body(obj).shape, arm.spec.kind):
@@ -282,7 +283,7 @@ class Grounder:
             volume = self.arm_volume(robot, refine(configs), holding=(obj, grasp) if held else None,
                                      grasp=(obj, grasp))
             self.queries += 1
-            if self.world.probe_collides(volume, against=("fixed", *self._others_home(robot)),
+            if self.world.probe_collides(volume, against=("fixed", *self._others_home(robot, partner)),
                                          ignore=() if held else (obj,)):
                 status = Status.COLLISION
                 continue
@@ -316,8 +317,8 @@ class Grounder:
         # the two arms are drawn in pairs (other seeds) until a pair does not collide
         for attempt in range(HANDOVER_PAIRS):
             key = f"handover:{point}" + (f":{attempt}" if attempt else "")
-            a = self._approach(giver, obj, g1, pose, key, avoid, approach=False, busy=busy)
-            b = self._approach(taker, obj, g2, pose, key, avoid, approach=False, busy=busy)
+            a = self._approach(giver, obj, g1, pose, key, avoid, approach=False, busy=busy, partner=taker)
+            b = self._approach(taker, obj, g2, pose, key, avoid, approach=False, busy=busy, partner=giver)
             if not (a.ok and b.ok):
                 return Answer(a.status if not a.ok else b.status, blockers=a.blockers | b.blockers)
             assert a.configs is not None and b.configs is not None
@@ -331,11 +332,11 @@ class Grounder:
     # ------------------------------------------------------------ paths
     def arm_path(self, robot: str, start: np.ndarray, goal: np.ndarray, holding: tuple[str, str] | None = None,
                  avoid: Iterable[str] = (), max_checks: int = MAX_CHECKS, resolution: float = 0.05,
-                 busy: Volume = ()) -> Answer:
+                 busy: Volume = (), partner: str | None = None) -> Answer:
         """A joint-space path (RRTConnect, at most ``max_checks`` validity checks: no clock decides) free of
         fixed objects, ``avoid`` and ``busy`` (and of the held object's collisions with them)."""
         arm = self.arm(robot)
-        against = ("fixed", *self._others_home(robot), *[a for a in avoid if not holding or a != holding[0]])
+        against = ("fixed", *self._others_home(robot, partner), *[a for a in avoid if not holding or a != holding[0]])
         ignore = (holding[0],) if holding else ()
         moving = self._busy_world(busy) if busy else None
 
@@ -351,7 +352,8 @@ class Grounder:
         return Answer(Status.OK if res.solved else Status.NO_PATH, path=list(res.path))
 
     def transfer(self, robot: str, obj: str, grasp: str, start: np.ndarray, goal: np.ndarray,
-                 avoid: Iterable[str] = (), lift: bool = False, busy: Volume = ()) -> Answer:
+                 avoid: Iterable[str] = (), lift: bool = False, busy: Volume = (), partner: str | None = None
+                 ) -> Answer:
         """How ``robot`` carries ``obj`` (held with ``grasp``) from configuration ``start`` to ``goal``: when
         ``lift`` (``start`` grasps the object where it rests), first straight up by :data:`TRANSFER_LIFT`
         (tool poses every centimetre, each by IK from the one before); then the straight joint-space line
@@ -362,7 +364,7 @@ class Grounder:
         :data:`PATH_RESOLUTION` between two; ``blockers`` the avoided objects in the way."""
         held = (obj, grasp)
         others = tuple(a for a in avoid if a != obj)
-        against = ("fixed", *self._others_home(robot), *others)
+        against = ("fixed", *self._others_home(robot, partner), *others)
         back = np.asarray(start, dtype=float)[None]
         moving = self._busy_world(busy) if busy else None
 
@@ -392,19 +394,19 @@ class Grounder:
         if blocked is None:
             return Answer(Status.OK, path=[*back, *line[1:]])
         planned = self.arm_path(robot, back[-1], np.asarray(goal, dtype=float), holding=held, avoid=others,
-                                resolution=PATH_RESOLUTION, busy=busy)
+                                resolution=PATH_RESOLUTION, busy=busy, partner=partner)
         if not planned.ok:
             return Answer(Status.NO_PATH, blockers=blocked)
         return Answer(Status.OK, path=[*back, *planned.path[1:]])
 
     def transit(self, robot: str, start: np.ndarray, goal: np.ndarray, avoid: Iterable[str] = (),
-                busy: Volume = (), via: np.ndarray | None = None) -> Answer:
+                busy: Volume = (), via: np.ndarray | None = None, partner: str | None = None) -> Answer:
         """An empty-handed motion of ``robot`` (fingers fully open, as the validator replays it) from
         ``start`` to ``goal``: along ``via`` first when given (configurations, ``start`` first, joined by
         straight joint-space lines: a release backing off along its approach), then the straight line or, when
         that collides, an RRTConnect path.  Free of fixed objects, of the other arms at home, of ``avoid`` and
         of ``busy``; ``path`` as for :meth:`transfer`."""
-        against = ("fixed", *self._others_home(robot), *avoid)
+        against = ("fixed", *self._others_home(robot, partner), *avoid)
         moving = self._busy_world(busy) if busy else None
 
         def free(configs: np.ndarray) -> bool:
@@ -421,7 +423,7 @@ class Grounder:
         if free(line):
             return Answer(Status.OK, path=[*back, *line[1:]])
         planned = self.arm_path(robot, back[-1], np.asarray(goal, dtype=float), avoid=tuple(avoid),
-                                resolution=PATH_RESOLUTION, busy=busy)
+                                resolution=PATH_RESOLUTION, busy=busy, partner=partner)
         if not planned.ok:
             return Answer(Status.NO_PATH)
         return Answer(Status.OK, path=[*back, *planned.path[1:]])

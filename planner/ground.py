@@ -203,7 +203,7 @@ class ReverseGrounder:
             planned.handover_point = point
             planned.configs["handover"] = _configs(answer.configs)
             giver = g.transfer(a.pick_robot, a.obj, a.pick_grasp, pick.configs[-1], answer.configs[0], avoid,
-                               lift=True, busy=busy.get("to-handover", []))
+                               lift=True, busy=busy.get("to-handover", []), partner=a.place_robot)
             if not giver.ok:
                 return _failed(f"carry to the handover by {a.pick_robot}", giver)
             planned.paths["to-handover"] = _configs(np.array(giver.path))
@@ -223,7 +223,8 @@ class ReverseGrounder:
                 continue
             assert place.configs is not None
             carry = g.transfer(a.place_robot, a.obj, a.place_grasp, start, place.configs[0], avoid, lift=lift,
-                               busy=busy.get("to-place", []))
+                               busy=busy.get("to-place", []),
+                               partner=a.pick_robot if a.pick_robot != a.place_robot else None)
             if not carry.ok:
                 last = _failed(f"carry to the placement by {a.place_robot}", carry)
                 continue
@@ -267,8 +268,9 @@ class ReverseGrounder:
                 if phase == "home":
                     for o, pose in new.items():
                         g.move(o, pose)
+                other = ({a.pick_robot, a.place_robot} - {robot}) if phase != "to-pick" else set()
                 ans = g.transit(robot, start, goal, avoid=obstacles, busy=busy.get(phase, []) + mine.get(phase, []),
-                                via=via)
+                                via=via, partner=next(iter(other), None))
                 if not ans.ok:
                     return _failed(f"{name} of {robot}", ans)
                 planned.paths[name] = _configs(np.array(ans.path))

@@ -175,7 +175,7 @@ class ScriptedGrounder:
         return Answer(Status.OK, configs=np.array([[1.0], [0.0]]))
 
     def transfer(self, robot: str, obj: str, grasp: str, start: np.ndarray, goal: np.ndarray, avoid: Any = (),
-                 lift: bool = False, busy: Any = ()) -> Answer:
+                 lift: bool = False, busy: Any = (), partner: Any = None) -> Answer:
         return Answer(Status.OK, path=[np.asarray(start), np.asarray(goal)])
 
     def placement(self, obj: str, region: str, avoid: Any = (), volume: Any = None, key: str = "",

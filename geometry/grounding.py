@@ -429,8 +429,9 @@ class Grounder:
         return Answer(Status.OK, path=[*back, *planned.path[1:]])
 
     def _lift(self, robot: str, q: np.ndarray) -> np.ndarray | None:
-        """Configurations raising the tool straight up from its pose at ``q`` by :data:`TRANSFER_LIFT` (one per
-        centimetre, each solved from the one before; None when one fails or jumps)."""
+        """Configurations raising the tool straight up from its pose at ``q`` by up to :data:`TRANSFER_LIFT`
+        (one per centimetre, each solved from the one before, as far as none fails or jumps; None when not
+        even the first centimetre can be solved)."""
         arm = self.arm(robot)
         tool = arm.tool_world(q[None])[0]
         out = [q]
@@ -438,9 +439,9 @@ class Grounder:
             target = arm.ee_target(translation(0.0, 0.0, float(dz)) @ tool)
             ik = solve_ik_many(arm.model, target[None], 0, q_init=out[-1], restarts=0)[0]
             if not ik.solved or float(np.abs(ik.q - out[-1]).max()) > 0.2:
-                return None
+                break  # as high as the arm goes straight up (at the edge of its reach: less)
             out.append(ik.q)
-        return np.array(out)
+        return np.array(out) if len(out) > 1 else None
 
     def base_path(self, robot: str, start: np.ndarray, goal: np.ndarray, holding: tuple[str, str] | None = None,
                   avoid: Iterable[str] = (), busy: Sequence[tuple[CollisionShape, np.ndarray]] = ()) -> Answer:
@@ -534,9 +535,13 @@ def _packing_grid(room: np.ndarray, cells: int = 15) -> list[tuple[float, float,
     room = np.maximum(room, 0.0)
     axes = [np.linspace(-r, r, max(1, min(cells, int(2 * r / 0.01) + 1))) for r in room]
     scale = np.maximum(room, 1e-9)
-    points = sorted(((float(x), float(y)) for x in axes[0] for y in axes[1]),
-                    key=lambda p: (-round(abs(p[0]) / scale[0] + abs(p[1]) / scale[1], 9), p))
-    return [(k * np.pi / 2, x, y) for x, y in points for k in range(4)]
+    def level(x: float, y: float) -> float:
+        return -round(abs(x) / scale[0] + abs(y) / scale[1], 9)
+
+    # the points of one level (the four corners, ...) at one yaw before the next yaw: a place that fails
+    # at one corner (out of reach) is tried at the others before another yaw
+    cands = [(level(float(x), float(y)), k, float(x), float(y)) for x in axes[0] for y in axes[1] for k in range(4)]
+    return [(k * np.pi / 2, x, y) for _, k, x, y in sorted(cands)]
 
 
 def joint_line(configs: np.ndarray, step: float) -> np.ndarray:

@@ -30,6 +30,9 @@ from mrgc.planner.outcome import Failure
 from mrgc.planner.plan import PlannedAction
 
 PLACEMENT_TRIES = 6  # placements sampled per place before the step gives up
+#: more placements an arm may try when they are out of its reach (a bin at the edge of the arm's reach:
+#: the corners come first when packing, and many are unreachable)
+OUT_OF_REACH_TRIES = 30
 #: paths replayed in another path's phase (the validator's execution model): name -> phase
 PATH_PHASE = {"taker-to-handover": "to-handover", "giver-home": "home"}
 
@@ -209,7 +212,10 @@ class ReverseGrounder:
             planned.paths["to-handover"] = _configs(np.array(giver.path))
             start, lift = answer.configs[1], False  # the taker's transfer starts at the exchange
         last: Failure | None = None
-        for k in range(PLACEMENT_TRIES):
+        tried = 0  # placements that failed for another reason than being out of the arm's reach
+        for k in range(PLACEMENT_TRIES + OUT_OF_REACH_TRIES):
+            if tried >= PLACEMENT_TRIES:
+                break
             # goal bins are shared by several objects: packed from the corners; elsewhere (moving an obstacle
             # aside) the middle of the region first, nearest the arms that reach it
             spot = g.placement(a.obj, a.region, avoid=avoid, volume=v_fut, key=key, skip=k,
@@ -220,7 +226,9 @@ class ReverseGrounder:
             place = g.place(a.place_robot, a.obj, a.place_grasp, spot.pose, avoid=avoid, busy=busy.get("place", []))
             if not place.ok:
                 last = _failed(f"place by {a.place_robot}", place)
+                tried += place.status is not Status.NO_IK
                 continue
+            tried += 1
             assert place.configs is not None
             carry = g.transfer(a.place_robot, a.obj, a.place_grasp, start, place.configs[0], avoid, lift=lift,
                                busy=busy.get("to-place", []),

@@ -44,6 +44,10 @@ Volume = list[tuple[CollisionShape, np.ndarray]]  # shapes at world transforms
 PATH_RESOLUTION = 0.01
 #: how far a transfer raises the tool straight up before it moves off (m): the approach's back-off
 TRANSFER_LIFT = 0.08
+#: validity checks an arm's transfer or transit path may spend when its straight line collides: a failed
+#: search costs all of them, at 0.5-1.5 ms a check (an arm holding an object, 1 cm steps), and a step tries
+#: several placements; 20,000 (motion.MAX_CHECKS) let one grounding run for minutes on a loaded machine
+TRANSFER_CHECKS = 4_000
 #: pairs of exchange configurations tried for a handover before the two arms are said to collide
 HANDOVER_PAIRS = 6
 #: an approach's last segment starts at most this many equal shares of the back-off from the grasp (the
@@ -394,7 +398,7 @@ class Grounder:
         if blocked is None:
             return Answer(Status.OK, path=[*back, *line[1:]])
         planned = self.arm_path(robot, back[-1], np.asarray(goal, dtype=float), holding=held, avoid=others,
-                                resolution=PATH_RESOLUTION, busy=busy, partner=partner)
+                                resolution=PATH_RESOLUTION, busy=busy, partner=partner, max_checks=TRANSFER_CHECKS)
         if not planned.ok:
             return Answer(Status.NO_PATH, blockers=blocked)
         return Answer(Status.OK, path=[*back, *planned.path[1:]])
@@ -423,7 +427,7 @@ class Grounder:
         if free(line):
             return Answer(Status.OK, path=[*back, *line[1:]])
         planned = self.arm_path(robot, back[-1], np.asarray(goal, dtype=float), avoid=tuple(avoid),
-                                resolution=PATH_RESOLUTION, busy=busy, partner=partner)
+                                resolution=PATH_RESOLUTION, busy=busy, partner=partner, max_checks=TRANSFER_CHECKS)
         if not planned.ok:
             return Answer(Status.NO_PATH)
         return Answer(Status.OK, path=[*back, *planned.path[1:]])

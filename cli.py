@@ -538,6 +538,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     except BrokenPipeError:
         return EXIT_OK
     except Exception as exc:  # noqa: BLE001 - the promise is: never a traceback
+        if signals.received() is not None:  # the signal's exception came back as another one (ctypes wraps a
+            # KeyboardInterrupt raised while it converts a call's arguments, as in z3's model building, in an
+            # ArgumentError): the signal still ends the run
+            print(f"mrgc: {signals.describe()}; nothing written", file=sys.stderr)
+            return signals.exit_code()
         print(f"mrgc: internal error[E070]: {type(exc).__name__}: {exc} "
               "(please report this with the input that caused it)", file=sys.stderr)
         return EXIT_INTERNAL

@@ -16,7 +16,7 @@ from typing import Any, Sequence
 from mrgc.backends.base import Backend, BackendInfo
 from mrgc.compiler.ir import Feature, Row, SkeletonModel, Solution, Status, Terms
 from mrgc.errors import MissingBackendError
-from mrgc.signals import stop_on_signal
+from mrgc.signals import shielded, stop_on_signal
 
 
 def _z3() -> Any:
@@ -38,6 +38,12 @@ class Z3Backend(Backend):
     )
 
     def _load(self, model: SkeletonModel) -> None:
+        # a signal while z3's Python API builds terms would cut a ctypes call short (an ArgumentError, or a
+        # half-made term whose __del__ then fails): building is shielded, the signal raised when it is done
+        with shielded():
+            self._build(model)
+
+    def _build(self, model: SkeletonModel) -> None:
         z3 = _z3()
         self.ctx = z3.Context()
         opt = z3.Optimize(ctx=self.ctx)

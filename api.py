@@ -137,7 +137,7 @@ def compile(source: ProblemSource, *, name: str | None = None, backend: BackendS
     problem = load_problem(source, name=name, allow_outside=allow_outside)
     _checked_layout(problem, robots=facts is None and needs_facts(problem))
     fact_list, facts_seconds = problem_facts(problem, facts, seed=seed)
-    result = compile_problem(problem, backend=backend, encoding=encoding, skeletons=skeletons,  # type: ignore[arg-type]
+    result = compile_problem(problem, backend=backend, encoding=encoding, skeletons=skeletons,
                              max_makespan=max_makespan, time_limit=time_limit, facts=fact_list, seed=seed)
     result.stats["facts_seconds"] = round(facts_seconds, 6)
     return result
@@ -157,17 +157,18 @@ def export_model(source: ProblemSource, path: str | os.PathLike[str], *, name: s
     horizon limit (``max_makespan``, capped at the number of objects in the task graph).  docs/backends.md
     says what each file holds and how to load it into its solver.
     """
-    from mrgc.planner.skeletons import export_model as write_model, problem_facts
+    from mrgc.planner.skeletons import export_model as write_model, needs_facts, problem_facts
 
     problem = load_problem(source, name=name, allow_outside=allow_outside)
     if horizon is not None and horizon < 1:
         raise InputError([Diagnostic("E000", f"the horizon is at least 1, not {horizon}")])
+    _checked_layout(problem, robots=facts is None and needs_facts(problem))
     fact_list, _ = problem_facts(problem, facts, seed=seed)
     if horizon is None:
         result = compile(problem, backend=backend, encoding=encoding, max_makespan=max_makespan, facts=fact_list,
                          seed=seed)
         horizon = result.skeletons[0].makespan if result.skeletons else None  # none: the limit
-    return write_model(problem, os.fspath(path), backend=backend, encoding=encoding, horizon=horizon,  # type: ignore[arg-type]
+    return write_model(problem, os.fspath(path), backend=backend, encoding=encoding, horizon=horizon,
                        facts=fact_list, max_makespan=max_makespan)
 
 

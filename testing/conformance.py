@@ -353,7 +353,8 @@ def check_incremental_cuts(backend: BackendClass) -> None:
     model.objectives.append(tuple((x, 1) for x in xs))
     solver = backend()
     solver.load(model)
-    found, costs = [], []
+    found: list[tuple[int, ...]] = []
+    costs: list[int] = []
     for _ in range(10):
         sol = solver.solve()
         if sol.status == Status.INFEASIBLE:

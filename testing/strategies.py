@@ -62,8 +62,8 @@ def symbolic_problems(*, robots: tuple[int, int] = (2, 3), objects: tuple[int, i
         raise ValueError(f"feasible is a share from 0 to 1, not {feasible}")
     if len(regions) < max(2, min_regions):
         raise ValueError("symbolic_problems needs at least two regions")
-    return _cases(tuple(robots), tuple(objects), tuple(regions), min_regions, tuple(goals), tuple(grasps),
-                  feasible, handover, domain)
+    return _cases((robots[0], robots[1]), (objects[0], objects[1]), tuple(regions), min_regions,
+                  (goals[0], goals[1]), tuple(grasps), feasible, handover, domain)
 
 
 @st.composite

@@ -50,6 +50,16 @@ def test_ap1_solves_a_packaging_problem_and_mrgc_validate_accepts_its_plan(tmp_p
     assert cli.main(["validate", str(PLACE_OBSTACLE), str(out)]) == 0
 
 
+def test_ap1_plans_full_motions_like_the_planner(tmp_path: Path) -> None:
+    out = tmp_path / "plan.json"
+    assert cli.main(["plan", str(PLACE_OBSTACLE), "--planner", "ap1", "--motions", "full", "--time-limit", "60",
+                     "-o", str(out)]) == 0
+    doc = json.loads(out.read_text(encoding="utf-8"))
+    assert doc["motion_model"]["arms"] == "full" and all(
+        {"to-pick", "to-place", "home"} <= set(a["paths"]) for step in doc["steps"] for a in step["actions"])
+    assert cli.main(["validate", str(PLACE_OBSTACLE), str(out)]) == 0
+
+
 def test_a_time_limit_is_a_status_with_its_reason(capsys: Any) -> None:
     assert cli.main(["plan", str(PLACE_OBSTACLE), "--planner", "ap1", "--time-limit", "0.001"]) == 3
     doc = json.loads(capsys.readouterr().out.split("\nplan for")[0])

@@ -44,7 +44,8 @@ from mrgc.compiler.task_graph import _actions_for as facts_actions
 from mrgc.language.model import Problem
 from mrgc.planner.ground import GroundedStep, label, moved_objects
 from mrgc.planner.outcome import Failure, PlanStatus, Why
-from mrgc.planner.plan import Plan, PlannedAction
+from mrgc.planner.plan import Plan, PlannedAction, planner_motion_model
+from mrgc.planner.search import MOTIONS
 from mrgc.planner.skeletons import must_move, problem_facts
 
 #: joint-action groundings the first depth-first run may make; every restart doubles it
@@ -74,13 +75,13 @@ class Attempt:
 class GeometricSteps:
     """Joint actions grounded on the scene by the planner's reverse grounding (planner/ground.py)."""
 
-    def __init__(self, problem: Problem, seed: int) -> None:
+    def __init__(self, problem: Problem, seed: int, full: bool = False) -> None:
         from mrgc.geometry.grounding import Grounder
         from mrgc.geometry.scene import scene_from_problem
         from mrgc.planner.ground import ReverseGrounder
 
         self.grounder = Grounder(scene_from_problem(problem), seed=seed)
-        self.reverse = ReverseGrounder(self.grounder, problem.goal_regions)
+        self.reverse = ReverseGrounder(self.grounder, problem.goal_regions, full=full)
 
     def ground(self, actions: tuple[Action, ...], fut: set[str], free: set[str], strict: bool, v_fut: list[Any],
                key: str, index: int) -> Attempt | Failure:
@@ -266,9 +267,12 @@ class Ap1Search:
 
 
 def plan_ap1(problem: Problem, problem_file: str, sha256: str, version: str, seed: int = 0,
-             time_limit: float = 60.0, log: Log | None = None) -> Plan:
+             time_limit: float = 60.0, log: Log | None = None, motions: str = "configurations") -> Plan:
     """Plan ``problem`` with Ap1 (see the module docstring); the same Plan, statuses and validation as
-    :func:`mrgc.planner.search.plan_problem`."""
+    :func:`mrgc.planner.search.plan_problem`, and the same ``motions`` (``full``: arms' empty-handed
+    motions planned too)."""
+    if motions not in MOTIONS:
+        raise ValueError(f"motions is one of {', '.join(MOTIONS)}, not {motions!r}")
     t0 = time.perf_counter()
     say: Log = log or (lambda line: None)
     facts, facts_seconds = problem_facts(problem, seed=seed)
@@ -276,6 +280,7 @@ def plan_ap1(problem: Problem, problem_file: str, sha256: str, version: str, see
     robots = [r.name for r in problem.robots]
     plan = Plan(problem.name, problem_file, sha256, version, "none", "none", seed, PlanStatus.EXHAUSTED,
                 symbolic=problem.symbolic)
+    plan.motion_model = None if problem.symbolic else planner_motion_model(motions)
     why = plan.why = Why()
     stats: dict[str, Any] = {"planner": "ap1", "robots": robots, "facts": len(facts),
                              "facts_seconds": round(facts_seconds, 4)}
@@ -289,7 +294,7 @@ def plan_ap1(problem: Problem, problem_file: str, sha256: str, version: str, see
         def accept(steps: list[GroundedStep]) -> bool:
             return _referee(problem, plan, steps, why, verdicts)
 
-        steps = SymbolicSteps(base) if problem.symbolic else GeometricSteps(problem, seed)
+        steps = SymbolicSteps(base) if problem.symbolic else GeometricSteps(problem, seed, full=motions == "full")
         search = Ap1Search(steps, base, accept, t0 + time_limit, why, one_handover=base.handover_capacity == 1)
         try:
             found, ended = search.run(goals, seed, lambda line: say(f"[t={time.perf_counter() - t0:.1f}s] {line}"))
@@ -329,10 +334,12 @@ def _referee(problem: Problem, plan: Plan, steps: list[GroundedStep], why: Why, 
     t0 = time.perf_counter()
     candidate = Plan(plan.problem, plan.problem_file, plan.problem_sha256, plan.mrgc_version, plan.backend,
                      plan.encoding, plan.seed, PlanStatus.SOLVED, [s.actions for s in steps],
-                     symbolic=problem.symbolic, stats={"robots": [r.name for r in problem.robots]})
+                     symbolic=problem.symbolic, stats={"robots": [r.name for r in problem.robots]},
+                     motion_model=plan.motion_model)
     # the referee judges the plan against the problem it was made for (no file need exist: a problem parsed
-    # from a string is planned too); ``mrgc validate`` checks the file's digest besides
-    report = validate(problem, candidate.to_json(), None)
+    # from a string is planned too); ``mrgc validate`` checks the file's digest besides.  The first violation
+    # is the verdict, so the replay stops there.
+    report = validate(problem, candidate.to_json(), None, first_only=True)
     verdicts["seconds"] += time.perf_counter() - t0
     verdicts["checked"] += 1
     if report.ok:

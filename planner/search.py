@@ -171,7 +171,8 @@ def _referee(problem: Problem, problem_file: str, plan: Plan, result: Grounding,
 
     candidate = Plan(plan.problem, plan.problem_file, plan.problem_sha256, plan.mrgc_version, plan.backend,
                      plan.encoding, plan.seed, PlanStatus.SOLVED, [s.actions for s in result.steps],
-                     symbolic=False, stats={"robots": [r.name for r in problem.robots]})
+                     symbolic=False, stats={"robots": [r.name for r in problem.robots]},
+                     motion_model=plan.motion_model)  # judged under the model the plan will state
     t0 = time.perf_counter()
     report = validate(problem, candidate.to_json(), problem_file, first_only=True)  # the verdict, fast
     seconds = time.perf_counter() - t0

@@ -49,7 +49,7 @@ _LAZY: dict[str, str] = {
     "Plan": "mrgc.planner.plan:Plan",
     "PlanStatus": "mrgc.planner.outcome:PlanStatus",
     "ValidationReport": "mrgc.planner.validate:ValidationReport",
-    "FactsResult": "mrgc.geometry.predicates:FactsResult",
+    "FactsResult": "mrgc.geometry.facts:FactsResult",
     "Backend": "mrgc.backends.base:Backend",
     "BackendInfo": "mrgc.backends.base:BackendInfo",
     "SkeletonModel": "mrgc.compiler.ir:SkeletonModel",
@@ -67,7 +67,7 @@ if TYPE_CHECKING:
     from mrgc.compiler.ir import Feature, Row, SkeletonModel, Solution
     from mrgc.compiler.ir import Status as SolveStatus
     from mrgc.compiler.skeleton import Skeleton
-    from mrgc.geometry.predicates import FactsResult
+    from mrgc.geometry.facts import FactsResult
     from mrgc.language.loader import MrgFile, parse_file, parse_string
     from mrgc.language.model import Domain, Fact, Problem
     from mrgc.language.printer import format_source

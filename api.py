@@ -22,7 +22,7 @@ from mrgc.errors import Diagnostic, InputError
 if TYPE_CHECKING:
     from mrgc.backends.base import Backend
     from mrgc.backends.registry import BackendRecord
-    from mrgc.geometry.predicates import FactsResult
+    from mrgc.geometry.facts import FactsResult
     from mrgc.language.loader import MrgFile
     from mrgc.language.model import Fact, Problem
     from mrgc.planner.plan import Plan

@@ -186,14 +186,14 @@ def cmd_compile(args: argparse.Namespace) -> int:
     import json
 
     from mrgc import api, outputs, signals
-    from mrgc.backends.registry import backend_class
+    from mrgc.backends.registry import check_export
     from mrgc.planner.skeletons import needs_facts
 
     mf = _load(args)
     problem = mf.problem(args.problem)
     if args.emit:  # before any solving: a path the solver cannot write, or a format it does not write
         check_output(args.emit, inputs_of(mf), option="--emit")
-        backend_class(args.backend).check_export(args.emit)
+        check_export(args.backend, args.emit)
     facts = None
     if needs_facts(problem):  # phase 1 once, for the skeletons and the export
         with signals.activity(f"computing the facts of {problem.name} (phase 1)"):

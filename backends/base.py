@@ -86,31 +86,24 @@ class Backend(ABC):
         return Solution(sol.status, (), (), seconds, sol.message)
 
     def export(self, path: str) -> None:
-        """Write the loaded model to ``path`` in the format its extension names (one of ``info.exports``).
+        """Write the loaded model to ``path`` in the format its extension names (one of ``info.exports``;
+        :func:`mrgc.backends.registry.check_export` refuses any other as bad input, E300, and a call with
+        one is a ValueError).
 
         The path is checked before the solver library sees it (some crash on a missing folder), and the
         file must exist and be non-empty afterwards (some report failure only by a return value).
         """
         if self.model is None:
             raise RuntimeError("export before load")
-        self.check_export(path)
+        ext = os.path.splitext(path)[1].lstrip(".").lower()
+        if ext not in self.info.exports:
+            raise ValueError(f"backend '{self.name}' does not write .{ext} files (check_export first)")
         folder = os.path.dirname(os.path.abspath(path))
         if not os.path.isdir(folder):
             raise InputError([Diagnostic("E006", f"cannot write {path}: folder {folder} does not exist")])
         self._export(path)
         if not os.path.isfile(path) or os.path.getsize(path) == 0:
             raise MrgcError(f"backend '{self.name}' wrote nothing to {path}")
-
-    @classmethod
-    def check_export(cls, path: str) -> None:
-        """InputError E300 when this backend cannot write files of ``path``'s extension."""
-        ext = os.path.splitext(path)[1].lstrip(".").lower()
-        if ext not in cls.info.exports:
-            from mrgc.backends.registry import feature_table
-
-            raise InputError([Diagnostic("E300", f"backend '{cls.info.name}' cannot write .{ext} files "
-                                         f"(it writes: {', '.join('.' + e for e in cls.info.exports) or 'none'})",
-                                         notes=tuple(feature_table().splitlines()))])
 
     @abstractmethod
     def _load(self, model: SkeletonModel) -> None: ...

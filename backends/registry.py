@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import importlib
 import importlib.util
+import os
 from dataclasses import dataclass
 from typing import Any
 
@@ -122,3 +123,14 @@ def feature_table() -> str:
                       " ".join("." + e for e in info.exports) or "-"])
     widths = [max(len(r[i]) for r in lines) for i in range(len(header))]
     return "\n".join("  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in lines)
+
+
+def check_export(backend: str | type[Backend], path: str) -> None:
+    """InputError E300 (with the backend × feature table as notes) when ``backend`` (a registered name or a
+    class) cannot write files of ``path``'s extension."""
+    info = (backend if isinstance(backend, type) else backend_class(backend)).info
+    ext = os.path.splitext(path)[1].lstrip(".").lower()
+    if ext not in info.exports:
+        raise InputError([Diagnostic("E300", f"backend '{info.name}' cannot write .{ext} files "
+                                     f"(it writes: {', '.join('.' + e for e in info.exports) or 'none'})",
+                                     notes=tuple(feature_table().splitlines()))])

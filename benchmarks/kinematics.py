@@ -25,7 +25,8 @@ import numpy as np
 from mrgc.geometry import fk as F
 from mrgc.geometry import ik as I
 from mrgc.geometry import transforms as tf
-from mrgc.geometry.kinematics import load_robot_model, pybullet_fk, pybullet_ik
+from mrgc.geometry.kinematics import load_robot_model
+from mrgc.testing.pybullet_reference import pybullet_fk, pybullet_ik
 
 
 def per_call(fn, repeat: int) -> float:

@@ -56,7 +56,7 @@ def config_check(n: int = 2000) -> float:
 
     from mrgc import parse_file
     from mrgc.geometry.arm import Arm
-    from mrgc.geometry.predicates import scene_world
+    from mrgc.geometry.collision import scene_world
     from mrgc.geometry.scene import scene_from_problem
 
     scene = scene_from_problem(parse_file(ROOT / "domains" / "packaging" / "pa10.mrg").problem())

@@ -1,36 +1,29 @@
-"""pybullet, the one module that imports it: clients, URDF loading, kinematics references, plan replay.
+"""The pybullet client: the one module that imports pybullet, and nothing of mrgc's kinematics.
 
 Everything here is lazy: ``import pybullet`` (and its build banner, silenced with :func:`quiet_output`)
 happens on first use.  Two kinds of client:
 
-- one shared DIRECT client per process (created again after a fork) for URDF validity checks and the
-  reference functions the tests and benchmarks compare the numpy kinematics and coal against:
-  :func:`pybullet_fk`, :func:`pybullet_ik`, :func:`pybullet_box_distance`;
-- one private DIRECT client per :class:`ReplayScene`, the validator's world: every robot loaded from its
-  URDF at its base pose, every fixed and movable object as a pybullet collision body, and signed distances
-  from pybullet's own collision engine (``getClosestPoints``), so that a bug in the planner's engine (coal)
-  cannot hide in the validator too.
+- one shared DIRECT client per process (:func:`shared_client`, created again after a fork) for URDF
+  validity checks (:func:`check_urdf`) and the kinematics references of :mod:`mrgc.testing.pybullet_reference`
+  (URDFs loaded once each: :func:`shared_body`);
+- private DIRECT clients (:func:`private_client`), one per world of its own: the validator's
+  :class:`~mrgc.geometry.replay_world.ReplayScene`.
 
-Frames: a link's frame is its URDF link frame (pybullet's ``worldLinkFrame``, not its centre of mass).
+Frames: a link's frame is its URDF link frame (pybullet's ``worldLinkFrame``, not its centre of mass);
+:func:`pose_of` turns pybullet's (position, quaternion) into a 4×4 transform.
 """
 
 from __future__ import annotations
 
 import contextlib
-import math
 import os
 import sys
-from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Callable, Iterator, Mapping, Sequence
+from typing import Any, Iterator, Sequence
 
 import numpy as np
+from numpy.typing import NDArray
 
 from mrgc.geometry import transforms as tf
-from mrgc.language.model import Box, Cylinder, Mesh, Shape, Sphere
-
-if TYPE_CHECKING:
-    from mrgc.geometry.kinematics import Link, RobotModel
-    from mrgc.geometry.scene import SceneSpec
 
 # -------------------------------------------------------------------------------- clients
 
@@ -79,9 +72,9 @@ def _c_fflush() -> None:
         pass
 
 
-def _pb() -> tuple[Any, int]:
+def shared_client() -> tuple[Any, int]:
     """The pybullet module and this process's shared DIRECT client (created on first use, again after fork):
-    the client of the kinematics references and of URDF checks (a :class:`ReplayScene` makes its own)."""
+    the client of URDF checks and of the kinematics references (a replay world makes its own)."""
     if _CLIENT.get("pid") != os.getpid():
         with quiet_output():
             import pybullet
@@ -99,9 +92,17 @@ def data_path() -> str:
     return str(pybullet_data.getDataPath())
 
 
-def _body(urdf: str) -> int:
+def private_client() -> tuple[Any, int]:
+    """The pybullet module and a new DIRECT client of the caller's own (disconnect it when done)."""
+    with quiet_output():
+        import pybullet
+
+        return pybullet, int(pybullet.connect(pybullet.DIRECT))
+
+
+def shared_body(urdf: str) -> int:
     """The body id of the resolved URDF in the shared client, loaded once (fixed base, identity base pose)."""
-    pb, cid = _pb()
+    pb, cid = shared_client()
     bodies: dict[str, int] = _CLIENT["bodies"]
     if urdf not in bodies:
         with quiet_output():
@@ -111,423 +112,16 @@ def _body(urdf: str) -> int:
 
 def check_urdf(path: str) -> str | None:
     """Why pybullet refuses to load the URDF at ``path`` (None: it loads)."""
-    pb, _ = _pb()
+    pb, _ = shared_client()
     try:
-        _body(path)
+        shared_body(path)
     except pb.error as exc:
         return str(exc) or "loadURDF failed"
     return None
 
 
-# ------------------------------------------------------------------------------ kinematics references
-
-def _pose(pos: Sequence[float], orn: Sequence[float]) -> np.ndarray:
+def pose_of(pos: Sequence[float], orn: Sequence[float]) -> NDArray[np.float64]:
+    """The 4×4 transform of a pybullet position and quaternion (x, y, z, w), the quaternion normalised
+    (pybullet's are single precision)."""
     quat = np.asarray(orn, dtype=float)
-    return tf.from_quaternion(pos, quat / np.linalg.norm(quat))  # pybullet's are single precision
-
-
-def _pb_links(model: RobotModel) -> tuple[int, dict[str, int], list[tuple[int, Link]]]:
-    """The model's body, link name → pybullet link index (base -1), and its movable joints in pybullet
-    order with our link (pybullet's IK takes and returns one value per movable joint, in that order)."""
-    pb, cid = _pb()
-    body = _body(model.urdf)
-    key = ("links", model.key)
-    if key not in _CLIENT:
-        by_name = {pb.getBodyInfo(body, physicsClientId=cid)[0].decode(): -1}
-        movable = []
-        for j in range(pb.getNumJoints(body, physicsClientId=cid)):
-            info = pb.getJointInfo(body, j, physicsClientId=cid)
-            by_name[info[12].decode()] = j
-            if info[2] != pb.JOINT_FIXED:
-                movable.append((j, model.links[model.link_index(info[12].decode())]))
-        _CLIENT[key] = (by_name, movable)
-    by_name, movable = _CLIENT[key]
-    return body, by_name, movable
-
-
-def _set_state(model: RobotModel, q: np.ndarray, base: np.ndarray | None,
-               fingers: float | None = None) -> tuple[Any, int, int]:
-    pb, cid = _pb()
-    body, _, movable = _pb_links(model)
-    base_t = np.eye(4) if base is None else np.asarray(base, dtype=float)
-    # resetBasePositionAndOrientation places the base's centre of mass, not its URDF frame
-    com = base_t @ _pose(*pb.getDynamicsInfo(body, -1, physicsClientId=cid)[3:5])
-    pos, orn = tf.to_quaternion(com)
-    pb.resetBasePositionAndOrientation(body, pos, orn, physicsClientId=cid)
-    for j, link in movable:
-        v = q[link.chain_index] if link.chain_index >= 0 else link.frozen_value
-        if link.finger and fingers is not None:
-            v = min(max(fingers, link.lower), link.upper)
-        pb.resetJointState(body, j, float(v), physicsClientId=cid)
-    return pb, cid, body
-
-
-def pybullet_fk(model: RobotModel, q: Sequence[float], base: np.ndarray | None = None,
-                fingers: float | None = None) -> dict[str, np.ndarray]:
-    """pybullet's forward kinematics (reference): link name → 4×4 URDF link frame in the world, with the
-    base link's frame at ``base`` (identity when None); off-chain joints at their frozen values, the finger
-    joints at ``fingers`` when given (clamped into their limits).
-
-    pybullet reports link frames in single precision (errors up to about 1e-7 m).
-    """
-    pb, cid, body = _set_state(model, np.asarray(q, dtype=float), base, fingers)
-    _, by_name, _ = _pb_links(model)
-    out = {}
-    bpos, born = pb.getBasePositionAndOrientation(body, physicsClientId=cid)
-    inertial = _pose(*pb.getDynamicsInfo(body, -1, physicsClientId=cid)[3:5])
-    names = [n for n in model.link_names if by_name[n] >= 0]
-    states = pb.getLinkStates(body, [by_name[n] for n in names], computeForwardKinematics=True, physicsClientId=cid)
-    out[model.links[0].name] = _pose(bpos, born) @ tf.inverse(inertial)
-    for name, st in zip(names, states):
-        out[name] = _pose(st[4], st[5])  # worldLinkFramePosition/Orientation, not the centre of mass
-    return out
-
-
-def pybullet_box_distance(model: RobotModel, q: Sequence[float], base: np.ndarray | None, size: Sequence[float],
-                          pose: np.ndarray, skip_links: Sequence[str] = ()) -> float:
-    """Reference signed distance (negative: penetration) between the robot's links at ``q`` and a box of full
-    side lengths ``size`` at ``pose``, from pybullet's own collision engine (``getClosestPoints``), the
-    second engine the tests compare coal against.  Links named in ``skip_links`` are left out."""
-    pb, cid, body = _set_state(model, np.asarray(q, dtype=float), base)
-    _, by_name, _ = _pb_links(model)
-    shape = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=[float(v) / 2 for v in size], physicsClientId=cid)
-    pos, orn = tf.to_quaternion(np.asarray(pose, dtype=float))
-    box = pb.createMultiBody(baseMass=0, baseCollisionShapeIndex=shape, basePosition=pos, baseOrientation=orn,
-                             physicsClientId=cid)
-    # the box body stays (pybullet refuses to remove it in DIRECT mode); only the robot's distance to it is read
-    best = float("inf")
-    for name, index in by_name.items():
-        if name in skip_links:
-            continue
-        for pt in pb.getClosestPoints(body, box, 1.0, linkIndexA=index, physicsClientId=cid):
-            best = min(best, float(pt[8]))
-    return best
-
-
-def pybullet_ik(model: RobotModel, target: np.ndarray, seed: int, q_init: Sequence[float] | None = None,
-                restarts: int = 8, tol_pos: float = 1e-4, tol_rot: float = 1e-3, max_iters: int = 200,
-                null_space: bool = False) -> Any:
-    """pybullet's ``calculateInverseKinematics`` with random restarts drawn like
-    :func:`mrgc.geometry.ik.solve_ik`'s, for comparison; ``target`` in the base frame.  A restart counts
-    when its result meets the tolerances within the joint limits.  Returns an
-    :class:`mrgc.geometry.ik.IKResult`.
-
-    ``null_space`` selects pybullet's variant that takes joint limits and rest poses; on the Panda it
-    rarely gets within 1e-4 m (0 of 100 reachable poses here), so the plain damped least squares is the
-    default.
-    """
-    from mrgc.geometry.fk import ee_pose
-    from mrgc.geometry.ik import IKResult, IKStatus, pose_error, restart_configurations
-
-    target = np.asarray(target, dtype=float)
-    pb, cid = _pb()
-    body, by_name, movable = _pb_links(model)
-    ll = [lk.frozen_value if lk.chain_index < 0 else model.lower[lk.chain_index] for _, lk in movable]
-    ul = [lk.frozen_value if lk.chain_index < 0 else model.upper[lk.chain_index] for _, lk in movable]
-    jr = [max(u - lo, 1e-6) for lo, u in zip(ll, ul)]
-    pos, orn = tf.to_quaternion(target)
-    best = (math.inf, math.inf)
-    starts = restart_configurations(model, seed, restarts, q_init)
-    for r, q0 in enumerate(starts):
-        _set_state(model, q0, None)
-        kw: dict[str, Any] = {}
-        if null_space:
-            rest = [float(q0[lk.chain_index]) if lk.chain_index >= 0 else lk.frozen_value for _, lk in movable]
-            kw = dict(lowerLimits=ll, upperLimits=ul, jointRanges=jr, restPoses=rest)
-        sol = pb.calculateInverseKinematics(body, by_name[model.end_effector], pos, orn, maxNumIterations=max_iters,
-                                            residualThreshold=1e-8, physicsClientId=cid, **kw)
-        q = np.zeros(model.dof)
-        for (_, lk), v in zip(movable, sol):
-            if lk.chain_index >= 0:
-                q[lk.chain_index] = v
-        pe, re = (float(e) for e in pose_error(ee_pose(model, q), target))
-        best = min(best, (pe, re), key=sum)
-        if pe <= tol_pos and re <= tol_rot and bool(model.within_limits(q)):
-            return IKResult(IKStatus.SOLVED, q, pe, re, r + 1)
-    return IKResult(IKStatus.NO_CONVERGENCE, None, best[0], best[1], len(starts))
-
-
-# ------------------------------------------------------------------------------------ plan replay
-
-#: where bodies wait while they are out of the scene (a parked body is never queried)
-PARKED = (0.0, 0.0, -1.0e3)
-#: the collision margin pybullet puts around every convex mesh shape (URDF meshes and ``GEOM_MESH``), which
-#: its distances include: measured 1.000 mm per mesh (a mesh cube 30 mm from a box: 29 mm; two: 28 mm;
-#: Panda link hulls vs coal's hulls of the same vertices: 1.99-2.00 mm link-link, up to 1.00 mm link-box).
-#: Primitive shapes have none.  :meth:`ReplayScene.closest` adds it back.
-MESH_MARGIN = 1e-3
-
-
-@dataclass(frozen=True)
-class Closest:
-    """The deepest pair of points between two bodies: ``distance`` (signed, negative when they overlap)
-    and the links involved (link names for robots, None for rigid objects)."""
-
-    distance: float
-    link_a: str | None
-    link_b: str | None
-
-
-@dataclass(frozen=True)
-class ReplayRobot:
-    """A robot of a :class:`ReplayScene`.
-
-    Arms: ``joints`` are the pybullet joint indices of the configuration vector's joints (the chain from
-    the base link to the end-effector link, in order), ``lower``/``upper`` their limits as pybullet reads
-    them from the URDF (an unlimited joint: -inf/+inf), ``ee`` the end-effector link index.  Planar robots
-    (``planar``) are one rigid body, their footprint, at the base pose lifted by ``lift``; their
-    configuration is ``(x, y, yaw)``, yaw in radians, limits infinite.  ``fingers``: an arm's finger joints
-    (pybullet index, lower, upper, frozen value) and ``finger_value`` the model's opening -> joint value.
-    """
-
-    name: str
-    body: int
-    planar: bool
-    joints: tuple[int, ...]
-    lower: np.ndarray
-    upper: np.ndarray
-    ee: int
-    links: dict[int, str]
-    base: np.ndarray
-    lift: np.ndarray
-    joint_names: tuple[str, ...] = ("x", "y", "yaw")
-    fingers: tuple[tuple[int, float, float, float], ...] = ()
-    finger_value: Callable[[float], float] | None = None
-
-    @property
-    def dof(self) -> int:
-        return len(self.joints) if not self.planar else 3
-
-
-class ReplayScene:
-    """A private pybullet world for replaying a plan (the validator's; no planner code runs in it).
-
-    Built from a :class:`~mrgc.geometry.scene.SceneSpec`: each fixed-base robot is its URDF loaded with a
-    fixed base at its base pose, its off-chain joints (a Panda's fingers) frozen as the kinematic model
-    says (gripper open); each planar robot is a rigid body of its footprint shape; fixed and movable
-    objects are static collision bodies (boxes as the convex hull of their 8 corners, because ``GEOM_BOX``'s
-    margin rounds edges and corners by up to about 1 mm; ``GEOM_CYLINDER``, ``GEOM_SPHERE``; meshes are
-    ``GEOM_MESH``, which pybullet reduces to the convex hull of the file's vertices).  Robot meshes are the
-    URDF's collision meshes as pybullet loads them (convex hulls too).  Distances are corrected for
-    pybullet's margin around mesh shapes (:data:`MESH_MARGIN`; a link with any mesh shape counts as a mesh).
-
-    **The base-link rule.**  A fixed-base arm is bolted to the surface it stands on, so contacts between an
-    arm's *base link* and any *fixed* object are ignored (its base standing on the table is not a
-    collision; a base inside a wall would be a fault of the problem file, not of a plan).  The base link
-    still counts against movable objects and other robots.
-
-    Use as a context manager, or call :meth:`close`.
-    """
-
-    def __init__(self, scene: "SceneSpec", models: Mapping[str, "RobotModel"] | None = None) -> None:
-        with quiet_output():
-            import pybullet
-
-            self.pb: Any = pybullet
-            self.cid: int = pybullet.connect(pybullet.DIRECT)
-        self.bodies: dict[str, int] = {}
-        self.fixed: set[str] = set()
-        self.robots: dict[str, ReplayRobot] = {}
-        self._owner: dict[int, str] = {}
-        self._margin: dict[tuple[int, int], float] = {}  # (body, link) -> MESH_MARGIN for mesh shapes
-        self._shaped: dict[int, tuple[int, ...]] = {}  # body -> its links with collision shapes
-        #: getClosestPoints calls made so far
-        self.queries = 0
-        try:
-            for b in scene.fixed:
-                self.add_object(b.name, b.shape, b.pose, fixed=True)
-            for b in scene.movable:
-                self.add_object(b.name, b.shape, b.pose)
-            for r in scene.robots:
-                if r.kind.base == "planar":
-                    self._add_planar(r.name, r.kind.footprint, r.base)
-                else:
-                    model = (models or {}).get(r.name)
-                    if model is None:
-                        from mrgc.geometry.kinematics import model_for_kind
-
-                        model = model_for_kind(r.kind, r.base_dir)  # InputError E400/E401 for a bad URDF
-                    self._add_arm(r.name, model, r.base)
-        except BaseException:
-            self.close()
-            raise
-
-    # ------------------------------------------------------------------ building
-    def _shape(self, shape: Shape) -> int:
-        pb, cid = self.pb, self.cid
-        if isinstance(shape, Box):  # an 8-vertex hull: exact once MESH_MARGIN is added back (GEOM_BOX rounds)
-            h = (shape.sx / 2, shape.sy / 2, shape.sz / 2)
-            corners = [[x * h[0], y * h[1], z * h[2]] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]
-            return int(pb.createCollisionShape(pb.GEOM_MESH, vertices=corners, physicsClientId=cid))
-        if isinstance(shape, Cylinder):
-            return int(pb.createCollisionShape(pb.GEOM_CYLINDER, radius=shape.radius, height=shape.height,
-                                               physicsClientId=cid))
-        if isinstance(shape, Sphere):
-            return int(pb.createCollisionShape(pb.GEOM_SPHERE, radius=shape.radius, physicsClientId=cid))
-        if isinstance(shape, Mesh):
-            with quiet_output():
-                return int(pb.createCollisionShape(pb.GEOM_MESH, fileName=shape.path, meshScale=[shape.scale] * 3,
-                                                   physicsClientId=cid))
-        raise TypeError(f"no pybullet shape for {shape!r}")
-
-    def add_object(self, name: str, shape: Shape, pose: np.ndarray | None, fixed: bool = False) -> None:
-        """A rigid static body called ``name`` at ``pose`` (parked when None); ``fixed`` objects are what
-        robots' base links may touch."""
-        body = int(self.pb.createMultiBody(baseMass=0, baseCollisionShapeIndex=self._shape(shape),
-                                           physicsClientId=self.cid))
-        self.bodies[name] = body
-        self._owner[body] = name
-        if isinstance(shape, (Mesh, Box)):
-            self._margin[(body, -1)] = MESH_MARGIN
-        if fixed:
-            self.fixed.add(name)
-        self.set_pose(name, pose)
-
-    def _add_arm(self, name: str, model: "RobotModel", base: np.ndarray) -> None:
-        pb, cid = self.pb, self.cid
-        pos, orn = tf.to_quaternion(np.asarray(base, dtype=float))
-        with quiet_output():
-            body = int(pb.loadURDF(model.urdf, basePosition=pos, baseOrientation=orn, useFixedBase=True,
-                                   physicsClientId=cid))
-        by_link: dict[str, int] = {pb.getBodyInfo(body, physicsClientId=cid)[0].decode(): -1}
-        info = {}
-        for j in range(pb.getNumJoints(body, physicsClientId=cid)):
-            ji = pb.getJointInfo(body, j, physicsClientId=cid)
-            by_link[ji[12].decode()] = j
-            info[ji[1].decode()] = ji
-        for link in by_link.values():
-            if any(d[2] == pb.GEOM_MESH for d in pb.getCollisionShapeData(body, link, physicsClientId=cid)):
-                self._margin[(body, link)] = MESH_MARGIN
-        joints, lower, upper = [], [], []
-        for joint in model.joints:
-            ji = info[joint.name]
-            joints.append(int(ji[0]))
-            lo, hi = float(ji[8]), float(ji[9])
-            lower.append(lo if lo <= hi else -math.inf)  # pybullet reports an unlimited joint as lower > upper
-            upper.append(hi if lo <= hi else math.inf)
-        fingers = []
-        for link in model.links:  # off-chain movable joints stay at their frozen values (fingers open)
-            j = by_link.get(link.name, -1)
-            if link.chain_index < 0 and link.joint_kind in ("revolute", "prismatic") and j >= 0:
-                pb.resetJointState(body, j, float(link.frozen_value), physicsClientId=cid)
-                if link.finger:
-                    fingers.append((j, link.lower, link.upper, float(link.frozen_value)))
-        self.robots[name] = ReplayRobot(
-            name=name, body=body, planar=False, joints=tuple(joints), lower=np.array(lower), upper=np.array(upper),
-            ee=by_link[model.end_effector], links={i: n for n, i in by_link.items()},
-            base=np.asarray(base, dtype=float), lift=np.eye(4), joint_names=tuple(jt.name for jt in model.joints),
-            fingers=tuple(fingers), finger_value=model.finger_value)
-        self._owner[body] = name
-
-    def _add_planar(self, name: str, footprint: Shape | None, base: np.ndarray) -> None:
-        from mrgc.geometry.planar import LIFT
-        from mrgc.geometry.scene import half_extents
-
-        if footprint is None:
-            raise ValueError(f"planar robot {name!r} has no footprint")
-        body = int(self.pb.createMultiBody(baseMass=0, baseCollisionShapeIndex=self._shape(footprint),
-                                           physicsClientId=self.cid))
-        if isinstance(footprint, (Mesh, Box)):
-            self._margin[(body, -1)] = MESH_MARGIN
-        lift = tf.translation(0.0, 0.0, float(half_extents(footprint)[2]) + LIFT)
-        self.robots[name] = ReplayRobot(
-            name=name, body=body, planar=True, joints=(), lower=np.full(3, -math.inf), upper=np.full(3, math.inf),
-            ee=-1, links={-1: "footprint"}, base=np.asarray(base, dtype=float), lift=lift)
-        self.bodies[name] = body
-        self._owner[body] = name
-        yaw = math.atan2(base[1, 0], base[0, 0])
-        self.set_config(name, [float(base[0, 3]), float(base[1, 3]), yaw])
-
-    # ------------------------------------------------------------------ state
-    def set_pose(self, name: str, pose: np.ndarray | None) -> None:
-        """Put object ``name`` at ``pose`` (world, 4×4); None parks it out of the scene."""
-        if pose is None:
-            pos, orn = PARKED, (0.0, 0.0, 0.0, 1.0)
-        else:
-            pos, orn = tf.to_quaternion(np.asarray(pose, dtype=float))
-        self.pb.resetBasePositionAndOrientation(self.bodies[name], pos, orn, physicsClientId=self.cid)
-
-    def set_config(self, robot: str, q: Sequence[float] | np.ndarray) -> None:
-        """Put ``robot`` at configuration ``q`` (joint values of the chain; planar: x, y, yaw in radians)."""
-        r = self.robots[robot]
-        if r.planar:
-            x, y, yaw = (float(v) for v in q[:3])
-            base = tf.rot_z(yaw)
-            base[0, 3], base[1, 3] = x, y
-            pos, orn = tf.to_quaternion(base @ r.lift)
-            self.pb.resetBasePositionAndOrientation(r.body, pos, orn, physicsClientId=self.cid)
-            return
-        self.pb.resetJointStatesMultiDof(r.body, r.joints, [[float(v)] for v in q[: len(r.joints)]],
-                                         physicsClientId=self.cid)
-
-    def set_fingers(self, robot: str, opening: float | None) -> None:
-        """Open an arm's fingers ``opening`` metres apart (None: back to their frozen, fully open values)."""
-        r = self.robots[robot]
-        for j, lo, hi, frozen in r.fingers:
-            v = frozen if opening is None or r.finger_value is None else min(max(r.finger_value(opening), lo), hi)
-            self.pb.resetJointState(r.body, j, float(v), physicsClientId=self.cid)
-
-    def ee_pose(self, robot: str) -> np.ndarray:
-        """The robot's end-effector link frame in the world at its current configuration (pybullet's forward
-        kinematics, single precision: errors up to about 1e-7 m); a planar robot's base frame."""
-        r = self.robots[robot]
-        if r.planar:
-            pos, orn = self.pb.getBasePositionAndOrientation(r.body, physicsClientId=self.cid)
-            return _pose(pos, orn) @ tf.inverse(r.lift)
-        st = self.pb.getLinkState(r.body, r.ee, computeForwardKinematics=True, physicsClientId=self.cid)
-        return _pose(st[4], st[5])
-
-    # ------------------------------------------------------------------ distances
-    def aabb(self, name: str) -> tuple[float, float, float, float, float, float]:
-        """The axis-aligned bounding box (min x, y, z, max x, y, z) of body ``name``'s collision shapes as
-        they stand now, all links of a robot together (pybullet's, margins included)."""
-        r = self.robots.get(name)
-        body = r.body if r is not None else self.bodies[name]
-        links = self._shaped.get(body)
-        if links is None:  # the links that have collision shapes (a link without one has no box)
-            links = self._shaped[body] = tuple(
-                link for link in (tuple(r.links) if r is not None else (-1,))
-                if self.pb.getCollisionShapeData(body, link, physicsClientId=self.cid)) or (-1,)
-        boxes = [self.pb.getAABB(body, link, physicsClientId=self.cid) for link in links]
-        lo = [min(b[0][k] for b in boxes) for k in range(3)]
-        hi = [max(b[1][k] for b in boxes) for k in range(3)]
-        return (lo[0], lo[1], lo[2], hi[0], hi[1], hi[2])
-
-    def closest(self, a: str, b: str, max_distance: float = 0.0) -> Closest | None:
-        """The deepest pair of points of bodies ``a`` and ``b`` (robots or objects) closer than
-        ``max_distance`` (None when there is none), after the base-link rule of the class docstring."""
-        ba = self.robots[a].body if a in self.robots else self.bodies[a]
-        bb = self.robots[b].body if b in self.robots else self.bodies[b]
-        # ask for 2 margins more: a mesh pair reported up to 2 mm short may still be within max_distance
-        pts = self.pb.getClosestPoints(ba, bb, float(max_distance) + 2 * MESH_MARGIN, physicsClientId=self.cid)
-        self.queries += 1
-        skip_a = a in self.robots and not self.robots[a].planar and b in self.fixed
-        skip_b = b in self.robots and not self.robots[b].planar and a in self.fixed
-        best: Closest | None = None
-        margin = self._margin
-        for p in pts:
-            if (skip_a and p[3] == -1) or (skip_b and p[4] == -1):
-                continue
-            d = float(p[8]) + margin.get((ba, p[3]), 0.0) + margin.get((bb, p[4]), 0.0)
-            if d < max_distance and (best is None or d < best.distance):
-                best = Closest(d, self._link(a, int(p[3])), self._link(b, int(p[4])))
-        return best
-
-    def _link(self, name: str, index: int) -> str | None:
-        r = self.robots.get(name)
-        return None if r is None else r.links.get(index, str(index))
-
-    # ------------------------------------------------------------------ lifetime
-    def close(self) -> None:
-        if self.cid >= 0:
-            try:
-                self.pb.disconnect(physicsClientId=self.cid)
-            except self.pb.error:  # pragma: no cover - already gone
-                pass
-            self.cid = -1
-
-    def __enter__(self) -> "ReplayScene":
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self.close()
+    return tf.from_quaternion(pos, quat / np.linalg.norm(quat))

@@ -55,12 +55,15 @@ coal traps handled here (coal 3.0.3):
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Iterable, Sequence, Union
+from typing import TYPE_CHECKING, Any, Iterable, Sequence, Union
 
 import numpy as np
 
 from mrgc.errors import Diagnostic, InputError
 from mrgc.language.model import Box, Cylinder, Mesh, Sphere
+
+if TYPE_CHECKING:
+    from mrgc.geometry.scene import SceneSpec
 
 #: coal's GJK tolerance (its default and its minimum): GJK's distances are exact to this (metres)
 GJK_TOLERANCE = 1e-6
@@ -441,6 +444,17 @@ class CollisionWorld:
             sel.manager.update()
             sel.version = self._version
         return sel.manager if sel.size else None
+
+
+def scene_world(scene: SceneSpec) -> CollisionWorld:
+    """A scene's collision world: fixed objects in group ``fixed``, movable objects (at their initial
+    poses) in group ``movable``."""
+    world = CollisionWorld()
+    for b in scene.fixed:
+        world.add(b.name, b.shape, b.pose, "fixed")
+    for b in scene.movable:
+        world.add(b.name, b.shape, b.pose, "movable")
+    return world
 
 
 def _place(obj: Any, t: np.ndarray) -> None:

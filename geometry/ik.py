@@ -16,7 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mrgc.geometry.fk import chain_frames, ee_pose, jacobian_t
+from mrgc.geometry.conventions import rotation_log
+from mrgc.geometry.fk import chain_frames, jacobian_t
 from mrgc.geometry.kinematics import RobotModel
 
 #: weight of the orientation error (radians) against the position error (metres) in the least squares
@@ -57,42 +58,6 @@ class IKResult:
     @property
     def solved(self) -> bool:
         return self.status is IKStatus.SOLVED
-
-
-_I1 = np.array([2, 0, 1])
-_I2 = np.array([1, 2, 0])
-
-
-def _rotation_log(r: np.ndarray) -> np.ndarray:
-    """Axis-angle vectors (..., 3) of rotation matrices (..., 3, 3), robust at 0 and at π."""
-    v = 0.5 * (r[..., _I1, _I2] - r[..., _I2, _I1])  # sin θ · axis
-    s = np.sqrt(np.einsum("...i,...i->...", v, v))
-    c = 0.5 * (r[..., 0, 0] + r[..., 1, 1] + r[..., 2, 2] - 1.0)
-    angle = np.arctan2(s, c)
-    out = v * (angle / np.maximum(s, 1e-300))[..., None]
-    small = s < 1e-6
-    if small.any():  # θ ≈ 0: the vector is v itself; θ ≈ π: the axis is the dominant column of (R + I)/2
-        out[small & (c > 0)] = v[small & (c > 0)]
-        near_pi = small & (c <= 0)
-        if near_pi.any():
-            b = 0.5 * (r[near_pi] + np.eye(3))
-            col = np.argmax(np.diagonal(b, axis1=-2, axis2=-1), axis=-1)
-            a = b[np.arange(len(b)), :, col]
-            out[near_pi] = np.pi * a / np.linalg.norm(a, axis=-1, keepdims=True)
-    return out
-
-
-def _errors(ee: np.ndarray, target: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Position error vector and rotation error vector (base frame) from ``ee`` to ``target``."""
-    e_pos = target[..., :3, 3] - ee[..., :3, 3]
-    e_rot = _rotation_log(target[..., :3, :3] @ np.swapaxes(ee[..., :3, :3], -1, -2))
-    return e_pos, e_rot
-
-
-def pose_error(pose: np.ndarray, target: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Position distance (m) and rotation angle (rad) between poses (broadcasting over leading axes)."""
-    e_pos, e_rot = _errors(np.asarray(pose, dtype=float), np.asarray(target, dtype=float))
-    return np.linalg.norm(e_pos, axis=-1), np.linalg.norm(e_rot, axis=-1)
 
 
 def restart_configurations(model: RobotModel, seed: int, restarts: int, q_init: np.ndarray | None = None) -> np.ndarray:
@@ -202,7 +167,7 @@ def _lm(model: RobotModel, targets: np.ndarray, starts: np.ndarray, seed: int, t
     for it in range(max_iters + 1):
         frames, ee = chain_frames(model, q)
         e_pos = t_pos - ee[:, :3, 3]
-        e_rot = _rotation_log(t_rot @ np.swapaxes(ee[:, :3, :3], -1, -2))
+        e_rot = rotation_log(t_rot @ np.swapaxes(ee[:, :3, :3], -1, -2))
         pe2 = np.einsum("ij,ij->i", e_pos, e_pos)
         re2 = np.einsum("ij,ij->i", e_rot, e_rot)
         conv = (pe2 <= tol_pos2) & (re2 <= tol_rot2)
@@ -256,8 +221,3 @@ def _lm(model: RobotModel, targets: np.ndarray, starts: np.ndarray, seed: int, t
                     checked[row] = np.inf
     return out  # type: ignore[return-value]
 
-
-def check_solution(model: RobotModel, q: np.ndarray, target: np.ndarray) -> tuple[float, float]:
-    """Position and rotation error of configuration ``q`` against ``target`` (for tests and validation)."""
-    pe, re = pose_error(ee_pose(model, q), target)
-    return float(pe), float(re)

@@ -9,8 +9,8 @@ kinematics (:mod:`mrgc.geometry.ik`) are numpy on this data.
 The URDF's joints and collisions are read with the standard library's XML parser (pybullet reports joint
 frames relative to centres of mass, with their rotations inverted); pybullet loads every URDF too, as a
 validity check and as the reference.  pybullet itself lives in :mod:`mrgc.geometry.bullet` (the only module
-that imports it); its forward and inverse kinematics and distance references (:func:`pybullet_fk`,
-:func:`pybullet_ik`, :func:`pybullet_box_distance`) are re-exported here for tests and benchmarks.
+that imports it); its forward and inverse kinematics and distance references, which tests and benchmarks
+compare this module's models against, are :mod:`mrgc.testing.pybullet_reference`.
 
 Frames: a link's frame is its URDF link frame (pybullet's ``worldLinkFrame``, not its centre of mass); a
 movable joint's frame is its child link's frame.  Off-chain movable joints (the Panda's fingers) are frozen
@@ -32,14 +32,14 @@ from typing import Iterator
 import numpy as np
 
 from mrgc.errors import Diagnostic, InputError, Span
-from mrgc.geometry.bullet import check_urdf, data_path, pybullet_box_distance, pybullet_fk, pybullet_ik
+from mrgc.geometry.bullet import check_urdf, data_path
 from mrgc.geometry.meshes import checked_vertices, read_mesh
 from mrgc.geometry.urdf import MAX_LENGTH, Urdf, UrdfError, mesh_path, parse_urdf, scalar, urdf_error, vec
 from mrgc.geometry.urdf import origin as urdf_origin
 from mrgc.language.model import RobotKind
 
 __all__ = ["E_LINK", "E_URDF", "Collision", "Joint", "Link", "RobotModel", "load_robot_model", "model_for_kind",
-           "pybullet_box_distance", "pybullet_fk", "pybullet_ik", "read_mesh", "resolve_urdf"]
+           "read_mesh", "resolve_urdf"]
 
 #: code of "robot URDF not found or unreadable" and of "end-effector link not in the URDF"
 E_URDF = "E400"

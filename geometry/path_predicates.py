@@ -27,7 +27,7 @@ the footprint (and the carried object) at every state of the dense path.  For ro
   greedily as for picks.
 - ``enable-goal-handover``: none.  The paper leaves handovers out of the box-moving domain ("they do not
   contribute significantly ... with mobile robots in synchronous setups"); a planar robot's
-  :class:`~mrgc.geometry.predicates.RobotFacts` has an empty ``handover`` map, so the fixed-arm handover
+  :class:`~mrgc.geometry.facts.RobotFacts` has an empty ``handover`` map, so the fixed-arm handover
   pass of :func:`~mrgc.geometry.predicates.compute_facts` adds nothing for it.
 
 Before a query is planned, :class:`~mrgc.geometry.planar.DiscGrid` checks a necessary condition (can the
@@ -45,10 +45,10 @@ from typing import Iterable
 
 import numpy as np
 
-from mrgc.geometry.collision import CollisionShape, CollisionWorld, collision_shape
+from mrgc.geometry.collision import CollisionShape, CollisionWorld, collision_shape, scene_world
 from mrgc.geometry.lattice import LatticePlanner
 from mrgc.geometry.planar import DiscGrid, PlanarRobot, planar_grasp, placements, scene_bounds
-from mrgc.geometry.predicates import RobotFacts, scene_world
+from mrgc.geometry.facts import RobotFacts
 from mrgc.geometry.scene import Body, SceneSpec, inside
 from mrgc.language.model import Fact
 

@@ -7,7 +7,8 @@ The model (docs/geometry.md, "Planar robots"):
   of a robot in a problem is its start (home) pose; its z is ignored.
 - **Footprint.**  The robot's body is its kind's ``:footprint`` shape (usually a box), centred over the base
   origin and standing on the floor: its frame is the base frame lifted by the shape's half height plus
-  :data:`LIFT` (so a footprint never touches a floor slab; touching counts as colliding).
+  :data:`~mrgc.geometry.conventions.PLANAR_LIFT` (so a footprint never touches a floor slab; touching counts
+  as colliding).
 - **Grasps.**  A planar robot grasps an object from one of its *side* faces: grasp ``side-x+`` means the
   robot stands on the object's +x side facing it (facing the object's -x direction), and so on for
   ``side-x-``, ``side-y+``, ``side-y-``.  ``top`` (and any grasp name this layer does not know) is not
@@ -19,13 +20,13 @@ The model (docs/geometry.md, "Planar robots"):
 - **Carrying.**  After the pick, M rides at the kind's ``:carry`` pose relative to the base frame (the pose
   of M's own frame, i.e. its centre), turned so that the grasped face still faces the robot:
   ``carry @ Rz(face yaw of g)`` (``side-x-``: 0°, ``side-y-``: -90°, ``side-x+``: 180°, ``side-y+``: 90°).
-  Without ``:carry`` the object rides on top of the footprint (centred, :data:`LIFT` above it).  The
+  Without ``:carry`` the object rides on top of the footprint (centred, ``PLANAR_LIFT`` above it).  The
   change from "M on the floor in front of the robot" to "M at the carry pose" is instantaneous (not swept),
   but M at the carry pose must be free of fixed objects at the pick base pose.
 - **Place base pose.**  Placing M at a pose P with grasp g is the pick geometry in reverse: the robot stands
   at the pick base pose it would use to pick M from P.  Candidate placements inside a region are a lattice
   (centre first) × four yaws (M's current yaw + 0°, 90°, 180°, 270°); a placement rests on the region's
-  floor, :data:`LIFT` above it.
+  floor, ``PLANAR_LIFT`` above it.
 - **Bounds.**  Base paths stay within the axis-aligned bounding box of every fixed object, movable object,
   region and robot start, grown by the footprint's circumradius plus 0.1 m.
 
@@ -41,14 +42,15 @@ from functools import cached_property
 import numpy as np
 
 from mrgc.geometry.collision import CollisionShape, collision_shape
+from mrgc.geometry.conventions import PLANAR_LIFT, lattice_offsets, wrap_angle, yaw_of
+from mrgc.geometry.conventions import se2 as se2  # the floor frames, imported from here by grounding
+from mrgc.geometry.conventions import to_se2 as to_se2
 from mrgc.geometry.scene import Body, RobotSpec, SceneSpec, half_extents, inside, outline
 from mrgc.geometry.transforms import from_pose, rot_z, translation
-from mrgc.language.model import Box, Cylinder, Shape
+from mrgc.language.model import Box, Cylinder, RobotKind, Shape
 
 #: gap between the robot's front and the face of the object it picks or places (m)
 CLEARANCE = 0.05
-#: footprints and placements float this much above the floor (touching counts as colliding) (m)
-LIFT = 1e-3
 #: placements tried per region: a GRID × GRID lattice, centre first (each at four yaws)
 PLACEMENT_GRID = 5
 #: placement yaws tried, relative to the object's current yaw (degrees)
@@ -73,19 +75,6 @@ def is_planar(spec: RobotSpec) -> bool:
     return spec.kind.base == "planar"
 
 
-def se2(x: float, y: float, yaw: float) -> np.ndarray:
-    """The 4×4 transform of a base pose (yaw in radians)."""
-    t = rot_z(yaw)
-    t[0, 3], t[1, 3] = x, y
-    return t
-
-
-def to_se2(t: np.ndarray) -> np.ndarray:
-    """``(x, y, yaw)`` of a 4×4 transform projected onto the floor (yaw in [-π, π))."""
-    yaw = math.atan2(t[1, 0], t[0, 0])
-    return np.array([t[0, 3], t[1, 3], (yaw + math.pi) % (2 * math.pi) - math.pi])
-
-
 class PlanarRobot:
     """A planar mobile robot of a scene: footprint, grasp geometry and carried-object poses."""
 
@@ -98,7 +87,7 @@ class PlanarRobot:
         self.half = half_extents(self.footprint)
         self.shape: CollisionShape = collision_shape(self.footprint)
         #: the footprint's frame relative to the base frame
-        self.lift = translation(0.0, 0.0, float(self.half[2]) + LIFT)
+        self.lift = translation(0.0, 0.0, float(self.half[2]) + PLANAR_LIFT)
         self.start = to_se2(spec.base)
 
     @cached_property
@@ -113,12 +102,7 @@ class PlanarRobot:
 
     def carry_transform(self, shape: Shape, grasp: str) -> np.ndarray:
         """Pose of a carried object (of ``shape``, held with ``grasp``) relative to the base frame."""
-        face_yaw = math.radians(PLANAR_GRASPS[grasp][1])
-        carry = self.spec.kind.carry
-        if carry is not None:
-            return from_pose(carry) @ rot_z(face_yaw)
-        h = half_extents(shape)
-        return translation(0.0, 0.0, 2 * float(self.half[2]) + 2 * LIFT + float(h[2])) @ rot_z(face_yaw)
+        return carry_transform(self.spec.kind, shape, grasp)
 
     def probe(self, q: np.ndarray, carried: tuple[CollisionShape, np.ndarray] | None = None
               ) -> list[tuple[CollisionShape, np.ndarray]]:
@@ -129,21 +113,35 @@ class PlanarRobot:
             out.append((carried[0], base @ carried[1]))
         return out
 
-    def standoff(self, shape: Shape, grasp: str) -> float:
-        """Distance from an object's centre to the base origin when grasping it with ``grasp``."""
-        normal = np.abs(np.array(PLANAR_GRASPS[grasp][0]))
-        return float(self.half[0]) + CLEARANCE + float(normal @ half_extents(shape)[:2])
-
     def grasp_base(self, pose: np.ndarray, shape: Shape, grasp: str) -> np.ndarray:
         """The base pose ``(x, y, yaw)`` from which the robot picks (or places) an object at ``pose``."""
-        nx, ny = PLANAR_GRASPS[grasp][0]
-        r = pose[:2, :2]
-        n = r @ np.array([nx, ny])
-        n = n / max(float(np.linalg.norm(n)), 1e-12)
-        d = self.standoff(shape, grasp)
-        x, y = float(pose[0, 3] + d * n[0]), float(pose[1, 3] + d * n[1])
-        yaw = math.atan2(-n[1], -n[0])
-        return np.array([x, y, (yaw + math.pi) % (2 * math.pi) - math.pi])
+        return grasp_base(self.spec.kind, pose, shape, grasp)
+
+
+def _footprint_half(kind: RobotKind) -> np.ndarray:
+    return half_extents(kind.footprint) if kind.footprint is not None else np.zeros(3)
+
+
+def carry_transform(kind: RobotKind, shape: Shape, grasp: str) -> np.ndarray:
+    """Pose of an object (of ``shape``) that a planar robot of ``kind`` carries, held with ``grasp``,
+    relative to its base frame: the kind's ``:carry`` pose, or on top of the footprint; the grasped face
+    towards the robot."""
+    face_yaw = math.radians(PLANAR_GRASPS[grasp][1])
+    if kind.carry is not None:
+        return from_pose(kind.carry) @ rot_z(face_yaw)
+    h, fp = half_extents(shape), _footprint_half(kind)
+    return translation(0.0, 0.0, 2 * float(fp[2]) + 2 * PLANAR_LIFT + float(h[2])) @ rot_z(face_yaw)
+
+
+def grasp_base(kind: RobotKind, pose: np.ndarray, shape: Shape, grasp: str) -> np.ndarray:
+    """The base pose ``(x, y, yaw)`` from which a planar robot of ``kind`` picks (or places) an object of
+    ``shape`` at ``pose`` with ``grasp``: facing the grasped face, its front :data:`CLEARANCE` from it."""
+    nx, ny = PLANAR_GRASPS[grasp][0]
+    n = pose[:2, :2] @ np.array([nx, ny])
+    n = n / max(float(np.linalg.norm(n)), 1e-12)
+    d = float(_footprint_half(kind)[0]) + CLEARANCE + float(np.abs([nx, ny]) @ half_extents(shape)[:2])
+    x, y = float(pose[0, 3] + d * n[0]), float(pose[1, 3] + d * n[1])
+    return np.array([x, y, wrap_angle(math.atan2(-n[1], -n[0]))])
 
 
 def scene_bounds(scene: SceneSpec, margin: float) -> tuple[float, float, float, float]:
@@ -166,15 +164,11 @@ def placements(obj: Body, region: Body, grid: int = PLACEMENT_GRID) -> list[np.n
     if not isinstance(region.shape, Box):
         return []
     h_o, h_r = half_extents(obj.shape), half_extents(region.shape)
-    if h_o[2] * 2 + LIFT > h_r[2] * 2:
+    if h_o[2] * 2 + PLANAR_LIFT > h_r[2] * 2:
         return []
-    ticks = np.linspace(-1, 1, grid) if grid > 1 else np.zeros(1)
-    offsets = sorted(((float(a), float(b)) for a in ticks for b in ticks),
-                     key=lambda ab: (ab[0] ** 2 + ab[1] ** 2, ab))
-    obj_yaw = math.atan2(obj.pose[1, 0], obj.pose[0, 0])
-    reg_yaw = math.atan2(region.pose[1, 0], region.pose[0, 0])
+    obj_yaw, reg_yaw = yaw_of(obj.pose), yaw_of(region.pose)
     out = []
-    for a, b in offsets:
+    for a, b in lattice_offsets(grid):
         for dyaw in PLACEMENT_YAWS:
             rel = obj_yaw - reg_yaw + math.radians(dyaw)  # the object's yaw in the region frame
             c, s = abs(math.cos(rel)), abs(math.sin(rel))
@@ -182,7 +176,7 @@ def placements(obj: Body, region: Body, grid: int = PLACEMENT_GRID) -> list[np.n
             room = (h_r[0] - ex, h_r[1] - ey)
             if room[0] < 0 or room[1] < 0:
                 continue
-            local = translation(a * room[0] * 0.95, b * room[1] * 0.95, -h_r[2] + h_o[2] + LIFT) @ rot_z(rel)
+            local = translation(a * room[0] * 0.95, b * room[1] * 0.95, -h_r[2] + h_o[2] + PLANAR_LIFT) @ rot_z(rel)
             pose = region.pose @ local
             if inside(region, obj.shape, pose):
                 out.append(pose)
@@ -216,7 +210,7 @@ class DiscGrid:
         fp = robot.footprint
         self.enabled = isinstance(fp, (Box, Cylinder))
         self.threshold = float(min(robot.half[0], robot.half[1])) - cell * math.sqrt(2) / 2 - slack
-        self.z_range = (LIFT, LIFT + 2 * float(robot.half[2]))
+        self.z_range = (PLANAR_LIFT, PLANAR_LIFT + 2 * float(robot.half[2]))
         self.bodies = {b.name: b for b in (*scene.fixed, *scene.movable)}
         self._masks: dict[str, np.ndarray | None] = {}
         self._reached: dict[frozenset[str], list[np.ndarray]] = {}

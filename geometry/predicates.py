@@ -21,14 +21,17 @@ and ``in-region M Re`` from the initial poses.  Everything is deterministic for 
 from __future__ import annotations
 
 import time
-import zlib
-from dataclasses import dataclass, field
 
 import numpy as np
 
-from mrgc.errors import Diagnostic
 from mrgc.geometry.arm import Arm
 from mrgc.geometry.collision import CollisionWorld
+from mrgc.geometry.collision import scene_world as scene_world  # re-exported: grounding imports it from here
+from mrgc.geometry.conventions import APPROACH_SAMPLES as APPROACH_SAMPLES  # re-exported (grounding)
+from mrgc.geometry.conventions import ARM_PLACE_LIFT, lattice_offsets
+from mrgc.geometry.conventions import refine as refine  # re-exported (grounding)
+from mrgc.geometry.conventions import seed_for as seed_for  # re-exported (grounding)
+from mrgc.geometry.facts import FactsResult, RobotFacts
 from mrgc.geometry.grasps import finger_opening, fits, grasp_transform, pregrasp_transform
 from mrgc.geometry.ik import solve_ik_many
 from mrgc.geometry.kinematics import model_for_kind
@@ -37,47 +40,11 @@ from mrgc.geometry.transforms import translation
 from mrgc.language.model import Box, Fact
 from mrgc.workers import map_in_workers, worker_count
 
-APPROACH_SAMPLES = 5  # configurations sampled from pre-grasp to grasp for the swept volume
-LIFT = 6e-3  # placements float this much above the region floor: touching counts as colliding, and the
-# object in hand dips a few mm below the straight line as the arm interpolates its approach in joint space
+#: the old name of :data:`~mrgc.geometry.conventions.ARM_PLACE_LIFT`, which grounding imports from here
+LIFT = ARM_PLACE_LIFT
 PLACEMENT_GRID = 3  # placements tried per region: a GRID × GRID lattice, centre first
 IK_SEEDS = 3  # IK solutions tried per target when looking for one free of movable objects
 IK_ITERS = 100  # Levenberg-Marquardt iterations per solve (reachable targets converge in far fewer)
-
-
-@dataclass
-class RobotFacts:
-    """What one robot's worker found: facts, handover configurations and counters."""
-
-    facts: list[Fact] = field(default_factory=list)
-    handover: dict[tuple[str, str, str], np.ndarray] = field(default_factory=dict)  # (M, point, g) -> q
-    ik_solves: int = 0
-    collision_checks: int = 0
-
-
-@dataclass
-class FactsResult:
-    """All facts of a scene (sorted, deterministic) and statistics; ``warnings`` about the problem's layout
-    (W271, W272: docs/errors.md) when :func:`mrgc.compute_facts` ran the layout checks."""
-
-    facts: list[Fact]
-    stats: dict[str, float]
-    warnings: tuple[Diagnostic, ...] = ()
-
-
-def seed_for(*parts: str, seed: int = 0) -> int:
-    """A stable per-query seed (Python's hash() is salted per process)."""
-    return (zlib.crc32("|".join(parts).encode()) + seed) % (2**31)
-
-
-def scene_world(scene: SceneSpec) -> CollisionWorld:
-    """Fixed objects in group ``fixed``, movable objects (at their initial poses) in group ``movable``."""
-    world = CollisionWorld()
-    for b in scene.fixed:
-        world.add(b.name, b.shape, b.pose, "fixed")
-    for b in scene.movable:
-        world.add(b.name, b.shape, b.pose, "movable")
-    return world
 
 
 class RobotEvaluator:
@@ -191,11 +158,9 @@ class RobotEvaluator:
         room = h_r[:2] - h_o[:2]
         if np.any(room < 0) or h_o[2] > h_r[2]:
             return []
-        ticks = np.linspace(-1, 1, PLACEMENT_GRID) if PLACEMENT_GRID > 1 else np.zeros(1)
-        offsets = sorted(((float(a), float(b)) for a in ticks for b in ticks), key=lambda ab: (ab[0] ** 2 + ab[1] ** 2, ab))
         out = []
-        for a, b in offsets:
-            pose = reg.pose @ translation(a * room[0] * 0.9, b * room[1] * 0.9, -h_r[2] + h_o[2] + LIFT)
+        for a, b in lattice_offsets(PLACEMENT_GRID):
+            pose = reg.pose @ translation(a * room[0] * 0.9, b * room[1] * 0.9, -h_r[2] + h_o[2] + ARM_PLACE_LIFT)
             if inside(reg, body.shape, pose):
                 out.append(pose)
         return out
@@ -255,20 +220,10 @@ class RobotEvaluator:
                 self.out.handover[key] = q
 
 
-def refine(configs: np.ndarray, sub: int = 4) -> np.ndarray:
-    """Configurations with ``sub - 1`` more interpolated between consecutive ones (the validator's
-    resolution), so facts and grounding agree with what the validator checks."""
-    if len(configs) < 2:
-        return configs
-    s = np.linspace(0.0, 1.0, sub + 1)[:-1, None]
-    return np.concatenate([a[None] * (1 - s) + b[None] * s for a, b in zip(configs[:-1], configs[1:])]
-                          + [configs[-1:]])
-
-
 def _robot_worker(args: tuple[SceneSpec, str, int]) -> RobotFacts:
     scene, robot, seed = args
     if scene.robot(robot).kind.base == "planar":  # path mode (box-moving)
-        from mrgc.geometry.path_predicates import PlanarEvaluator  # imports this module: import here
+        from mrgc.geometry.path_predicates import PlanarEvaluator  # coal's lattice: only for planar robots
 
         return PlanarEvaluator(scene, robot, seed).run()
     return RobotEvaluator(scene, robot, seed).run()

@@ -12,7 +12,7 @@ import math
 
 from mrgc.geometry.collision import CollisionWorld
 from mrgc.geometry.grounding import Grounder
-from mrgc.geometry.predicates import refine
+from mrgc.geometry.conventions import refine
 
 
 def pick_obstruction(g: Grounder, robot: str, obj: str, grasp: str, blocker: str) -> str:

@@ -17,7 +17,8 @@ import os
 from dataclasses import dataclass, field
 
 from mrgc.errors import Diagnostic, InputError
-from mrgc.geometry.predicates import FactsResult, compute_facts
+from mrgc.geometry.facts import FactsResult
+from mrgc.geometry.predicates import compute_facts
 from mrgc.geometry.scene import scene_from_problem
 from mrgc.language.loader import MrgFile, inside, urdf_candidates
 from mrgc.language.model import Fact, Problem

@@ -1,7 +1,7 @@
 """Geometric plan replay for the validator: every step re-run in pybullet, finer than the planner checks.
 
 Nothing here comes from the planner's search or grounding: configurations are read from the plan, forward
-kinematics and signed distances are pybullet's (:class:`mrgc.geometry.bullet.ReplayScene`: the robots'
+kinematics and signed distances are pybullet's (:class:`mrgc.geometry.replay_world.ReplayScene`: the robots'
 URDF collision meshes, the objects as pybullet shapes), grasp frames come from their specification
 (:mod:`mrgc.geometry.grasps`), the planar-robot model from :mod:`mrgc.geometry.planar`'s docstring.  Each
 action's geometry is read and checked by :mod:`mrgc.planner.replay_actions`; this module sweeps it.
@@ -39,7 +39,7 @@ than the resolution (:data:`RESOLUTION`, or the plan's finer one, never below :d
 - what :mod:`~mrgc.planner.replay_actions` checks per action: ``[motion-model]``, ``[missing]``,
   ``[config]``, ``[joint-limits]``, ``[pose]``, ``[grasp]``, ``[approach]``, ``[handover]``, ``[path]``;
 - no collision (penetration deeper than :data:`CONTACT_TOL`) robot-robot, robot-object, robot-fixed
-  (except an arm's base link, see :class:`~mrgc.geometry.bullet.ReplayScene`), held object-object and held
+  (except an arm's base link, see :class:`~mrgc.geometry.replay_world.ReplayScene`), held object-object and held
   object-fixed, at every sample of every phase ``[collision-...]``; a robot is exempt from the object it
   holds, and from the object it picks only in the *contact segment* of its pick approach (between its last
   two configurations); a collision is reported once per step, phase and pair, at its deepest;
@@ -61,7 +61,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from mrgc.geometry.bullet import ReplayScene
+from mrgc.geometry.replay_world import ReplayScene
 from mrgc.geometry.scene import SceneSpec, inside, outline, scene_from_problem
 from mrgc.geometry.transforms import translation
 from mrgc.language.model import Problem
@@ -69,7 +69,7 @@ from mrgc.planner.plan import MotionModel
 from mrgc.planner.plan_reader import Action
 from mrgc.planner.replay_actions import PATH_PHASES, ActionGeometry, ActionReader
 from mrgc.planner.sampling import config_at, sample_count, sample_times, where
-from mrgc.planner.validate import Violation
+from mrgc.planner.violation import Violation
 
 RESOLUTION = 0.01  # largest joint (rad) or planar base (m, rad) motion between samples
 MIN_RESOLUTION = 1e-3  # a plan's finer resolution is followed down to this

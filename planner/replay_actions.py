@@ -3,28 +3,27 @@ that needs no sweep (configurations, joint limits, grasps, approaches, handovers
 
 :class:`ActionReader` turns a typed :class:`~mrgc.planner.plan_reader.Action` into an :class:`ActionGeometry`
 (numpy arrays, the motion of each phase) and reports what is wrong with it; :mod:`mrgc.planner.replay`
-sweeps the motions.  Forward kinematics are pybullet's (:class:`~mrgc.geometry.bullet.ReplayScene`), grasp
+sweeps the motions.  Forward kinematics are pybullet's (:class:`~mrgc.geometry.replay_world.ReplayScene`), grasp
 frames come from their specification (:mod:`mrgc.geometry.grasps`), the planar model from
 :mod:`mrgc.geometry.planar`'s docstring; nothing comes from the planner's search or grounding.
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from mrgc.geometry.bullet import ReplayScene
+from mrgc.geometry.replay_world import ReplayScene
 from mrgc.geometry.grasps import APPROACH, finger_opening, fits, grasp_transform, pregrasp_transform
-from mrgc.geometry.planar import CLEARANCE, LIFT, PLANAR_GRASPS
-from mrgc.geometry.scene import SceneSpec, half_extents
-from mrgc.geometry.transforms import from_pose, inverse, rot_z, translation
+from mrgc.geometry.conventions import pose_error, wrap_angle, yaw_of
+from mrgc.geometry.planar import PLANAR_GRASPS, carry_transform, grasp_base
+from mrgc.geometry.scene import SceneSpec
+from mrgc.geometry.transforms import from_pose, inverse
 from mrgc.planner.plan import MotionModel
 from mrgc.planner.plan_reader import Action
-from mrgc.planner.sampling import pose_error
-from mrgc.planner.validate import Violation
+from mrgc.planner.violation import Violation
 
 POS_TOL = 1e-3  # m: tool vs grasp, handover position, path continuity of planar bases
 ROT_TOL = 0.01  # rad
@@ -108,7 +107,7 @@ class ActionReader:
         spec = self.scene.robot(name)
         if rr.planar:
             b = spec.base
-            return np.array([b[0, 3], b[1, 3], math.atan2(b[1, 0], b[0, 0])])
+            return np.array([b[0, 3], b[1, 3], yaw_of(b)])
         home = np.array(spec.kind.home, dtype=float)
         if len(home) < rr.dof:
             mid = np.where(np.isfinite(rr.lower) & np.isfinite(rr.upper), (rr.lower + rr.upper) / 2, 0.0)
@@ -128,13 +127,7 @@ class ActionReader:
         shape = self.shapes[obj]
         if not self.planar[robot]:
             return grasp_transform(self.scene.grasp(grasp), shape)
-        kind = self.scene.robot(robot).kind
-        face = rot_z(math.radians(PLANAR_GRASPS[grasp][1]))
-        if kind.carry is not None:
-            return from_pose(kind.carry) @ face  # type: ignore[no-any-return]
-        fp = half_extents(kind.footprint) if kind.footprint is not None else np.zeros(3)
-        lift = 2 * float(fp[2]) + 2 * LIFT + float(half_extents(shape)[2])  # on top of the footprint
-        return translation(0.0, 0.0, lift) @ face  # type: ignore[no-any-return]
+        return carry_transform(self.scene.robot(robot).kind, shape, grasp)
 
     def opening(self, obj: str, grasp: str) -> float:
         return finger_opening(self.scene.grasp(grasp), self.shapes[obj])
@@ -156,13 +149,7 @@ class ActionReader:
     def _grasp_base(self, robot: str, obj: str, grasp: str, pose: np.ndarray) -> np.ndarray:
         """The planar model's base pose (x, y, yaw) for grasping ``obj`` at ``pose`` with ``grasp``: facing
         the grasped face, the front CLEARANCE from it."""
-        kind = self.scene.robot(robot).kind
-        fp = half_extents(kind.footprint) if kind.footprint is not None else np.zeros(3)
-        nx, ny = PLANAR_GRASPS[grasp][0]
-        n = pose[:2, :2] @ np.array([nx, ny])
-        n = n / max(float(np.linalg.norm(n)), 1e-12)
-        d = float(fp[0]) + CLEARANCE + float(np.abs([nx, ny]) @ half_extents(self.shapes[obj])[:2])
-        return np.array([pose[0, 3] + d * n[0], pose[1, 3] + d * n[1], math.atan2(-n[1], -n[0])])
+        return grasp_base(self.scene.robot(robot).kind, pose, self.shapes[obj], grasp)
 
     # ------------------------------------------------------------------ the model
     def check_model(self) -> None:
@@ -327,13 +314,13 @@ class ActionReader:
                                                 f"{len(act.configs[phase])} base poses, not 1 (its motions are paths)")
                 want = self._grasp_base(robot, obj, grasp, pose)
                 dp = float(np.hypot(q[0] - want[0], q[1] - want[1]))
-                dr = abs((q[2] - want[2] + math.pi) % (2 * math.pi) - math.pi)
+                dr = abs(wrap_angle(float(q[2] - want[2])))
                 if dp > POS_TOL or dr > ROT_TOL:
                     self._v(t, robot, "grasp", f"the last {phase} base pose of {robot} is {dp * 1e3:.1f} mm, "
                                                f"{dr:.3f} rad from where grasp {grasp!r} of {obj} puts it (at "
                                                f"{what}; tolerance {POS_TOL * 1e3:g} mm, {ROT_TOL} rad)")
                 continue
-            dp, dr = pose_error(self.tool(robot, q), pose @ grasp_transform(self.scene.grasp(grasp), self.shapes[obj]))
+            dp, dr = _pose_error(self.tool(robot, q), pose @ grasp_transform(self.scene.grasp(grasp), self.shapes[obj]))
             if dp > POS_TOL or dr > ROT_TOL:
                 self._v(t, robot, "grasp", f"the last {phase} configuration of {robot} puts the tool "
                                            f"{dp * 1e3:.1f} mm, {dr:.3f} rad from grasp {grasp!r} of {obj} at {what} "
@@ -350,7 +337,7 @@ class ActionReader:
                         self._v(t, robot, "handover", f"{robot} holds {obj} (grasp {grasp!r}) {d * 1e3:.1f} mm from "
                                                       f"handover point {a.handover_point} (tolerance "
                                                       f"{POS_TOL * 1e3:g} mm)")
-            dp, dr = pose_error(x1, x2)
+            dp, dr = _pose_error(x1, x2)
             if dp > POS_TOL or dr > ROT_TOL:
                 self._v(t, obj, "handover", f"giver {a.pick_robot} and taker {a.place_robot} hold {obj} at poses "
                                             f"{dp * 1e3:.1f} mm, {dr:.3f} rad apart (tolerance {POS_TOL * 1e3:g} mm, "
@@ -375,7 +362,7 @@ class ActionReader:
                                               f"configuration{'s' * (len(qs) != 1)}; the motion model's approaches "
                                               f"hold {n}, {word} first")
             g = pose @ grasp_transform(self.scene.grasp(grasp), self.shapes[obj])
-            dp, dr = pose_error(self.tool(robot, qs[0]), pose @ pregrasp_transform(
+            dp, dr = _pose_error(self.tool(robot, qs[0]), pose @ pregrasp_transform(
                 grasp_transform(self.scene.grasp(grasp), self.shapes[obj])))
             if dp > POS_TOL or dr > ROT_TOL:
                 self._v(t, robot, "approach", f"the first {phase} configuration of {robot} puts the tool "
@@ -426,7 +413,7 @@ class ActionReader:
                 want, what = found
             if self.planar[robot]:
                 dp = float(np.hypot(*(q[:2] - want[:2])))
-                dr = abs((q[2] - want[2] + math.pi) % (2 * math.pi) - math.pi)
+                dr = abs(wrap_angle(float(q[2] - want[2])))
                 bad, gap = dp > POS_TOL or dr > ROT_TOL, f"{dp * 1e3:.1f} mm, {dr:.3f} rad"
             else:
                 d = float(np.abs(q - want).max())
@@ -435,3 +422,9 @@ class ActionReader:
                 self._v(act.step, robot, "path", f"path {name!r} (moving {act.obj}) {which} {gap} away from the "
                                                  f"{what} (tolerance {JOINT_TOL} rad; planar {POS_TOL * 1e3:g} mm, "
                                                  f"{ROT_TOL} rad)")
+
+
+def _pose_error(a: np.ndarray, b: np.ndarray) -> tuple[float, float]:
+    """Position distance (m) and rotation angle (rad) between two poses."""
+    dp, dr = pose_error(a, b)
+    return float(dp), float(dr)

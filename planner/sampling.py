@@ -1,4 +1,4 @@
-"""Where the validator looks along a motion: sample times, configurations at a time, pose errors.
+"""Where the validator looks along a motion: sample times and configurations at a time.
 
 A motion is a list of configurations; the validator reads it as linear in joint space between consecutive
 configurations (a planar yaw the shortest way round), consecutive configurations equally spaced in time
@@ -17,6 +17,8 @@ import math
 
 import numpy as np
 
+from mrgc.geometry.conventions import wrap_angle
+
 SUBSTEPS = 4  # samples per segment of a motion of few configurations, at least
 FEW = 16  # a motion of at most this many segments is "few configurations"
 
@@ -25,7 +27,7 @@ def deltas(configs: np.ndarray, planar: bool) -> np.ndarray:
     """The motion of each segment (m-1, dof), a planar yaw wrapped into [-pi, pi)."""
     d = np.diff(configs, axis=0)
     if planar and d.size:
-        d[:, 2] = (d[:, 2] + math.pi) % (2 * math.pi) - math.pi
+        d[:, 2] = wrap_angle(d[:, 2])
     return d  # type: ignore[no-any-return]
 
 
@@ -69,7 +71,7 @@ def config_at(configs: np.ndarray, s: float, planar: bool) -> np.ndarray:
     d = configs[j + 1] - configs[j]
     if planar:
         d = d.copy()
-        d[2] = (d[2] + math.pi) % (2 * math.pi) - math.pi
+        d[2] = wrap_angle(float(d[2]))
     return configs[j] + u * d  # type: ignore[no-any-return]
 
 
@@ -83,9 +85,3 @@ def where(label: str, m: int, s: float) -> str:
         return f"at {label} configuration {k + 1} of {m}"
     return f"between {label} configurations {math.floor(x) + 1} and {math.floor(x) + 2} of {m}"
 
-
-def pose_error(a: np.ndarray, b: np.ndarray) -> tuple[float, float]:
-    """Position distance (m) and rotation angle (rad) between two poses."""
-    dp = float(np.linalg.norm(a[:3, 3] - b[:3, 3]))
-    c = (float(np.trace(a[:3, :3].T @ b[:3, :3])) - 1.0) / 2.0
-    return dp, math.acos(max(-1.0, min(1.0, c)))

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 from typing import Any, Iterable
 
 from mrgc.backends.base import Backend
-from mrgc.backends.registry import backend_class
+from mrgc.backends.registry import backend_class, check_export
 from mrgc.compiler.diagnose import explain_infeasible
 from mrgc.compiler.encodings import get_encoding
 from mrgc.compiler.enumerate import ERROR, EXHAUSTED, TIME_LIMIT, Batch, SkeletonGenerator
@@ -149,6 +149,7 @@ def export_model(problem: Problem, path: str, backend: str | type[Backend] = DEF
     gen = source.generator
     chosen = horizon or gen.limit
     enc = gen.encoding.build(gen.graph, chosen)
+    check_export(backend, path)
     solver = (backend if isinstance(backend, type) else backend_class(backend))()
     solver.load(enc.model)
     solver.export(path)

@@ -45,29 +45,11 @@ from mrgc.planner.plan import file_sha256
 from mrgc.planner.plan_reader import (
     E_JSON, E_LIMIT, E_READ, E_SCHEMA, E_VERSION, Action, PlanFile, check_schema, load_plan, read_plan,
     schema_errors)
+from mrgc.planner.violation import Violation
 
-#: the reader's entry points are re-exported here, where the CLI and the tests import them
+#: the reader's entry points and :class:`Violation` are re-exported here, where the CLI and the tests import them
 __all__ = ["E_JSON", "E_LIMIT", "E_READ", "E_SCHEMA", "E_VERSION", "ValidationReport", "Violation", "check_schema",
            "load_plan", "schema_errors", "validate"]
-
-
-@dataclass(frozen=True)
-class Violation:
-    """One way a plan fails: the step (1-based, None for the whole plan), the robot or object concerned
-    (None when none in particular), a stable code and a one-line message."""
-
-    step: int | None
-    subject: str | None
-    code: str
-    message: str
-
-    def __str__(self) -> str:
-        where = "".join([f"step {self.step}: " if self.step is not None else "",
-                         f"{self.subject}: " if self.subject else ""])
-        return f"{where}{self.message} [{self.code}]"
-
-    def to_json(self) -> dict[str, Any]:
-        return {"step": self.step, "subject": self.subject, "code": self.code, "message": self.message}
 
 
 @dataclass

@@ -18,6 +18,7 @@ from typing import Any, Iterator, Mapping
 
 import numpy as np
 
+from mrgc.geometry.conventions import wrap_angle
 from mrgc.geometry.scene import Body, SceneSpec, outline, scene_from_problem
 from mrgc.geometry.transforms import from_pose, inverse
 from mrgc.language.model import Box, Cylinder, Mesh, Problem, Shape, Sphere
@@ -129,7 +130,7 @@ class RobotView:
         base's metres plus its turn in radians scaled by the footprint's half length)."""
         d = np.asarray(b, dtype=float) - np.asarray(a, dtype=float)
         if self.planar:
-            turn = abs((d[2] + math.pi) % (2 * math.pi) - math.pi)
+            turn = abs(wrap_angle(float(d[2])))
             return float(math.hypot(d[0], d[1]) + turn * float(self.mobile.half[0]))
         return float(np.abs(d).max()) if d.size else 0.0
 

@@ -16,8 +16,10 @@ from mrgc.errors import InputError
 from mrgc.geometry import fk as F
 from mrgc.geometry import ik as I
 from mrgc.geometry import transforms as tf
-from mrgc.geometry.kinematics import load_robot_model, model_for_kind, pybullet_fk, pybullet_ik, read_mesh
+from mrgc.geometry.conventions import pose_error, rotation_log
+from mrgc.geometry.kinematics import load_robot_model, model_for_kind, read_mesh
 from mrgc.language.model import Pose, RobotKind
+from mrgc.testing.pybullet_reference import pybullet_fk, pybullet_ik
 
 PANDA = "franka_panda/panda.urdf"
 
@@ -37,7 +39,7 @@ def in_limits(model, u) -> np.ndarray:
 
 def assert_same_frames(ref: dict[str, np.ndarray], ours: np.ndarray, model, tol: float = 1e-6) -> None:
     for link in model.links:
-        pe, re = I.pose_error(ours[link.index], ref[link.name])
+        pe, re = pose_error(ours[link.index], ref[link.name])
         assert pe <= tol, (link.name, float(pe))
         assert re <= tol, (link.name, float(re))
 
@@ -102,7 +104,8 @@ def test_missing_end_effector_is_a_diagnostic() -> None:
 
 
 def test_loading_prints_nothing() -> None:
-    code = ("from mrgc.geometry.kinematics import load_robot_model, pybullet_fk; "
+    code = ("from mrgc.geometry.kinematics import load_robot_model; "
+            "from mrgc.testing.pybullet_reference import pybullet_fk; "
             f"m = load_robot_model({PANDA!r}, '.', 'panda_hand'); pybullet_fk(m, [0.0] * 7); print('ok')")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout == "ok\n"
@@ -252,7 +255,7 @@ def test_jacobian_matches_finite_differences(panda, toy) -> None:
             dq[i] = h
             t1 = F.ee_pose(model, q + dq)
             lin = (t1[:3, 3] - t0[:3, 3]) / h
-            ang = I._rotation_log(t1[:3, :3] @ t0[:3, :3].T) / h
+            ang = rotation_log(t1[:3, :3] @ t0[:3, :3].T) / h
             assert np.allclose(jac[:3, i], lin, atol=1e-5) and np.allclose(jac[3:, i], ang, atol=1e-5)
 
 
@@ -294,7 +297,7 @@ def test_ik_round_trip(panda, round_trip) -> None:
     for target, res in zip(targets, results):
         if res.solved:
             assert panda.within_limits(res.q)
-            pe, re = I.pose_error(F.ee_pose(panda, res.q), target)
+            pe, re = pose_error(F.ee_pose(panda, res.q), target)
             assert pe <= 1e-4 and re <= 1e-3
             assert res.pos_error == pytest.approx(float(pe), abs=1e-12)
         else:
@@ -340,9 +343,9 @@ def test_unreachable_targets(panda) -> None:
 def test_rotation_log_at_pi() -> None:
     for axis in np.eye(3):
         r = tf.from_xyz_rpy([0, 0, 0], np.pi * axis)[:3, :3]
-        v = I._rotation_log(r)
+        v = rotation_log(r)
         assert np.isclose(np.linalg.norm(v), np.pi) and np.allclose(np.abs(v), np.pi * axis)
-    assert np.allclose(I._rotation_log(np.eye(3)), 0.0)
+    assert np.allclose(rotation_log(np.eye(3)), 0.0)
 
 
 def test_pybullet_ik_reference(panda) -> None:
@@ -351,4 +354,4 @@ def test_pybullet_ik_reference(panda) -> None:
     for t in targets:
         res = pybullet_ik(panda, t, seed=0)
         if res.solved:
-            assert I.pose_error(F.ee_pose(panda, res.q), t)[0] <= 1e-4 and panda.within_limits(res.q)
+            assert pose_error(F.ee_pose(panda, res.q), t)[0] <= 1e-4 and panda.within_limits(res.q)

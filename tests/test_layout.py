@@ -13,7 +13,7 @@ import pytest
 ROOT = Path(__file__).resolve().parent.parent
 SKIP_DIRS = {".venv", ".git", "tests", "docs", "benchmarks", "build", "dist", "domains", ".hypothesis"}
 
-#: DESIGN.md section 3: layer -> layers it may import (besides itself)
+#: docs/architecture.md, "Layers and who may import whom": layer -> layers it may import (besides itself)
 MAY_IMPORT: dict[str, set[str]] = {
     "errors": set(),
     "language": {"errors"},
@@ -29,11 +29,28 @@ MAY_IMPORT: dict[str, set[str]] = {
     "limits": {"errors"},
     "cli": {"*"},
     "api": {"*"},
-    # test helpers for users and plug-ins: the conformance kit compiles through planner/skeletons.py
-    "testing": {"errors", "language", "compiler", "backends", "planner", "signals"},  # the public API the CLI wraps: it calls into every layer, nothing imports it but cli and __init__
+    # test helpers for users and plug-ins: the conformance kit compiles through planner/skeletons.py; the
+    # pybullet references of the kinematics read geometry/
+    "testing": {"errors", "language", "compiler", "backends", "geometry", "planner", "signals"},
     "bench": {"*"},  # studies drive the command line: bench imports everything, nothing imports bench but cli
     "__init__": {"*"},
 }
+
+#: docs/architecture.md, "Rules inside the layers": module -> the only mrgc modules it may import
+ONLY_IMPORTS: dict[str, set[str]] = {
+    # the pybullet client knows nothing of mrgc's kinematics (the references are mrgc.testing's)
+    "geometry/bullet.py": {"mrgc.geometry.transforms"},
+    # the conventions sit under everything else of the geometry layer
+    "geometry/conventions.py": {"mrgc.geometry.transforms"},
+}
+#: the validator (docs/validator.md) and the modules it reads: none of the planner's search and grounding,
+#: coal or the numpy kinematics; it replays in pybullet (geometry/replay_world.py)
+VALIDATOR = ["planner/validate.py", "planner/violation.py", "planner/plan_reader.py", "planner/replay.py",
+             "planner/replay_actions.py", "planner/sampling.py", "geometry/replay_world.py"]
+NOT_FOR_THE_VALIDATOR = {"mrgc.planner.ground", "mrgc.planner.mcts", "mrgc.planner.search",
+                         "mrgc.geometry.grounding", "mrgc.geometry.predicates", "mrgc.geometry.path_predicates",
+                         "mrgc.geometry.collision", "mrgc.geometry.fk", "mrgc.geometry.ik", "mrgc.geometry.arm",
+                         "mrgc.geometry.motion", "mrgc.geometry.lattice"}
 
 #: heavy library -> the one module allowed to import it (filled in as backends/geometry modules land)
 HEAVY = {
@@ -61,7 +78,7 @@ def code_files() -> list[Path]:
     out = []
     for path in ROOT.rglob("*.py"):
         rel = path.relative_to(ROOT)
-        if rel.parts[0] in SKIP_DIRS or rel.parts[0].startswith("."):
+        if rel.parts[0] in SKIP_DIRS or rel.parts[0].startswith(".") or rel.parts[0].endswith(".egg-info"):
             continue
         out.append(path)
     return sorted(out)
@@ -71,17 +88,79 @@ def layer(rel: Path) -> str:
     return rel.parts[0] if len(rel.parts) > 1 else rel.stem
 
 
-def imports(path: Path) -> list[tuple[str, bool]]:
-    """(module, at top level?) for every import in the file."""
+def module_name(rel: Path) -> str:
+    parts = list(rel.with_suffix("").parts)
+    return ".".join(["mrgc", *(parts[:-1] if parts[-1] == "__init__" else parts)])
+
+
+MODULES = {module_name(p.relative_to(ROOT)): p for p in code_files()}
+
+
+def imports(path: Path, rel: Path | None = None) -> list[tuple[str, bool]]:
+    """(module, at top level?) for every import in the file (at ``rel`` in the package, default: where it
+    is): absolute and relative (resolved), at module level, inside functions and under ``if
+    TYPE_CHECKING``; ``from package import module`` names the module."""
+    rel = rel or path.relative_to(ROOT)
+    package = module_name(rel) if path.name == "__init__.py" else module_name(rel).rpartition(".")[0]
     tree = ast.parse(path.read_text(encoding="utf-8"))
     top = set(map(id, tree.body))
     out = []
     for node in ast.walk(tree):
         if isinstance(node, ast.Import):
             out += [(a.name, id(node) in top) for a in node.names]
-        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
-            out.append((node.module, id(node) in top))
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                parts = package.split(".")
+                base = ".".join(parts[:len(parts) - node.level + 1] + ([node.module] if node.module else []))
+            for a in node.names:
+                name = f"{base}.{a.name}"
+                out.append((name if name in MODULES else base, id(node) in top))
     return out
+
+
+def mrgc_imports(path: Path, rel: Path | None = None) -> set[str]:
+    """The mrgc modules ``path`` imports (a name inside a module counts as its module)."""
+    out = set()
+    for module, _ in imports(path, rel):
+        while module not in MODULES and "." in module:
+            module = module.rpartition(".")[0]
+        if module in MODULES and module != "mrgc":
+            out.add(module)
+    return out
+
+
+def import_cycles() -> list[list[str]]:
+    """The strongly connected components of more than one module of the import graph (Tarjan)."""
+    graph = {m: mrgc_imports(p) - {m} for m, p in MODULES.items()}
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    out: list[list[str]] = []
+
+    def visit(v: str) -> None:
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        for w in sorted(graph[v]):
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in stack:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            scc = []
+            while True:
+                w = stack.pop()
+                scc.append(w)
+                if w == v:
+                    break
+            if len(scc) > 1:
+                out.append(sorted(scc))
+
+    for v in sorted(graph):
+        if v not in index:
+            visit(v)
+    return sorted(out)
 
 
 def test_every_code_folder_is_packaged() -> None:
@@ -111,8 +190,7 @@ def test_import_rules(path: Path) -> None:
         parts = module.split(".")
         if parts[0] == "mrgc":
             if len(parts) == 1:
-                assert me in {"cli", "__init__"} or module == "mrgc", f"{rel} imports the mrgc root"
-                continue
+                continue  # the package root: its __version__ and the lazy API names
             target = parts[1]
             assert target != "cli" or me in {"__init__", "bench"}, f"{rel} imports the CLI"
             assert target != "bench" or me in {"cli", "bench"}, f"{rel} imports mrgc.bench (only the CLI may)"
@@ -120,6 +198,50 @@ def test_import_rules(path: Path) -> None:
         if parts[0] in HEAVY:
             assert str(rel) == HEAVY[parts[0]] or parts[0] in ALSO_HEAVY.get(str(rel), set()), \
                 f"{rel} imports {parts[0]}; only {HEAVY[parts[0]]} may"
+    if str(rel) in ONLY_IMPORTS:
+        assert mrgc_imports(path) <= ONLY_IMPORTS[str(rel)], f"{rel} imports {mrgc_imports(path)}"
+    if str(rel) in VALIDATOR:
+        assert not mrgc_imports(path) & NOT_FOR_THE_VALIDATOR, \
+            f"the validator's {rel} imports {mrgc_imports(path) & NOT_FOR_THE_VALIDATOR}"
+
+
+#: cycles in mrgc.bench (and through the CLI, which registers bench's parser while bench runs the CLI's
+#: main), which another change is reworking; the test below fails as soon as they are gone, so that they
+#: are removed from here
+BENCH_CYCLES = [
+    ["mrgc.bench.arena", "mrgc.bench.command", "mrgc.bench.db", "mrgc.bench.execute", "mrgc.bench.executors",
+     "mrgc.bench.figures", "mrgc.bench.instances", "mrgc.bench.methods", "mrgc.bench.outcome",
+     "mrgc.bench.progress", "mrgc.bench.report", "mrgc.bench.run", "mrgc.cli"],
+    ["mrgc.bench.schema", "mrgc.bench.study"],
+]
+
+
+def test_no_module_imports_itself_through_others() -> None:
+    """No import cycle between modules, counting every import (in functions and TYPE_CHECKING blocks too)."""
+    cycles = [c for c in import_cycles() if not set(c) <= {m for b in BENCH_CYCLES for m in b}]
+    assert cycles == []
+
+
+@pytest.mark.xfail(strict=True, reason="mrgc.bench is being reworked by another change (issue 13)")
+def test_no_import_cycle_in_bench() -> None:
+    assert [c for c in import_cycles() if set(c) <= {m for b in BENCH_CYCLES for m in b}] == []
+
+
+def test_the_import_reader_sees_relative_and_late_imports(tmp_path: Path) -> None:
+    """The reader behind these rules: relative imports resolved, imports inside functions and
+    TYPE_CHECKING blocks read, ``from package import module`` naming the module."""
+    path = tmp_path / "probe.py"
+    path.write_text("from typing import TYPE_CHECKING\n"
+                    "from . import transforms\n"
+                    "from ..planner import search\n"
+                    "if TYPE_CHECKING:\n"
+                    "    from .scene import SceneSpec\n"
+                    "def f():\n"
+                    "    from mrgc.geometry.ik import solve_ik\n", encoding="utf-8")
+    rel = Path("geometry", "probe.py")
+    assert mrgc_imports(path, rel) == {"mrgc.geometry.transforms", "mrgc.planner.search", "mrgc.geometry.scene",
+                                       "mrgc.geometry.ik"}
+    assert [top for m, top in imports(path, rel) if m.startswith("mrgc.")] == [True, True, False, False]
 
 
 @pytest.mark.parametrize("path", code_files(), ids=lambda p: str(p.relative_to(ROOT)))

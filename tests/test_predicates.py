@@ -15,12 +15,13 @@ from hypothesis import strategies as st
 from mrgc import cli, parse_file
 from mrgc.geometry.collision import CollisionWorld, ConvexHull, collision_shape
 from mrgc.geometry.fk import fk_world
-from mrgc.geometry.kinematics import load_robot_model, pybullet_box_distance
+from mrgc.geometry.kinematics import load_robot_model
 from mrgc.geometry.predicates import compute_facts
 from mrgc.geometry.scene import scene_from_problem
 from mrgc.geometry.transforms import rot_z, translation
 from mrgc.language.model import Box, Fact
 from mrgc.planner.skeletons import compile_problem
+from mrgc.testing.pybullet_reference import pybullet_box_distance
 
 ROOT = Path(__file__).resolve().parent.parent
 PACKAGING = ROOT / "domains" / "packaging"

@@ -526,7 +526,7 @@ def test_the_validator_imports_no_planner_search_or_grounding() -> None:
 
 # ------------------------------------------------------------------------------------- the replay scene
 def test_replay_scene_distances_and_kinematics(pa3: Any, grounder: Grounder, tmp_path: Path) -> None:
-    from mrgc.geometry.bullet import ReplayScene
+    from mrgc.geometry.replay_world import ReplayScene
     from mrgc.geometry.fk import ee_pose
     from mrgc.language.model import Box, Mesh
 
@@ -558,7 +558,7 @@ def test_replay_scene_distances_and_kinematics(pa3: Any, grounder: Grounder, tmp
 def test_replay_boxes_are_exact_at_edges(gap: float, diagonal: bool) -> None:
     """Boxes are 8-vertex hulls in the replay world: their distances are exact at edges and corners too,
     where GEOM_BOX's rounded margin read up to 1.1 mm wrong (docs/geometry.md)."""
-    from mrgc.geometry.bullet import ReplayScene
+    from mrgc.geometry.replay_world import ReplayScene
     from mrgc.geometry.scene import SceneSpec
     from mrgc.language.model import Box
 

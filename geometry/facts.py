@@ -1,0 +1,32 @@
+"""What phase 1 finds: one robot's facts (:class:`RobotFacts`, from the arm evaluator of
+:mod:`mrgc.geometry.predicates` or the planar one of :mod:`mrgc.geometry.path_predicates`) and all facts
+of a scene (:class:`FactsResult`)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from mrgc.errors import Diagnostic
+from mrgc.language.model import Fact
+
+
+@dataclass
+class RobotFacts:
+    """What one robot's worker found: facts, handover configurations and counters."""
+
+    facts: list[Fact] = field(default_factory=list)
+    handover: dict[tuple[str, str, str], np.ndarray] = field(default_factory=dict)  # (M, point, g) -> q
+    ik_solves: int = 0
+    collision_checks: int = 0
+
+
+@dataclass
+class FactsResult:
+    """All facts of a scene (sorted, deterministic) and statistics; ``warnings`` about the problem's layout
+    (W271, W272: docs/errors.md) when :func:`mrgc.compute_facts` ran the layout checks."""
+
+    facts: list[Fact]
+    stats: dict[str, float]
+    warnings: tuple[Diagnostic, ...] = ()

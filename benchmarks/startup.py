@@ -1,7 +1,8 @@
-"""CLI start-up: wall time of ``mrgc --help``, ``mrgc check`` and ``mrgc compile`` on a symbolic file.
+"""CLI start-up: wall time of ``mrgc --help``, ``check``, ``compile`` and ``plan`` on a symbolic file.
 
     python benchmarks/startup.py                      # this checkout, 15 runs per command
     python benchmarks/startup.py --root /tmp/old-checkout --root . --runs 15   # before / after
+    python benchmarks/startup.py --only cpsat          # the commands whose name holds "cpsat"
 
 Each run is a fresh interpreter running the CLI (``from mrgc.cli import main``) with the checkout at
 ``--root`` first on the import path; with several roots their runs alternate, so a busy machine slows
@@ -31,6 +32,7 @@ COMMANDS = {
     "mrgc compile chain-3.mrg (cpsat)": ["compile", CHAIN3],
     "mrgc compile chain-3.mrg --backend mip": ["compile", CHAIN3, "--backend", "mip"],
     "mrgc compile chain-3.mrg --backend smt": ["compile", CHAIN3, "--backend", "smt"],
+    "mrgc plan chain-3.mrg (cpsat)": ["plan", CHAIN3],
 }
 RUNNER = ("import sys; sys.path.insert(0, sys.argv[1]); del sys.argv[1]; "
           "from mrgc.cli import main; code = main(sys.argv[1:]); "
@@ -42,7 +44,11 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--root", type=Path, action="append", help="a checkout to measure (repeatable; default: this one)")
     ap.add_argument("--runs", type=int, default=15)
+    ap.add_argument("--only", default="", help="measure only the commands whose name holds this text")
     args = ap.parse_args()
+    commands = {name: argv for name, argv in COMMANDS.items() if args.only in name}
+    if not commands:
+        ap.error(f"no command's name holds {args.only!r}: {', '.join(COMMANDS)}")
     roots = [r.resolve() for r in (args.root or [ROOT])]
     with tempfile.TemporaryDirectory() as tmp:
         links = []
@@ -65,14 +71,14 @@ def main() -> None:
             return seconds, out.stderr
 
         for k in range(len(roots)):  # warm the bytecode caches
-            for argv in COMMANDS.values():
+            for argv in commands.values():
                 run(k, argv)
-        print(f"{args.runs} runs per command and checkout, Python {sys.version.split()[0]}; median / least wall "
-              f"time in seconds (modules imported)")
+        print(f"{args.runs} runs per command and checkout, Python {sys.version.split()[0]}, load average "
+              f"{os.getloadavg()[0]:.1f} at the start; median / least wall time in seconds (modules imported)")
         print()
         print("| command | " + " | ".join(str(r) for r in roots) + " |")
         print("| --- |" + " --- |" * len(roots))
-        for name, argv in COMMANDS.items():
+        for name, argv in commands.items():
             times: list[list[float]] = [[] for _ in roots]
             for _ in range(args.runs):
                 for k in range(len(roots)):
@@ -82,6 +88,7 @@ def main() -> None:
                 modules = run(k, argv, count=True)[1].strip().splitlines()[-1]
                 cells.append(f"{statistics.median(times[k]):.3f} / {min(times[k]):.3f} ({modules})")
             print(f"| `{name}` | " + " | ".join(cells) + " |", flush=True)
+        print(f"\nload average {os.getloadavg()[0]:.1f} at the end")
 
 
 if __name__ == "__main__":

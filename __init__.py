@@ -5,10 +5,12 @@ Public API (docs/api.md; everything the ``mrgc`` command does is a thin layer ov
 - :func:`parse_file`, :func:`parse_string`: read and check a ``.mrg`` file → :class:`MrgFile` holding checked
   :class:`Problem` objects (raises :class:`InputError` listing every diagnostic); :func:`check` adds the
   layout checks of ``mrgc check`` and returns the warnings; :func:`format_source`: canonical text.
-- :func:`compute_facts` (phase 1), :func:`compile` (task skeletons and statistics), :func:`export_model`
-  (the skeleton model as a solver file), :func:`plan` (a :class:`Plan` with status, reasons and statistics),
+- :func:`compute_facts` (phase 1), :func:`compile` (task skeletons and statistics: a :class:`CompileResult`
+  with a :class:`CompileStatus`), :func:`export_model` (the skeleton model as a solver file), :func:`plan`
+  (a :class:`Plan` with a :class:`PlanStatus`, reasons and statistics),
   :func:`validate` (a :class:`ValidationReport`), :func:`backends` (the registered solver backends).
-  Each takes a checked :class:`Problem` or the path of a ``.mrg`` file.
+  Each takes a checked :class:`Problem` or the path of a ``.mrg`` file.  :class:`ExitCode`: the command's
+  exit codes, one per outcome.
 - For backend plug-in authors: :class:`Backend`, :class:`BackendInfo` and the model they translate
   (:class:`SkeletonModel`, :class:`Row`, :class:`Feature`, :class:`Solution`, :class:`SolveStatus`);
   :mod:`mrgc.testing` holds the conformance kit, the skeleton oracle and hypothesis strategies.
@@ -45,6 +47,8 @@ _LAZY: dict[str, str] = {
     "BackendRecord": "mrgc.backends.registry:BackendRecord",
     "CheckReport": "mrgc.api:CheckReport",
     "CompileResult": "mrgc.planner.skeletons:CompileResult",
+    "CompileStatus": "mrgc.planner.skeletons:CompileStatus",
+    "ExitCode": "mrgc.exits:ExitCode",
     "Skeleton": "mrgc.compiler.skeleton:Skeleton",
     "Plan": "mrgc.planner.plan:Plan",
     "PlanStatus": "mrgc.planner.outcome:PlanStatus",
@@ -56,7 +60,7 @@ _LAZY: dict[str, str] = {
     "Row": "mrgc.compiler.ir:Row",
     "Feature": "mrgc.compiler.ir:Feature",
     "Solution": "mrgc.compiler.ir:Solution",
-    "SolveStatus": "mrgc.compiler.ir:Status",
+    "SolveStatus": "mrgc.compiler.ir:SolveStatus",
 }
 
 if TYPE_CHECKING:
@@ -64,8 +68,7 @@ if TYPE_CHECKING:
     from mrgc.api import CheckReport, check, compile, compute_facts, export_model, load_problem, plan, validate
     from mrgc.backends.registry import BackendRecord
     from mrgc.backends.base import Backend, BackendInfo
-    from mrgc.compiler.ir import Feature, Row, SkeletonModel, Solution
-    from mrgc.compiler.ir import Status as SolveStatus
+    from mrgc.compiler.ir import Feature, Row, SkeletonModel, Solution, SolveStatus
     from mrgc.compiler.skeleton import Skeleton
     from mrgc.geometry.facts import FactsResult
     from mrgc.language.loader import MrgFile, parse_file, parse_string
@@ -73,7 +76,8 @@ if TYPE_CHECKING:
     from mrgc.language.printer import format_source
     from mrgc.planner.outcome import PlanStatus
     from mrgc.planner.plan import Plan
-    from mrgc.planner.skeletons import CompileResult
+    from mrgc.exits import ExitCode
+    from mrgc.planner.skeletons import CompileResult, CompileStatus
     from mrgc.planner.validate import ValidationReport
 
 
@@ -93,7 +97,7 @@ def __dir__() -> list[str]:
 
 
 __all__ = ["__version__", "Diagnostic", "InputError", "MrgcError", "Span", "Backend", "BackendInfo",
-    "BackendRecord", "CheckReport", "CompileResult", "Domain", "Fact", "FactsResult", "Feature", "MrgFile",
+    "BackendRecord", "CheckReport", "CompileResult", "CompileStatus", "Domain", "ExitCode", "Fact", "FactsResult", "Feature", "MrgFile",
     "Plan", "PlanStatus", "Problem", "Row", "Skeleton", "SkeletonModel", "Solution", "SolveStatus",
     "ValidationReport", "backends", "check", "compile", "compute_facts", "export_model", "format_source",
     "load_problem", "parse_file", "parse_string", "plan", "validate"]

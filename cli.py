@@ -1,10 +1,7 @@
 """The ``mrgc`` command: a thin layer over the Python API.
 
-Exit codes (docs/errors.md): 0 ok; 1 infeasible (no skeleton under the facts) / ``fmt --check`` found
-unformatted files / ``validate`` found the plan invalid; 2 input error (bad file, bad plan file or bad
-command line); 3 time limit; 4 missing backend; 5 ``plan``: every skeleton tried, none grounded into a valid
-plan; 70 internal error; 130 interrupted (SIGINT), 143 terminated (SIGTERM).  No input produces a Python traceback:
-unexpected exceptions are reported in one line with exit code 70.
+Exit codes: the table of :mod:`mrgc.exits` (docs/errors.md is written from it).  No input produces a Python
+traceback: unexpected exceptions are reported in one line with exit code 70.
 """
 
 from __future__ import annotations
@@ -17,19 +14,11 @@ from typing import TYPE_CHECKING, Callable, Sequence
 
 from mrgc import __version__
 from mrgc.errors import Diagnostic, InputError, MrgcError
+from mrgc.exits import ExitCode
 from mrgc.limits import count, number
 
 if TYPE_CHECKING:
     from mrgc.language.loader import MrgFile
-
-EXIT_OK = 0
-EXIT_NO_PLAN = 1
-EXIT_INPUT = 2
-EXIT_TIME_LIMIT = 3
-EXIT_MISSING_BACKEND = 4
-EXIT_INTERNAL = 70
-EXIT_INTERRUPTED = 130
-
 
 class _Parser(argparse.ArgumentParser):
     """argparse whose usage errors are one ``error[E000]`` line and exit code 2."""
@@ -37,7 +26,7 @@ class _Parser(argparse.ArgumentParser):
     def error(self, message: str) -> None:  # type: ignore[override]
         self.print_usage(sys.stderr)
         print(f"mrgc: error[E000]: {message}", file=sys.stderr)
-        raise SystemExit(EXIT_INPUT)
+        raise SystemExit(ExitCode.INPUT)
 
 
 def _report(exc: InputError) -> None:
@@ -65,13 +54,13 @@ def _warn(path: str, text: str, warnings: Sequence[Diagnostic]) -> None:
 def cmd_check(args: argparse.Namespace) -> int:
     from mrgc.api import check
 
-    status = EXIT_OK
+    status = ExitCode.OK
     for path in args.files:
         try:
             report = check(path, allow_outside=getattr(args, "allow_outside", None) or ())
         except InputError as exc:
             _report(exc)
-            status = EXIT_INPUT
+            status = ExitCode.INPUT
             continue
         mf = report.file
         _warn(mf.path, mf.text, report.warnings)
@@ -94,7 +83,7 @@ def cmd_fmt(args: argparse.Namespace) -> int:
 
     if not (args.check or args.write or args.diff) and len(args.files) != 1:
         raise InputError([Diagnostic("E000", "fmt prints one file; use --check, --diff or --write for several")])
-    status = EXIT_OK
+    status = ExitCode.OK
     for path in args.files:
         text, diag = read_source(path)
         if diag is None:
@@ -104,7 +93,7 @@ def cmd_fmt(args: argparse.Namespace) -> int:
                 diag = tree
         if diag is not None:
             _report(InputError([diag], {path: text} if text is not None else {}))
-            status = EXIT_INPUT
+            status = ExitCode.INPUT
             continue
         assert text is not None and not isinstance(tree, Diagnostic)
         pretty = format_source(tree, text)
@@ -113,7 +102,7 @@ def cmd_fmt(args: argparse.Namespace) -> int:
                 sys.stdout.write(_unified_diff(path, text, pretty))
                 if args.check:
                     print(f"{path}: would reformat", file=sys.stderr)
-                    status = status or EXIT_NO_PLAN
+                    status = status or ExitCode.NO_PLAN
         elif args.write:
             if pretty != text:
                 write_text(path, pretty, option="fmt --write")
@@ -187,7 +176,7 @@ def cmd_compile(args: argparse.Namespace) -> int:
 
     from mrgc import api, outputs, signals
     from mrgc.backends.registry import check_export
-    from mrgc.planner.skeletons import needs_facts
+    from mrgc.planner.skeletons import COMPILE_EXIT_CODES, needs_facts
 
     mf = _load(args)
     problem = mf.problem(args.problem)
@@ -232,8 +221,8 @@ def cmd_compile(args: argparse.Namespace) -> int:
         if args.emit:
             print(f"model written to {args.emit} (horizon {result.stats['emitted_horizon']})")
     if result.skeletons:
-        return EXIT_OK
-    return {"infeasible": EXIT_NO_PLAN, "time limit": EXIT_TIME_LIMIT}.get(result.status, EXIT_INTERNAL)
+        return ExitCode.OK
+    return COMPILE_EXIT_CODES[result.status]
 
 
 def cmd_facts(args: argparse.Namespace) -> int:
@@ -261,7 +250,7 @@ def cmd_facts(args: argparse.Namespace) -> int:
         sys.stdout.write(doc.text)
     if args.stats:
         print(json.dumps(result.stats, indent=2), file=sys.stdout if args.output else sys.stderr)
-    return EXIT_OK
+    return ExitCode.OK
 
 
 def _write_asset(path: str, data: bytes, inputs: Sequence[str]) -> None:
@@ -339,7 +328,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
     else:
         for line in report.lines():
             print(line)
-    return EXIT_OK if report.ok else EXIT_NO_PLAN
+    return ExitCode.OK if report.ok else ExitCode.NO_PLAN
 
 
 def cmd_generate(args: argparse.Namespace) -> int:
@@ -350,10 +339,10 @@ def cmd_generate(args: argparse.Namespace) -> int:
                     others=args.others)
     if not args.output:
         sys.stdout.write(text)
-        return EXIT_OK
+        return ExitCode.OK
     write_text(args.output, text, [domain_path(args.kind)])
     print(f"{args.output}: {args.kind} problem written")
-    return EXIT_OK
+    return ExitCode.OK
 
 
 def cmd_backends(args: argparse.Namespace) -> int:
@@ -365,13 +354,13 @@ def cmd_backends(args: argparse.Namespace) -> int:
     rows = backends()
     if args.format == "json":
         print(json.dumps([r.to_json() for r in rows], indent=2))
-        return EXIT_OK
+        return ExitCode.OK
     for r in rows:
         state = f"installed ({r.library} {r.version})" if r.installed else f"missing: pip install {r.library}"
         print(f"{r.name:6} {r.title}: {state}; encodings: {', '.join(r.encodings)}")
     print()
     print(feature_table())
-    return EXIT_OK
+    return ExitCode.OK
 
 
 # ---------------------------------------------------------------- wiring
@@ -516,7 +505,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         args = parser.parse_args(argv)
         if not getattr(args, "func", None):
             parser.print_help()
-            return EXIT_INPUT
+            return ExitCode.INPUT
         func: Callable[[argparse.Namespace], int] = args.func
         code = func(args)
         if signals.received() is not None and code not in signals.EXIT_CODES.values():
@@ -525,7 +514,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             return signals.exit_code()
         return code
     except SystemExit as exc:  # argparse --help / --version / usage errors
-        return exc.code if isinstance(exc.code, int) else EXIT_INPUT
+        return exc.code if isinstance(exc.code, int) else ExitCode.INPUT
     except KeyboardInterrupt as exc:  # SIGINT, or SIGTERM (signals.Terminated)
         print(f"mrgc: {signals.describe(exc)}; nothing written", file=sys.stderr)
         return signals.exit_code(signal_of(exc))
@@ -536,7 +525,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"mrgc: error: {exc}", file=sys.stderr)
         return exc.exit_code
     except BrokenPipeError:
-        return EXIT_OK
+        return ExitCode.OK
     except Exception as exc:  # noqa: BLE001 - the promise is: never a traceback
         if signals.received() is not None:  # the signal's exception came back as another one (ctypes wraps a
             # KeyboardInterrupt raised while it converts a call's arguments, as in z3's model building, in an
@@ -545,7 +534,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             return signals.exit_code()
         print(f"mrgc: internal error[E070]: {type(exc).__name__}: {exc} "
               "(please report this with the input that caused it)", file=sys.stderr)
-        return EXIT_INTERNAL
+        return ExitCode.INTERNAL
     finally:
         signals.uninstall()
 

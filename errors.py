@@ -12,6 +12,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Iterable, NamedTuple, Sequence
 
+from mrgc.exits import ExitCode
+
 
 class Span(NamedTuple):
     """A half-open region of a source file: 1-based line and column of its first and one-past-last char.
@@ -78,7 +80,7 @@ def _snippet(text_lines: Sequence[str], span: Span) -> list[str]:
 class MrgcError(Exception):
     """Root of every exception mrgc raises on purpose.  ``exit_code`` is what the CLI exits with."""
 
-    exit_code: int = 70
+    exit_code: ExitCode = ExitCode.INTERNAL
 
     def __init__(self, message: str, diagnostics: Sequence[Diagnostic] = ()) -> None:
         super().__init__(message)
@@ -99,7 +101,7 @@ def _rebuild(cls: type, args: tuple[object, ...], state: dict[str, object]) -> "
 class InputError(MrgcError):
     """The user's input (a file or the command line) is wrong; carries every diagnostic found."""
 
-    exit_code = 2
+    exit_code = ExitCode.INPUT
 
     def __init__(self, diagnostics: Iterable[Diagnostic], sources: dict[str, str] | None = None) -> None:
         diags = tuple(diagnostics)
@@ -126,10 +128,10 @@ class InputError(MrgcError):
 class MissingBackendError(MrgcError):
     """A solver or geometry library needed for the request is not installed."""
 
-    exit_code = 4
+    exit_code = ExitCode.MISSING_BACKEND
 
 
 class InternalError(MrgcError):
     """A bug in mrgc; reported without a traceback and exit code 70."""
 
-    exit_code = 70
+    exit_code = ExitCode.INTERNAL

@@ -32,8 +32,10 @@ import sys
 import threading
 from typing import Callable, Iterator
 
+from mrgc.exits import ExitCode
+
 #: exit code of each handled signal (128 + the signal number, the shell's convention)
-EXIT_CODES: dict[int, int] = {signal.SIGINT: 130, signal.SIGTERM: 143}
+EXIT_CODES: dict[int, ExitCode] = {signal.SIGINT: ExitCode.INTERRUPTED, signal.SIGTERM: ExitCode.TERMINATED}
 NAMES: dict[int, str] = {signal.SIGINT: "interrupted (SIGINT)", signal.SIGTERM: "terminated (SIGTERM)"}
 
 
@@ -153,7 +155,7 @@ def received() -> int | None:
 def exit_code(signum: int | None = None) -> int:
     """The exit code for ``signum`` (default: the first received; SIGINT's 130 when none was)."""
     sig = signum if signum is not None else received()
-    return EXIT_CODES.get(sig if sig is not None else signal.SIGINT, 130)
+    return EXIT_CODES.get(sig if sig is not None else signal.SIGINT, ExitCode.INTERRUPTED)
 
 
 def describe(exc: BaseException | None = None) -> str:

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 from typing import ClassVar, Sequence
 
 from mrgc.compiler.encodings import ENCODINGS
-from mrgc.compiler.ir import Feature, Row, SkeletonModel, Solution, Status
+from mrgc.compiler.ir import Feature, Row, SkeletonModel, Solution, SolveStatus
 from mrgc.compiler.lowering import lower
 from mrgc.errors import Diagnostic, InputError, MrgcError
 
@@ -73,13 +73,13 @@ class Backend(ABC):
         try:
             sol = self._solve(time_limit)
         except Exception as exc:  # noqa: BLE001 - a failing solver is an outcome, not a crash
-            return Solution(Status.ERROR, message=f"{self.name}: {type(exc).__name__}: {exc}",
+            return Solution(SolveStatus.ERROR, message=f"{self.name}: {type(exc).__name__}: {exc}",
                             seconds=time.perf_counter() - t0)
         seconds = time.perf_counter() - t0
-        if sol.status in (Status.OPTIMAL, Status.FEASIBLE):
+        if sol.status in (SolveStatus.OPTIMAL, SolveStatus.FEASIBLE):
             bad = self.model.violated(sol.values)
             if bad:
-                return Solution(Status.ERROR, message=f"{self.name} returned a solution violating {bad[:3]}",
+                return Solution(SolveStatus.ERROR, message=f"{self.name} returned a solution violating {bad[:3]}",
                                 seconds=seconds)
             objective = tuple(self.model.evaluate(o, sol.values) for o in self.model.objectives)
             return Solution(sol.status, sol.values, objective, seconds, sol.message)

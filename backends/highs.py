@@ -11,7 +11,7 @@ import re
 from typing import Any, Sequence
 
 from mrgc.backends.base import Backend, BackendInfo
-from mrgc.compiler.ir import Row, SkeletonModel, Solution, Status
+from mrgc.compiler.ir import Row, SkeletonModel, Solution, SolveStatus
 from mrgc.errors import MissingBackendError
 from mrgc.signals import stop_on_signal
 
@@ -107,19 +107,19 @@ class HighsBackend(Backend):
         S = hs.HighsModelStatus
         if status == S.kModelEmpty:  # no variables: only constant rows, which hold or not
             assert self.model is not None
-            return Solution(Status.INFEASIBLE if self.model.violated(()) else Status.OPTIMAL, ())
+            return Solution(SolveStatus.INFEASIBLE if self.model.violated(()) else SolveStatus.OPTIMAL, ())
         if status == S.kOptimal:
             values = tuple(int(round(x)) for x in self.h.getSolution().col_value)
-            return Solution(Status.OPTIMAL, values)
+            return Solution(SolveStatus.OPTIMAL, values)
         if status in (S.kInfeasible, S.kUnboundedOrInfeasible):
-            return Solution(Status.INFEASIBLE)
+            return Solution(SolveStatus.INFEASIBLE)
         if status in (S.kTimeLimit, S.kInterrupt, S.kIterationLimit, S.kSolutionLimit):
             info = self.h.getInfo()
             if info.primal_solution_status == 2:  # a feasible incumbent exists
                 values = tuple(int(round(x)) for x in self.h.getSolution().col_value)
-                return Solution(Status.FEASIBLE, values, message="time limit")
-            return Solution(Status.TIME_LIMIT, message="time limit")
-        return Solution(Status.ERROR, message=f"HiGHS: {self.h.modelStatusToString(status)}")
+                return Solution(SolveStatus.FEASIBLE, values, message="time limit")
+            return Solution(SolveStatus.TIME_LIMIT, message="time limit")
+        return Solution(SolveStatus.ERROR, message=f"HiGHS: {self.h.modelStatusToString(status)}")
 
     def _export(self, path: str) -> None:
         """``writeModel``; rows without terms (0 >= 1 says "infeasible") and models without variables are

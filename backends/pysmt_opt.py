@@ -12,7 +12,7 @@ import time
 from typing import Any, Sequence
 
 from mrgc.backends.base import Backend, BackendInfo
-from mrgc.compiler.ir import Feature, Row, SkeletonModel, Solution, Status, Terms
+from mrgc.compiler.ir import Feature, Row, SkeletonModel, Solution, SolveStatus, Terms
 from mrgc.errors import MissingBackendError
 from mrgc.signals import stop_on_signal
 
@@ -127,8 +127,8 @@ class PysmtBackend(Backend):
         finally:
             self.solver.pop()
         if best is None:
-            return Solution(Status.INFEASIBLE)
-        return Solution(Status.OPTIMAL, best)
+            return Solution(SolveStatus.INFEASIBLE)
+        return Solution(SolveStatus.OPTIMAL, best)
 
     def _stop(self) -> None:
         """Interrupt a running check (Ctrl-C / SIGTERM, mrgc.signals); only the z3 wrapper can."""
@@ -142,5 +142,5 @@ class PysmtBackend(Backend):
     @staticmethod
     def _timed_out(best: tuple[int, ...] | None) -> Solution:
         if best is None:
-            return Solution(Status.TIME_LIMIT, message="time limit")
-        return Solution(Status.FEASIBLE, best, message="time limit")
+            return Solution(SolveStatus.TIME_LIMIT, message="time limit")
+        return Solution(SolveStatus.FEASIBLE, best, message="time limit")

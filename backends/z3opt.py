@@ -14,7 +14,7 @@ import threading
 from typing import Any, Sequence
 
 from mrgc.backends.base import Backend, BackendInfo
-from mrgc.compiler.ir import Feature, Row, SkeletonModel, Solution, Status, Terms
+from mrgc.compiler.ir import Feature, Row, SkeletonModel, Solution, SolveStatus, Terms
 from mrgc.errors import MissingBackendError
 from mrgc.signals import shielded, stop_on_signal
 
@@ -110,19 +110,19 @@ class Z3Backend(Backend):
             if watchdog is not None:
                 watchdog.cancel()
         if res == z3.unsat:
-            return Solution(Status.INFEASIBLE)
+            return Solution(SolveStatus.INFEASIBLE)
         if res == z3.unknown:
             reason = self.opt.reason_unknown()
             if time_limit is not None or "timeout" in reason or "canceled" in reason:
-                return Solution(Status.TIME_LIMIT, message=reason or "time limit")
-            return Solution(Status.ERROR, message=f"z3: {reason}")
+                return Solution(SolveStatus.TIME_LIMIT, message=reason or "time limit")
+            return Solution(SolveStatus.ERROR, message=f"z3: {reason}")
         m = self.opt.model()
         values = tuple(
             (1 if z3.is_true(m.eval(x, model_completion=True)) else 0) if b
             else m.eval(x, model_completion=True).as_long()
             for x, b in zip(self.x, self.is_bool)
         )
-        return Solution(Status.OPTIMAL, values)
+        return Solution(SolveStatus.OPTIMAL, values)
 
     def _export(self, path: str) -> None:
         with open(path, "w", encoding="utf-8") as fh:

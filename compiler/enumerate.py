@@ -10,6 +10,7 @@ the horizon and the cuts, so asking again continues where it stopped.
 
 from __future__ import annotations
 
+import enum
 import math
 import time
 from dataclasses import dataclass, field
@@ -17,16 +18,25 @@ from typing import Callable
 
 from mrgc.compiler.diagnose import prune
 from mrgc.compiler.encodings.base import Encoded, Encoding
-from mrgc.compiler.ir import Row, Solver, Status
+from mrgc.compiler.ir import Row, SolveStatus, Solver
 from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import TaskGraph
 
 
-# Why ``next`` stopped: outcomes are values, not exceptions.
-ENOUGH = "enough"  # k skeletons found (more may exist)
-EXHAUSTED = "exhausted"  # every skeleton within the horizon limit has been returned
-TIME_LIMIT = "time limit"
-ERROR = "error"
+class BatchOutcome(enum.StrEnum):
+    """Why :meth:`SkeletonGenerator.next` stopped: outcomes are values, not exceptions."""
+
+    #: the skeletons asked for were found (more may exist)
+    ENOUGH = "enough"
+    #: every skeleton within the horizon limit has been returned
+    EXHAUSTED = "exhausted"
+    TIME_LIMIT = "time limit"
+    #: the solver failed (its message says how)
+    ERROR = "error"
+
+
+#: the former name of ``BatchOutcome.EXHAUSTED``, kept while planner/search.py still imports it
+EXHAUSTED = BatchOutcome.EXHAUSTED
 
 
 @dataclass
@@ -34,7 +44,7 @@ class Batch:
     """What one call of :meth:`SkeletonGenerator.next` produced."""
 
     skeletons: list[Skeleton]
-    outcome: str
+    outcome: BatchOutcome
     message: str = ""
     stats: dict[str, float] = field(default_factory=dict)
 
@@ -80,34 +90,34 @@ class SkeletonGenerator:
         out: list[Skeleton] = []
         if self.trivial and not self.done:
             self.done = True
-            return Batch([Skeleton(())] if k > 0 else [], EXHAUSTED, stats=dict(self.stats))
+            return Batch([Skeleton(())] if k > 0 else [], BatchOutcome.EXHAUSTED, stats=dict(self.stats))
         while len(out) < k:
             if self.done or self.horizon > self.limit:
                 self.done = True
-                return Batch(out, EXHAUSTED, stats=dict(self.stats))
+                return Batch(out, BatchOutcome.EXHAUSTED, stats=dict(self.stats))
             if self.solver is None:
                 self._load()
             assert self.solver is not None and self.encoded is not None
             left = None if deadline is None else deadline - time.perf_counter()
             if left is not None and left <= 0:
-                return Batch(out, TIME_LIMIT, stats=dict(self.stats))
+                return Batch(out, BatchOutcome.TIME_LIMIT, stats=dict(self.stats))
             sol = self.solver.solve(left)
             self.stats["solves"] += 1
             self.stats["solve_seconds"] += sol.seconds
-            if sol.status == Status.OPTIMAL:
+            if sol.status == SolveStatus.OPTIMAL:
                 skel = self.encoded.decode(sol.values)
                 chosen = frozenset(i for i, v in enumerate(self.encoded.select) if sol.values[v])
                 self.found.append(chosen)
                 self.solver.add_rows([self.encoded.cut(chosen, name=f"cut{len(self.found) - 1}")])
                 out.append(skel)
-            elif sol.status == Status.INFEASIBLE:
+            elif sol.status == SolveStatus.INFEASIBLE:
                 if not self.encoding.horizon_loop:
                     self.done = True
                     continue
                 self.horizon += 1
                 self.solver = None
-            elif sol.status in (Status.TIME_LIMIT, Status.FEASIBLE):
-                return Batch(out, TIME_LIMIT, sol.message, stats=dict(self.stats))
+            elif sol.status in (SolveStatus.TIME_LIMIT, SolveStatus.FEASIBLE):
+                return Batch(out, BatchOutcome.TIME_LIMIT, sol.message, stats=dict(self.stats))
             else:
-                return Batch(out, ERROR, sol.message, stats=dict(self.stats))
-        return Batch(out, ENOUGH, stats=dict(self.stats))
+                return Batch(out, BatchOutcome.ERROR, sol.message, stats=dict(self.stats))
+        return Batch(out, BatchOutcome.ENOUGH, stats=dict(self.stats))

@@ -152,8 +152,8 @@ def merge_terms(terms: Sequence[tuple[int, int]]) -> Terms:
     return tuple((v, c) for v, c in acc.items() if c)
 
 
-class Status(str, enum.Enum):
-    """How a solve ended."""
+class SolveStatus(enum.StrEnum):
+    """How one solve of a skeleton model ended (``mrgc.SolveStatus``)."""
 
     OPTIMAL = "optimal"
     FEASIBLE = "feasible"
@@ -162,11 +162,15 @@ class Status(str, enum.Enum):
     ERROR = "error"
 
 
+#: the former name of :class:`SolveStatus`, kept while backends/cpsat.py still imports it
+Status = SolveStatus
+
+
 @dataclass(frozen=True)
 class Solution:
     """A solver's answer: a status, and for OPTIMAL/FEASIBLE the value of every variable."""
 
-    status: Status
+    status: SolveStatus
     values: tuple[int, ...] = ()
     objective: tuple[int, ...] = ()
     seconds: float = 0.0

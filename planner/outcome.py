@@ -28,8 +28,10 @@ from collections import Counter
 from dataclasses import dataclass, field
 from typing import Any
 
+from mrgc.exits import ExitCode
 
-class PlanStatus(str, enum.Enum):
+
+class PlanStatus(enum.StrEnum):
     """The outcome of a planning run (see the module docstring for the exit codes)."""
 
     SOLVED = "solved"
@@ -38,17 +40,14 @@ class PlanStatus(str, enum.Enum):
     TIME_LIMIT = "time limit"
     INTERRUPTED = "interrupted"
 
-    def __str__(self) -> str:
-        return self.value
 
-
-#: status -> process exit code of ``mrgc plan``
-EXIT_CODES: dict[PlanStatus, int] = {
-    PlanStatus.SOLVED: 0,
-    PlanStatus.INFEASIBLE: 1,
-    PlanStatus.TIME_LIMIT: 3,
-    PlanStatus.EXHAUSTED: 5,
-    PlanStatus.INTERRUPTED: 130,
+#: status -> process exit code of ``mrgc plan`` (the codes of :mod:`mrgc.exits`)
+EXIT_CODES: dict[PlanStatus, ExitCode] = {
+    PlanStatus.SOLVED: ExitCode.OK,
+    PlanStatus.INFEASIBLE: ExitCode.NO_PLAN,
+    PlanStatus.TIME_LIMIT: ExitCode.TIME_LIMIT,
+    PlanStatus.EXHAUSTED: ExitCode.EXHAUSTED,
+    PlanStatus.INTERRUPTED: ExitCode.INTERRUPTED,
 }
 
 

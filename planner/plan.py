@@ -127,7 +127,8 @@ class Plan:
     backend: str
     encoding: str
     seed: int
-    status: PlanStatus | str  # a PlanStatus (its value is what the JSON holds)
+    #: how the run ended (a status's value, as the JSON holds it, is turned into the status)
+    status: PlanStatus
     steps: list[list[PlannedAction]] = field(default_factory=list)
     symbolic: bool = False
     stats: dict[str, Any] = field(default_factory=dict)
@@ -141,8 +142,12 @@ class Plan:
     #: for any file holding this problem (its facts file too), whatever its bytes
     problem_digest: str | None = None
 
+    def __post_init__(self) -> None:
+        self.status = PlanStatus(self.status)
+
     @property
     def makespan(self) -> int:
+        """The number of steps."""
         return len(self.steps)
 
     @property
@@ -161,7 +166,7 @@ class Plan:
             "backend": self.backend,
             "encoding": self.encoding,
             "seed": self.seed,
-            "status": str(PlanStatus(self.status)),
+            "status": str(self.status),
             "symbolic": self.symbolic,
             **({} if self.symbolic else {"motion_model": (self.motion_model or planner_motion_model()).to_json()}),
             "makespan": self.makespan if self.steps else None,
@@ -181,7 +186,7 @@ class Plan:
         return json.dumps(self.to_json(), indent=1, sort_keys=False) + "\n"
 
     def summary(self) -> list[str]:
-        lines = [f"plan for {self.problem}: {PlanStatus(self.status)}"
+        lines = [f"plan for {self.problem}: {self.status}"
                  + (f", makespan {self.makespan}, {self.motion_cost} objects moved" if self.steps else "")]
         for i, step in enumerate(self.steps, 1):
             parts = []
@@ -190,7 +195,7 @@ class Plan:
                 grasp = a.pick_grasp if a.kind == "pick-place" else f"{a.pick_grasp}->{a.place_grasp}"
                 parts.append(f"{who} moves {a.object} to {a.region} ({grasp})")
             lines.append(f"  step {i}: " + "; ".join(parts))
-        if self.why is not None and PlanStatus(self.status) is not PlanStatus.SOLVED:
+        if self.why is not None and self.status is not PlanStatus.SOLVED:
             lines += self.why.lines()
         return lines
 

@@ -7,6 +7,7 @@ A geometric problem without cached facts gets them from phase 1 (the geometry la
 
 from __future__ import annotations
 
+import enum
 import time
 from dataclasses import dataclass, field
 from typing import Any, Iterable
@@ -15,29 +16,47 @@ from mrgc.backends.base import Backend
 from mrgc.backends.registry import backend_class, check_export
 from mrgc.compiler.diagnose import explain_infeasible
 from mrgc.compiler.encodings import get_encoding
-from mrgc.compiler.enumerate import ERROR, EXHAUSTED, TIME_LIMIT, Batch, SkeletonGenerator
+from mrgc.compiler.enumerate import Batch, BatchOutcome, SkeletonGenerator
 from mrgc.compiler.facts import FactBase
 from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import TaskGraph, build_task_graph
 from mrgc.errors import Diagnostic, InputError
+from mrgc.exits import ExitCode
 from mrgc.language.model import Fact, Problem
 
 DEFAULT_BACKEND = "cpsat"
 DEFAULT_ENCODING = "time-of-move"
 
 
+class CompileStatus(enum.StrEnum):
+    """How compiling a problem ended (``mrgc.CompileStatus``; its value is what the JSON holds)."""
+
+    #: the skeletons asked for, or every one that exists, in proven order
+    OPTIMAL = "optimal"
+    #: no skeleton within the horizon limit
+    INFEASIBLE = "infeasible"
+    TIME_LIMIT = "time limit"
+    #: the solver failed (the reasons say how)
+    ERROR = "error"
+
+
+#: status -> exit code of ``mrgc compile`` when it found no skeleton (with a skeleton it exits 0)
+COMPILE_EXIT_CODES: dict[CompileStatus, ExitCode] = {
+    CompileStatus.OPTIMAL: ExitCode.OK,
+    CompileStatus.INFEASIBLE: ExitCode.NO_PLAN,
+    CompileStatus.TIME_LIMIT: ExitCode.TIME_LIMIT,
+    CompileStatus.ERROR: ExitCode.INTERNAL,
+}
+
+
 @dataclass
 class CompileResult:
-    """The outcome of compiling a problem: a status and the skeletons in (makespan, moved) order.
-
-    ``status`` is ``optimal`` (the skeletons asked for, or every one that exists, in proven order),
-    ``infeasible`` (no skeleton within the horizon limit), ``time limit`` or ``error``.
-    """
+    """The outcome of compiling a problem: a status and the skeletons in (makespan, moved) order."""
 
     problem: str
     backend: str
     encoding: str
-    status: str
+    status: CompileStatus
     skeletons: list[Skeleton]
     reasons: list[str] = field(default_factory=list)
     stats: dict[str, Any] = field(default_factory=dict)
@@ -47,7 +66,7 @@ class CompileResult:
             "problem": self.problem,
             "backend": self.backend,
             "encoding": self.encoding,
-            "status": self.status,
+            "status": str(self.status),
             "skeletons": [s.to_json() for s in self.skeletons],
             "reasons": list(self.reasons),
             "stats": self.stats,
@@ -125,14 +144,14 @@ def compile_problem(problem: Problem, backend: str | type[Backend] = DEFAULT_BAC
         "total_seconds": round(time.perf_counter() - t0 + source.graph_seconds, 6),
         **{k: (round(v, 6) if isinstance(v, float) else v) for k, v in batch.stats.items()},
     }
-    if batch.outcome == ERROR:
-        status = "error"
-    elif batch.outcome == TIME_LIMIT:
-        status = "time limit"
-    elif not batch.skeletons and batch.outcome == EXHAUSTED:
-        status = "infeasible"
+    if batch.outcome is BatchOutcome.ERROR:
+        status = CompileStatus.ERROR
+    elif batch.outcome is BatchOutcome.TIME_LIMIT:
+        status = CompileStatus.TIME_LIMIT
+    elif not batch.skeletons and batch.outcome is BatchOutcome.EXHAUSTED:
+        status = CompileStatus.INFEASIBLE
     else:
-        status = "optimal"
+        status = CompileStatus.OPTIMAL
     reasons = list(source.reasons) or ([batch.message] if batch.message else [])
     return CompileResult(problem.name, source.backend, encoding, status, batch.skeletons, reasons, stats)
 

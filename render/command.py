@@ -14,6 +14,7 @@ import sys
 from typing import Any, Iterator
 
 from mrgc.errors import Diagnostic, InputError
+from mrgc.exits import ExitCode
 
 MAX_SIDE = 4096  # pixels
 MAX_FPS = 60.0
@@ -126,7 +127,7 @@ def cmd_render(args: argparse.Namespace) -> int:
             assert plan is not None
             stats = outputs.write_animation(problem, plan, tmp, opts, source, bar)
     print(_written(kind, args.output, stats))
-    return 0
+    return ExitCode.OK
 
 
 def _written(kind: str, path: str, stats: dict[str, Any]) -> str:
@@ -165,4 +166,4 @@ def cmd_graph(args: argparse.Namespace) -> int:
         with files.atomic_path(args.output, list(mf.files)) as tmp:
             graph.run_dot(text, ext[1:], tmp)
     print(f"{args.output}: task graph of {problem.name}: {info}")
-    return 0
+    return ExitCode.OK

@@ -36,7 +36,7 @@ from pathlib import Path
 from typing import Callable, Sequence
 
 from mrgc.backends.base import Backend
-from mrgc.compiler.ir import AtMostOne, NoOverlap, Row, SkeletonModel, Solution, Status
+from mrgc.compiler.ir import AtMostOne, NoOverlap, Row, SkeletonModel, Solution, SolveStatus
 
 #: the shipped symbolic fixtures (installed with the package)
 FIXTURES = Path(__file__).resolve().parent.parent / "domains" / "symbolic"
@@ -87,7 +87,7 @@ def objectives(model: SkeletonModel, values: Sequence[int]) -> tuple[int, ...]:
     return tuple(sum(c * values[v] for v, c in terms) for terms in model.objectives)
 
 
-def brute_force(model: SkeletonModel) -> tuple[Status, tuple[int, ...] | None, list[tuple[int, ...]]]:
+def brute_force(model: SkeletonModel) -> tuple[SolveStatus, tuple[int, ...] | None, list[tuple[int, ...]]]:
     """(status, lexicographic optimum, every optimal assignment) by trying every assignment."""
     best: tuple[int, ...] | None = None
     arg: list[tuple[int, ...]] = []
@@ -99,7 +99,7 @@ def brute_force(model: SkeletonModel) -> tuple[Status, tuple[int, ...] | None, l
             best, arg = obj, [values]
         elif obj == best:
             arg.append(values)
-    return (Status.INFEASIBLE if best is None else Status.OPTIMAL), best, arg
+    return (SolveStatus.INFEASIBLE if best is None else SolveStatus.OPTIMAL), best, arg
 
 
 # ---------------------------------------------------------------- the models
@@ -236,22 +236,22 @@ class Case:
     """A model of the kit with its expected status and lexicographic optimum."""
 
     build: Callable[[], SkeletonModel]
-    status: Status
+    status: SolveStatus
     optimum: tuple[int, ...] | None
 
 
 #: model name -> its case
 MODELS: dict[str, Case] = {
-    "pure-rows": Case(pure_rows, Status.OPTIMAL, (5,)),
-    "ints": Case(rows_with_ints, Status.OPTIMAL, (6,)),
-    "conditional": Case(conditional_rows, Status.OPTIMAL, (5,)),
-    "at-most-one": Case(at_most_one, Status.OPTIMAL, (-5,)),
-    "no-overlap": Case(no_overlap, Status.OPTIMAL, (-7,)),
-    "no-overlap-makespan": Case(no_overlap_makespan, Status.OPTIMAL, (4,)),
-    "lexicographic": Case(lexicographic, Status.OPTIMAL, (0, 8, -1)),
-    "infeasible-bools": Case(infeasible_bools, Status.INFEASIBLE, None),
-    "infeasible-integrality": Case(infeasible_integrality, Status.INFEASIBLE, None),
-    "infeasible-conditional": Case(infeasible_conditional, Status.INFEASIBLE, None),
+    "pure-rows": Case(pure_rows, SolveStatus.OPTIMAL, (5,)),
+    "ints": Case(rows_with_ints, SolveStatus.OPTIMAL, (6,)),
+    "conditional": Case(conditional_rows, SolveStatus.OPTIMAL, (5,)),
+    "at-most-one": Case(at_most_one, SolveStatus.OPTIMAL, (-5,)),
+    "no-overlap": Case(no_overlap, SolveStatus.OPTIMAL, (-7,)),
+    "no-overlap-makespan": Case(no_overlap_makespan, SolveStatus.OPTIMAL, (4,)),
+    "lexicographic": Case(lexicographic, SolveStatus.OPTIMAL, (0, 8, -1)),
+    "infeasible-bools": Case(infeasible_bools, SolveStatus.INFEASIBLE, None),
+    "infeasible-integrality": Case(infeasible_integrality, SolveStatus.INFEASIBLE, None),
+    "infeasible-conditional": Case(infeasible_conditional, SolveStatus.INFEASIBLE, None),
 }
 
 
@@ -308,7 +308,7 @@ def check_known_optima(backend: BackendClass) -> None:
         sol = solve(backend, model)
         _require(sol.status == case.status, f"{name}: status {sol.status.value}, expected {case.status.value} "
                                             f"({sol.message})")
-        if case.status == Status.OPTIMAL:
+        if case.status == SolveStatus.OPTIMAL:
             require_valid(model, sol)
             got = objectives(model, sol.values)
             _require(got == case.optimum, f"{name}: objective {got}, the optimum is {case.optimum}")
@@ -357,9 +357,9 @@ def check_incremental_cuts(backend: BackendClass) -> None:
     costs: list[int] = []
     for _ in range(10):
         sol = solver.solve()
-        if sol.status == Status.INFEASIBLE:
+        if sol.status == SolveStatus.INFEASIBLE:
             break
-        _require(sol.status == Status.OPTIMAL, f"cuts: status {sol.status.value} ({sol.message})")
+        _require(sol.status == SolveStatus.OPTIMAL, f"cuts: status {sol.status.value} ({sol.message})")
         values = tuple(sol.values[:3])
         require_valid(model, sol, f" after {len(found)} cuts")
         found.append(values)
@@ -381,12 +381,12 @@ def check_rows_after_solving(backend: BackendClass) -> None:
     makespan = len(model.vars) - 1
     solver.add_rows([Row(((makespan, 1),), lo=5, name="C>=5")])
     sol = solver.solve()
-    _require(sol.status == Status.OPTIMAL and sol.objective == (5,),
+    _require(sol.status == SolveStatus.OPTIMAL and sol.objective == (5,),
              f"after C >= 5: {sol.status.value} {sol.objective}, expected optimal (5,)")
     require_valid(model, sol, " after C >= 5")
     solver.add_rows([Row(((0, 1),), hi=0, name="p0 absent")])  # contradicts p0 >= 1
     sol = solver.solve()
-    _require(sol.status == Status.INFEASIBLE, f"after p0 <= 0 (p0 >= 1 holds): {sol.status.value}, expected "
+    _require(sol.status == SolveStatus.INFEASIBLE, f"after p0 <= 0 (p0 >= 1 holds): {sol.status.value}, expected "
                                               f"infeasible")
 
 
@@ -394,20 +394,20 @@ def check_zero_variables(backend: BackendClass) -> None:
     """Models without variables: optimal with no values (objective 0 when there is one); a constant row
     0 >= 1 is infeasible (the encodings produce such rows)."""
     sol = solve(backend, SkeletonModel(name="empty"))
-    _require((sol.status, sol.values, sol.objective) == (Status.OPTIMAL, (), ()), f"empty model: {sol}")
+    _require((sol.status, sol.values, sol.objective) == (SolveStatus.OPTIMAL, (), ()), f"empty model: {sol}")
     sol = solve(backend, SkeletonModel(name="empty-objective", objectives=[()]))
-    _require((sol.status, sol.values, sol.objective) == (Status.OPTIMAL, (), (0,)), f"empty objective: {sol}")
+    _require((sol.status, sol.values, sol.objective) == (SolveStatus.OPTIMAL, (), (0,)), f"empty objective: {sol}")
     sol = solve(backend, SkeletonModel(name="empty-true", rows=[Row((), lo=0, hi=0)]))
-    _require(sol.status == Status.OPTIMAL, f"0 == 0: {sol.status.value}, expected optimal")
+    _require(sol.status == SolveStatus.OPTIMAL, f"0 == 0: {sol.status.value}, expected optimal")
     sol = solve(backend, SkeletonModel(name="empty-false", rows=[Row((), lo=1)]))
-    _require(sol.status == Status.INFEASIBLE, f"0 >= 1: {sol.status.value}, expected infeasible ({sol.message})")
+    _require(sol.status == SolveStatus.INFEASIBLE, f"0 >= 1: {sol.status.value}, expected infeasible ({sol.message})")
 
 
 def check_determinism(backend: BackendClass) -> None:
     """The same model and seed give the same values (the model has many optima)."""
     first = solve(backend, symmetric(), seed=7)
     second = solve(backend, symmetric(), seed=7)
-    _require(first.status == second.status == Status.OPTIMAL, f"symmetric: {first.status.value}, "
+    _require(first.status == second.status == SolveStatus.OPTIMAL, f"symmetric: {first.status.value}, "
                                                                f"{second.status.value}")
     _require(first.values == second.values, f"symmetric, seed 7: {first.values} then {second.values}")
     require_valid(symmetric(), first)
@@ -421,11 +421,11 @@ def check_time_limit(backend: BackendClass) -> None:
     mean "no limit"."""
     hard = hard_ish(1000)
     sol = solve(backend, hard, time_limit=0.001)
-    _require(sol.status in (Status.TIME_LIMIT, Status.FEASIBLE, Status.OPTIMAL),
+    _require(sol.status in (SolveStatus.TIME_LIMIT, SolveStatus.FEASIBLE, SolveStatus.OPTIMAL),
              f"1 ms limit: status {sol.status.value} ({sol.message})")
-    if sol.status in (Status.FEASIBLE, Status.OPTIMAL):
+    if sol.status in (SolveStatus.FEASIBLE, SolveStatus.OPTIMAL):
         require_valid(hard, sol, " (1 ms limit)")
-    if sol.status == Status.OPTIMAL:
+    if sol.status == SolveStatus.OPTIMAL:
         _require(sol.objective == (999,), f"1 ms limit: claims optimal {sol.objective}, the optimum is (999,)")
     harder = hard_ish(2000)
     solver = backend()
@@ -433,7 +433,7 @@ def check_time_limit(backend: BackendClass) -> None:
     t0 = time.perf_counter()
     sol = solver.solve(time_limit=0.0004)
     elapsed = time.perf_counter() - t0
-    _require(sol.status in (Status.TIME_LIMIT, Status.FEASIBLE, Status.OPTIMAL),
+    _require(sol.status in (SolveStatus.TIME_LIMIT, SolveStatus.FEASIBLE, SolveStatus.OPTIMAL),
              f"0.4 ms limit: status {sol.status.value} ({sol.message})")
     _require(elapsed < 0.3, f"0.4 ms limit: ran {elapsed:.2f} s ({sol.status.value})")
 

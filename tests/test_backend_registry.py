@@ -14,7 +14,7 @@ import pytest
 from mrgc import cli
 from mrgc.backends import registry
 from mrgc.backends.base import Backend, BackendInfo
-from mrgc.compiler.ir import Row, SkeletonModel, Solution, Status
+from mrgc.compiler.ir import Row, SkeletonModel, Solution, SolveStatus
 
 ROOT = Path(__file__).resolve().parent.parent
 CHAIN3 = str(ROOT / "domains" / "symbolic" / "chain-3.mrg")
@@ -81,8 +81,8 @@ class BruteForceBackend(Backend):
             if best_obj is None or obj < best_obj:
                 best, best_obj = values, obj
         if best is None:
-            return Solution(Status.INFEASIBLE)
-        return Solution(Status.OPTIMAL, best)
+            return Solution(SolveStatus.INFEASIBLE)
+        return Solution(SolveStatus.OPTIMAL, best)
 
 
 class _EntryPoint:

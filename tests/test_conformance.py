@@ -11,7 +11,7 @@ import pytest
 
 from mrgc.backends.base import BackendInfo
 from mrgc.backends.registry import backend_class, names
-from mrgc.compiler.ir import Row, SkeletonModel, Solution, Status
+from mrgc.compiler.ir import Row, SkeletonModel, Solution, SolveStatus
 from mrgc.testing import conformance as kit
 
 BACKENDS = names()
@@ -68,7 +68,7 @@ def test_conditional_model_tells_negative_literals_apart() -> None:
 def test_lexicographic_model_tells_weightings_apart() -> None:
     m = kit.lexicographic()
     status, lex, _ = kit.brute_force(m)
-    assert status == Status.OPTIMAL and lex == (0, 8, -1)
+    assert status == SolveStatus.OPTIMAL and lex == (0, 8, -1)
     naive = SkeletonModel(m.vars, m.rows, objectives=[((m.objectives[0][0][0], 16),) + m.objectives[1] + m.objectives[2]])
     _, _, arg = kit.brute_force(naive)
     assert arg and all(kit.objectives(m, v)[0] == 1 for v in arg)  # a too-small weight picks a = 1
@@ -85,9 +85,9 @@ def _broken(name: str, fault: str) -> type:
 
         def _solve(self, time_limit: float | None) -> Solution:
             sol: Solution = super()._solve(time_limit)
-            if fault == "infeasible-as-optimal" and sol.status == Status.INFEASIBLE:
+            if fault == "infeasible-as-optimal" and sol.status == SolveStatus.INFEASIBLE:
                 assert self.model is not None
-                return Solution(Status.OPTIMAL, tuple(v.lb for v in self.model.vars))
+                return Solution(SolveStatus.OPTIMAL, tuple(v.lb for v in self.model.vars))
             if fault == "ignores-added-rows":
                 return self._first if hasattr(self, "_first") else self._remember(sol)
             return sol

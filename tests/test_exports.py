@@ -15,7 +15,7 @@ import mrgc
 from mrgc import cli
 from mrgc.backends.registry import backend_class
 from mrgc.compiler.facts import FactBase
-from mrgc.compiler.ir import Solution, Status
+from mrgc.compiler.ir import Solution, SolveStatus
 from mrgc.planner.skeletons import SkeletonSource, must_move
 
 SYMBOLIC = Path(__file__).resolve().parent.parent / "domains" / "symbolic"
@@ -33,7 +33,7 @@ def reference(problem: Any, backend: str, encoding: str, horizon: int) -> Soluti
     return solver.solve()
 
 
-def reload(path: Path) -> tuple[Status, tuple[int, ...]]:
+def reload(path: Path) -> tuple[SolveStatus, tuple[int, ...]]:
     """(status, objective values) of the model file solved by its own solver, read the solver's way."""
     ext = path.suffix.lstrip(".")
     if ext == "smt2":
@@ -43,10 +43,10 @@ def reload(path: Path) -> tuple[Status, tuple[int, ...]]:
         opt.from_file(str(path))
         result = opt.check()
         if result == z3.unsat:
-            return Status.INFEASIBLE, ()
+            return SolveStatus.INFEASIBLE, ()
         assert result == z3.sat, result
         model = opt.model()
-        return Status.OPTIMAL, tuple(model.eval(o, model_completion=True).as_long() for o in opt.objectives())
+        return SolveStatus.OPTIMAL, tuple(model.eval(o, model_completion=True).as_long() for o in opt.objectives())
     if ext in ("lp", "mps"):
         import highspy
 
@@ -56,9 +56,9 @@ def reload(path: Path) -> tuple[Status, tuple[int, ...]]:
         h.run()
         status = h.getModelStatus()
         if status in (highspy.HighsModelStatus.kInfeasible, highspy.HighsModelStatus.kUnboundedOrInfeasible):
-            return Status.INFEASIBLE, ()
+            return SolveStatus.INFEASIBLE, ()
         assert status == highspy.HighsModelStatus.kOptimal, h.modelStatusToString(status)
-        return Status.OPTIMAL, (round(h.getInfo().objective_function_value),)
+        return SolveStatus.OPTIMAL, (round(h.getInfo().objective_function_value),)
     from ortools.sat.python import cp_model
 
     model = cp_model.CpModel()
@@ -67,9 +67,9 @@ def reload(path: Path) -> tuple[Status, tuple[int, ...]]:
     solver.parameters.num_workers = 1
     status = solver.Solve(model)
     if status == cp_model.INFEASIBLE:
-        return Status.INFEASIBLE, ()
+        return SolveStatus.INFEASIBLE, ()
     assert status == cp_model.OPTIMAL, solver.StatusName(status)
-    return Status.OPTIMAL, (round(solver.ObjectiveValue()),)
+    return SolveStatus.OPTIMAL, (round(solver.ObjectiveValue()),)
 
 
 @pytest.mark.parametrize("encoding", ENCODINGS)
@@ -83,7 +83,7 @@ def test_every_export_reloads_to_the_same_optimum(name: str, backend: str, ext: 
     want = reference(problem, backend, encoding, horizon)
     status, values = reload(path)
     assert status == want.status, (status, want)
-    if status == Status.OPTIMAL:
+    if status == SolveStatus.OPTIMAL:
         assert values == want.objective, (values, want.objective)
 
 
@@ -94,14 +94,14 @@ def test_the_default_model_is_the_first_skeletons(name: str, tmp_path: Path) -> 
     first = mrgc.compile(problem, backend="smt").skeletons[0]
     path = tmp_path / "m.smt2"
     assert mrgc.export_model(problem, path, backend="smt") == first.makespan
-    assert reload(path) == (Status.OPTIMAL, first.key)
+    assert reload(path) == (SolveStatus.OPTIMAL, first.key)
 
 
 def test_an_infeasible_problem_exports_the_horizon_limit(tmp_path: Path) -> None:
     problem = mrgc.parse_file(SYMBOLIC / "pick-cycle.mrg").problem()
     assert mrgc.compile(problem).status == "infeasible"
     horizon = mrgc.export_model(problem, tmp_path / "m.lp", backend="mip", encoding="paper")
-    assert horizon == len(problem.movable) and reload(tmp_path / "m.lp")[0] == Status.INFEASIBLE
+    assert horizon == len(problem.movable) and reload(tmp_path / "m.lp")[0] == SolveStatus.INFEASIBLE
 
 
 @pytest.mark.parametrize(("backend", "ext"), KINDS)

@@ -308,7 +308,7 @@ def plan_ap1(problem: Problem, problem_file: str, sha256: str, version: str, see
         else:
             plan.status = {"time limit": PlanStatus.TIME_LIMIT, "interrupted": PlanStatus.INTERRUPTED}.get(
                 ended, PlanStatus.EXHAUSTED)
-        why.summary = _summary(PlanStatus(plan.status), time_limit, why)
+        why.summary = _summary(plan.status, time_limit, why)
         stats.update({k: (round(v, 4) if isinstance(v, float) else int(v)) for k, v in search.stats.items()})
         stats["validation_seconds"] = round(verdicts["seconds"], 4)
         if isinstance(steps, GeometricSteps):

@@ -173,13 +173,33 @@ def _plan_status(raw: RawRun, data: dict[str, Any] | None) -> tuple[RunStatus, s
     elif data is not None and data.get("status") in PLAN_STATUS:
         expected, status = PLAN_STATUS[data["status"]]
         if code == expected:
-            why = data.get("why") or {}
-            return status, str(why.get("summary", "")) if status is not RunStatus.SOLVED else ""
+            return status, why_detail(data.get("why") or {}) if status is not RunStatus.SOLVED else ""
         return RunStatus.CRASH, f"exit code {code} disagrees with the plan's status '{data['status']}'"
     if code in INPUT_EXITS:
         return RunStatus.ERROR, _last_line(raw.plan_stderr)
     what = "no plan file" if not raw.task.compile_only else "no skeleton output"
     return RunStatus.CRASH, f"{what}; ended with {_ending(code, proc.signal)}: {_last_line(raw.plan_stderr)}"
+
+
+def why_detail(why: dict[str, Any], failures: int = 3, limit: int = 1000) -> str:
+    """A failed plan's reasons in one line for the ``detail`` column: the plan's ``why`` summary, the facts
+    and blocking cycles that prove it infeasible, the complete plans the validator rejected, and the
+    ``failures`` most frequent grounding failures (docs/planner.md), cut at ``limit`` characters."""
+    parts = [str(why.get("summary", ""))] if why.get("summary") else []
+    parts += [str(f) for f in why.get("facts") or []][:3]
+    cycles = why.get("cycles") or []
+    if cycles:
+        parts.append(f"{len(cycles)} blocking cycle(s): " + ", ".join(
+            " -> ".join(map(str, c.get("objects", []))) for c in cycles[:3] if isinstance(c, dict)))
+    if why.get("rejected_plans"):
+        parts.append(f"{why['rejected_plans']} complete plan(s) rejected by the validator")
+    top = [f for f in why.get("grounding_failures") or [] if isinstance(f, dict)][:failures]
+    if top:
+        parts.append("most frequent grounding failures: " + "; ".join(
+            f"{f.get('count')} x step {f.get('step')}, {f.get('action')}: {f.get('check')}"
+            + (f" ({f['detail']})" if f.get("detail") else "") for f in top))
+    text = "; ".join(parts)
+    return text if len(text) <= limit else text[:limit - 3] + "..."
 
 
 def _ending(code: int | None, sig: int | None) -> str:

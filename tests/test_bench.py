@@ -28,7 +28,7 @@ from mrgc.bench import ResultsDB, RunStatus, parse_study, render, run_study
 from mrgc.bench.execute import RunTask, execute_run, mrgc_argv
 from mrgc.bench.instances import expand_instances
 from mrgc.bench.methods import check_methods, method_args
-from mrgc.bench.outcome import classify
+from mrgc.bench.outcome import classify, why_detail
 from mrgc.bench.runner import run_limited
 from mrgc.bench.schema import parse_megabytes, parse_seeds
 from mrgc.bench.study import Limits
@@ -252,6 +252,28 @@ def test_a_crashing_run_is_recorded_as_a_crash_with_its_stderr(tmp_path: Path) -
     (r,) = rows(tmp_path / "r.db")
     assert r["status"] == "crash" and not r["success"] and r["signal"] == signal.SIGSEGV
     assert "SIGSEGV" in str(r["detail"]) and r["exit_code"] is None
+
+
+def test_a_failed_run_records_its_reasons(tmp_path: Path) -> None:
+    """A failure's ``detail`` holds the plan's reasons, not only its summary: the fact that proves a real
+    run infeasible; and, from the recorded ``why`` of a real BO8 run cut by its time limit, the plans the
+    validator rejected and the most frequent grounding failures."""
+    symbolic_copy(tmp_path / "p", "infeasible")
+    study = parse_study("study: why\ninstances: [{file: p/infeasible.mrg}]\nmethods: [{name: Ours}]\n",
+                        str(tmp_path / "s.yaml"))
+    (inst,) = expand_instances(study, str(tmp_path / "w"))
+    task = RunTask("why", inst, "Ours", tuple(method_args(study.methods[0])), 0, Limits(time=30), str(tmp_path / "out"))
+    result = classify(execute_run(task))
+    assert result.status == "infeasible" and not result.success
+    assert result.detail.startswith("infeasible by the facts; every action moving o1 is obstructed by")
+    why = json.loads((GOLDEN / "why-time-limit.json").read_text(encoding="utf-8"))["why"]
+    detail = why_detail(why)
+    assert detail.startswith("no plan within the time limit of 300 s; 42 complete plan(s) rejected by the validator; "
+                             "most frequent grounding failures: 28 x step 1, r2 moves door-s to start (side-x-): "
+                             "carry to the placement: no path; 22 x step 5, validator (1 violation): "
+                             "collision-robot-fixed (home: footprint of r1")
+    assert detail.count(" x step ") == 3
+    assert len(why_detail(why, limit=80)) == 80
 
 
 def test_an_invalid_plan_is_a_failure(tmp_path: Path) -> None:

@@ -1,17 +1,19 @@
-"""The backend base class: capabilities as data, checks in the public methods, work in private hooks."""
+"""The backend base class: capabilities as data, checks in the public methods, work in private hooks; and
+:func:`solver_library`, the one way a backend imports its solver library (lazily, on first use)."""
 
 from __future__ import annotations
 
+import contextlib
 import os
 import time
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
-from typing import ClassVar, Sequence
+from typing import ClassVar, Iterator, Sequence
 
 from mrgc.compiler.encodings import ENCODINGS
-from mrgc.compiler.ir import Feature, Row, SkeletonModel, Solution, SolveStatus
+from mrgc.compiler.ir import Feature, Row, SkeletonModel, Solution, SolveStatus, Solver
 from mrgc.compiler.lowering import lower
-from mrgc.errors import Diagnostic, InputError, MrgcError
+from mrgc.errors import Diagnostic, InputError, MissingBackendError, MrgcError
 
 
 @dataclass(frozen=True)
@@ -34,7 +36,26 @@ class BackendInfo:
 
     @property
     def pip(self) -> str:
+        """What to ``pip install`` for the library (``install``, else the distribution's name)."""
         return self.install or self.distribution
+
+
+@contextlib.contextmanager
+def solver_library(info: BackendInfo) -> Iterator[None]:
+    """Around a backend's import of its solver library (inside a function, so that only a solve loads it):
+    an ImportError becomes a :class:`~mrgc.errors.MissingBackendError`, one line naming what to ``pip
+    install`` (exit code 4)::
+
+        def _highspy() -> Any:
+            with solver_library(HighsBackend.info):
+                import highspy
+            return highspy
+    """
+    try:
+        yield
+    except ImportError as exc:
+        raise MissingBackendError(f"backend '{info.name}' needs {info.distribution}: pip install '{info.pip}' "
+                                  f"({exc})") from None
 
 
 class Backend(ABC):
@@ -54,6 +75,7 @@ class Backend(ABC):
 
     @property
     def name(self) -> str:
+        """The registered name (``info.name``)."""
         return self.info.name
 
     def load(self, model: SkeletonModel) -> None:
@@ -116,3 +138,9 @@ class Backend(ABC):
 
     def _export(self, path: str) -> None:  # pragma: no cover - backends with exports override
         raise NotImplementedError
+
+
+def _is_a_solver(backend: Backend) -> Solver:
+    """Never called: mypy checks here that a :class:`Backend` satisfies the compiler's
+    :class:`~mrgc.compiler.ir.Solver` protocol."""
+    return backend

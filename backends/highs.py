@@ -10,19 +10,16 @@ from __future__ import annotations
 import re
 from typing import Any, Sequence
 
-from mrgc.backends.base import Backend, BackendInfo
+from mrgc.backends.base import Backend, BackendInfo, solver_library
 from mrgc.compiler.ir import Row, SkeletonModel, Solution, SolveStatus
-from mrgc.errors import MissingBackendError
 from mrgc.signals import stop_on_signal
 
 INF = float("inf")
 
 
 def _highspy() -> Any:
-    try:
+    with solver_library(HighsBackend.info):
         import highspy
-    except ImportError as exc:  # pragma: no cover - installed by default
-        raise MissingBackendError(f"backend 'mip' needs highspy: pip install 'highspy==1.12.0' ({exc})") from None
     return highspy
 
 

@@ -11,19 +11,16 @@ from __future__ import annotations
 import time
 from typing import Any, Sequence
 
-from mrgc.backends.base import Backend, BackendInfo
+from mrgc.backends.base import Backend, BackendInfo, solver_library
 from mrgc.compiler.ir import Feature, Row, SkeletonModel, Solution, SolveStatus, Terms
-from mrgc.errors import MissingBackendError
 from mrgc.signals import stop_on_signal
 
 
 def _pysmt() -> Any:
-    try:
+    with solver_library(PysmtBackend.info):
         import pysmt.environment
         import pysmt.exceptions
         import pysmt.typing
-    except ImportError as exc:  # pragma: no cover - installed by default
-        raise MissingBackendError(f"backend 'pysmt' needs pysmt: pip install pysmt==0.9.6 ({exc})") from None
     return pysmt
 
 

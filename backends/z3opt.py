@@ -13,17 +13,14 @@ import math
 import threading
 from typing import Any, Sequence
 
-from mrgc.backends.base import Backend, BackendInfo
+from mrgc.backends.base import Backend, BackendInfo, solver_library
 from mrgc.compiler.ir import Feature, Row, SkeletonModel, Solution, SolveStatus, Terms
-from mrgc.errors import MissingBackendError
 from mrgc.signals import shielded, stop_on_signal
 
 
 def _z3() -> Any:
-    try:
+    with solver_library(Z3Backend.info):
         import z3
-    except ImportError as exc:  # pragma: no cover - installed by default
-        raise MissingBackendError(f"backend 'smt' needs z3: pip install z3-solver ({exc})") from None
     return z3
 
 

@@ -178,9 +178,12 @@ class Solution:
 
 
 class Solver(Protocol):
-    """What skeleton enumeration needs of a backend (backends/ implements it; compiler/ never imports it)."""
+    """What skeleton enumeration needs of a backend (backends/ implements it; compiler/ never imports it;
+    mypy checks that :class:`mrgc.backends.base.Backend` satisfies it)."""
 
-    name: str
+    @property
+    def name(self) -> str:
+        """The backend's registered name."""
 
     def load(self, model: SkeletonModel) -> None:
         """Take a (lowered) model; replaces any previous one."""

@@ -84,6 +84,14 @@ class TaskGraph:
         """Objects obstructing action i (pick first, then place), without repeats."""
         return tuple(dict.fromkeys(self.block_pick[i] + self.block_place[i]))
 
+    def obstacles(self, i: int) -> list[tuple[str, bool]]:
+        """(obstacle, strict) for action i: pick obstacles move strictly before it, place obstacles no later
+        (strictly before too when the placing robot drives through them: :attr:`strict_place`)."""
+        out = [(o, True) for o in self.block_pick[i]]
+        strict = self.actions[i].place_robot in self.strict_place
+        out += [(o, strict) for o in self.block_place[i] if o not in self.block_pick[i]]
+        return out
+
     @cached_property
     def _blocks(self) -> dict[str, list[int]]:
         out: dict[str, list[int]] = {o: [] for o in self.objects}

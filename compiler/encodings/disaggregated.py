@@ -11,7 +11,7 @@ Measured >120 s with big-M vs 4.5 s without on a 40-object instance with HiGHS.
 
 from __future__ import annotations
 
-from mrgc.compiler.encodings.paper import PaperEncoding, _obstacles
+from mrgc.compiler.encodings.paper import PaperEncoding
 from mrgc.compiler.ir import SkeletonModel
 from mrgc.compiler.task_graph import TaskGraph
 
@@ -22,7 +22,7 @@ class DisaggregatedEncoding(PaperEncoding):
     def precedence(self, m: SkeletonModel, graph: TaskGraph, X: list[list[int]], of: dict[str, list[int]],
                    T: int) -> None:
         for a in range(len(graph.actions)):
-            for o, strict in _obstacles(graph, a):
+            for o, strict in graph.obstacles(a):
                 for t in range(T):
                     later = t + 1 if strict else t  # index of X[a]@(t+2) or X[a]@(t+1)
                     terms = [(X[a2][t], 1) for a2 in of[o]] + [(X[a][0], 1)]

@@ -82,16 +82,7 @@ class PaperEncoding(Encoding):
                    T: int) -> None:
         """(11) pick obstacles strictly earlier, (12) place obstacles no later, as conditional rows."""
         for a in range(len(graph.actions)):
-            for o, strict in _obstacles(graph, a):
+            for o, strict in graph.obstacles(a):
                 terms = [(v, 1) for v in X[a]] + [(v, -1) for a2 in of[o] for v in X[a2]]
                 m.add_if([(X[a][0], True)], terms, lo=1 if strict else 0,
                          name=f"c{11 if strict else 12}[{a},{o}]", big_m=T + 1 if strict else T)
-
-
-def _obstacles(graph: TaskGraph, a: int) -> list[tuple[str, bool]]:
-    """(obstacle, strict) for action a: pick obstacles strictly before, place obstacles no later (strictly
-    before too when the placing robot drives through them: ``graph.strict_place``)."""
-    out = [(o, True) for o in graph.block_pick[a]]
-    strict = graph.actions[a].place_robot in graph.strict_place
-    out += [(o, strict) for o in graph.block_place[a] if o not in graph.block_pick[a]]
-    return out

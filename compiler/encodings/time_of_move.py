@@ -14,7 +14,7 @@ from __future__ import annotations
 from typing import Sequence
 
 from mrgc.compiler.encodings.base import Encoded, Encoding
-from mrgc.compiler.encodings.paper import _obstacles, action_label
+from mrgc.compiler.encodings.paper import action_label
 from mrgc.compiler.ir import NoOverlap, SkeletonModel
 from mrgc.compiler.skeleton import Skeleton, skeleton_from_schedule
 from mrgc.compiler.task_graph import TaskGraph
@@ -47,7 +47,7 @@ class TimeOfMoveEncoding(Encoding):
             m.add([(makespan, 1), (tau[o], -1)], lo=0, name=f"makespan[{o}]")
         for a in A:
             me = graph.actions[a].obj
-            for o, strict in _obstacles(graph, a):
+            for o, strict in graph.obstacles(a):
                 m.add([(y[a2], 1) for a2 in of[o]] + [(y[a], -1)], lo=0, name=f"obstacle[{a},{o}]")
                 m.add_if([(y[a], True)], [(tau[me], 1), (tau[o], -1)], lo=1 if strict else 0,
                          name=f"{'pick' if strict else 'place'}-before[{a},{o}]")

@@ -8,14 +8,16 @@ Each run is a fresh interpreter running the CLI (``from mrgc.cli import main``) 
 ``--root`` first on the import path; with several roots their runs alternate, so a busy machine slows
 them alike.  Bytecode is cached (``PYTHONPYCACHEPREFIX`` in a temporary folder, warmed by one run of each
 command first), as in an installed package: without a cache every start compiles mrgc's sources again.
-The table gives, per checkout, the median and the least wall time of each command and the number of
-modules it imports (counted in an extra run).
+The table gives, per checkout, the median and the least wall time of each command, its median CPU time
+(user + system, of the child process: less sensitive than wall time to other jobs on the machine, though
+not immune), and the number of modules it imports (counted in an extra run).
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import resource
 import statistics
 import subprocess
 import sys
@@ -59,34 +61,39 @@ def main() -> None:
             links.append(link)
         env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
 
-        def run(k: int, argv: list[str], count: bool = False) -> tuple[float, str]:
-            t0 = time.perf_counter()
+        def run(k: int, argv: list[str], count: bool = False) -> tuple[float, float, str]:
+            t0, c0 = time.perf_counter(), resource.getrusage(resource.RUSAGE_CHILDREN)
             out = subprocess.run([sys.executable, "-c", RUNNER, str(links[k].parent), *argv], cwd=roots[k],
                                  text=True, capture_output=True,
                                  env={**env, "PYTHONPYCACHEPREFIX": str(Path(tmp) / f"pyc{k}"),
                                       **({"COUNT": "1"} if count else {})})
-            seconds = time.perf_counter() - t0
+            seconds, c1 = time.perf_counter() - t0, resource.getrusage(resource.RUSAGE_CHILDREN)
             if out.returncode != 0:
                 raise SystemExit(f"mrgc {' '.join(argv)} failed ({out.returncode}): {out.stderr.strip()[-300:]}")
-            return seconds, out.stderr
+            return seconds, c1.ru_utime + c1.ru_stime - c0.ru_utime - c0.ru_stime, out.stderr
 
         for k in range(len(roots)):  # warm the bytecode caches
             for argv in commands.values():
                 run(k, argv)
         print(f"{args.runs} runs per command and checkout, Python {sys.version.split()[0]}, load average "
-              f"{os.getloadavg()[0]:.1f} at the start; median / least wall time in seconds (modules imported)")
+              f"{os.getloadavg()[0]:.1f} at the start; median / least wall time in seconds, median CPU time "
+              f"(user + system) in seconds, modules imported")
         print()
         print("| command | " + " | ".join(str(r) for r in roots) + " |")
         print("| --- |" + " --- |" * len(roots))
         for name, argv in commands.items():
             times: list[list[float]] = [[] for _ in roots]
+            cpu: list[list[float]] = [[] for _ in roots]
             for _ in range(args.runs):
                 for k in range(len(roots)):
-                    times[k].append(run(k, argv)[0])
+                    wall, used, _err = run(k, argv)
+                    times[k].append(wall)
+                    cpu[k].append(used)
             cells = []
             for k in range(len(roots)):
-                modules = run(k, argv, count=True)[1].strip().splitlines()[-1]
-                cells.append(f"{statistics.median(times[k]):.3f} / {min(times[k]):.3f} ({modules})")
+                modules = run(k, argv, count=True)[2].strip().splitlines()[-1]
+                cells.append(f"{statistics.median(times[k]):.3f} / {min(times[k]):.3f}, CPU "
+                             f"{statistics.median(cpu[k]):.3f} ({modules})")
             print(f"| `{name}` | " + " | ".join(cells) + " |", flush=True)
         print(f"\nload average {os.getloadavg()[0]:.1f} at the end")
 

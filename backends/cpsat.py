@@ -19,9 +19,9 @@ from __future__ import annotations
 
 from typing import Any, Sequence
 
-from mrgc.backends.base import Backend, BackendInfo
-from mrgc.compiler.ir import Feature, Row, SkeletonModel, Solution, Status, Terms
-from mrgc.errors import MissingBackendError, MrgcError
+from mrgc.backends.base import Backend, BackendInfo, solver_library
+from mrgc.compiler.ir import Feature, Row, SkeletonModel, Solution, SolveStatus, Terms
+from mrgc.errors import MrgcError
 from mrgc.signals import stop_on_signal
 
 #: the bound ``cp_model`` users write for a missing side of a row (CP-SAT's domains stay within int64)
@@ -30,10 +30,8 @@ UNBOUNDED = 2**62
 
 def _helper() -> Any:
     """OR-Tools' native CP-SAT module (``ortools.sat.python.cp_model_helper``, no pandas or numpy)."""
-    try:
+    with solver_library(CpSatBackend.info):
         from ortools.sat.python import cp_model_helper
-    except ImportError as exc:  # pragma: no cover - installed by default
-        raise MissingBackendError(f"backend 'cpsat' needs OR-Tools: pip install 'ortools>=9.15,<9.16' ({exc})") from None
     return cp_model_helper
 
 
@@ -133,13 +131,13 @@ class CpSatBackend(Backend):
         if status in (statuses.OPTIMAL, statuses.FEASIBLE):
             values = tuple(int(x) for x in response.solution)  # one value per variable, in order
             if status == statuses.OPTIMAL:
-                return Solution(Status.OPTIMAL, values)
-            return Solution(Status.FEASIBLE, values, message="time limit")
+                return Solution(SolveStatus.OPTIMAL, values)
+            return Solution(SolveStatus.FEASIBLE, values, message="time limit")
         if status == statuses.INFEASIBLE:
-            return Solution(Status.INFEASIBLE)
+            return Solution(SolveStatus.INFEASIBLE)
         if status == statuses.UNKNOWN:
-            return Solution(Status.TIME_LIMIT, message="time limit")
-        return Solution(Status.ERROR, message=f"CP-SAT: {status.name}")
+            return Solution(SolveStatus.TIME_LIMIT, message="time limit")
+        return Solution(SolveStatus.ERROR, message=f"CP-SAT: {status.name}")
 
     def _export(self, path: str) -> None:
         if not _helper().CpSatHelper.write_model_to_file(self.proto, path):

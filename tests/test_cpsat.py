@@ -19,7 +19,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 
 from mrgc.backends.cpsat import CpSatBackend, normal_form
-from mrgc.compiler.ir import AtMostOne, CondRow, NoOverlap, Row, SkeletonModel, Solution, Status, Var
+from mrgc.compiler.ir import AtMostOne, CondRow, NoOverlap, Row, SkeletonModel, Solution, SolveStatus, Var
 from mrgc.language.loader import parse_file
 from mrgc.planner.skeletons import compile_problem
 from mrgc.testing import conformance as kit
@@ -94,8 +94,8 @@ class Twin(CpSatBackend):
     def _solve(self, time_limit: float | None) -> Solution:
         sol = super()._solve(time_limit)
         name, values = self.reference.solve(time_limit)
-        expected = {"OPTIMAL": Status.OPTIMAL, "FEASIBLE": Status.FEASIBLE, "INFEASIBLE": Status.INFEASIBLE,
-                    "UNKNOWN": Status.TIME_LIMIT}.get(name, Status.ERROR)
+        expected = {"OPTIMAL": SolveStatus.OPTIMAL, "FEASIBLE": SolveStatus.FEASIBLE, "INFEASIBLE": SolveStatus.INFEASIBLE,
+                    "UNKNOWN": SolveStatus.TIME_LIMIT}.get(name, SolveStatus.ERROR)
         assert (sol.status, sol.values) == (expected, values), name
         Twin.compared.append("solve")
         return sol
@@ -156,16 +156,16 @@ def test_corner_cases_give_cp_models_message(objective: str) -> None:
                         "absent": []}[objective]
     backend = Twin()
     backend.load(model)
-    assert backend.solve().status == Status.ERROR  # the empty domain makes the model invalid: the same verdict
+    assert backend.solve().status == SolveStatus.ERROR  # the empty domain makes the model invalid: the same verdict
     feasible = SkeletonModel(model.vars[:5], [model.rows[k] for k in (0, 2, 4, 5, 6, 8)], model.cond_rows,
                              model.at_most_one, model.no_overlap, objectives=model.objectives)
     backend = Twin()
     backend.load(feasible)
-    assert backend.solve().status == Status.OPTIMAL
+    assert backend.solve().status == SolveStatus.OPTIMAL
     backend.add_rows([Row(((3, 1), (4, 1)), 2, None), Row((), None, 0)])
-    assert backend.solve().status == Status.OPTIMAL
+    assert backend.solve().status == SolveStatus.OPTIMAL
     backend.add_rows([Row((), 1, None)])  # false: an empty bool_or
-    assert backend.solve().status == Status.INFEASIBLE
+    assert backend.solve().status == SolveStatus.INFEASIBLE
 
 
 def test_normal_form_sums_a_variable_drops_zeros_sorts() -> None:

@@ -64,19 +64,28 @@ _LAZY: dict[str, str] = {
 }
 
 if TYPE_CHECKING:
-    from mrgc.api import backends
-    from mrgc.api import CheckReport, check, compile, compute_facts, export_model, load_problem, plan, validate
-    from mrgc.backends.registry import BackendRecord
+    from mrgc.api import (
+        CheckReport,
+        backends,
+        check,
+        compile,
+        compute_facts,
+        export_model,
+        load_problem,
+        plan,
+        validate,
+    )
     from mrgc.backends.base import Backend, BackendInfo
+    from mrgc.backends.registry import BackendRecord
     from mrgc.compiler.ir import Feature, Row, SkeletonModel, Solution, SolveStatus
     from mrgc.compiler.skeleton import Skeleton
+    from mrgc.exits import ExitCode
     from mrgc.geometry.facts import FactsResult
     from mrgc.language.loader import MrgFile, parse_file, parse_string
     from mrgc.language.model import Domain, Fact, Problem
     from mrgc.language.printer import format_source
     from mrgc.planner.outcome import PlanStatus
     from mrgc.planner.plan import Plan
-    from mrgc.exits import ExitCode
     from mrgc.planner.skeletons import CompileResult, CompileStatus
     from mrgc.planner.validate import ValidationReport
 
@@ -97,7 +106,8 @@ def __dir__() -> list[str]:
 
 
 __all__ = ["__version__", "Diagnostic", "InputError", "MrgcError", "Span", "Backend", "BackendInfo",
-    "BackendRecord", "CheckReport", "CompileResult", "CompileStatus", "Domain", "ExitCode", "Fact", "FactsResult", "Feature", "MrgFile",
+    "BackendRecord", "CheckReport", "CompileResult", "CompileStatus", "Domain", "ExitCode", "Fact", "FactsResult",
+    "Feature", "MrgFile",
     "Plan", "PlanStatus", "Problem", "Row", "Skeleton", "SkeletonModel", "Solution", "SolveStatus",
     "ValidationReport", "backends", "check", "compile", "compute_facts", "export_model", "format_source",
     "load_problem", "parse_file", "parse_string", "plan", "validate"]

@@ -157,7 +157,8 @@ def export_model(source: ProblemSource, path: str | os.PathLike[str], *, name: s
     horizon limit (``max_makespan``, capped at the number of objects in the task graph).  docs/backends.md
     says what each file holds and how to load it into its solver.
     """
-    from mrgc.planner.skeletons import export_model as write_model, needs_facts, problem_facts
+    from mrgc.planner.skeletons import export_model as write_model
+    from mrgc.planner.skeletons import needs_facts, problem_facts
 
     problem = load_problem(source, name=name, allow_outside=allow_outside)
     if horizon is not None and horizon < 1:
@@ -211,7 +212,8 @@ def validate(source: ProblemSource, plan: "Plan | Mapping[str, Any] | str | os.P
     cannot be used at all raises InputError (E500-E504).  A file holding several problems is read for the
     one the plan names (unless ``name`` says otherwise).  The plan must be for the same problem contents:
     the file it was made from or its facts file are both accepted."""
-    from mrgc.planner.validate import load_plan, validate as run
+    from mrgc.planner.validate import load_plan
+    from mrgc.planner.validate import validate as run
 
     doc: Any = plan
     if isinstance(plan, (str, os.PathLike)):

@@ -147,7 +147,7 @@ def inputs_of(mf: "MrgFile") -> list[str]:
 
     files = list(mf.files)
     for p in mf.problems:
-        shapes = [o.shape for o in (*p.movable, *p.fixed, *p.regions)] + [k.footprint for k in p.domain.robot_kinds]
+        shapes = [o.shape for o in p.bodies] + [k.footprint for k in p.domain.robot_kinds]
         files.extend(s.path for s in shapes if isinstance(s, Mesh))
         for kind in p.domain.robot_kinds:
             if kind.urdf is not None:
@@ -398,7 +398,8 @@ def build_parser() -> argparse.ArgumentParser:
     mode.add_argument("--write", action="store_true", help="rewrite files in place")
     p.set_defaults(func=cmd_fmt)
 
-    p = sub.add_parser("facts", help="phase 1: compute the geometric facts of a problem and write it with :init completed")
+    p = sub.add_parser("facts",
+                       help="phase 1: compute the geometric facts of a problem and write it with :init completed")
     p.add_argument("file", metavar="FILE")
     p.add_argument("-o", "--output", metavar="OUT", help="write here (default: standard output)")
     p.add_argument("--problem", help="which problem of the file (default: its only one)")

@@ -92,10 +92,10 @@ class MrgcError(Exception):
 
 
 def _rebuild(cls: type, args: tuple[object, ...], state: dict[str, object]) -> "MrgcError":
-    err = Exception.__new__(cls)
+    err: MrgcError = Exception.__new__(cls)
     err.args = args
     err.__dict__.update(state)
-    return err  # type: ignore[no-any-return]
+    return err
 
 
 class InputError(MrgcError):

@@ -96,7 +96,7 @@ def uninstall() -> None:
         os.close(_S.wakeup[1])  # the watcher reads EOF and closes its end
         _S.wakeup = None
     if _S.unraisable is not None:
-        sys.unraisablehook = _S.unraisable  # type: ignore[assignment]
+        sys.unraisablehook = _S.unraisable
     _S.installed = False
 
 

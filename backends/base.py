@@ -11,7 +11,7 @@ from dataclasses import dataclass
 from typing import ClassVar, Iterator, Sequence
 
 from mrgc.compiler.encodings import ENCODINGS
-from mrgc.compiler.ir import Feature, Row, SkeletonModel, Solution, SolveStatus, Solver
+from mrgc.compiler.ir import Feature, Row, SkeletonModel, Solution, Solver, SolveStatus
 from mrgc.compiler.lowering import lower
 from mrgc.errors import Diagnostic, InputError, MissingBackendError, MrgcError
 

@@ -81,7 +81,9 @@ class HighsBackend(Backend):
             return
         lower = np.array([-INF if r.lo is None else r.lo for r in rows], dtype=np.float64)
         upper = np.array([INF if r.hi is None else r.hi for r in rows], dtype=np.float64)
-        starts, index, value = [], [], []
+        starts: list[int] = []
+        index: list[int] = []
+        value: list[float] = []
         for r in rows:
             starts.append(len(index))
             for v, c in r.terms:

@@ -114,7 +114,7 @@ def records() -> list[BackendRecord]:
 
 def feature_table() -> str:
     """A backend × feature table (native = translated by the solver, lowered = rewritten to rows)."""
-    feats = [f for f in Feature]
+    feats = list(Feature)
     header = ["backend", *[f.value for f in feats], "exports"]
     lines = [header]
     for name in names():

@@ -111,11 +111,11 @@ def main(argv: list[str] | None = None) -> None:
         hits = sum(bool(world.probe_collides(p)) for p in probes)
         note = f"{hits}/{batches} configurations collide"
         row(f"{n_links} link hulls vs {args.boxes} boxes + table: `probe_collides`",
-            lambda i: world.probe_collides(probes[i]), note)
+            lambda i, probes=probes: world.probe_collides(probes[i]), note)
         row(f"{n_links} link hulls vs {args.boxes} boxes + table: `probe_hits`",
-            lambda i: world.probe_hits(probes[i]), note)
+            lambda i, probes=probes: world.probe_hits(probes[i]), note)
         row(f"{n_links} link hulls vs {args.boxes} boxes + table: `batch_collides`",
-            lambda i: world.batch_collides(links, configs[i]), note)
+            lambda i, links=links, configs=configs: world.batch_collides(links, configs[i]), note)
 
     # swept volume: 30 configurations of a 7-link chain
     links = make_links(7, rng)

@@ -82,7 +82,8 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--scenes", nargs="+", default=SCENES)
     args = ap.parse_args()
-    print("| scene | robots | objects | facts | IK solves | workers | phase 1 median (s) | min (s) | incl. imports (s) |")
+    print("| scene | robots | objects | facts | IK solves | workers | phase 1 median (s) | min (s) "
+          "| incl. imports (s) |")
     print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     for name in args.scenes:
         r = phase1(name, args.repeat)

@@ -8,8 +8,9 @@
 domains/box-moving/bo*.mrg) or paths of .mrg files (each holding one problem, symbolic or geometric).
 
 Each run is a fresh process (cold caches) calling the planner with one seed; the table gives the success
-rate (plans the validator accepts, re-checked in the child after planning), the median and max wall time of the planner (phase 1 included, interpreter start-up excluded), the
-median makespan and motion cost (objects moved), and the median share of time in each phase.
+rate (plans the validator accepts, re-checked in the child after planning), the median and max wall time
+of the planner (phase 1 included, interpreter start-up excluded), the median makespan and motion cost
+(objects moved), and the median share of time in each phase.
 """
 
 from __future__ import annotations
@@ -73,8 +74,9 @@ def main() -> None:
         if not ok:
             print(f"| {name} | 0/{args.seeds} | - | - | - | - | - | - | - |", flush=True)
             continue
-        med = lambda key: statistics.median(r[key] for r in ok)  # noqa: E731
-        share = lambda key: statistics.median(100 * r.get(key, 0) / max(r["seconds"], 1e-9) for r in ok)  # noqa: E731
+        med = lambda key, ok=ok: statistics.median(r[key] for r in ok)  # noqa: E731
+        share = lambda key, ok=ok: statistics.median(  # noqa: E731
+            100 * r.get(key, 0) / max(r["seconds"], 1e-9) for r in ok)
         print(f"| {name} | {len(ok)}/{args.seeds} | {med('seconds'):.2f} | {max(r['seconds'] for r in ok):.2f} | "
               f"{med('makespan'):g} | {med('cost'):g} | {share('facts_seconds'):.0f} | "
               f"{share('skeleton_seconds'):.0f} | {share('grounding_seconds'):.0f} |", flush=True)

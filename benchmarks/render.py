@@ -40,8 +40,8 @@ def main() -> int:
     args = ap.parse_args()
     problem = parse_file(args.problem).problem(None)
     plan = json.loads(Path(args.plan).read_text())
-    print("| size | frames | steps | draw / frame (wall) | draw / frame (CPU) | GIF write | `mrgc render` / step (wall) "
-          "| `mrgc render` / step (CPU) |")
+    print("| size | frames | steps | draw / frame (wall) | draw / frame (CPU) | GIF write "
+          "| `mrgc render` / step (wall) | `mrgc render` / step (CPU) |")
     print("| --- | --- | --- | --- | --- | --- | --- | --- |")
     for size in args.size or ["400x300", "640x480"]:
         w, h = (int(v) for v in size.split("x"))

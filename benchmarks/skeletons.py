@@ -25,7 +25,7 @@ BACKENDS = ["cpsat", "mip", "smt", "pysmt"]
 ENCODINGS = ["time-of-move", "disaggregated", "paper"]
 
 
-def instance(n_objects: int, n_robots: int, seed: int) -> tuple[FactBase, list[str]]:
+def instance(n_objects: int, n_robots: int, seed: int) -> tuple[FactBase, list[str]]:  # noqa: C901
     """A PA-like fact base whose task graph holds all ``n_objects`` objects.
 
     Robots stand around a table; each object can be picked by one or two robots with one or two grasps;
@@ -128,7 +128,8 @@ def main() -> None:
         for r in args.robots:
             insts = [instance(n, r, seed) for seed in range(args.repeat)]
             graphs = [build_task_graph(base, must) for base, must in insts]
-            size = f"{statistics.median(len(g.objects) for g in graphs):g}/{statistics.median(len(g.actions) for g in graphs):g}"
+            objects = statistics.median(len(g.objects) for g in graphs)
+            size = f"{objects:g}/{statistics.median(len(g.actions) for g in graphs):g}"
             for b in args.backends:
                 for e in args.encodings:
                     res = [run(base, must, b, e, args.time_limit) for base, must in insts]

@@ -18,7 +18,7 @@ from typing import Callable
 
 from mrgc.compiler.diagnose import prune
 from mrgc.compiler.encodings.base import Encoded, Encoding
-from mrgc.compiler.ir import Row, SolveStatus, Solver
+from mrgc.compiler.ir import Row, Solver, SolveStatus
 from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import TaskGraph
 

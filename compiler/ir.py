@@ -128,7 +128,8 @@ class SkeletonModel:
             if not _holds(row, self.evaluate(row.terms, values)):
                 bad.append(row.name or "row")
         for cr in self.cond_rows:
-            if all(bool(values[v]) == val for v, val in cr.when) and not _holds(cr.row, self.evaluate(cr.row.terms, values)):
+            active = all(bool(values[v]) == val for v, val in cr.when)
+            if active and not _holds(cr.row, self.evaluate(cr.row.terms, values)):
                 bad.append(cr.row.name or "conditional row")
         for amo in self.at_most_one:
             if sum(values[v] for v in amo.vars) > 1:

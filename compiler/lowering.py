@@ -13,7 +13,8 @@ from __future__ import annotations
 
 from itertools import combinations
 
-from mrgc.compiler.ir import AtMostOne, CondRow, Feature, NoOverlap, Row, SkeletonModel, Terms, merge_terms as _merge
+from mrgc.compiler.ir import AtMostOne, CondRow, Feature, NoOverlap, Row, SkeletonModel, Terms
+from mrgc.compiler.ir import merge_terms as _merge
 
 
 def lower(model: SkeletonModel, native: frozenset[Feature]) -> SkeletonModel:

@@ -67,7 +67,7 @@ def _decl(name: str, f: Footprint, height: float) -> str:
     return box_decl(name, f.x, f.y, f.hx, f.hy, height, f.yaw)
 
 
-def _layout(rng: np.random.Generator, robots: int, goals: int, others: int):  # type: ignore[no-untyped-def]
+def _layout(rng: np.random.Generator, robots: int, goals: int, others: int):  # type: ignore[no-untyped-def]  # noqa: C901
     """One attempt at a whole layout, or None when some item found no place (the caller draws again)."""
     fx, fy = _u(rng, *FLOOR_X, 1), _u(rng, *FLOOR_Y, 1)
     n_rooms = 3 if fx >= 3 * ROOM_MIN + 2 * WALL_T and rng.random() < 0.5 else 2

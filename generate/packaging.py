@@ -161,10 +161,11 @@ def _arms(rng: np.random.Generator, n: int, table: Footprint) -> list[Arm] | Non
             t = float(rng.uniform(0, perimeter))
             off = float(rng.uniform(*EDGE_OFFSET))
             jitter = float(rng.uniform(-YAW_JITTER, YAW_JITTER))
-            for length, (sx, sy), (dx, dy), (nx, ny) in edges:
-                if t <= length:
+            for edge in edges:
+                if t <= edge[0]:
                     break
-                t -= length
+                t -= edge[0]
+            _, (sx, sy), (dx, dy), (nx, ny) = edge
             x, y = round(sx + t * dx + off * nx, 3), round(sy + t * dy + off * ny, 3)
             yaw = round(math.degrees(math.atan2(-y, -x)) + jitter)
             yaw = (yaw + 180) % 360 - 180

@@ -45,11 +45,13 @@ class Arm:
 
     def ee_target(self, tool_world: np.ndarray) -> np.ndarray:
         """The end-effector pose (base frame) that puts the tool centre point at ``tool_world``."""
-        return self.base_inv @ tool_world @ self.tcp_inv
+        target: np.ndarray = self.base_inv @ tool_world @ self.tcp_inv
+        return target
 
     def tool_world(self, q: np.ndarray) -> np.ndarray:
         """Tool centre point pose(s) in the world at configuration(s) ``q``."""
-        return self.base @ ee_pose(self.model, q) @ self.tcp
+        tool: np.ndarray = self.base @ ee_pose(self.model, q) @ self.tcp
+        return tool
 
     def link_transforms(self, q: np.ndarray, opening: float | None = None) -> np.ndarray:
         """World transforms of the probed links: ``q.shape[:-1] + (L, 4, 4)``, the fingers ``opening``

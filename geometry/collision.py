@@ -428,7 +428,7 @@ class CollisionWorld:
     def _manager(self, against: Against, ignore: Against, exclude: tuple[str, ...]) -> Any:
         """The broadphase manager of the selected objects (None when nothing is selected), refit if stale."""
         key = (against if against is None or isinstance(against, str) else frozenset(against),
-               ignore if isinstance(ignore, str) else frozenset(ignore), exclude)
+               ignore if isinstance(ignore, str) else frozenset(ignore or ()), exclude)
         sel = self._selections.get(key)
         if sel is None:
             chosen = self._tokens(against) - self._tokens(ignore) - set(exclude)

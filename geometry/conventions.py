@@ -51,7 +51,7 @@ def wrap_angle(angle: Array) -> Array: ...
 def wrap_angle(angle: float | Array) -> float | Array:
     """``angle`` (radians, or an array of them) wrapped into [-π, π)."""
     if isinstance(angle, np.ndarray):
-        return (angle + math.pi) % (2 * math.pi) - math.pi  # type: ignore[no-any-return]
+        return (angle + math.pi) % (2 * math.pi) - math.pi
     return (float(angle) + math.pi) % (2 * math.pi) - math.pi
 
 

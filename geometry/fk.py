@@ -65,8 +65,10 @@ def _terms(origin: np.ndarray, kind: str, axis: np.ndarray) -> tuple[np.ndarray,
 def _local(kind: str, origin: np.ndarray, axis: np.ndarray, value: float) -> np.ndarray:
     a, b = _terms(origin, kind, axis)
     if kind == "revolute":
-        return origin + np.sin(value) * a + (1 - np.cos(value)) * b
-    return origin + value * a
+        local: np.ndarray = origin + np.sin(value) * a + (1 - np.cos(value)) * b
+        return local
+    slid: np.ndarray = origin + value * a
+    return slid
 
 
 def plan(model: RobotModel) -> _Plan:
@@ -80,7 +82,7 @@ def plan(model: RobotModel) -> _Plan:
 
         ta = [_terms(j.origin, j.kind, j.axis) for j in js]
         tp = [_terms(j.pre, j.kind, j.axis) for j in js]
-        steps = []
+        steps: list[tuple[int, int, int, np.ndarray | None]] = []
         for link in model.links[1:]:
             if link.chain_index >= 0:
                 steps.append((link.index, link.parent, link.chain_index, None))

@@ -72,7 +72,7 @@ def restart_configurations(model: RobotModel, seed: int, restarts: int, q_init: 
 
 # ------------------------------------------------------------------------------------------ the cache
 
-_CACHE: dict[tuple, IKResult] = {}
+_CACHE: dict[tuple[object, ...], IKResult] = {}
 CACHE_SIZE = 200_000
 
 
@@ -80,12 +80,13 @@ def clear_ik_cache() -> None:
     _CACHE.clear()
 
 
-def _key(model: RobotModel, target: np.ndarray, seed: int, q_init: np.ndarray | None, params: tuple) -> tuple:
+def _key(model: RobotModel, target: np.ndarray, seed: int, q_init: np.ndarray | None,
+         params: tuple[object, ...]) -> tuple[object, ...]:
     init = None if q_init is None else np.round(np.asarray(q_init, dtype=float), 9).tobytes()
     return (model.key, np.round(target[:3], 9).tobytes(), seed, init, params)
 
 
-def _remember(key: tuple, result: IKResult) -> None:
+def _remember(key: tuple[object, ...], result: IKResult) -> None:
     if len(_CACHE) >= CACHE_SIZE:
         _CACHE.clear()
     _CACHE[key] = result
@@ -125,8 +126,8 @@ def solve_ik_many(model: RobotModel, targets: np.ndarray, seed: int, q_init: np.
         if hit is not None:
             results[i] = hit
         elif gap[i] > 1e-9:
-            results[i] = IKResult(IKStatus.UNREACHABLE, None, float(gap[i]), float("inf"), 0)
-            _remember(key, results[i])
+            results[i] = miss = IKResult(IKStatus.UNREACHABLE, None, float(gap[i]), float("inf"), 0)
+            _remember(key, miss)
         else:
             todo.append(i)
     if todo:

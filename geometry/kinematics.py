@@ -166,12 +166,14 @@ class RobotModel:
 
     def clamp(self, q: np.ndarray) -> np.ndarray:
         """``q`` clipped into the joint limits."""
-        return np.clip(q, self.lower, self.upper)
+        clipped: np.ndarray = np.clip(q, self.lower, self.upper)
+        return clipped
 
     def within_limits(self, q: np.ndarray, eps: float = 1e-9) -> np.ndarray:
         """Whether each configuration of ``q`` (..., dof) respects the limits."""
         q = np.asarray(q)
-        return np.all((q >= self.lower - eps) & (q <= self.upper + eps), axis=-1)
+        inside: np.ndarray = np.all((q >= self.lower - eps) & (q <= self.upper + eps), axis=-1)
+        return inside
 
     def __repr__(self) -> str:
         return f"RobotModel({self.name!r}, ee={self.end_effector!r}, dof={self.dof}, links={len(self.links)})"
@@ -259,14 +261,14 @@ def _build_model(path: str, end_effector: str, roots: tuple[str, ...] = ()) -> R
 
     links: list[Link] = []
     for k, name in enumerate(urdf.order):
-        j = urdf.joint_of.get(name)
-        if j is None:
+        uj = urdf.joint_of.get(name)
+        if uj is None:
             kind, origin, axis, parent, jname, lo, hi = "base", np.eye(4), np.zeros(3), -1, None, 0.0, 0.0
         else:
-            kind = {"continuous": "revolute"}.get(j.kind, j.kind)
+            kind = {"continuous": "revolute"}.get(uj.kind, uj.kind)
             if kind not in ("revolute", "prismatic"):
                 kind = "fixed"  # off-chain floating/planar joints are frozen at zero
-            origin, axis, parent, jname, lo, hi = j.origin, j.axis, index[j.parent], j.name, j.lower, j.upper
+            origin, axis, parent, jname, lo, hi = uj.origin, uj.axis, index[uj.parent], uj.name, uj.lower, uj.upper
         chain_index = chain_names.index(name) if name in chain_names else -1
         frozen = 0.0
         if chain_index < 0 and kind == "prismatic":
@@ -379,4 +381,5 @@ def _ring_points(radius: float, length: float, capsule: bool, segments: int = 16
 def _sphere_points(radius: float) -> np.ndarray:
     d = np.array([[x, y, z] for x in (-1, 0, 1) for y in (-1, 0, 1) for z in (-1, 0, 1) if (x, y, z) != (0, 0, 0)],
                  dtype=float)
-    return radius * d / np.linalg.norm(d, axis=1, keepdims=True)
+    points: np.ndarray = radius * d / np.linalg.norm(d, axis=1, keepdims=True)
+    return points

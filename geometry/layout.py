@@ -204,7 +204,7 @@ def region_diagnostics(problem: Problem) -> list[Diagnostic]:
 
 
 # ---------------------------------------------------------------------------------------------- robots
-def robot_diagnostics(problem: Problem) -> list[Diagnostic]:
+def robot_diagnostics(problem: Problem) -> list[Diagnostic]:  # noqa: C901
     """E266 for arms at home that overlap something, W272 for regions no robot reaches (none for a
     symbolic problem)."""
     if problem.symbolic:

@@ -53,7 +53,7 @@ def read_mesh(path: str) -> tuple[np.ndarray, np.ndarray]:
 def checked_vertices(path: str, scale: float | tuple[float, ...] = 1.0) -> np.ndarray:
     """The vertices of ``path`` scaled by ``scale``, E403 when a scaled coordinate exceeds MAX_COORD."""
     v, _ = read_mesh(path)
-    scaled = v * np.asarray(scale, dtype=float)
+    scaled: np.ndarray = v * np.asarray(scale, dtype=float)
     if scaled.size and float(np.abs(scaled).max()) > MAX_COORD:
         raise mesh_error(path, f"a coordinate times the scale {scale} exceeds {MAX_COORD:g} m (wrong units?)")
     return scaled

@@ -60,7 +60,9 @@ _quiet = False
 
 def _ompl() -> tuple[Any, Any, Any]:
     global _quiet
-    from ompl import base as ob, geometric as og, util as ou
+    from ompl import base as ob
+    from ompl import geometric as og
+    from ompl import util as ou
 
     if not _quiet:
         ou.setLogLevel(ou.LogLevel.LOG_NONE)

@@ -46,9 +46,9 @@ from typing import Iterable
 import numpy as np
 
 from mrgc.geometry.collision import CollisionShape, CollisionWorld, collision_shape, scene_world
-from mrgc.geometry.lattice import LatticePlanner
-from mrgc.geometry.planar import DiscGrid, PlanarRobot, planar_grasp, placements, scene_bounds
 from mrgc.geometry.facts import RobotFacts
+from mrgc.geometry.lattice import LatticePlanner
+from mrgc.geometry.planar import DiscGrid, PlanarRobot, placements, planar_grasp, scene_bounds
 from mrgc.geometry.scene import Body, SceneSpec, inside
 from mrgc.language.model import Fact
 
@@ -94,7 +94,7 @@ class PlanarEvaluator:
 
     def _in_bounds(self, q: np.ndarray) -> bool:
         xmin, xmax, ymin, ymax = self.bounds
-        return xmin <= q[0] <= xmax and ymin <= q[1] <= ymax
+        return bool(xmin <= q[0] <= xmax and ymin <= q[1] <= ymax)
 
     def _path(self, start: np.ndarray, goal: np.ndarray, carried: Carried, carry_key: tuple[str, ...],
               obstacles: frozenset[str]) -> Path | None:
@@ -120,7 +120,8 @@ class PlanarEvaluator:
         bodies = [(b.name, b.shape, b.pose) for b in self.scene.fixed]
         bodies += [(name, self.scene.body(name).shape, self.scene.body(name).pose) for name in sorted(obstacles)]
         occupied = self.lattice.occupancy(parts, bodies)  # type: ignore[arg-type]
-        res = self.lattice.plan(occupied, start, goal, valid, RESOLUTION, YAW_RESOLUTION)
+        res = self.lattice.plan(occupied, tuple(map(float, start)), tuple(map(float, goal)), valid, RESOLUTION,
+                                YAW_RESOLUTION)
         self.stats["path_queries"] += 1
         self.stats["path_checks"] += res.checks
         self.stats["path_seconds"] += res.planning_time
@@ -190,7 +191,7 @@ class PlanarEvaluator:
                 self.out.facts.append(Fact("reachable-pick", (m.name, g, r)))
                 self.out.facts.extend(Fact("occludes-pick", (o, m.name, g, r)) for o in sorted(hits))
                 goal = scene.goal.get(m.name)
-                for region in sorted({goal, self.current.get(m.name)} - {None}):  # type: ignore[type-var]
+                for region in sorted({r for r in (goal, self.current.get(m.name)) if r is not None}):
                     place = self._place(m, g, region, q_pick, want_free=region == goal)
                     if place is None:
                         continue
@@ -208,7 +209,7 @@ class PlanarEvaluator:
         found = self._least_blocked(self.robot.start, q, None, (), frozenset({m.name}), self.movable - {m.name})
         return None if found is None else (q, found[1])
 
-    def _place(self, m: Body, g: str, region: str, q_pick: np.ndarray, want_free: bool) -> set[str] | None:
+    def _place(self, m: Body, g: str, region: str, q_pick: np.ndarray, want_free: bool) -> set[str] | None:  # noqa: C901
         """The objects the chosen placement of m in region (grasp g) and its path hit, or None if none is
         reachable; for ``want_free`` (goal pairs) a placement and path free of movable objects is preferred."""
         robot = self.robot
@@ -218,7 +219,8 @@ class PlanarEvaluator:
         others = self.movable - {m.name}
         if self._collides(robot.probe(q_pick, carried), ()):
             return None  # M cannot be lifted to its carry pose where it was picked
-        free, blocked = [], []
+        free: list[tuple[np.ndarray, np.ndarray]] = []
+        blocked: list[tuple[np.ndarray, np.ndarray]] = []
         for pose in placements(m, self.scene.body(region)):
             q = robot.grasp_base(pose, m.shape, g)
             if not self._in_bounds(q):
@@ -234,7 +236,7 @@ class PlanarEvaluator:
             if len(free) >= PLACE_FREE_TRIES + PLACE_FIXED_TRIES:
                 break
         if want_free:
-            for pose, q in free[:PLACE_FREE_TRIES]:
+            for _, q in free[:PLACE_FREE_TRIES]:
                 if self._path(q_pick, q, carried, key, others) is not None:
                     return set()
         best: tuple[Path, set[str], np.ndarray, np.ndarray] | None = None

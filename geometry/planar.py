@@ -98,7 +98,8 @@ class PlanarRobot:
     # ------------------------------------------------------------------------------------ geometry
     def body_transform(self, q: np.ndarray) -> np.ndarray:
         """World transform of the footprint at base pose ``q`` = (x, y, yaw)."""
-        return se2(q[0], q[1], q[2]) @ self.lift
+        body: np.ndarray = se2(q[0], q[1], q[2]) @ self.lift
+        return body
 
     def carry_transform(self, shape: Shape, grasp: str) -> np.ndarray:
         """Pose of a carried object (of ``shape``, held with ``grasp``) relative to the base frame."""
@@ -126,11 +127,11 @@ def carry_transform(kind: RobotKind, shape: Shape, grasp: str) -> np.ndarray:
     """Pose of an object (of ``shape``) that a planar robot of ``kind`` carries, held with ``grasp``,
     relative to its base frame: the kind's ``:carry`` pose, or on top of the footprint; the grasped face
     towards the robot."""
-    face_yaw = math.radians(PLANAR_GRASPS[grasp][1])
-    if kind.carry is not None:
-        return from_pose(kind.carry) @ rot_z(face_yaw)
-    h, fp = half_extents(shape), _footprint_half(kind)
-    return translation(0.0, 0.0, 2 * float(fp[2]) + 2 * PLANAR_LIFT + float(h[2])) @ rot_z(face_yaw)
+    face = rot_z(math.radians(PLANAR_GRASPS[grasp][1]))
+    on: np.ndarray = from_pose(kind.carry) if kind.carry is not None else translation(
+        0.0, 0.0, 2 * float(_footprint_half(kind)[2]) + 2 * PLANAR_LIFT + float(half_extents(shape)[2]))
+    carried: np.ndarray = on @ face
+    return carried
 
 
 def grasp_base(kind: RobotKind, pose: np.ndarray, shape: Shape, grasp: str) -> np.ndarray:

@@ -171,14 +171,14 @@ class RobotEvaluator:
         near = {m.name: self.arm.in_reach(m.pose[:3, 3], margin=0.3) for m in scene.movable}
         picks = [(m.name, g, m.pose, False, "pick") for m in scene.movable if near[m.name]
                  for g in scene.grasps[m.name] if self.usable(m.name, g)]
-        for i, (path, hits) in sorted(self._solve(picks, want_free=True).items()):
+        for i, (_, hits) in sorted(self._solve(picks, want_free=True).items()):
             obj, g = picks[i][0], picks[i][1]
             self.out.facts.append(Fact("reachable-pick", (obj, g, r)))
             self.out.facts.extend(Fact("occludes-pick", (o, obj, g, r)) for o in sorted(hits))
         # placements: round k tries the k-th candidate pose of every (object, region, grasp) not yet placed
-        triples = []
+        triples: list[tuple[str, str, str, list[np.ndarray]]] = []
         for m in scene.movable:
-            for region in sorted({scene.goal.get(m.name), self.current.get(m.name)} - {None}):  # type: ignore[type-var]
+            for region in sorted({r for r in (scene.goal.get(m.name), self.current.get(m.name)) if r is not None}):
                 poses = [p for p in self.placements(m.name, region) if self.arm.in_reach(p[:3, 3], margin=0.3)]
                 triples.extend((m.name, region, g, poses) for g in scene.grasps[m.name]
                                if self.usable(m.name, g) and poses)
@@ -189,7 +189,7 @@ class RobotEvaluator:
             if not open_:
                 break
             queries = [(triples[i][0], triples[i][2], triples[i][3][k], True, "place") for i in open_]
-            for j, (path, hits) in self._solve(queries, want_free=False).items():
+            for j, (_, hits) in self._solve(queries, want_free=False).items():
                 i = open_[j]
                 if i not in placed or (placed[i] and not hits):
                     placed[i] = hits

@@ -166,9 +166,9 @@ class ReplayScene:
             ji = pb.getJointInfo(body, j, physicsClientId=cid)
             by_link[ji[12].decode()] = j
             info[ji[1].decode()] = ji
-        for link in by_link.values():
-            if any(d[2] == pb.GEOM_MESH for d in pb.getCollisionShapeData(body, link, physicsClientId=cid)):
-                self._margin[(body, link)] = MESH_MARGIN
+        for index in by_link.values():
+            if any(d[2] == pb.GEOM_MESH for d in pb.getCollisionShapeData(body, index, physicsClientId=cid)):
+                self._margin[(body, index)] = MESH_MARGIN
         joints, lower, upper = [], [], []
         for joint in model.joints:
             ji = info[joint.name]
@@ -241,7 +241,8 @@ class ReplayScene:
         r = self.robots[robot]
         if r.planar:
             pos, orn = self.pb.getBasePositionAndOrientation(r.body, physicsClientId=self.cid)
-            return pose_of(pos, orn) @ tf.inverse(r.lift)
+            base: np.ndarray = pose_of(pos, orn) @ tf.inverse(r.lift)
+            return base
         st = self.pb.getLinkState(r.body, r.ee, computeForwardKinematics=True, physicsClientId=self.cid)
         return pose_of(st[4], st[5])
 

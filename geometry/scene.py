@@ -93,7 +93,7 @@ def scene_from_problem(problem: Problem) -> SceneSpec:
 
 
 def _mesh_shapes(problem: Problem) -> list[Mesh]:
-    shapes = [o.shape for o in (*problem.movable, *problem.fixed, *problem.regions)]
+    shapes = [o.shape for o in problem.bodies]
     shapes += [k.footprint for k in problem.domain.robot_kinds]
     return [s for s in shapes if isinstance(s, Mesh)]
 
@@ -110,8 +110,8 @@ def half_extents(shape: Shape) -> np.ndarray:
 
 
 def mesh_half_extents(mesh: Mesh) -> np.ndarray:
-    pts = mesh_vertices(mesh)
-    return np.abs(pts).max(axis=0)
+    extents: np.ndarray = np.abs(mesh_vertices(mesh)).max(axis=0)
+    return extents
 
 
 def mesh_vertices(mesh: Mesh) -> np.ndarray:
@@ -126,7 +126,8 @@ def outline(shape: Shape) -> np.ndarray:
         return mesh_vertices(shape)
     h = half_extents(shape)
     signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=float)
-    return signs * h
+    corners: np.ndarray = signs * h
+    return corners
 
 
 def inside(region: Body, shape: Shape, pose: np.ndarray, tol: float = 1e-6) -> bool:

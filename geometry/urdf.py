@@ -83,7 +83,8 @@ class Urdf:
 
 def urdf_error(path: str, message: str, line: int = 1, note: str | None = None) -> InputError:
     """E400 located at ``path:line``."""
-    return InputError([Diagnostic(E_URDF, f"robot URDF '{os.path.basename(path)}': {message}", Span(path, line, 1, line, 2),
+    return InputError([Diagnostic(E_URDF, f"robot URDF '{os.path.basename(path)}': {message}",
+                                  Span(path, line, 1, line, 2),
                                   notes=(note,) if note else ())])
 
 

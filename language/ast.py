@@ -16,7 +16,7 @@ NOWHERE = Span("<generated>", 1, 1, 1, 2)
 
 
 def _span() -> Span:
-    return field(default=NOWHERE, compare=False, repr=False)  # type: ignore[no-any-return]
+    return field(default=NOWHERE, compare=False, repr=False)
 
 
 # ---------------------------------------------------------------- values

@@ -6,7 +6,7 @@ checks and their codes are listed in :mod:`mrgc.language.codes` and docs/errors.
 
 from __future__ import annotations
 
-from typing import Any, Iterable
+from typing import Any, Iterable, cast
 
 from mrgc.errors import Diagnostic, Span
 from mrgc.language import ast
@@ -18,9 +18,9 @@ from mrgc.language.model import (
     PREDICATES,
     REQUIREMENTS,
     Domain,
-    GraspSpec,
     Fact,
     FixedObject,
+    GraspSpec,
     HandoverPoint,
     MovableObject,
     Problem,
@@ -98,7 +98,8 @@ class Checker:
             if isinstance(sec, ast.RobotKindDecl):
                 kind = self.robot_kind(sec)
                 if sec.name in kinds:
-                    self.err("E200", f"robot kind '{sec.name}' declared twice (first at {kinds[sec.name].span})", sec.span)
+                    self.err("E200", f"robot kind '{sec.name}' declared twice (first at {kinds[sec.name].span})",
+                             sec.span)
                 else:
                     kinds[sec.name] = kind
         grasps: tuple[str, ...] = ()
@@ -129,7 +130,8 @@ class Checker:
         for key in ("approach", "fingers"):
             if key not in table:
                 self.err("E255", f"{what} needs ':{key}'", d.span)
-        approach, fingers = vals.get("approach"), vals.get("fingers")
+        approach = cast("tuple[float, float, float] | None", vals.get("approach"))
+        fingers = cast("tuple[float, float, float] | None", vals.get("fingers"))
         if approach is None or fingers is None or ("depth" in table and vals["depth"] is None) or (
                 "offset" in table and vals["offset"] is None):
             return None
@@ -184,7 +186,8 @@ class Checker:
             kind = v.get("kind")
             if kind is not None and kind not in kinds:
                 span = _prop_span(d, "kind")
-                self.err("E214", f"undeclared robot kind '{kind}' in domain '{domain.name}'{did_you_mean(kind, kinds)}", span)
+                self.err("E214", f"undeclared robot kind '{kind}' in domain '{domain.name}'"
+                                 f"{did_you_mean(kind, kinds)}", span)
             if geometric and "kind" not in v and not _has(d, "kind"):
                 self.err("E260", f"robot '{d.name}' of a geometric problem needs ':kind'", d.span)
             robots.append(Robot(d.name, kind, v.get("base"), d.span))
@@ -320,7 +323,8 @@ class Checker:
             return False
         have = sort_of[name][0]
         if have != want:
-            self.err("E216", f"'{name}' is {_article(SORTS[have][1])}, but '{predicate}' expects {_article(noun)} here", span)
+            self.err("E216", f"'{name}' is {_article(SORTS[have][1])}, but '{predicate}' expects {_article(noun)} "
+                             f"here", span)
             return False
         return True
 

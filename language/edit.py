@@ -30,7 +30,9 @@ def with_init(problem: ast.ProblemDef, facts: Iterable[Fact]) -> ast.ProblemDef:
 
 def strip_spans(tree: ast.SourceFile) -> ast.SourceFile:
     """The tree with every span replaced by the generated marker, so the printer ignores old positions."""
-    return _strip(tree)  # type: ignore[no-any-return]
+    out = _strip(tree)
+    assert isinstance(out, ast.SourceFile)
+    return out
 
 
 def _strip(node: object) -> object:
@@ -40,7 +42,7 @@ def _strip(node: object) -> object:
         return tuple(_strip(n) for n in node)
     if not is_dataclass(node) or isinstance(node, type):
         return node
-    changes = {}
+    changes: dict[str, object] = {}
     for f in fields(node):
         value = getattr(node, f.name)
         if f.name == "span":
@@ -49,7 +51,7 @@ def _strip(node: object) -> object:
             changes[f.name] = ()
         elif isinstance(value, tuple) or is_dataclass(value):
             changes[f.name] = _strip(value)
-    return replace(node, **changes)  # type: ignore[type-var]
+    return replace(node, **changes)
 
 
 #: ``relocate(path, what, declaring_file)`` -> the path to write instead; ``what`` is ``mesh``, ``urdf``
@@ -76,7 +78,7 @@ def relocate_paths(node: object, relocate: Relocate, declaring_file: str) -> obj
         return node
     changes = {f.name: relocate_paths(getattr(node, f.name), relocate, declaring_file) for f in fields(node)
                if isinstance(getattr(node, f.name), tuple) or is_dataclass(getattr(node, f.name))}
-    return replace(node, **changes)  # type: ignore[type-var]
+    return replace(node, **changes)
 
 
 def facts_document(source: ast.SourceFile, problem_name: str, domain_name: str, domain_file: str,

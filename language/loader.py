@@ -50,7 +50,8 @@ class MrgFile:
         if name is None:
             if len(self.problems) != 1:
                 found = ", ".join(p.name for p in self.problems) or "none"
-                raise InputError([Diagnostic("E230", f"{self.path} holds {len(self.problems)} problems ({found}); name one")])
+                raise InputError([Diagnostic("E230", f"{self.path} holds {len(self.problems)} problems ({found}); "
+                                                     f"name one")])
             return self.problems[0]
         for p in self.problems:
             if p.name == name:
@@ -232,7 +233,8 @@ def load(path: str, text: str | None = None, root_dir: str | None = None,
     """Parse and check ``path`` (or ``text`` under that name); raise InputError with every diagnostic.
 
     ``allow_outside``: folders whose files (meshes, URDFs) may be used besides the file's own tree."""
-    base = root_dir if root_dir is not None else (os.path.dirname(os.path.abspath(path)) if text is None else os.getcwd())
+    here = os.path.dirname(os.path.abspath(path)) if text is None else os.getcwd()
+    base = root_dir if root_dir is not None else here
     loader = _Loader(base)
     tree = loader.parse(path, text)
     if tree is None:
@@ -303,7 +305,7 @@ def confinement(problem: Problem, roots: tuple[str, ...]) -> list[Diagnostic]:
     out = []
     hint = "; pass --allow-outside FOLDER to allow it"
     shown_roots = " or ".join(shown(r) for r in roots[:1])
-    for obj in (*problem.movable, *problem.fixed, *problem.regions):
+    for obj in problem.bodies:
         if isinstance(obj.shape, Mesh) and not inside(obj.shape.path, roots):
             out.append(Diagnostic("E236", f"mesh file '{obj.shape.path}' of '{obj.name}' is outside the folder "
                                   f"tree of {shown_roots}{hint}", obj.span))

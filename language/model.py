@@ -56,7 +56,7 @@ DEFAULT_GRIPPER_OPENING = 0.08  # m: a Franka Panda's fingers open 2 × 4 cm
 
 
 def _span() -> Span:
-    return field(default=NOWHERE, compare=False, repr=False)  # type: ignore[no-any-return]
+    return field(default=NOWHERE, compare=False, repr=False)
 
 
 @dataclass(frozen=True)
@@ -303,7 +303,13 @@ class Problem:
         """Object name → the region ``(in-region o r)`` in ``:init`` puts it in (where stated)."""
         return {f.args[0]: f.args[1] for f in self.init if f.predicate == "in-region"}
 
+    @property
+    def bodies(self) -> tuple[MovableObject | FixedObject | Region, ...]:
+        """Every movable object, fixed object and region, in that order."""
+        return (*self.movable, *self.fixed, *self.regions)
+
     def object(self, name: str) -> MovableObject:
+        """The movable object called ``name``."""
         return next(m for m in self.movable if m.name == name)
 
     def grasps_of(self, name: str) -> tuple[str, ...]:

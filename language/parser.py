@@ -301,7 +301,7 @@ def _first_syntax_diagnostic(exc: UnexpectedInput, text: str, file: str) -> Diag
     if isinstance(exc, UnexpectedCharacters):
         allowed = set(exc.allowed or ())
         sections = _section_literals(allowed)
-        word = _word_at(text, exc.pos_in_stream)
+        word = _word_at(text, exc.pos_in_stream or 0)
         span = Span(file, line, col, line, col + max(1, len(word)))
         if word.startswith(":") and sections:
             return _unknown_section(word, sections, span)

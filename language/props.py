@@ -123,7 +123,8 @@ class PropReader:
         if value.name not in AXES:
             word = value.name.lower()
             word = word if word in AXES else word[::-1] if word[::-1] in AXES else ""  # -Z, z-
-            hint = f" (did you mean '{word}'?)" if word else did_you_mean(value.name, AXES) or f" (use {' '.join(words)})"
+            hint = (f" (did you mean '{word}'?)" if word
+                    else did_you_mean(value.name, AXES) or f" (use {' '.join(words)})")
             self.err("E240", f"unknown axis '{value.name}' for {what}{hint}", value.span)
             return None
         return AXES[value.name]
@@ -207,13 +208,16 @@ class PropReader:
         if head.name == "mesh":
             return self._mesh(value, args)
         if len(args) != len(names):
-            self.err("E252", f"a {head.name} needs {len(names)} numbers ({', '.join(names)}), got {len(args)}", value.span)
+            self.err("E252", f"a {head.name} needs {len(names)} numbers ({', '.join(names)}), got {len(args)}",
+                     value.span)
             return None
         dims = [self._length(a, f"{head.name} {n}") for a, n in zip(args, names)]
-        if any(d is None for d in dims):
+        given = [d for d in dims if d is not None]
+        if len(given) < len(dims):
             return None
-        cls = {"box": Box, "cylinder": Cylinder, "sphere": Sphere}[head.name]
-        return cls(*dims)  # type: ignore[arg-type]
+        if head.name == "box":
+            return Box(*given)
+        return Cylinder(*given) if head.name == "cylinder" else Sphere(*given)
 
     def _mesh(self, value: ast.ListValue, args: tuple[ast.Number | ast.Symbol | ast.String, ...]) -> Optional[Mesh]:
         if not 1 <= len(args) <= 2 or not isinstance(args[0], ast.String):

@@ -11,8 +11,8 @@ from __future__ import annotations
 import math
 
 from mrgc.geometry.collision import CollisionWorld
-from mrgc.geometry.grounding import Grounder
 from mrgc.geometry.conventions import refine
+from mrgc.geometry.grounding import Grounder
 
 
 def pick_obstruction(g: Grounder, robot: str, obj: str, grasp: str, blocker: str) -> str:

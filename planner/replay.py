@@ -155,7 +155,8 @@ class _Replayer(ActionReader):
         self.budget_spent = False
         self._worst: dict[tuple[Any, ...], tuple[float, str, str]] = {}
         self.first_only = False
-        self._boxes: dict[str, tuple[float, ...]] = {}  # bounding boxes (min x y z, max x y z) of the bodies of the phase being swept
+        #: bounding boxes (min x y z, max x y z) of the bodies of the phase being swept
+        self._boxes: dict[str, tuple[float, ...]] = {}
         self._placements_state()
         self.support = {o: self._supports(o) for o in self.movable}  # what each object rests on
 
@@ -223,7 +224,7 @@ class _Replayer(ActionReader):
         self.flush()
 
     # ------------------------------------------------------------------ sweeping a phase
-    def _sweep(self, t: int, phase: str, tracks: list[_Track], static: list[str], present: list[str]) -> None:
+    def _sweep(self, t: int, phase: str, tracks: list[_Track], static: list[str], present: list[str]) -> None:  # noqa: C901
         if not tracks or self.budget_spent:
             return
         rs = self.rs
@@ -231,8 +232,9 @@ class _Replayer(ActionReader):
         n = max(counts)
         if n > MAX_SAMPLES:
             tr = tracks[counts.index(n)]
-            self._v(t, tr.robot, "too-long", f"{phase}: the {tr.label} motion of {tr.robot} is too long to check "
-                                             f"({n} samples at {self.resolution:g} rad or m each; at most {MAX_SAMPLES})")
+            self._v(t, tr.robot, "too-long",
+                    f"{phase}: the {tr.label} motion of {tr.robot} is too long to check "
+                    f"({n} samples at {self.resolution:g} rad or m each; at most {MAX_SAMPLES})")
             return
         if self.samples + sum(counts) * len(tracks) > MAX_PLAN_SAMPLES:
             self._v(t, None, "too-long", f"{phase}: the plan's motions need more than {MAX_PLAN_SAMPLES} robot "

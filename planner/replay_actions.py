@@ -15,10 +15,10 @@ from typing import Any
 
 import numpy as np
 
-from mrgc.geometry.replay_world import ReplayScene
-from mrgc.geometry.grasps import APPROACH, finger_opening, fits, grasp_transform, pregrasp_transform
 from mrgc.geometry.conventions import pose_error, wrap_angle, yaw_of
+from mrgc.geometry.grasps import APPROACH, finger_opening, fits, grasp_transform, pregrasp_transform
 from mrgc.geometry.planar import PLANAR_GRASPS, carry_transform, grasp_base
+from mrgc.geometry.replay_world import ReplayScene
 from mrgc.geometry.scene import SceneSpec
 from mrgc.geometry.transforms import from_pose, inverse
 from mrgc.planner.plan import MotionModel
@@ -111,7 +111,7 @@ class ActionReader:
         home = np.array(spec.kind.home, dtype=float)
         if len(home) < rr.dof:
             mid = np.where(np.isfinite(rr.lower) & np.isfinite(rr.upper), (rr.lower + rr.upper) / 2, 0.0)
-            return mid  # type: ignore[no-any-return]
+            return mid
         return np.clip(home[: rr.dof], rr.lower, rr.upper)  # type: ignore[no-any-return]
 
     def _v(self, step: int | None, subject: str | None, code: str, message: str) -> None:
@@ -120,7 +120,8 @@ class ActionReader:
     def tool(self, robot: str, q: np.ndarray) -> np.ndarray:
         """Arms: the tool centre point in the world (pybullet FK); planar robots: the base frame."""
         self.rs.set_config(robot, q)
-        return self.rs.ee_pose(robot) @ self.tcp[robot]
+        tool: np.ndarray = self.rs.ee_pose(robot) @ self.tcp[robot]
+        return tool
 
     def grasp_frame(self, robot: str, obj: str, grasp: str) -> np.ndarray:
         """Arms: the tool pose in the object frame; planar robots: the object's carry pose in the base frame."""
@@ -365,9 +366,10 @@ class ActionReader:
             dp, dr = _pose_error(self.tool(robot, qs[0]), pose @ pregrasp_transform(
                 grasp_transform(self.scene.grasp(grasp), self.shapes[obj])))
             if dp > POS_TOL or dr > ROT_TOL:
-                self._v(t, robot, "approach", f"the first {phase} configuration of {robot} puts the tool "
-                                              f"{dp * 1e3:.1f} mm, {dr:.3f} rad from the {word} of {obj} ({APPROACH:g} m "
-                                              f"back from grasp {grasp!r}; tolerance {POS_TOL * 1e3:g} mm, {ROT_TOL} rad)")
+                self._v(t, robot, "approach",
+                        f"the first {phase} configuration of {robot} puts the tool "
+                        f"{dp * 1e3:.1f} mm, {dr:.3f} rad from the {word} of {obj} ({APPROACH:g} m "
+                        f"back from grasp {grasp!r}; tolerance {POS_TOL * 1e3:g} mm, {ROT_TOL} rad)")
             d = float(np.linalg.norm(self.tool(robot, qs[-2])[:3, 3] - g[:3, 3])) if len(qs) > 1 else 0.0
             if d > share + POS_TOL:
                 self._v(t, robot, "approach", f"the contact segment of {robot}'s {phase} approach (moving {obj}) "

@@ -28,7 +28,7 @@ def deltas(configs: np.ndarray, planar: bool) -> np.ndarray:
     d = np.diff(configs, axis=0)
     if planar and d.size:
         d[:, 2] = wrap_angle(d[:, 2])
-    return d  # type: ignore[no-any-return]
+    return d
 
 
 def sample_count(configs: np.ndarray, planar: bool, resolution: float) -> int:
@@ -51,13 +51,13 @@ def sample_times(configs: np.ndarray, planar: bool, resolution: float) -> np.nda
     if m - 1 <= FEW:
         per = np.maximum(SUBSTEPS, np.ceil(seg / resolution)).astype(int)
         parts = [(j + np.arange(k) / k) / (m - 1) for j, k in enumerate(per)]
-        return np.concatenate(parts + [np.ones(1)])  # type: ignore[no-any-return]
+        return np.concatenate(parts + [np.ones(1)])
     cum = np.concatenate([[0.0], np.cumsum(seg)])
     pieces = max(1, math.ceil(float(cum[-1]) / resolution))
     targets = np.linspace(0.0, float(cum[-1]), pieces + 1)
     j = np.clip(np.searchsorted(cum, targets, side="right") - 1, 0, m - 2)
     u = np.divide(targets - cum[j], seg[j], out=np.zeros_like(targets), where=seg[j] > 0)
-    return np.unique(np.concatenate([(j + np.clip(u, 0.0, 1.0)) / (m - 1), [0.0, 1.0]]))  # type: ignore[no-any-return]
+    return np.unique(np.concatenate([(j + np.clip(u, 0.0, 1.0)) / (m - 1), [0.0, 1.0]]))
 
 
 def config_at(configs: np.ndarray, s: float, planar: bool) -> np.ndarray:

@@ -17,7 +17,8 @@ Checks on every plan (codes in brackets):
 - the plan is for this problem: same name ``[problem]``, same contents ``[problem-changed]`` (the plan's
   ``problem_digest``, the checked problem's content digest of :mod:`mrgc.language.digest`, matches: the
   file the plan was made from and its facts file both qualify; a plan without a digest compares the
-  sha256 of the problem file's bytes), symbolic flag as the problem's ``[plan-kind]``; status ``solved`` ``[status]``; ``makespan``/``motion_cost``/step
+  sha256 of the problem file's bytes), symbolic flag as the problem's ``[plan-kind]``; status ``solved``
+  ``[status]``; ``makespan``/``motion_cost``/step
   indices agree with the steps ``[summary]``;
 - every name is declared (objects, regions, robots of actions and of ``waiting``, handover points), every
   grasp allowed for its object ``[unknown-name]``; the ``kind`` matches the robots, and a pick-and-place
@@ -43,8 +44,18 @@ from typing import Any
 from mrgc.language.model import Problem
 from mrgc.planner.plan import file_sha256
 from mrgc.planner.plan_reader import (
-    E_JSON, E_LIMIT, E_READ, E_SCHEMA, E_VERSION, Action, PlanFile, check_schema, load_plan, read_plan,
-    schema_errors)
+    E_JSON,
+    E_LIMIT,
+    E_READ,
+    E_SCHEMA,
+    E_VERSION,
+    Action,
+    PlanFile,
+    check_schema,
+    load_plan,
+    read_plan,
+    schema_errors,
+)
 from mrgc.planner.violation import Violation
 
 #: the reader's entry points and :class:`Violation` are re-exported here, where the CLI and the tests import them
@@ -131,8 +142,9 @@ def _header(problem: Problem, plan: PlanFile, problem_path: str | None, out: lis
             out.append(Violation(i, None, "summary", f"step {i} is numbered {s.index}"))
     moved = sum(len(s.actions) for s in plan.steps)
     if plan.makespan != len(plan.steps) or plan.motion_cost != moved:
-        out.append(Violation(None, None, "summary", f"the plan says makespan {plan.makespan}, motion cost "
-                                                    f"{plan.motion_cost}; its steps give {len(plan.steps)} and {moved}"))
+        out.append(Violation(None, None, "summary",
+                             f"the plan says makespan {plan.makespan}, motion cost {plan.motion_cost}; its steps "
+                             f"give {len(plan.steps)} and {moved}"))
     for i, s in enumerate(plan.steps, 1):
         if not s.actions:
             out.append(Violation(i, None, "summary", "the step is empty"))
@@ -165,7 +177,7 @@ def _changed(problem: Problem, plan: PlanFile, problem_path: str | None) -> str:
             f"{file_digest[:12]}... now")
 
 
-def _names(problem: Problem, plan: PlanFile, out: list[Violation]) -> set[int]:
+def _names(problem: Problem, plan: PlanFile, out: list[Violation]) -> set[int]:  # noqa: C901
     """Ids of the actions whose names all resolve (the others are reported and left out of later checks);
     unknown robots in ``waiting`` are reported too."""
     robots = {r.name for r in problem.robots}
@@ -242,7 +254,7 @@ def _structure(problem: Problem, plan: PlanFile, usable: set[int], out: list[Vio
                 out.append(Violation(t, r, "waiting", f"{r} is in no action of the step and not listed as waiting"))
 
 
-def _symbolic(problem: Problem, steps: list[tuple[Action, ...]], usable: set[int], out: list[Violation]) -> None:
+def _symbolic(problem: Problem, steps: list[tuple[Action, ...]], usable: set[int], out: list[Violation]) -> None:  # noqa: C901
     facts = {(f.predicate, f.args) for f in problem.init}
     goal = problem.goal_regions
     initial = problem.initial_regions

@@ -77,7 +77,7 @@ class Camera:
     def linear_depth(self, zbuffer: np.ndarray) -> np.ndarray:
         """Eye-space depth from an OpenGL depth buffer in [0, 1]."""
         n, f = self.near, self.far
-        return f * n / (f - (f - n) * zbuffer)  # type: ignore[no-any-return]
+        return f * n / (f - (f - n) * zbuffer)
 
 
 def fit(points: np.ndarray, preset: str = DEFAULT_PRESET, aspect: float = 4 / 3, fov: float = FOV) -> Camera:

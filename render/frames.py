@@ -103,7 +103,7 @@ class Timeline:
         """The frames at ``fps``: the start, then ``ceil(duration · fps)`` per phase (at least one)."""
         w = self.world
         configs = {r: v.home.copy() for r, v in w.robots.items()}
-        fingers: dict[str, float | None] = {r: None for r in w.robots}
+        fingers: dict[str, float | None] = dict.fromkeys(w.robots)
         poses = {o: p.copy() for o, p in w.start.items()}
         holder: dict[str, tuple[str, str]] = {}
         out = [Frame(0.0, 0, "start", self.title, dict(configs), dict(fingers), dict(poses), key=True)]
@@ -137,12 +137,13 @@ def interpolate(configs: np.ndarray, s: float, planar: bool = False) -> np.ndarr
     spaced, straight lines between them (a planar yaw turns the shorter way)."""
     c = np.asarray(configs, dtype=float)
     if len(c) == 1:
-        return c[0].copy()
+        first: np.ndarray = c[0].copy()
+        return first
     if planar:
         c = c.copy()
         c[:, 2] = np.unwrap(c[:, 2])
     grid = np.linspace(0.0, 1.0, len(c))
-    return np.array([np.interp(min(max(s, 0.0), 1.0), grid, c[:, j]) for j in range(c.shape[1])])
+    return np.array([np.interp(min(max(s, 0.0), 1.0), grid, c[:, j]) for j in range(c.shape[1])], dtype=float)
 
 
 # ------------------------------------------------------------------------------------------- building
@@ -237,7 +238,7 @@ def _step_phases(world: World, t: int, n: int, acts: list[_Act], home: Mapping[s
     return out
 
 
-def _parse(world: World, a: Mapping[str, Any], t: int, source: str) -> _Act:
+def _parse(world: World, a: Mapping[str, Any], t: int, source: str) -> _Act:  # noqa: C901
     """One action of the plan, checked against the world (E510 when it does not fit)."""
     def fail(message: str) -> InputError:
         return InputError([Diagnostic(E_PLAN_FIT, f"{source}: step {t}: {message} (problem "
@@ -275,7 +276,7 @@ def _parse(world: World, a: Mapping[str, Any], t: int, source: str) -> _Act:
                        f"{world.robots[robot].home.size} values ({robot})")
         configs[name] = arr
     paths: dict[str, np.ndarray] = {}
-    from mrgc.planner.replay import PATH_PHASES
+    from mrgc.planner.replay_actions import PATH_PHASES
 
     for name, qs in (a.get("paths") or {}).items():
         if name not in PATH_PHASES:

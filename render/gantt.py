@@ -24,7 +24,7 @@ def write(problem: Problem, plan: Mapping[str, Any], path: str) -> None:
 
     matplotlib.use("Agg", force=True)
     import matplotlib.pyplot as plt
-    from matplotlib.patches import Patch
+    from matplotlib.patches import Patch, Rectangle
 
     robots = [r.name for r in problem.robots]
     row = {r: i for i, r in enumerate(robots)}
@@ -43,8 +43,8 @@ def write(problem: Problem, plan: Mapping[str, Any], path: str) -> None:
                     bars.insert(0, (giver, f"{a['object']} \u2192 {taker}\n{a['pick_grasp']}"))
                 for robot, label in bars:
                     y = row.get(robot, 0)
-                    ax.add_patch(plt.Rectangle((t - BAR / 2, y - BAR / 2), BAR, BAR, facecolor=face,
-                                               edgecolor=colours.get(robot, (0, 0, 0)), linewidth=2.0))
+                    ax.add_patch(Rectangle((t - BAR / 2, y - BAR / 2), BAR, BAR, facecolor=face,
+                                           edgecolor=colours.get(robot, (0, 0, 0)), linewidth=2.0))
                     ax.text(t, y, label, ha="center", va="center", fontsize=8, color="white", fontweight="bold")
                 if giver != taker:
                     y0, y1 = row.get(giver, 0), row.get(taker, 0)
@@ -57,9 +57,9 @@ def write(problem: Problem, plan: Mapping[str, Any], path: str) -> None:
         ax.set_ylim(len(robots) - 0.5, -0.5)
         ax.set_xticks(range(1, n + 1), [f"step {t}" for t in range(1, n + 1)])
         ax.set_yticks(range(len(robots)), robots)
-        for label in ax.get_yticklabels():
-            label.set_color(colours[label.get_text()])
-            label.set_fontweight("bold")
+        for tick in ax.get_yticklabels():
+            tick.set_color(colours[tick.get_text()])
+            tick.set_fontweight("bold")
         ax.set_xticks([t + 0.5 for t in range(n)], minor=True)
         ax.grid(which="minor", axis="x", color="0.85")
         ax.tick_params(which="minor", length=0)

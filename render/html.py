@@ -78,7 +78,7 @@ def _record(server: Any, world: World, frames: list[Frame], camera: Camera, fps:
     label = scene.add_label("/caption", first.caption, position=tuple(float(v) for v in top),
                             anchor="bottom-center", font_screen_scale=1.2)
     serializer = server.get_scene_serializer()
-    last = {name: None for name in handles}
+    last = dict.fromkeys(handles)
     text = first.caption
     for i, frame in enumerate(frames[1:], 2):
         serializer.insert_sleep(1.0 / fps)

@@ -192,7 +192,7 @@ def scene_frame(world: World) -> Frame:
     text = (f"{world.problem.name}: {len(world.robots)} robots, {len(world.objects)} objects, "
             f"{len(world.regions)} regions; goal: {goal or 'none'}")
     return Frame(0.0, 0, "start", text, {r: v.home for r, v in world.robots.items()},
-                 {r: None for r in world.robots}, dict(world.start), key=True)
+                 dict.fromkeys(world.robots), dict(world.start), key=True)
 
 
 def write_html(problem: Problem, plan: Mapping[str, Any] | None, path: str, opts: Options, source: str,

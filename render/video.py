@@ -8,7 +8,7 @@ H.264 in yuv420p, padded by one pixel to even sizes where needed.
 from __future__ import annotations
 
 import importlib.util
-from typing import Sequence
+from typing import Any, Sequence
 
 import numpy as np
 
@@ -34,8 +34,9 @@ def write_mp4(path: str, images: Sequence[np.ndarray], fps: float, hold_last: fl
 
     h, w = images[0].shape[:2]
     hold = max(1, round(hold_last * fps))
-    with iio2.get_writer(path, format="FFMPEG", mode="I", fps=fps, codec="libx264", macro_block_size=1,
-                         ffmpeg_log_level="error", output_params=["-pix_fmt", "yuv420p"]) as out:
+    writer: Any = iio2.get_writer(path, format="FFMPEG", mode="I", fps=fps, codec="libx264", macro_block_size=1,
+                                  ffmpeg_log_level="error", output_params=["-pix_fmt", "yuv420p"])
+    with writer as out:
         for i, img in enumerate(images):
             even = np.pad(img, ((0, h % 2), (0, w % 2), (0, 0)), mode="edge")
             for _ in range(hold if i == len(images) - 1 else 1):

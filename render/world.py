@@ -22,8 +22,7 @@ from mrgc.geometry.conventions import wrap_angle
 from mrgc.geometry.scene import Body, SceneSpec, outline, scene_from_problem
 from mrgc.geometry.transforms import from_pose, inverse
 from mrgc.language.model import Box, Cylinder, Mesh, Problem, Shape, Sphere
-from mrgc.render.palette import (FIXED, GOAL_REGION, OTHER_REGION, RGB, ROLE_COLOURS, moved_objects, robot_colours,
-                                 roles)
+from mrgc.render.palette import FIXED, GOAL_REGION, OTHER_REGION, RGB, ROLE_COLOURS, moved_objects, robot_colours, roles
 
 
 @dataclass(frozen=True, eq=False)

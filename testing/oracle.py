@@ -57,7 +57,7 @@ def _steps(skeleton: Any) -> list[tuple[Action, ...]]:
 
 
 # ------------------------------------------------------------------ (a) checking one skeleton
-def check_skeleton(graph: TaskGraph, skeleton: Any) -> list[str]:
+def check_skeleton(graph: TaskGraph, skeleton: Any) -> list[str]:  # noqa: C901
     """Every way ``skeleton`` (an object with ``.steps``, or a list of steps) breaks the definitions."""
     steps = _steps(skeleton)
     obstacles = _obstacles(graph)
@@ -187,7 +187,7 @@ def _assign(rel: list[list[tuple[int, str]]], step: list[int], k: int, m: int) -
     return False
 
 
-def feasible_action_sets(graph: TaskGraph) -> dict[frozenset[Action], int]:
+def feasible_action_sets(graph: TaskGraph) -> dict[frozenset[Action], int]:  # noqa: C901
     """Every action set that has a valid schedule, with its minimum makespan.
 
     Search over subsets: each object of the graph is either not moved or moved by one of its actions
@@ -215,7 +215,7 @@ def feasible_action_sets(graph: TaskGraph) -> dict[frozenset[Action], int]:
                 if b not in options:
                     return False
         else:
-            for other, c in choice.items():
+            for c in choice.values():
                 if c is not None and o in blockers(c):
                     return False
         return True
@@ -248,9 +248,10 @@ def oracle_keys(graph: TaskGraph) -> list[tuple[int, int]]:
 
 
 # ------------------------------------------------------------------ Alg. 1 on raw facts
-def reference_task_graph(robots: Sequence[str], grasps: Mapping[str, Sequence[str]], goal: Mapping[str, str],
-                         region: Mapping[str, str], facts: Iterable[tuple[str, ...]],
-                         must_move: Sequence[str], moved: Iterable[str] = ()) -> TaskGraph:
+def reference_task_graph(  # noqa: C901
+        robots: Sequence[str], grasps: Mapping[str, Sequence[str]], goal: Mapping[str, str],
+        region: Mapping[str, str], facts: Iterable[tuple[str, ...]], must_move: Sequence[str],
+        moved: Iterable[str] = ()) -> TaskGraph:
     """Alg. 1 (AddObject for every object of M*) on fact tuples ``(predicate, arg, ...)``.
 
     ``moved`` are the objects of the already grounded suffix S' (they move later, once): they get no node
@@ -324,7 +325,8 @@ def reference_task_graph(robots: Sequence[str], grasps: Mapping[str, Sequence[st
     )
 
 
-def graph_signature(graph: TaskGraph) -> tuple[frozenset[str], frozenset[str], frozenset[tuple[Action, frozenset[str], frozenset[str]]]]:
+def graph_signature(graph: TaskGraph) -> tuple[frozenset[str], frozenset[str],
+                                               frozenset[tuple[Action, frozenset[str], frozenset[str]]]]:
     """(objects, M*, {(action, pick obstacles, place obstacles)}): a graph up to the order of its lists."""
     return (
         frozenset(graph.objects),

@@ -135,7 +135,7 @@ def pybullet_ik(model: RobotModel, target: Array, seed: int, q_init: Sequence[fl
         kw: dict[str, Any] = {}
         if null_space:
             rest = [float(q0[lk.chain_index]) if lk.chain_index >= 0 else lk.frozen_value for _, lk in movable]
-            kw = dict(lowerLimits=ll, upperLimits=ul, jointRanges=jr, restPoses=rest)
+            kw = {"lowerLimits": ll, "upperLimits": ul, "jointRanges": jr, "restPoses": rest}
         sol = pb.calculateInverseKinematics(body, by_name[model.end_effector], pos, orn, maxNumIterations=max_iters,
                                             residualThreshold=1e-8, physicsClientId=cid, **kw)
         q = np.zeros(model.dof)

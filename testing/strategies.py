@@ -47,7 +47,8 @@ class SymbolicCase:
 
 
 def symbolic_problems(*, robots: tuple[int, int] = (2, 3), objects: tuple[int, int] = (2, 5),
-                      regions: Sequence[str] = ("ra", "rb", "rc"), min_regions: int = 2, goals: tuple[int, int] = (1, 2),
+                      regions: Sequence[str] = ("ra", "rb", "rc"), min_regions: int = 2,
+                      goals: tuple[int, int] = (1, 2),
                       grasps: Sequence[str] = ("top", "side"), feasible: float | None = 0.5, handover: bool = True,
                       domain: str = "abstract") -> st.SearchStrategy[SymbolicCase]:
     """Random small symbolic problems (see the module docstring).

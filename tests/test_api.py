@@ -351,7 +351,8 @@ def test_include_inside_the_folder_through_dotdot_is_fine(tmp_path: Path) -> Non
 
 
 def test_include_not_found(tmp_path: Path) -> None:
-    path = write(tmp_path / "p.mrg", DOMAIN.replace("(:grasps top side-x+)", '(:grasps top side-x+) (:include "nope.mrg")'))
+    path = write(tmp_path / "p.mrg",
+                 DOMAIN.replace("(:grasps top side-x+)", '(:grasps top side-x+) (:include "nope.mrg")'))
     with pytest.raises(InputError) as info:
         mrgc.parse_file(path)
     assert codes(info) == ["E234"]

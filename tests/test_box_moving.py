@@ -137,8 +137,9 @@ def test_disc_grid_separates_blocked_rooms_only(doorway: tuple[SceneSpec, set[Fa
 
 @pytest.mark.parametrize("door_y", [0.0, 0.08, 0.16, 0.22, 0.3])
 def test_disc_grid_never_rules_out_a_path_the_planner_finds(door_y: float) -> None:
-    scene = scene_from_problem(problem_of(DOORWAY.replace("(door :shape (box 0.3 0.3 0.3) :pose (0 0 0.15 0))",
-                                                          f"(door :shape (box 0.3 0.3 0.3) :pose (0 {door_y} 0.15 0))")))
+    moved = DOORWAY.replace("(door :shape (box 0.3 0.3 0.3) :pose (0 0 0.15 0))",
+                            f"(door :shape (box 0.3 0.3 0.3) :pose (0 {door_y} 0.15 0))")
+    scene = scene_from_problem(problem_of(moved))
     ev = PlanarEvaluator(scene, "r1")
     ev.grid.enabled = False
     start, goal = ev.robot.start, np.array([1.0, 0.0, 0.0])

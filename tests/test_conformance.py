@@ -69,7 +69,8 @@ def test_lexicographic_model_tells_weightings_apart() -> None:
     m = kit.lexicographic()
     status, lex, _ = kit.brute_force(m)
     assert status == SolveStatus.OPTIMAL and lex == (0, 8, -1)
-    naive = SkeletonModel(m.vars, m.rows, objectives=[((m.objectives[0][0][0], 16),) + m.objectives[1] + m.objectives[2]])
+    naive = SkeletonModel(m.vars, m.rows,
+                          objectives=[((m.objectives[0][0][0], 16),) + m.objectives[1] + m.objectives[2]])
     _, _, arg = kit.brute_force(naive)
     assert arg and all(kit.objectives(m, v)[0] == 1 for v in arg)  # a too-small weight picks a = 1
 

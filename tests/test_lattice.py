@@ -7,7 +7,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from mrgc.geometry.collision import CollisionWorld, collision_shape
 from mrgc.geometry.lattice import LatticePlanner, hull2d, interpolate, wrap

@@ -68,7 +68,8 @@ def test_a_geometric_blocking_cycle_shows_the_bodies_and_the_depth(tmp_path: Pat
     """Two boxes 7 cm apart, each allowed only the side grasp whose approach comes through the other."""
     cycle = PA3.replace("""    (o1 :shape (box 0.05 0.05 0.12) :pose (0 -0.25 0.06 0))
     (o2 :shape (box 0.05 0.05 0.12) :pose (0.07 -0.25 0.06 0))
-    (o3 :shape (box 0.05 0.05 0.12) :pose (-0.07 -0.25 0.06 0)))""", """    (o1 :shape (box 0.05 0.05 0.12) :pose (0 -0.25 0.06 0) :grasps (side-x+))
+    (o3 :shape (box 0.05 0.05 0.12) :pose (-0.07 -0.25 0.06 0)))""",
+        """    (o1 :shape (box 0.05 0.05 0.12) :pose (0 -0.25 0.06 0) :grasps (side-x+))
     (o2 :shape (box 0.05 0.05 0.12) :pose (0.07 -0.25 0.06 0) :grasps (side-x-)))""").replace(
         "(:goal (in-region o1 bin-b))", "(:goal (and (in-region o1 bin-a) (in-region o2 bin-a)))")
     code, data, text = run_plan(tmp_path, cycle, "--time-limit", "60")

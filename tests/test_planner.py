@@ -17,7 +17,8 @@ from mrgc.planner.search import plan_problem
 from mrgc.planner.validate import validate
 
 ROOT = Path(__file__).resolve().parent.parent
-GEOMETRIC = sorted((ROOT / "domains" / "packaging").glob("pa*.mrg")) + sorted((ROOT / "domains" / "box-moving").glob("bo*.mrg"))
+GEOMETRIC = (sorted((ROOT / "domains" / "packaging").glob("pa*.mrg"))
+             + sorted((ROOT / "domains" / "box-moving").glob("bo*.mrg")))
 
 
 def plan_of(path: Path, seed: int = 0, time_limit: float = 120.0):  # type: ignore[no-untyped-def]

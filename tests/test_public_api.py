@@ -142,8 +142,8 @@ def test_a_plugin_compiles_through_the_api_like_a_registered_backend() -> None:
 
 
 # ---------------------------------------------------------------- a domain of one's own, property-tested
-WAREHOUSE = dict(robots=(2, 3), objects=(2, 4), regions=("dock", "aisle", "shelf"), grasps=("claw", "suction"),
-                 domain="warehouse")
+WAREHOUSE = {"robots": (2, 3), "objects": (2, 4), "regions": ("dock", "aisle", "shelf"),
+             "grasps": ("claw", "suction"), "domain": "warehouse"}
 
 
 @settings(max_examples=20, deadline=None, suppress_health_check=[HealthCheck.too_slow])

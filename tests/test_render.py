@@ -14,11 +14,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from headless_chromium import colour_share, screenshot_when
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from PIL import Image
 
-from headless_chromium import colour_share, screenshot_when
 from mrgc import cli
 from mrgc.language.loader import parse_file
 from mrgc.render.camera import PRESETS

@@ -156,8 +156,8 @@ def test_strategy_reaches_every_section_kind() -> None:
 def test_reserved_words_as_names(word: str) -> None:
     """`define`/`domain`/`problem`/`and` survive as names in every position but a goal atom's predicate."""
     tree = ast.SourceFile((
-        ast.DomainDef(word, (ast.RobotKindDecl(word, (ast.Property(word, ast.Symbol(word)),)), ast.Grasps((ast.Decl(word),)),
-                             ast.Requirements((word,)))),
+        ast.DomainDef(word, (ast.RobotKindDecl(word, (ast.Property(word, ast.Symbol(word)),)),
+                             ast.Grasps((ast.Decl(word),)), ast.Requirements((word,)))),
         ast.ProblemDef(word, (
             ast.DomainRef(word),
             ast.DeclSection("robots", (ast.Decl(word), ast.Decl(word, (ast.Property(word, ast.ListValue(
@@ -224,7 +224,7 @@ def commented(draw: st.DrawFn) -> tuple[ast.SourceFile, str, list[str]]:
     lines = format_source(tree).split("\n")[:-1]
     out: list[str] = []
     comments: list[str] = []
-    for i, line in enumerate([*lines, None]):
+    for line in [*lines, None]:
         if draw(st.integers(0, 9)) == 0:
             out.append("")
         for _ in range(draw(st.integers(0, 2))):  # own-line comments before this line

@@ -3,8 +3,8 @@
 Random small symbolic problems (mrgc.testing.strategies: 2-3 robots, 2-5 objects, 2-3 regions, grasps
 top/side, random reachability, occlusion and handover facts, 1-2 goal objects, half of them drawn
 feasible) are written as .mrg text and parsed; the oracle must agree with the strategy's feasibility.  For
-every backend x encoding the first K skeleton keys (makespan, moved) must equal the oracle's, every skeleton must satisfy
-the model's definitions, and the action sets of one run must be pairwise distinct; Alg. 1 must build the
+every backend x encoding the first K skeleton keys (makespan, moved) must equal the oracle's, every skeleton
+must satisfy the model's definitions, and the action sets of one run must be pairwise distinct; Alg. 1 must build the
 same graph as the oracle's own reading of it.  A second property asks what the planner asks during search:
 other M*, objects of a grounded suffix excluded, a horizon limit, skeletons fetched a few at a time.  The
 oracle itself is checked on hand-broken skeletons, so a vacuous oracle cannot make the properties pass.

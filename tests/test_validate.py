@@ -18,15 +18,15 @@ from typing import Any, Callable
 
 import numpy as np
 import pytest
+import validator_plans as vp
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-import validator_plans as vp
 from mrgc import cli
 from mrgc.errors import InputError
+from mrgc.geometry.grasps import grasp_transform
 from mrgc.geometry.grounding import Grounder
 from mrgc.geometry.ik import solve_ik_many
-from mrgc.geometry.grasps import grasp_transform
 from mrgc.geometry.transforms import translation
 from mrgc.language.loader import parse_file
 from mrgc.planner.plan import PlannedAction
@@ -462,8 +462,9 @@ MALFORMED: dict[str, tuple[Callable[[str], str | bytes] | None, str, str]] = {
                          "E504", "plan nests arrays and objects more than 32 deep"),
     "400-digit integer": (lambda t: t.replace('"seed": 0', '"seed": ' + "9" * 400), "E504",
                           "plan holds an integer of 400 digits (at most 20)"),
-    "400-digit integer in a configuration": (_edit(lambda p: _action(p, 1)["configs"]["pick"][0].__setitem__(0, int("9" * 400))),
-                                             "E504", "an integer of 400 digits"),
+    "400-digit integer in a configuration": (
+        _edit(lambda p: _action(p, 1)["configs"]["pick"][0].__setitem__(0, int("9" * 400))),
+        "E504", "an integer of 400 digits"),
     "beyond double precision": (lambda t: t.replace('"seed": 0', '"seed": 1e999'), "E504",
                                 "the number 1e999 lies beyond double precision"),
     "key twice": (lambda t: t.replace('"seed": 0', '"seed": 0, "seed": 1'), "E501",
@@ -526,8 +527,8 @@ def test_the_validator_imports_no_planner_search_or_grounding() -> None:
 
 # ------------------------------------------------------------------------------------- the replay scene
 def test_replay_scene_distances_and_kinematics(pa3: Any, grounder: Grounder, tmp_path: Path) -> None:
-    from mrgc.geometry.replay_world import ReplayScene
     from mrgc.geometry.fk import ee_pose
+    from mrgc.geometry.replay_world import ReplayScene
     from mrgc.language.model import Box, Mesh
 
     cube = tmp_path / "cube.obj"

@@ -31,10 +31,10 @@ from typing import Any, Callable
 
 import numpy as np
 import pytest
+import validator_plans as vp
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-import validator_plans as vp
 from mrgc.geometry.transforms import rot_z, translation
 from mrgc.planner.validate import validate
 

@@ -26,7 +26,7 @@ class PaperEncoding(Encoding):
     name = "paper"
     horizon_loop = True
 
-    def build(self, graph: TaskGraph, horizon: int) -> Encoded:
+    def build(self, graph: TaskGraph, horizon: int) -> Encoded:  # noqa: C901
         T = horizon
         m = SkeletonModel(name=f"{self.name}-T{T}")
         A = range(len(graph.actions))

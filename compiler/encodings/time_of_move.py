@@ -69,10 +69,10 @@ class TimeOfMoveEncoding(Encoding):
         # redundant capacity rows (valid for every skeleton, they tighten the makespan bound): a robot
         # acts at most once per step, and all robots together at most |R| times per step
         for r in graph.robots:
-            mine = [(y[a], 1) for a in A if r in graph.actions[a].robots]
-            if mine:
-                m.add(mine + [(makespan, -1)], hi=0, name=f"load[{r}]")
-        m.add([(y[a], len(graph.actions[a].robots)) for a in A] + [(makespan, -len(graph.robots))], hi=0,
+            acts = [(y[a], 1) for a in A if r in graph.actions[a].robots]
+            if acts:
+                m.add([*acts, (makespan, -1)], hi=0, name=f"load[{r}]")
+        m.add([*((y[a], len(graph.actions[a].robots)) for a in A), (makespan, -len(graph.robots))], hi=0,
               name="load[all]")
         m.objectives.append(((makespan, 1),))
         m.objectives.append(tuple((y[a], 1) for a in A))

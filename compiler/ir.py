@@ -163,10 +163,6 @@ class SolveStatus(enum.StrEnum):
     ERROR = "error"
 
 
-#: the former name of :class:`SolveStatus`, kept while backends/cpsat.py still imports it
-Status = SolveStatus
-
-
 @dataclass(frozen=True)
 class Solution:
     """A solver's answer: a status, and for OPTIMAL/FEASIBLE the value of every variable."""

@@ -92,10 +92,16 @@ def category(row: dict[str, object]) -> str:
         facts = " ".join(why.get("facts", []))
         if "blocking cycle" in facts:
             return "infeasible: blocking cycle"
-        if "reach" in facts:
+        if "no robot can reach" in facts:
             return "infeasible: a goal region out of reach"
-        if "pick" in facts:
+        if "no robot can pick" in facts:
             return "infeasible: an object nobody can pick"
+        if "can also place it" in facts:
+            return "infeasible: no robot or handover takes a goal object from its pick to its bin"
+        if "obstructed by an object no robot can move" in facts:
+            return "infeasible: obstructed by an object nobody can move"
+        if "no robot can place" in facts:
+            return "infeasible: a goal object fits its bin for nobody"
         return "infeasible: other"
     return out
 

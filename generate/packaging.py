@@ -91,6 +91,8 @@ def packaging(robots: int = 2, goals: int = 3, others: int = 2, seed: int = 0) -
     table, arms, start, objects, bins, handovers, pitch = layout
     goal_idx = sorted(int(i) for i in rng.choice(len(objects), goals, replace=False))
     goal_bin = {i: bins[int(rng.integers(len(bins)))].name for i in goal_idx}
+    # a stream of its own, so that a layout that needs no repair stays exactly as drawn
+    handovers = _connect(np.random.default_rng([seed, 1]), arms, table, objects, bins, goal_bin, handovers)
     name = f"packaging-r{robots}-g{goals}-o{others}-s{seed}"
     command = f"mrgc generate packaging --robots {robots} --goals {goals} --others {others} --seed {seed}"
     n_cyl = sum(o.foot.disc for o in objects)
@@ -254,6 +256,65 @@ def _handovers(rng: np.random.Generator, arms: list[Arm],
         else:
             return None
     return points
+
+
+def reaches(arm: Arm, item: Item) -> bool:
+    """Whether ``item`` (an object: its centre; a bin: its centre 10 cm above the table) is within REACH of
+    the arm's shoulder: the generator's coarse reach test (no kinematics)."""
+    z = item.height / 2 if item.height < REGION_HEIGHT else 0.1
+    return arm.shoulder_distance(item.foot.x, item.foot.y, z) <= REACH
+
+
+def connected(arms: list[Arm], obj: Item, region: Item, handovers: list[tuple[str, tuple[float, float, float]]]) -> bool:
+    """Whether some arm reaches both ``obj`` and ``region``, or a handover point lies within REACH of an arm
+    that reaches ``obj`` and of another arm that reaches ``region``."""
+    pickers = [a for a in arms if reaches(a, obj)]
+    placers = [a for a in arms if reaches(a, region)]
+    if any(a in placers for a in pickers):
+        return True
+    return any(a.shoulder_distance(*p) <= REACH and b.shoulder_distance(*p) <= REACH
+               for _, p in handovers for a in pickers for b in placers)
+
+
+def _connect(rng: np.random.Generator, arms: list[Arm], table: Footprint, objects: list[Item], bins: list[Item],
+             goal_bin: dict[int, str], handovers: list[tuple[str, tuple[float, float, float]]]
+             ) -> list[tuple[str, tuple[float, float, float]]]:
+    """Handover points added where a goal object is not :func:`connected` to its bin: between the closest
+    pair of an arm that reaches the object and one that reaches the bin, within REACH of both shoulders (as
+    drawn points are), when such a pair is close enough.  The layout is otherwise left as drawn."""
+    points = list(handovers)
+    region = {b.name: b for b in bins}
+    for i, name in sorted(goal_bin.items()):
+        obj, reg = objects[i], region[name]
+        if connected(arms, obj, reg, points):
+            continue
+        pairs = sorted(((a, b) for a in arms if reaches(a, obj) for b in arms if b is not a and reaches(b, reg)),
+                       key=lambda p: (math.hypot(p[0].x - p[1].x, p[0].y - p[1].y), p[0].name, p[1].name))
+        for a, b in pairs:
+            spot = _between(rng, a, b, table, points)
+            if spot is not None:
+                points.append((f"h{len(points) + 1}", spot))
+                break
+    return points
+
+
+def _between(rng: np.random.Generator, a: Arm, b: Arm, table: Footprint,
+             points: list[tuple[str, tuple[float, float, float]]]) -> tuple[float, float, float] | None:
+    """A handover point above the table between arms ``a`` and ``b`` as :func:`_handovers` draws them, within
+    REACH of both shoulders and 10 cm from the other points; None when ATTEMPTS draws find none."""
+    for _ in range(ATTEMPTS):
+        w = float(rng.uniform(0.35, 0.65))
+        x = round(_u(rng, -0.1, 0.1) + a.x + w * (b.x - a.x), 3) + 0.0
+        y = round(_u(rng, -0.1, 0.1) + a.y + w * (b.y - a.y), 3) + 0.0
+        z = _u(rng, *HANDOVER_Z)
+        if table.distance_to_point(x, y) != 0.0:
+            continue
+        if max(a.shoulder_distance(x, y, z), b.shoulder_distance(x, y, z)) > REACH:
+            continue
+        if any(math.dist((x, y, z), p) < 0.1 for _, p in points):
+            continue
+        return (x, y, z)
+    return None
 
 
 # ---------------------------------------------------------------- the shipped PA-n benchmark problems

@@ -18,6 +18,9 @@ class RobotFacts:
 
     facts: list[Fact] = field(default_factory=list)
     handover: dict[tuple[str, str, str], np.ndarray] = field(default_factory=dict)  # (M, point, g) -> q
+    #: the other arms whose links at home each handover configuration hits (the partner may be one of them:
+    #: it is at the exchange then, not at home)
+    handover_homes: dict[tuple[str, str, str], frozenset[str]] = field(default_factory=dict)
     ik_solves: int = 0
     collision_checks: int = 0
 

@@ -55,6 +55,11 @@ HANDOVER_PAIRS = 6
 CONTACT_START = 1.5
 
 
+#: the detail of a failed query whose motion collided with what another robot of the step sweeps in the same
+#: phase (the skeleton step may be split: planner/ground.py)
+BUSY = "another robot of the step moves there in the same phase"
+
+
 class Status(str, enum.Enum):
     OK = "ok"
     NO_PLACEMENT = "no placement"
@@ -73,6 +78,9 @@ class Answer:
     configs: np.ndarray | None = None  # (C, dof): approach configurations, pre-grasp first
     path: list[np.ndarray] = field(default_factory=list)
     blockers: set[str] = field(default_factory=set)
+    #: what else was in the way when the status is COLLISION: fixed bodies, another arm at home, or what
+    #: another robot of the step sweeps meanwhile (a line for the failure report)
+    detail: str = ""
 
     @property
     def ok(self) -> bool:
@@ -92,6 +100,7 @@ class Grounder:
         self._grids: dict[str, DiscGrid] = {}
         self._lattices: dict[str, LatticePlanner] = {}
         self._paths: dict[tuple[object, ...], Answer] = {}
+        self._grips: dict[tuple[str, str], tuple[float, np.ndarray]] = {}
         self._vol_world = _PieceWorld()
         self._moving_world = _PieceWorld()
         # planar robots wait at their start pose (as the validator assumes): obstacles for the others
@@ -106,6 +115,8 @@ class Grounder:
         #: arms wait at home while others move (the validator's rule): each arm's links at home, group
         #: ``home:<arm>``, an obstacle to the other arms' motions
         self.homes: tuple[str, ...] = ()
+        #: the arms of the step being grounded that are *not* at home, by phase (see :meth:`step`)
+        self._away: dict[str, frozenset[str]] = {}
 
     def _arm_homes(self) -> tuple[str, ...]:
         """Put every arm's links at home into the world (once) and name their groups."""
@@ -118,10 +129,22 @@ class Grounder:
             self.homes = tuple(f"home:{s.name}" for s in self.scene.robots if not is_planar(s))
         return self.homes
 
-    def _others_home(self, robot: str, partner: str | None = None) -> tuple[str, ...]:
-        """The groups of the other arms at home (but ``partner``, which moves with ``robot``: the other arm of
-        a handover, at the exchange or in transit)."""
-        return tuple(h for h in self._arm_homes() if h not in (f"home:{robot}", f"home:{partner}"))
+    def step(self, pickers: Iterable[str], placers: Iterable[str]) -> None:
+        """Declare the step whose actions are grounded next: its arms that pick and that place.  The
+        validator's execution model says where the step's other arms are in each phase: in the to-pick and
+        pick phases the picking arms move and every other arm stands at home; in the place phase the placing
+        arms; in the phases between (to-handover, handover, to-place, home) the step's arms are in transit
+        (not at home) and only the waiting arms stand there.  ``step((), ())`` forgets it."""
+        pick, place = frozenset(pickers), frozenset(placers)
+        self._away = {"to-pick": pick, "pick": pick, "place": place, "*": pick | place} if pick | place else {}
+
+    def _others_home(self, robot: str, partner: str | None = None, phase: str = "*") -> tuple[str, ...]:
+        """The groups of the other arms at home in ``phase`` of the current step (see :meth:`step`): all
+        arms but ``robot``, ``partner`` (which moves with ``robot``: the other arm of a handover, at the
+        exchange or in transit) and the step's arms away from home then."""
+        away = self._away.get(phase, self._away.get("*", frozenset()))
+        return tuple(h for h in self._arm_homes()
+                     if h not in (f"home:{robot}", f"home:{partner}") and h[5:] not in away)
 
     # ------------------------------------------------------------ state
     def arm(self, robot: str) -> Arm:
@@ -154,17 +177,25 @@ class Grounder:
         shapes, _ = arm.probes
         out: Volume = []
         fingers = holding or grasp
-        opening = None if fingers is None else \
-            finger_opening(self.scene.grasp(fingers[1]), self.scene.body(fingers[0]).shape)
+        opening = None if fingers is None else self._grip(*fingers)[0]
         transforms = arm.link_transforms(np.atleast_2d(configs), opening)
         for t in transforms:
             out.extend(zip(shapes, t))
         if holding is not None:
             obj, held_grasp = holding
-            g_inv = np.linalg.inv(grasp_transform(self.scene.grasp(held_grasp), self.scene.body(obj).shape))
+            g_inv = self._grip(obj, held_grasp)[1]
             for tool in arm.tool_world(np.atleast_2d(configs)):
                 out.append((self.shape(obj), tool @ g_inv))
         return out
+
+    def _grip(self, obj: str, grasp: str) -> tuple[float, np.ndarray]:
+        """The finger opening holding ``obj`` with ``grasp`` and the object's pose in the tool frame (the
+        inverse grasp transform), computed once per pair: volumes ask for them at every configuration."""
+        key = (obj, grasp)
+        if key not in self._grips:
+            spec, shape = self.scene.grasp(grasp), self.scene.body(obj).shape
+            self._grips[key] = (finger_opening(spec, shape), np.linalg.inv(grasp_transform(spec, shape)))
+        return self._grips[key]
 
     def base_volume(self, robot: str, path: Sequence[np.ndarray], holding: tuple[str, str] | None = None) -> Volume:
         """Footprint (and the carried object) at every state of an SE(2) path."""
@@ -247,7 +278,7 @@ class Grounder:
     # ------------------------------------------------------------ arm configurations
     def _approach(self, robot: str, obj: str, grasp: str, pose: np.ndarray, key: str,
                   avoid: Iterable[str], attempts: int = 8, approach: bool = True, held: bool = False,
-                  busy: Volume = (), partner: str | None = None) -> Answer:
+                  busy: Volume = (), partner: str | None = None, from_home: bool = True) -> Answer:
         spec = self.scene.grasp_specs.get(grasp)
         arm = self.arm(robot)
         if spec is None or not fits(spec, self.scene.body(obj).shape, arm.spec.kind):
@@ -257,12 +288,14 @@ class Grounder:
         blockers: set[str] = set()
         status = Status.NO_IK
         moving = self._busy_world(busy) if busy else None
+        clash: tuple[str, Volume] | None = None  # the last attempt's collision not with ``avoid``: told at the end
+        phase = key.split(":")[0]  # "pick", "place" or "handover"
         for attempt in range(attempts):
             seed = seed_for(robot, obj, grasp, key, str(attempt), seed=self.seed)
             # the first attempt starts from home (the solution nearest it); the others from a start drawn from
             # their seed, or every attempt would converge to that same solution again
-            start = arm.home if attempt == 0 else np.random.default_rng(seed).uniform(arm.model.lower,
-                                                                                       arm.model.upper)
+            start = arm.home if attempt == 0 and from_home else np.random.default_rng(seed).uniform(
+                arm.model.lower, arm.model.upper)
             q = solve_ik_many(arm.model, arm.ee_target(pose @ g_t)[None], seed, q_init=start)[0]
             if not q.solved:
                 if q.status.value == "unreachable":
@@ -287,9 +320,9 @@ class Grounder:
             volume = self.arm_volume(robot, refine(configs), holding=(obj, grasp) if held else None,
                                      grasp=(obj, grasp))
             self.queries += 1
-            if self.world.probe_collides(volume, against=("fixed", *self._others_home(robot, partner)),
+            if self.world.probe_collides(volume, against=("fixed", *self._others_home(robot, partner, phase)),
                                          ignore=() if held else (obj,)):
-                status = Status.COLLISION
+                status, clash = Status.COLLISION, ("fixed", volume)
                 continue
             hit = self.world.probe_hits(volume, against=avoid) if avoid else set()
             if hit:
@@ -297,10 +330,26 @@ class Grounder:
                 status = Status.COLLISION
                 continue
             if moving is not None and moving.probe_collides(volume, against="volume"):
-                status = Status.COLLISION  # another robot of the step moves there meanwhile: another IK seed
+                # another robot of the step moves there meanwhile: another IK seed
+                status, clash = Status.COLLISION, ("moving", volume)
                 continue
             return Answer(Status.OK, pose=pose, configs=configs)
-        return Answer(status, blockers=blockers)
+        detail = ""
+        if clash is not None and not blockers:
+            detail = self._clash_detail(robot, partner, phase, clash, ignore=() if held else (obj,))
+        return Answer(status, blockers=blockers, detail=detail)
+
+    def _clash_detail(self, robot: str, partner: str | None, phase: str, clash: tuple[str, Volume],
+                      ignore: tuple[str, ...]) -> str:
+        """Name what a volume collided with besides the avoided objects: fixed bodies, other arms at home
+        (their links are named ``@<arm>:<i>``), or the other robots of the step."""
+        kind, volume = clash
+        if kind == "moving":
+            return BUSY
+        hit = self.world.probe_hits(volume, against=("fixed", *self._others_home(robot, partner, phase)),
+                                    ignore=ignore)
+        named = sorted({f"{h[1:].split(':')[0]} at home" if h.startswith("@") else h for h in hit})
+        return "hits " + ", ".join(named) if named else ""
 
     def pick(self, robot: str, obj: str, grasp: str, avoid: Iterable[str] = (), busy: Volume = ()) -> Answer:
         """Approach configurations for ``robot`` to grasp ``obj`` (at its current pose) with ``grasp``,
@@ -317,30 +366,53 @@ class Grounder:
                  avoid: Iterable[str] = (), busy: Volume = ()) -> Answer:
         """Both arms' configurations holding ``obj`` at handover point ``point`` (configs: giver, taker)."""
         pose = translation(*self.scene.handover_points[point])
-        # as in phase 1, a handover is checked at the exchange configurations (no approach); IK solutions of
-        # the two arms are drawn in pairs (other seeds) until a pair does not collide
+        # as in phase 1, a handover is checked at the exchange configurations (no approach).  Each round draws
+        # one more free exchange configuration of each arm (the first from home, the others from seeded
+        # random starts: from home IK finds the same solution every time) and tries it against every
+        # configuration of the other arm drawn so far, until a pair does not collide
+        found: dict[str, list[np.ndarray]] = {giver: [], taker: []}
+        failed = Answer(Status.COLLISION)
+        worlds: list[CollisionWorld] = []  # the taker's configurations, one world each
         for attempt in range(HANDOVER_PAIRS):
             key = f"handover:{point}" + (f":{attempt}" if attempt else "")
-            a = self._approach(giver, obj, g1, pose, key, avoid, approach=False, busy=busy, partner=taker)
-            b = self._approach(taker, obj, g2, pose, key, avoid, approach=False, busy=busy, partner=giver)
-            if not (a.ok and b.ok):
-                return Answer(a.status if not a.ok else b.status, blockers=a.blockers | b.blockers)
-            assert a.configs is not None and b.configs is not None
-            world = CollisionWorld()
-            for i, (shape, t) in enumerate(self.arm_volume(taker, b.configs[-1:], grasp=(obj, g2))):
-                world.add(f"t{i}", shape, t, "taker")
-            if not world.probe_collides(self.arm_volume(giver, a.configs[-1:], grasp=(obj, g1)), against="taker"):
-                return Answer(Status.OK, pose=pose, configs=np.stack([a.configs[-1], b.configs[-1]]))
-        return Answer(Status.COLLISION)
+            a = self._approach(giver, obj, g1, pose, key, avoid, approach=False, busy=busy, partner=taker,
+                               from_home=attempt == 0)
+            b = self._approach(taker, obj, g2, pose, key, avoid, approach=False, busy=busy, partner=giver,
+                               from_home=attempt == 0)
+            if not b.ok:
+                failed = b
+            else:
+                assert b.configs is not None
+                found[taker].append(b.configs[-1])
+                world = CollisionWorld()
+                for i, (shape, t) in enumerate(self.arm_volume(taker, b.configs[-1:], grasp=(obj, g2))):
+                    world.add(f"t{i}", shape, t, "taker")
+                worlds.append(world)
+                for q in found[giver]:  # the new taker configuration against the giver's earlier ones
+                    if not world.probe_collides(self.arm_volume(giver, q[None], grasp=(obj, g1)), against="taker"):
+                        return Answer(Status.OK, pose=pose, configs=np.stack([q, b.configs[-1]]))
+            if not a.ok:
+                failed = a
+            else:
+                assert a.configs is not None
+                found[giver].append(a.configs[-1])
+                volume = self.arm_volume(giver, a.configs[-1:], grasp=(obj, g1))
+                for q, world in zip(found[taker], worlds):  # the new giver configuration against every taker's
+                    if not world.probe_collides(volume, against="taker"):
+                        return Answer(Status.OK, pose=pose, configs=np.stack([a.configs[-1], q]))
+        if not (found[giver] and found[taker]):  # one arm never got there: why (its last attempt)
+            return Answer(failed.status, blockers=failed.blockers, detail=failed.detail)
+        return Answer(Status.COLLISION, detail="the two arms collide at every exchange drawn")
 
     # ------------------------------------------------------------ paths
     def arm_path(self, robot: str, start: np.ndarray, goal: np.ndarray, holding: tuple[str, str] | None = None,
                  avoid: Iterable[str] = (), max_checks: int = MAX_CHECKS, resolution: float = 0.05,
-                 busy: Volume = (), partner: str | None = None) -> Answer:
+                 busy: Volume = (), partner: str | None = None, phase: str = "*") -> Answer:
         """A joint-space path (RRTConnect, at most ``max_checks`` validity checks: no clock decides) free of
         fixed objects, ``avoid`` and ``busy`` (and of the held object's collisions with them)."""
         arm = self.arm(robot)
-        against = ("fixed", *self._others_home(robot, partner), *[a for a in avoid if not holding or a != holding[0]])
+        against = ("fixed", *self._others_home(robot, partner, phase),
+                   *[a for a in avoid if not holding or a != holding[0]])
         ignore = (holding[0],) if holding else ()
         moving = self._busy_world(busy) if busy else None
 
@@ -372,11 +444,14 @@ class Grounder:
         back = np.asarray(start, dtype=float)[None]
         moving = self._busy_world(busy) if busy else None
 
+        crossed = [False]  # did the last blocked motion cross what another robot of the step sweeps?
+
         def hits(configs: np.ndarray, holding: tuple[str, str] | None = held) -> set[str] | None:
             """None when free, else the avoided objects hit (empty: a fixed one or a moving robot)."""
             self.queries += 1
             volume = self.arm_volume(robot, configs, holding=holding, grasp=held)
-            if moving is not None and moving.probe_collides(volume, against="volume"):
+            crossed[0] = moving is not None and moving.probe_collides(volume, against="volume")
+            if crossed[0]:
                 return set()
             if not self.world.probe_collides(volume, against=against, ignore=(obj,)):
                 return None
@@ -392,7 +467,7 @@ class Grounder:
             if blocked is None:
                 blocked = hits(back[len(first) - 1:])
             if blocked is not None:
-                return Answer(Status.COLLISION, blockers=blocked)
+                return Answer(Status.COLLISION, blockers=blocked, detail=BUSY if crossed[0] else "")
         line = joint_line(np.stack([back[-1], np.asarray(goal, dtype=float)]), PATH_RESOLUTION)
         blocked = hits(line)
         if blocked is None:
@@ -400,17 +475,19 @@ class Grounder:
         planned = self.arm_path(robot, back[-1], np.asarray(goal, dtype=float), holding=held, avoid=others,
                                 resolution=PATH_RESOLUTION, busy=busy, partner=partner, max_checks=TRANSFER_CHECKS)
         if not planned.ok:
-            return Answer(Status.NO_PATH, blockers=blocked)
+            return Answer(Status.NO_PATH, blockers=blocked, detail=BUSY if crossed[0] else "")
         return Answer(Status.OK, path=[*back, *planned.path[1:]])
 
     def transit(self, robot: str, start: np.ndarray, goal: np.ndarray, avoid: Iterable[str] = (),
-                busy: Volume = (), via: np.ndarray | None = None, partner: str | None = None) -> Answer:
+                busy: Volume = (), via: np.ndarray | None = None, partner: str | None = None,
+                phase: str = "*") -> Answer:
         """An empty-handed motion of ``robot`` (fingers fully open, as the validator replays it) from
         ``start`` to ``goal``: along ``via`` first when given (configurations, ``start`` first, joined by
         straight joint-space lines: a release backing off along its approach), then the straight line or, when
         that collides, an RRTConnect path.  Free of fixed objects, of the other arms at home, of ``avoid`` and
-        of ``busy``; ``path`` as for :meth:`transfer`."""
-        against = ("fixed", *self._others_home(robot, partner), *avoid)
+        of ``busy``; ``path`` as for :meth:`transfer`.  ``phase`` (``to-pick``, ``home`` ...) says which arms
+        stand at home meanwhile (:meth:`step`)."""
+        against = ("fixed", *self._others_home(robot, partner, phase), *avoid)
         moving = self._busy_world(busy) if busy else None
 
         def free(configs: np.ndarray) -> bool:
@@ -427,7 +504,8 @@ class Grounder:
         if free(line):
             return Answer(Status.OK, path=[*back, *line[1:]])
         planned = self.arm_path(robot, back[-1], np.asarray(goal, dtype=float), avoid=tuple(avoid),
-                                resolution=PATH_RESOLUTION, busy=busy, partner=partner, max_checks=TRANSFER_CHECKS)
+                                resolution=PATH_RESOLUTION, busy=busy, partner=partner, max_checks=TRANSFER_CHECKS,
+                                phase=phase)
         if not planned.ok:
             return Answer(Status.NO_PATH)
         return Answer(Status.OK, path=[*back, *planned.path[1:]])

@@ -54,6 +54,14 @@ class RobotEvaluator:
         self.scene = scene
         self.arm = Arm(scene.robot(robot))
         self.world = scene_world(scene)
+        # the other arms wait at home while this one picks or places (the validator's execution model): their
+        # links at home are obstacles like the fixed objects, named ``@<arm>:<link>``
+        for spec in scene.robots:
+            if spec.name != robot and spec.kind.base != "planar":
+                other = Arm(spec)
+                shapes, _ = other.probes
+                for i, (shape, t) in enumerate(zip(shapes, other.link_transforms(other.home[None])[0])):
+                    self.world.add(f"@{spec.name}:{i}", shape, t, "fixed")
         self.seed = seed
         self.out = RobotFacts()
         self.current = {m.name: r.name for m in scene.movable for r in scene.regions if inside(r, m.shape, m.pose)}
@@ -215,9 +223,16 @@ class RobotEvaluator:
                     if self.usable(obj, g):
                         keys.append((obj, point, g))
                         tools.append(pose @ grasp_transform(self.scene.grasp(g), body.shape))
+        shapes, _ = self.arm.probes
         for key, q in zip(keys, self._ik(tools, "handover")):
-            if q is not None and self._free(q[None], (key[0],), self.opening(key[0], key[2])):
+            if q is None:
+                continue
+            self.out.collision_checks += 1
+            hits = self.world.batch_hits(shapes, self.arm.link_transforms(q[None], self.opening(key[0], key[2])),
+                                         against="fixed", ignore=(key[0],))
+            if all(h.startswith("@") for h in hits):  # only arms at home: fine if the partner is the one hit
                 self.out.handover[key] = q
+                self.out.handover_homes[key] = frozenset(h[1:].split(":")[0] for h in hits)
 
 
 def _robot_worker(args: tuple[SceneSpec, str, int]) -> RobotFacts:
@@ -280,6 +295,10 @@ def _handovers(scene: SceneSpec, per_robot: dict[str, RobotFacts]) -> set[Fact]:
                             continue
                         fact = Fact("enable-goal-handover", (obj, g1, g2, r1, r2))
                         if fact in out:
+                            continue
+                        # an arm may reach into the other one's home only: that one is at the exchange
+                        if not (per_robot[r1].handover_homes[(o1, point, g1)] <= {r2}
+                                and per_robot[r2].handover_homes[(o2, point2, g2)] <= {r1}):
                             continue
                         a1 = arms.setdefault(r1, Arm(scene.robot(r1)))
                         a2 = arms.setdefault(r2, Arm(scene.robot(r2)))

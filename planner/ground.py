@@ -23,7 +23,7 @@ import numpy as np
 from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action
 from mrgc.geometry.collision import CollisionWorld
-from mrgc.geometry.grounding import Answer, Grounder, Status, Volume
+from mrgc.geometry.grounding import BUSY, Answer, Grounder, Status, Volume
 from mrgc.geometry.predicates import refine
 from mrgc.geometry.planar import to_se2
 from mrgc.planner.outcome import Failure
@@ -92,12 +92,12 @@ class ReverseGrounder:
         for t in range(skeleton.makespan - 1, -1, -1):
             step = skeleton.steps[t]
             same = {a.obj for a in step}
-            strict = self._step(step, fut_objs | out_objs, same, volume, f"{key}:{t}", t + 1)
+            strict = self._steps(step, fut_objs | out_objs, volume, f"{key}:{t}", t + 1)
             if isinstance(strict, Failure):
-                relaxed = self._step(step, fut_objs, same, volume, f"{key}:{t}:relaxed", t + 1)
+                relaxed = self._steps(step, fut_objs, volume, f"{key}:{t}:relaxed", t + 1)
                 if isinstance(relaxed, Failure):
                     return Grounding(Outcome.FAIL, reason=relaxed.line(), failures=[relaxed])
-                grounded.insert(0, relaxed)
+                grounded[:0] = relaxed
                 steps = grounded + suffix
                 moved = {o for s in steps for o in s.moved}
                 # M* as the paper defines it: every movable object not moved in S' that obstructs the whole
@@ -108,14 +108,50 @@ class ReverseGrounder:
                 must = {o for o in self.goal if o not in moved} | blockers
                 return Grounding(Outcome.PARTIAL, steps, must, reason=f"step {t + 1} needs {sorted(blockers)} moved",
                                  failures=[strict])
-            grounded.insert(0, strict)
-            volume = volume + strict.volume
+            grounded[:0] = strict
+            volume = volume + [p for s in strict for p in s.volume]
             fut_objs |= same
         return Grounding(Outcome.SUCCESS, grounded + suffix)
 
     # ------------------------------------------------------------ one joint action
+    def _steps(self, step: tuple[Action, ...], avoid: set[str], v_fut: Volume, key: str,
+               index: int) -> list[GroundedStep] | Failure:
+        """Ground one skeleton step; when its robots get in each other's way (an action collides with what
+        another robot of the step sweeps in the same phase), split it: the failing action alone one step
+        later, or else one step earlier, than the others (each part split again as needed).  The skeleton's
+        action set and order constraints are kept (actions of one step constrain each other in neither
+        direction); only the plan's makespan grows."""
+        same = {a.obj for a in step}
+        done = self._step(step, avoid, same, v_fut, key, index)
+        if not isinstance(done, Failure):
+            return [done]
+        if len(step) < 2 or not (done.detail == BUSY or done.check.endswith("robots of the step collide")):
+            return done
+        alone = next(a for a in step if label(a) == done.action)
+        rest = tuple(a for a in step if a is not alone)
+        for later, earlier in (((alone,), rest), (rest, (alone,))):
+            # the reverse search grounds the later part first; the earlier one then avoids its objects (at
+            # their initial poses) and its volume
+            tail = self._steps(later, avoid, v_fut, f"{key}:late", index)
+            if isinstance(tail, Failure):
+                continue
+            head = self._steps(earlier, avoid | {a.obj for a in later}, v_fut + [p for s in tail for p in s.volume],
+                               f"{key}:early", index)
+            if not isinstance(head, Failure):
+                return head + tail
+        return done
+
     def _step(self, step: tuple[Action, ...], avoid: set[str], same: set[str], v_fut: Volume,
               key: str, index: int = 0) -> GroundedStep | Failure:
+        # the step's arms are not at home while they pick, place or are in transit (the validator's model)
+        self.g.step([a.pick_robot for a in step], [a.place_robot for a in step])
+        try:
+            return self._actions(step, avoid, same, v_fut, key, index)
+        finally:
+            self.g.step((), ())
+
+    def _actions(self, step: tuple[Action, ...], avoid: set[str], same: set[str], v_fut: Volume,
+                 key: str, index: int) -> GroundedStep | Failure:
         actions: list[PlannedAction] = []
         step_volume: Volume = []
         motions: dict[str, dict[str, list[Volume]]] = {}  # robot -> phase -> volume at each sample
@@ -278,7 +314,7 @@ class ReverseGrounder:
                         g.move(o, pose)
                 other = ({a.pick_robot, a.place_robot} - {robot}) if phase != "to-pick" else set()
                 ans = g.transit(robot, start, goal, avoid=obstacles, busy=busy.get(phase, []) + mine.get(phase, []),
-                                via=via, partner=next(iter(other), None))
+                                via=via, partner=next(iter(other), None), phase=phase)
                 if not ans.ok:
                     return _failed(f"{name} of {robot}", ans)
                 planned.paths[name] = _configs(np.array(ans.path))
@@ -351,7 +387,7 @@ class ReverseGrounder:
             if ans.ok:
                 return point, ans
             failure = _failed(f"handover at {point}", ans)
-            if ans.status is Status.COLLISION and not ans.blockers:
+            if ans.status is Status.COLLISION and not ans.blockers and not ans.detail.startswith(("hits", BUSY)):
                 failure = replace(failure, check=f"handover at {point}: the two arms collide",
                                   bodies=tuple(sorted((a.pick_robot, a.place_robot))))
         return failure
@@ -366,7 +402,7 @@ def label(a: Action) -> str:
 
 def _failed(what: str, answer: Answer) -> Failure:
     """A failure of a geometric query: its status as the check, the objects that were in the way as bodies."""
-    return Failure(0, "", f"{what}: {answer.status.value}", tuple(sorted(answer.blockers)))
+    return Failure(0, "", f"{what}: {answer.status.value}", tuple(sorted(answer.blockers)), answer.detail)
 
 
 def _phases_collide(mine: dict[str, list[Volume]], theirs: dict[str, list[Volume]]) -> str:

@@ -296,3 +296,29 @@ def test_phase1_yields_facts(text: str) -> None:
     predicates = {f.predicate for f in facts}
     assert {"in-region", "reachable-pick"} <= predicates, predicates
     assert sum(f.predicate == "in-region" for f in facts) == len(problem.movable)
+
+
+@SETTINGS
+@given(st.integers(2, 6), st.integers(1, 8), st.integers(0, 12), st.integers(0, 10_000))
+def test_packaging_goals_are_reach_connected_to_their_bins(robots: int, goals: int, others: int, seed: int) -> None:
+    """Every goal object reaches its bin: one arm's shoulder is within REACH of both (the object's centre,
+    the bin's centre 10 cm above the table), or a handover point is within REACH of an arm reaching the
+    object and of another arm reaching the bin, unless no such pair of arms is close enough to share a
+    point (then no handover point can be added)."""
+    problem = parse(packaging(robots=robots, goals=goals, others=others, seed=seed))
+    shoulders = {r.name: (r.base.x, r.base.y, SHOULDER) for r in problem.robots}
+    regions = {r.name: r for r in problem.regions}
+    objects = {o.name: o for o in problem.movable}
+    points = [h.position for h in problem.handover_points]
+    for name, region in problem.goal_regions.items():
+        o, b = objects[name].pose, regions[region].pose
+        assert o is not None and b is not None
+        pickers = {r for r, s in shoulders.items() if math.dist(s, (o.x, o.y, o.z)) <= REACH + 1e-6}
+        placers = {r for r, s in shoulders.items() if math.dist(s, (b.x, b.y, 0.1)) <= REACH + 1e-6}
+        if pickers & placers:
+            continue
+        linked = any(math.dist(shoulders[p], h) <= REACH + 1e-6 and math.dist(shoulders[q], h) <= REACH + 1e-6
+                     for h in points for p in pickers for q in placers)
+        # two shoulders 1 m apart share many points 25 - 50 cm above the table within REACH of both
+        close = any(math.dist(shoulders[p][:2], shoulders[q][:2]) <= 1.0 for p in pickers for q in placers)
+        assert linked or not close, (name, region, pickers, placers)

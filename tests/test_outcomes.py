@@ -18,7 +18,7 @@ import pytest
 from mrgc import __version__, cli, parse_file
 from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action
-from mrgc.geometry.grounding import Answer, Status
+from mrgc.geometry.grounding import BUSY, Answer, Status
 from mrgc.planner.ground import GroundedStep, Outcome, ReverseGrounder
 from mrgc.planner.outcome import EXIT_CODES, PlanStatus
 from mrgc.planner.plan import PlannedAction, file_sha256
@@ -157,19 +157,27 @@ class ScriptedGrounder:
     """Answers the reverse grounder's geometric queries from a script: picks of an object fail while any
     object of ``blocked_by[obj]`` must be avoided; volumes are tokens, and ``hits`` reads them."""
 
-    def __init__(self, movable: list[str], blocked_by: dict[str, set[str]], sweeps: dict[str, set[str]]) -> None:
+    def __init__(self, movable: list[str], blocked_by: dict[str, set[str]], sweeps: dict[str, set[str]],
+                 crowded: frozenset[str] = frozenset()) -> None:
         self.scene = SimpleNamespace(movable=[SimpleNamespace(name=m) for m in movable], handover_of={},
                                      handover_points={})
         self.blocked_by, self.sweeps = blocked_by, sweeps
+        self.crowded = crowded  # objects whose pick collides with whatever another robot of the step sweeps
         self.poses = {m: np.eye(4) for m in movable}
+        self.steps: list[tuple[list[str], list[str]]] = []
 
     def is_planar(self, robot: str) -> bool:
         return False
+
+    def step(self, pickers: Any, placers: Any) -> None:
+        self.steps.append((list(pickers), list(placers)))  # the script has no arms at home: only recorded
 
     def pick(self, robot: str, obj: str, grasp: str, avoid: Any = (), busy: Any = ()) -> Answer:
         hit = self.blocked_by.get(obj, set()) & set(avoid)
         if hit:
             return Answer(Status.COLLISION, blockers=hit)
+        if obj in self.crowded and busy:
+            return Answer(Status.COLLISION, detail=BUSY)
         return Answer(Status.OK, configs=np.array([[0.0], [1.0]]))
 
     def place(self, robot: str, obj: str, grasp: str, pose: np.ndarray, avoid: Any = (), busy: Any = ()) -> Answer:
@@ -213,3 +221,32 @@ def test_m_star_keeps_the_blockers_of_an_older_suffix() -> None:
     assert result.must_move == {"b", "d"}  # b from the older suffix, d from this call's step
     (failure,) = result.failures
     assert failure.step == 2 and failure.check.startswith("pick by r1") and failure.bodies == ("d",)
+
+
+def test_a_step_whose_robots_collide_is_split() -> None:
+    """r1 and r2 pick a and b in one skeleton step, but b's pick collides with what r1 sweeps meanwhile: the
+    step is grounded as two (b alone one step later), keeping the skeleton's actions; the grounder was told
+    each time which arms pick and place in the step (arms of the step are not at home then)."""
+    grounder = ScriptedGrounder(["a", "b"], blocked_by={}, sweeps={}, crowded=frozenset({"b"}))
+    reverse = ReverseGrounder(grounder, {"a": "goal", "b": "goal"})  # type: ignore[arg-type]
+    skeleton = Skeleton(((Action("a", "goal", "r1", "r1", "top", "top"), Action("b", "goal", "r2", "r2", "top", "top")),))
+    result = reverse.ground(skeleton, [])
+    assert result.outcome is Outcome.SUCCESS
+    assert [s.moved for s in result.steps] == [("a",), ("b",)]
+    assert [a.object for s in result.steps for a in s.actions] == ["a", "b"]
+    assert grounder.steps[0] == (["r1", "r2"], ["r1", "r2"])  # the whole step first
+    assert (["r2"], ["r2"]) in grounder.steps and (["r1"], ["r1"]) in grounder.steps
+    assert grounder.steps[-1] == ([], [])  # forgotten after each step
+
+
+def test_a_step_is_not_split_for_other_failures(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A pick blocked by an avoided object is not a conflict between the step's robots: no split, M* grows."""
+    import mrgc.planner.ground as ground_module
+
+    monkeypatch.setattr(ground_module, "_volumes_collide", lambda a, b: False)  # the script's volumes are tokens
+    grounder = ScriptedGrounder(["a", "b", "c"], blocked_by={"b": {"c"}}, sweeps={"arm:r2:": {"c"}})
+    reverse = ReverseGrounder(grounder, {"a": "goal", "b": "goal"})  # type: ignore[arg-type]
+    skeleton = Skeleton(((Action("a", "goal", "r1", "r1", "top", "top"), Action("b", "goal", "r2", "r2", "top", "top")),))
+    result = reverse.ground(skeleton, [])
+    assert result.outcome is Outcome.PARTIAL and result.must_move >= {"c"}
+    assert len(result.steps) == 1 and result.steps[0].moved == ("a", "b")

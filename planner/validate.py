@@ -72,6 +72,7 @@ class ValidationReport:
     stats: dict[str, Any] = field(default_factory=dict)
 
     def lines(self) -> list[str]:
+        """The report as ``mrgc validate`` prints it: ``valid: ...``, or each violation and a count."""
         if self.ok:
             s = self.stats
             geo = (f"; replayed {s['configurations']} configurations, {s['distance_queries']} pybullet distance "
@@ -82,6 +83,7 @@ class ValidationReport:
         return [str(v) for v in self.violations] + [f"invalid: {n} violation{'s' * (n != 1)}"]
 
     def to_json(self) -> dict[str, Any]:
+        """The report as ``mrgc validate --format json`` prints it."""
         return {"ok": self.ok, "violations": [v.to_json() for v in self.violations], "stats": self.stats}
 
 

@@ -97,6 +97,7 @@ class Timeline:
 
     @property
     def duration(self) -> float:
+        """The replay's length (s)."""
         return sum(p.duration for p in self.phases)
 
     def frames(self, fps: float) -> list[Frame]:

@@ -9,8 +9,8 @@ import tomllib
 from pathlib import Path
 
 import pytest
+from support import ROOT
 
-ROOT = Path(__file__).resolve().parent.parent
 SKIP_DIRS = {".venv", ".git", "tests", "docs", "benchmarks", "build", "dist", "domains", ".hypothesis"}
 
 #: docs/architecture.md, "Layers and who may import whom": layer -> layers it may import (besides itself)

@@ -18,15 +18,19 @@ from mrgc.compiler.task_graph import TaskGraph
 
 
 def action_label(graph: TaskGraph, i: int) -> str:
+    """The action's label in model names: object, region, robots and grasps."""
     a = graph.actions[i]
     return f"{a.obj},{a.region},{a.pick_robot},{a.place_robot},{a.pick_grasp},{a.place_grasp}"
 
 
 class PaperEncoding(Encoding):
+    """The paper's skeleton model: one boolean per action and step; the horizon grows until the model is feasible."""
+
     name = "paper"
     horizon_loop = True
 
     def build(self, graph: TaskGraph, horizon: int) -> Encoded:  # noqa: C901
+        """The model of horizon ``horizon`` (steps) for ``graph``."""
         T = horizon
         m = SkeletonModel(name=f"{self.name}-T{T}")
         A = range(len(graph.actions))

@@ -42,12 +42,18 @@ Volume = list[tuple[CollisionShape, np.ndarray]]  # shapes at world transforms
 #: largest step (m of translation, rad of turn) between checked states of a planar path, and largest joint
 #: motion (rad) between the configurations of an arm's transfer: the validator's
 PATH_RESOLUTION = 0.01
-#: how far a transfer raises the tool straight up before it moves off (m): the approach's back-off
+#: how far a transfer raises the tool straight up before it moves off (m): the approach's back-off, or more
+#: when taller objects stand around the one picked (see :meth:`Grounder.lift_height`), up to MAX_LIFT
 TRANSFER_LIFT = 0.08
+MAX_LIFT = 0.30
+#: objects whose footprint comes this close (m, horizontally) to the picked one's count as its neighbours
+NEIGHBOURHOOD = 0.10
 #: validity checks an arm's transfer or transit path may spend when its straight line collides: a failed
 #: search costs all of them, at 0.5-1.5 ms a check (an arm holding an object, 1 cm steps), and a step tries
 #: several placements; 20,000 (motion.MAX_CHECKS) let one grounding run for minutes on a loaded machine
 TRANSFER_CHECKS = 4_000
+#: path answers (transfers, base paths) remembered per grounder
+REMEMBERED = 4096
 #: pairs of exchange configurations tried for a handover before the two arms are said to collide
 HANDOVER_PAIRS = 6
 #: an approach's last segment starts at most this many equal shares of the back-off from the grasp (the
@@ -430,9 +436,33 @@ class Grounder:
     def transfer(self, robot: str, obj: str, grasp: str, start: np.ndarray, goal: np.ndarray,
                  avoid: Iterable[str] = (), lift: bool = False, busy: Volume = (), partner: str | None = None
                  ) -> Answer:
+        """:meth:`_transfer`, remembered: the same question (same configurations, objects at the same poses,
+        the same moving robots and arms at home) gets the same answer without a second search (the reverse
+        search asks again when it splits a step or grounds a skeleton that shares a suffix)."""
+        avoid = tuple(sorted(set(avoid)))
+        digest = hashlib.sha1()
+        for part in (np.asarray(start, dtype=float), np.asarray(goal, dtype=float),
+                     *(self.poses[o] for o in sorted(self.poses)), *(t for _, t in busy)):
+            digest.update(np.ascontiguousarray(part).tobytes())
+        key = ("transfer", robot, obj, grasp, avoid, lift, partner, tuple(id(shape) for shape, _ in busy),
+               tuple(sorted(self._away.items())), digest.digest())
+        if key not in self._paths:
+            self._remember(key, self._transfer(robot, obj, grasp, start, goal, avoid, lift, busy, partner))
+        return self._paths[key]
+
+    def _remember(self, key: tuple[object, ...], answer: Answer) -> None:
+        """Keep a path answer, forgetting the oldest beyond :data:`REMEMBERED` (insertion order: the same
+        run forgets the same ones)."""
+        if len(self._paths) >= REMEMBERED:
+            del self._paths[next(iter(self._paths))]
+        self._paths[key] = answer
+
+    def _transfer(self, robot: str, obj: str, grasp: str, start: np.ndarray, goal: np.ndarray,
+                  avoid: Iterable[str] = (), lift: bool = False, busy: Volume = (), partner: str | None = None
+                  ) -> Answer:
         """How ``robot`` carries ``obj`` (held with ``grasp``) from configuration ``start`` to ``goal``: when
-        ``lift`` (``start`` grasps the object where it rests), first straight up by :data:`TRANSFER_LIFT`
-        (tool poses every centimetre, each by IK from the one before); then the straight joint-space line
+        ``lift`` (``start`` grasps the object where it rests), first straight up by :meth:`lift_height`
+        (tool poses every centimetre, each by IK from the one before; as far as the way up is free); then the straight joint-space line
         (the validator's reading of a plan that gives no transfer) or, when that line collides, an
         RRTConnect path (a budget of checks, seeded from the query).  Free of fixed objects, of the other arms
         at home, of ``avoid`` and of ``busy`` (what other robots sweep meanwhile).
@@ -458,16 +488,21 @@ class Grounder:
             return self.world.probe_hits(volume, against=others, ignore=(obj,)) if others else set()
 
         if lift:
-            up = self._lift(robot, back[0])
+            up = self._lift(robot, back[0], self.lift_height(obj))
             if up is None:
                 return Answer(Status.NO_IK)
             first = joint_line(up[:2], PATH_RESOLUTION)  # the object leaves what it rests on: arm alone
-            back = joint_line(up, PATH_RESOLUTION)
             blocked = hits(first, holding=None)
-            if blocked is None:
-                blocked = hits(back[len(first) - 1:])
+            if blocked is None:  # held from the end of the first centimetre on
+                blocked = hits(first[-1:])
             if blocked is not None:
                 return Answer(Status.COLLISION, blockers=blocked, detail=BUSY if crossed[0] else "")
+            # then centimetre by centimetre as far as the way up is free (an arm waiting at home above the
+            # table may stop it early; the carry goes on from there)
+            top = 1
+            while top + 1 < len(up) and hits(joint_line(up[top:top + 2], PATH_RESOLUTION)) is None:
+                top += 1
+            back = joint_line(up[:top + 1], PATH_RESOLUTION)
         line = joint_line(np.stack([back[-1], np.asarray(goal, dtype=float)]), PATH_RESOLUTION)
         blocked = hits(line)
         if blocked is None:
@@ -510,14 +545,31 @@ class Grounder:
             return Answer(Status.NO_PATH)
         return Answer(Status.OK, path=[*back, *planned.path[1:]])
 
-    def _lift(self, robot: str, q: np.ndarray) -> np.ndarray | None:
+    def lift_height(self, obj: str) -> float:
+        """How far to raise ``obj`` straight up from where it rests before carrying it off: until its bottom
+        clears the tops of its neighbours (other objects within :data:`NEIGHBOURHOOD` of its footprint) by
+        1 cm, at least :data:`TRANSFER_LIFT`, at most :data:`MAX_LIFT`.  Among taller neighbours (a dense
+        start grid) a lift of a few centimetres leaves the object boxed in, and every carry from there has
+        to find the way up by sampling."""
+        pose, h = self.poses[obj], half_extents(self.scene.body(obj).shape)
+        bottom, reach = pose[2, 3] - h[2], float(np.hypot(h[0], h[1])) + NEIGHBOURHOOD
+        top = bottom
+        for body in self.scene.movable:
+            if body.name == obj:
+                continue
+            other, g = self.poses[body.name], half_extents(body.shape)
+            if np.hypot(*(other[:2, 3] - pose[:2, 3])) <= reach + float(np.hypot(g[0], g[1])):
+                top = max(top, other[2, 3] + g[2])
+        return float(np.clip(top - bottom + 0.01, TRANSFER_LIFT, MAX_LIFT))
+
+    def _lift(self, robot: str, q: np.ndarray, height: float = TRANSFER_LIFT) -> np.ndarray | None:
         """Configurations raising the tool straight up from its pose at ``q`` by up to :data:`TRANSFER_LIFT`
         (one per centimetre, each solved from the one before, as far as none fails or jumps; None when not
         even the first centimetre can be solved)."""
         arm = self.arm(robot)
         tool = arm.tool_world(q[None])[0]
         out = [q]
-        for dz in np.arange(1, round(TRANSFER_LIFT / 0.01) + 1) * 0.01:
+        for dz in np.arange(1, round(height / 0.01) + 1) * 0.01:
             target = arm.ee_target(translation(0.0, 0.0, float(dz)) @ tool)
             ik = solve_ik_many(arm.model, target[None], 0, q_init=out[-1], restarts=0)[0]
             if not ik.solved or float(np.abs(ik.q - out[-1]).max()) > 0.2:
@@ -541,7 +593,7 @@ class Grounder:
             digest.update(np.ascontiguousarray(part).tobytes())
         key = (robot, holding, tuple(movers), tuple(id(shape) for shape, _ in busy), digest.digest())
         if key not in self._paths:
-            self._paths[key] = self._base_path(robot, start, goal, holding, movers, busy)
+            self._remember(key, self._base_path(robot, start, goal, holding, movers, busy))
         return self._paths[key]
 
     def _base_path(self, robot: str, start: np.ndarray, goal: np.ndarray, holding: tuple[str, str] | None,

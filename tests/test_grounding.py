@@ -2,15 +2,18 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
-from support import ROOT
 
 from mrgc import parse_file
 from mrgc.geometry.grounding import Grounder, Status
 from mrgc.geometry.planar import to_se2
 from mrgc.geometry.scene import inside, scene_from_problem
 from mrgc.geometry.transforms import translation
+
+ROOT = Path(__file__).resolve().parent.parent
 
 
 @pytest.fixture()
@@ -136,3 +139,28 @@ def test_same_queries_same_answers() -> None:
     a = Grounder(scene_from_problem(problem), seed=4).placement("o2", "start", avoid=["o1", "o3"])
     b = Grounder(scene_from_problem(problem), seed=4).placement("o2", "start", avoid=["o1", "o3"])
     assert a.pose is not None and b.pose is not None and np.array_equal(a.pose, b.pose)
+
+
+def test_a_transfer_lifts_the_object_clear_of_taller_neighbours(pa3: Grounder) -> None:
+    """o1 (12 cm) between o2 and o3: a lift of 8 cm does not clear them when o2 stands 10 cm higher; the
+    lift then rises until o1's bottom is 1 cm above o2's top, straight up, and the whole carry keeps clear
+    of both neighbours."""
+    assert pa3.lift_height("o1") == pytest.approx(0.13)  # neighbours as tall as o1: 12 cm + 1 cm
+    pa3.move("o2", pa3.poses["o2"] @ translation(0, 0, 0.10))  # (floating: the lift only reads heights)
+    assert pa3.lift_height("o1") == pytest.approx(0.23)
+    pa3.move("o3", pa3.poses["o3"] @ translation(0, 0, 0.50))
+    assert pa3.lift_height("o1") == pytest.approx(0.30)  # at most MAX_LIFT
+    pa3.move("o3", pa3.scene.body("o3").pose)
+    pick = pa3.pick("r1", "o1", "top", avoid=["o2", "o3"])
+    hand = pa3.handover("o1", "h1", "r1", "top", "r2", "side-x+")
+    assert pick.ok and pick.configs is not None and hand.ok and hand.configs is not None
+    carry = pa3.transfer("r1", "o1", "top", pick.configs[-1], hand.configs[0], avoid=["o2", "o3"], lift=True)
+    assert carry.ok
+    path = np.array(carry.path)
+    arm = pa3.arm("r1")
+    z = arm.tool_world(path)[:, 2, 3]
+    rise = next(i for i, h in enumerate(z) if h >= z[0] + 0.23 - 1e-4)
+    tools = arm.tool_world(path[:rise + 1])[:, :2, 3]
+    assert np.abs(tools - tools[0]).max() < 2e-3  # straight up all the way
+    volume = pa3.arm_volume("r1", path[1:], holding=("o1", "top"))
+    assert pa3.hits(volume, among=["o2", "o3"]) == set()

@@ -78,6 +78,7 @@ class Urdf:
     lines: dict[ET.Element, int]
 
     def line(self, el: ET.Element) -> int:
+        """The line of the file an element starts on (1 when unknown)."""
         return self.lines.get(el, 1)
 
 

@@ -67,6 +67,7 @@ class Checker:
         self._sorted_names: dict[str, tuple[dict[str, tuple[str, Span]], frozenset[str]]] = {}
 
     def err(self, code: str, message: str, span: Span) -> None:
+        """Record a diagnostic."""
         self.diags.append(Diagnostic(code, message, span))
 
     def _once(self, sections: Iterable[Any], label: Any) -> dict[str, Any]:
@@ -84,6 +85,7 @@ class Checker:
 
     # ------------------------------------------------------------ domains
     def domain(self, d: ast.DomainDef) -> Domain:
+        """A checked :class:`~mrgc.language.model.Domain` (diagnostics recorded, not raised)."""
         secs = self._once(d.sections, _domain_label)
         reqs: tuple[str, ...] = ()
         if "requirements" in secs:
@@ -144,6 +146,8 @@ class Checker:
                          vals.get("offset", (0.0, 0.0, 0.0)), span=d.span)  # type: ignore[arg-type]
 
     def robot_kind(self, k: ast.RobotKindDecl) -> RobotKind:
+        """A checked robot kind: URDF and end effector (fixed base) or footprint (planar base), home, TCP, carry
+        pose."""
         what = f"robot kind '{k.name}'"
         table = self.props.table("robot-kind", what, k.props)
         vals = {key: self.props.read("robot-kind", prop) for key, prop in table.items()}
@@ -170,6 +174,7 @@ class Checker:
 
     # ------------------------------------------------------------ problems
     def problem(self, p: ast.ProblemDef, domain: Domain) -> Problem:
+        """A checked :class:`~mrgc.language.model.Problem` of ``domain`` (diagnostics recorded, not raised)."""
         secs = self._once(p.sections, _problem_label)
         decls: dict[str, tuple[ast.Decl, ...]] = {
             kind: secs[kind].decls if kind in secs else () for kind in SECTION_SORT

@@ -19,13 +19,13 @@ from typing import Sequence
 
 import pytest
 from hypothesis import HealthCheck, event, given, settings
+from support import ROOT
 
 import mrgc
 import mrgc.testing
 from mrgc.testing import oracle
 from mrgc.testing.strategies import SymbolicCase, symbolic_problems
 
-ROOT = Path(__file__).resolve().parent.parent
 SYMBOLIC = ROOT / "domains" / "symbolic"
 CHAIN3 = SYMBOLIC / "chain-3.mrg"
 

@@ -21,10 +21,13 @@ from mrgc.compiler.task_graph import TaskGraph
 
 
 class TimeOfMoveEncoding(Encoding):
+    """The time-of-move encoding (module docstring): one integer step per object, no horizon loop."""
+
     name = "time-of-move"
     horizon_loop = False
 
     def build(self, graph: TaskGraph, horizon: int) -> Encoded:
+        """The model for ``graph`` with steps up to ``horizon``."""
         H = horizon
         m = SkeletonModel(name=f"{self.name}-H{H}")
         A = range(len(graph.actions))

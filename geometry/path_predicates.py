@@ -263,9 +263,16 @@ class PlanarEvaluator:
                 break
         if best is None:
             return None
+        return self._place_hits(q_pick, best, carried, key, others)
+
+    def _place_hits(self, q_pick: np.ndarray, best: tuple[Path, set[str], np.ndarray, np.ndarray],
+                    carried: tuple[CollisionShape, np.ndarray], key: tuple[str, str],
+                    others: frozenset[str]) -> set[str]:
+        """What the chosen place path (and the object at its placement) hits, the path's hits reduced: as
+        :meth:`_least_blocked`, first a path around the known occluders, then greedily."""
         path, hits, pose, q = best
-        at_place = self.world.probe_hits([(shape, pose)], against=others)
-        if hits - at_place - self.occluders and self.occluders & others:  # as _least_blocked: known occluders
+        at_place = self.world.probe_hits([(carried[0], pose)], against=others)
+        if hits - at_place - self.occluders and self.occluders & others:
             known = self._path(q_pick, q, carried, key, others - self.occluders - at_place)
             if known is not None:
                 path, hits = known, self._sweep(known, carried, others) | at_place

@@ -87,14 +87,7 @@ class Checker:
     def domain(self, d: ast.DomainDef) -> Domain:
         """A checked :class:`~mrgc.language.model.Domain` (diagnostics recorded, not raised)."""
         secs = self._once(d.sections, _domain_label)
-        reqs: tuple[str, ...] = ()
-        if "requirements" in secs:
-            req: ast.Requirements = secs["requirements"]
-            for flag, span in zip(req.flags, req.flag_spans or (req.span,) * len(req.flags)):
-                if flag not in REQUIREMENTS:
-                    hint = did_you_mean(flag, REQUIREMENTS) or f" (known: {', '.join(':' + r for r in REQUIREMENTS)})"
-                    self.err("E235", f"unknown requirement ':{flag}'{hint}", span)
-            reqs = tuple(dict.fromkeys(f for f in req.flags if f in REQUIREMENTS))
+        reqs = self._requirements(secs["requirements"]) if "requirements" in secs else ()
         kinds: dict[str, RobotKind] = {}
         for sec in d.sections:
             if isinstance(sec, ast.RobotKindDecl):
@@ -104,25 +97,36 @@ class Checker:
                              sec.span)
                 else:
                     kinds[sec.name] = kind
-        grasps: tuple[str, ...] = ()
-        specs: list[GraspSpec] = []
-        if "grasps" in secs:
-            seen: dict[str, Span] = {}
-            for decl in secs["grasps"].decls:
-                if decl.name in seen:
-                    self.err("E200", f"grasp '{decl.name}' declared twice (first at {seen[decl.name]})", decl.span)
-                    continue
-                seen[decl.name] = decl.span
-                if not decl.bare:
-                    spec = self.grasp(decl)
-                    if spec is not None:
-                        specs.append(spec)
-                elif kinds and decl.name not in BUILTIN_GRASPS:
-                    hint = did_you_mean(decl.name, BUILTIN_GRASPS) or f" (built in: {' '.join(BUILTIN_GRASPS)})"
-                    self.err("E243", f"grasp '{decl.name}' has no geometry: it is not built in and not declared "
-                             f"as ({decl.name} :approach AXIS :fingers AXIS){hint}", decl.span)
-            grasps = tuple(seen)
+        grasps, specs = self._grasps(secs["grasps"], bool(kinds)) if "grasps" in secs else ((), [])
         return Domain(d.name, reqs, tuple(kinds.values()), grasps, self.file, d.span, tuple(specs))
+
+    def _requirements(self, req: ast.Requirements) -> tuple[str, ...]:
+        """The known requirement flags, once each (E235 for the others)."""
+        for flag, span in zip(req.flags, req.flag_spans or (req.span,) * len(req.flags)):
+            if flag not in REQUIREMENTS:
+                hint = did_you_mean(flag, REQUIREMENTS) or f" (known: {', '.join(':' + r for r in REQUIREMENTS)})"
+                self.err("E235", f"unknown requirement ':{flag}'{hint}", span)
+        return tuple(dict.fromkeys(f for f in req.flags if f in REQUIREMENTS))
+
+    def _grasps(self, section: ast.Grasps, has_kinds: bool) -> tuple[tuple[str, ...], list[GraspSpec]]:
+        """The declared grasp names (E200 for repeats) and the geometry of those declared with it (E243 for a
+        bare name that is not built in, when the domain has robot kinds)."""
+        seen: dict[str, Span] = {}
+        specs: list[GraspSpec] = []
+        for decl in section.decls:
+            if decl.name in seen:
+                self.err("E200", f"grasp '{decl.name}' declared twice (first at {seen[decl.name]})", decl.span)
+                continue
+            seen[decl.name] = decl.span
+            if not decl.bare:
+                spec = self.grasp(decl)
+                if spec is not None:
+                    specs.append(spec)
+            elif has_kinds and decl.name not in BUILTIN_GRASPS:
+                hint = did_you_mean(decl.name, BUILTIN_GRASPS) or f" (built in: {' '.join(BUILTIN_GRASPS)})"
+                self.err("E243", f"grasp '{decl.name}' has no geometry: it is not built in and not declared "
+                         f"as ({decl.name} :approach AXIS :fingers AXIS){hint}", decl.span)
+        return tuple(seen), specs
 
     def grasp(self, d: ast.Decl) -> GraspSpec | None:
         """The geometry of a declared grasp ``(NAME :approach AXIS :fingers AXIS :depth D :offset (X Y Z))``."""

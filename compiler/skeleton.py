@@ -19,7 +19,6 @@ class Skeleton:
 
     @property
     def makespan(self) -> int:
-        """The number of steps."""
         return len(self.steps)
 
     @property
@@ -29,7 +28,6 @@ class Skeleton:
 
     @property
     def actions(self) -> frozenset[Action]:
-        """Every action of every step."""
         return frozenset(a for step in self.steps for a in step)
 
     @property
@@ -38,7 +36,6 @@ class Skeleton:
         return (self.makespan, len(self.moved))
 
     def to_json(self) -> dict[str, Any]:
-        """The skeleton as ``mrgc compile --format json`` prints it."""
         return {
             "makespan": self.makespan,
             "moved": sorted(self.moved),

@@ -106,7 +106,6 @@ class Grasps:
 
     @property
     def names(self) -> tuple[str, ...]:
-        """The declared names, in order."""
         return tuple(d.name for d in self.decls)
 
 

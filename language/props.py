@@ -62,7 +62,6 @@ class PropReader:
         self.file = file
 
     def err(self, code: str, message: str, span: Span) -> None:
-        """Record a diagnostic."""
         self.diags.append(Diagnostic(code, message, span))
 
     # ------------------------------------------------------------ property tables

@@ -15,7 +15,6 @@ from typing import Any
 
 from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
-from support import ROOT
 
 from mrgc import cli, parse_file, parse_string
 from mrgc.language.model import Problem
@@ -25,6 +24,7 @@ from mrgc.planner.plan import Plan
 from mrgc.planner.validate import validate
 from mrgc.testing import oracle
 
+ROOT = Path(__file__).resolve().parent.parent
 SYMBOLIC = ROOT / "domains" / "symbolic"
 PLACE_OBSTACLE = ROOT / "domains" / "packaging" / "pa3-place-obstacle.mrg"
 

@@ -7,8 +7,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from support import ROOT
-
+ROOT = Path(__file__).resolve().parent.parent
 SCRIPT = ROOT / "benchmarks" / "planning.py"
 
 

@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 import re
+from pathlib import Path
 
-from support import ROOT
+ROOT = Path(__file__).resolve().parent.parent
 
 
 def quick_start() -> list[str]:

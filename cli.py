@@ -52,6 +52,7 @@ def _warn(path: str, text: str, warnings: Sequence[Diagnostic]) -> None:
 
 # ---------------------------------------------------------------- commands
 def cmd_check(args: argparse.Namespace) -> int:
+    """``mrgc check``: check every file (and its layout); exit 2 when any has an error."""
     from mrgc.api import check
 
     status = ExitCode.OK
@@ -77,6 +78,7 @@ def cmd_check(args: argparse.Namespace) -> int:
 
 
 def cmd_fmt(args: argparse.Namespace) -> int:
+    """``mrgc fmt``: print, check (``--check``), diff (``--diff``) or rewrite (``--write``) the canonical form."""
     from mrgc.language.loader import read_source
     from mrgc.language.parser import parse_text
     from mrgc.language.printer import format_source
@@ -172,6 +174,7 @@ def check_output(path: str | None, inputs: Sequence[str] = (), option: str = "-o
 
 
 def cmd_compile(args: argparse.Namespace) -> int:
+    """``mrgc compile``: the first skeletons of a problem (text or JSON), and with ``--emit`` its model file."""
     import json
 
     from mrgc import api, outputs, signals
@@ -226,6 +229,7 @@ def cmd_compile(args: argparse.Namespace) -> int:
 
 
 def cmd_facts(args: argparse.Namespace) -> int:
+    """``mrgc facts``: phase 1, written as the problem with its ``:init`` completed."""
     import json
 
     from mrgc import signals
@@ -276,6 +280,7 @@ def _progress(message: str) -> "contextlib.AbstractContextManager[object]":
 
 
 def cmd_plan(args: argparse.Namespace) -> int:
+    """``mrgc plan``: plan end to end and write the plan; the exit code is the plan's status's."""
     from mrgc import api, signals
     from mrgc.planner.outcome import EXIT_CODES, PlanStatus
 
@@ -316,6 +321,7 @@ def cmd_plan(args: argparse.Namespace) -> int:
 
 
 def cmd_validate(args: argparse.Namespace) -> int:
+    """``mrgc validate``: the independent validator's report on a plan; exit 1 when the plan is invalid."""
     import json
 
     from mrgc.api import validate
@@ -332,6 +338,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
 
 def cmd_generate(args: argparse.Namespace) -> int:
+    """``mrgc generate``: a random problem of a domain, checked before it is written."""
     from mrgc.generate import generate
     from mrgc.generate.document import domain_path
 
@@ -346,6 +353,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
 
 
 def cmd_backends(args: argparse.Namespace) -> int:
+    """``mrgc backends``: the registered solver backends and what they translate natively."""
     import json
 
     from mrgc.api import backends
@@ -377,6 +385,7 @@ def add_allow_outside(p: argparse.ArgumentParser) -> None:
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The ``mrgc`` argument parser with every command (usage errors are one ``E000`` line, exit 2)."""
     parser = _Parser(prog="mrgc", description="Multi-robot geometric task-and-motion planning compiler and solver.")
     parser.add_argument("--version", action="version", version=f"mrgc {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)

@@ -79,16 +79,22 @@ class Backend(ABC):
         return self.info.name
 
     def load(self, model: SkeletonModel) -> None:
+        """Take a skeleton model, lowered to the features this backend translates natively (replaces any previous
+        one)."""
         self.model = lower(model, self.info.features)
         self._load(self.model)
 
     def add_rows(self, rows: Sequence[Row]) -> None:
+        """Add rows (cuts) to the loaded model; the next solve respects them."""
         if self.model is None:
             raise RuntimeError("add_rows before load")
         self.model.rows.extend(rows)
         self._add_rows(rows)
 
     def solve(self, time_limit: float | None = None) -> Solution:
+        """Minimise the loaded model's objectives in order: a :class:`~mrgc.compiler.ir.Solution` whose status says
+        how the solve ended (never an exception for infeasibility, time-outs or solver failures); every solution
+        returned satisfies the lowered model."""
         if self.model is None:
             raise RuntimeError("solve before load")
         t0 = time.perf_counter()

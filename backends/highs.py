@@ -40,6 +40,8 @@ def lp_names(names: Sequence[str]) -> list[str]:
 
 
 class HighsBackend(Backend):
+    """The ``mip`` backend: the model as a mixed-integer program for HiGHS (conditional rows as big-M rows)."""
+
     info = BackendInfo(
         name="mip",
         title="HiGHS MIP (highspy)",

@@ -25,6 +25,9 @@ def _pysmt() -> Any:
 
 
 class PysmtBackend(Backend):
+    """The ``pysmt`` backend: the model as pysmt formulas solved by z3, each objective minimised by tightening its
+    bound until the solver answers unsat."""
+
     info = BackendInfo(
         name="pysmt",
         title="pysmt (z3), optimised by bound tightening",

@@ -35,6 +35,7 @@ def _all() -> dict[str, str]:
 
 
 def names() -> list[str]:
+    """The names of every registered backend: the built-in ones, then the entry-point plug-ins."""
     return list(_all())
 
 
@@ -54,10 +55,12 @@ def backend_class(name: str) -> type[Backend]:
 
 
 def installed(info: BackendInfo) -> bool:
+    """Whether the solver library of ``info`` can be imported (found without importing it)."""
     return importlib.util.find_spec(info.module) is not None
 
 
 def version(info: BackendInfo) -> str:
+    """The installed version of the solver library of ``info`` (``-`` when it is not installed)."""
     import importlib.metadata
 
     try:
@@ -100,6 +103,7 @@ class BackendRecord:
     exports: tuple[str, ...] = ()
 
     def to_json(self) -> dict[str, Any]:
+        """The record as ``mrgc backends --format json`` prints it."""
         return {"name": self.name, "title": self.title, "installed": self.installed, "library": self.library,
                 "version": self.version, "features": list(self.features), "encodings": list(self.encodings),
                 "exports": list(self.exports)}

@@ -25,6 +25,8 @@ def _z3() -> Any:
 
 
 class Z3Backend(Backend):
+    """The ``smt`` backend: the model for z3's Optimize (lexicographic objectives, native at-most-one)."""
+
     info = BackendInfo(
         name="smt",
         title="z3 Optimize (OMT)",

@@ -25,7 +25,7 @@ BACKENDS = ["cpsat", "mip", "smt", "pysmt"]
 ENCODINGS = ["time-of-move", "disaggregated", "paper"]
 
 
-def instance(n_objects: int, n_robots: int, seed: int) -> tuple[FactBase, list[str]]:  # noqa: C901
+def instance(n_objects: int, n_robots: int, seed: int) -> tuple[FactBase, list[str]]:
     """A PA-like fact base whose task graph holds all ``n_objects`` objects.
 
     Robots stand around a table; each object can be picked by one or two robots with one or two grasps;
@@ -45,43 +45,53 @@ def instance(n_objects: int, n_robots: int, seed: int) -> tuple[FactBase, list[s
     reach = {b: set(rng.sample(robots, max(1, n_robots // 2))) for b in bins}
     facts = [Fact("in-region", (o, "start")) for o in objs]
     pickers_of = {o: rng.sample(robots, min(len(robots), rng.choice([1, 2]))) for o in objs}
-    for i, o in enumerate(objs):
-        if i >= n_goals:  # o blocks the pick of an earlier object, whatever robot and grasp picks it
-            parent = objs[rng.randrange(i)]
-            for r in pickers_of[parent]:
-                for g in grasps:
-                    facts.append(Fact("occludes-pick", (o, parent, g, r)))
-        pickers = pickers_of[o]
-        pick_grasps = {}
-        for r in pickers:
-            pick_grasps[r] = rng.sample(grasps, rng.choice([1, 2]))
-            for g in pick_grasps[r]:
-                facts.append(Fact("reachable-pick", (o, g, r)))
-                facts.append(Fact("reachable-place", (o, "start", g, r)))
-        if o in goal:
-            for r in robots:
-                if r in reach[goal[o]]:
-                    for g in grasps:
-                        facts.append(Fact("reachable-place", (o, goal[o], g, r)))
-            for r1 in pickers:
-                for r2 in robots:
-                    if r2 != r1 and rng.random() < 0.5:
-                        facts.append(Fact("enable-goal-handover", (o, pick_grasps[r1][0], "side", r1, r2)))
-            if not reach[goal[o]] & set(pickers):  # keep the instance feasible: a handover into the bin
-                r1, r2 = pickers[0], sorted(reach[goal[o]])[0]
-                facts.append(Fact("enable-goal-handover", (o, pick_grasps[r1][0], "top", r1, r2)))
-        later = objs[max(i + 1, n_goals):]
-        if later and rng.random() < 0.3:
-            blocker = rng.choice(later)
-            for r in pickers:
-                facts.append(Fact("occludes-pick", (blocker, o, rng.choice(grasps), r)))
-        if o in goal and later and rng.random() < 0.5:
-            b = rng.choice(later)
-            for r in robots:
-                for g in grasps:
-                    facts.append(Fact("occludes-goal-place", (b, o, goal[o], g, r)))
+    for i in range(len(objs)):
+        facts += _object_facts(rng, i, objs, robots, grasps, n_goals, goal, reach, pickers_of)
     base = FactBase.from_facts(robots, objs, {o: tuple(grasps) for o in objs}, goal, facts)
     return base, list(goal)
+
+
+def _object_facts(rng: random.Random, i: int, objs: list[str], robots: list[str], grasps: list[str], n_goals: int,
+                  goal: dict[str, str], reach: dict[str, set[str]], pickers_of: dict[str, list[str]]) -> list[Fact]:
+    """The facts of the i-th object (see :func:`instance`), drawn from ``rng`` in a fixed order."""
+    o = objs[i]
+    facts: list[Fact] = []
+    if i >= n_goals:  # o blocks the pick of an earlier object, whatever robot and grasp picks it
+        parent = objs[rng.randrange(i)]
+        facts += [Fact("occludes-pick", (o, parent, g, r)) for r in pickers_of[parent] for g in grasps]
+    pickers = pickers_of[o]
+    pick_grasps = {}
+    for r in pickers:
+        pick_grasps[r] = rng.sample(grasps, rng.choice([1, 2]))
+        for g in pick_grasps[r]:
+            facts.append(Fact("reachable-pick", (o, g, r)))
+            facts.append(Fact("reachable-place", (o, "start", g, r)))
+    if o in goal:
+        facts += _goal_facts(rng, o, goal[o], robots, grasps, reach[goal[o]], pickers, pick_grasps)
+    later = objs[max(i + 1, n_goals):]
+    if later and rng.random() < 0.3:
+        blocker = rng.choice(later)
+        for r in pickers:
+            facts.append(Fact("occludes-pick", (blocker, o, rng.choice(grasps), r)))
+    if o in goal and later and rng.random() < 0.5:
+        b = rng.choice(later)
+        facts += [Fact("occludes-goal-place", (b, o, goal[o], g, r)) for r in robots for g in grasps]
+    return facts
+
+
+def _goal_facts(rng: random.Random, o: str, bin_: str, robots: list[str], grasps: list[str], reach: set[str],
+                pickers: list[str], pick_grasps: dict[str, list[str]]) -> list[Fact]:
+    """A goal object's places into its bin and handovers (always one into the bin when no picking robot
+    reaches it)."""
+    facts = [Fact("reachable-place", (o, bin_, g, r)) for r in robots if r in reach for g in grasps]
+    for r1 in pickers:
+        for r2 in robots:
+            if r2 != r1 and rng.random() < 0.5:
+                facts.append(Fact("enable-goal-handover", (o, pick_grasps[r1][0], "side", r1, r2)))
+    if not reach & set(pickers):  # keep the instance feasible: a handover into the bin
+        r1, r2 = pickers[0], sorted(reach)[0]
+        facts.append(Fact("enable-goal-handover", (o, pick_grasps[r1][0], "top", r1, r2)))
+    return facts
 
 
 def run(base: FactBase, must: list[str], backend: str, encoding: str, limit: float) -> dict[str, float | None]:

@@ -55,6 +55,7 @@ class FactBase:
     def from_facts(cls, robots: Iterable[str], objects: Iterable[str], grasps: dict[str, tuple[str, ...]],
                    goal: dict[str, str], facts: Iterable[Fact], handover_capacity: int | None = None,
                    drivers: Iterable[str] = ()) -> "FactBase":
+        """A fact base from its parts (the symbolic problem's facts, or phase 1's)."""
         region: dict[str, str] = {}
         pick: set[tuple[str, str, str]] = set()
         place: set[tuple[str, str, str, str]] = set()

@@ -89,21 +89,26 @@ class SkeletonModel:
     name: str = "skeleton"
 
     def bool_var(self, name: str) -> int:
+        """A new boolean variable; its index."""
         self.vars.append(Var(name, 0, 1, True))
         return len(self.vars) - 1
 
     def int_var(self, name: str, lb: int, ub: int) -> int:
+        """A new integer variable in ``[lb, ub]``; its index."""
         self.vars.append(Var(name, lb, ub, False))
         return len(self.vars) - 1
 
     def add(self, terms: Sequence[tuple[int, int]], lo: int | None = None, hi: int | None = None,
             name: str = "") -> Row:
+        """Add the row ``lo <= sum(terms) <= hi`` (repeated variables merged); the row."""
         row = Row(merge_terms(terms), lo, hi, name)
         self.rows.append(row)
         return row
 
     def add_if(self, when: Sequence[tuple[int, bool]], terms: Sequence[tuple[int, int]], lo: int | None = None,
                hi: int | None = None, name: str = "", big_m: int | None = None) -> None:
+        """Add a row that holds only when every ``(variable, value)`` of ``when`` does (``big_m``: the bound a
+        backend without indicator constraints uses)."""
         self.cond_rows.append(CondRow(tuple(when), Row(merge_terms(terms), lo, hi, name), big_m))
 
     def bounds(self, terms: Terms) -> tuple[int, int]:
@@ -116,6 +121,7 @@ class SkeletonModel:
         return lo, hi
 
     def evaluate(self, terms: Terms, values: Sequence[int]) -> int:
+        """The value of a linear expression at ``values``."""
         return sum(c * values[v] for v, c in terms)
 
     def violated(self, values: Sequence[int]) -> list[str]:

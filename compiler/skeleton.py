@@ -19,6 +19,7 @@ class Skeleton:
 
     @property
     def makespan(self) -> int:
+        """The number of steps."""
         return len(self.steps)
 
     @property
@@ -28,6 +29,7 @@ class Skeleton:
 
     @property
     def actions(self) -> frozenset[Action]:
+        """Every action of every step."""
         return frozenset(a for step in self.steps for a in step)
 
     @property
@@ -36,6 +38,7 @@ class Skeleton:
         return (self.makespan, len(self.moved))
 
     def to_json(self) -> dict[str, Any]:
+        """The skeleton as ``mrgc compile --format json`` prints it."""
         return {
             "makespan": self.makespan,
             "moved": sorted(self.moved),

@@ -39,6 +39,7 @@ class Action:
 
     @property
     def handover(self) -> bool:
+        """Whether two robots share the action (one picks, the other places)."""
         return self.pick_robot != self.place_robot
 
     def __str__(self) -> str:

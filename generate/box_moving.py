@@ -67,21 +67,54 @@ def _decl(name: str, f: Footprint, height: float) -> str:
     return box_decl(name, f.x, f.y, f.hx, f.hy, height, f.yaw)
 
 
-def _layout(rng: np.random.Generator, robots: int, goals: int, others: int):  # type: ignore[no-untyped-def]  # noqa: C901
+Named = list[tuple[str, Footprint]]
+#: walls, regions, boxes (name, footprint, height), carts, rooms, doorway blockers, alcove?
+Layout = tuple[Named, Named, list[tuple[str, Footprint, float]], list[Footprint], int, int, bool]
+
+
+def _layout(rng: np.random.Generator, robots: int, goals: int, others: int) -> Layout | None:
     """One attempt at a whole layout, or None when some item found no place (the caller draws again)."""
     fx, fy = _u(rng, *FLOOR_X, 1), _u(rng, *FLOOR_Y, 1)
     n_rooms = 3 if fx >= 3 * ROOM_MIN + 2 * WALL_T and rng.random() < 0.5 else 2
+    rooms = _rooms(rng, fx, fy, n_rooms)
+    if rooms is None:
+        return None
+    walls, dividers, doors = rooms
+    x0, y0 = -fx / 2, -fy / 2
+    alcove = rng.random() < ALCOVE
+    if alcove:
+        w, d = _u(rng, *ALCOVE_WIDTH, 2), _u(rng, *ALCOVE_DEPTH, 2)
+        yc = _u(rng, y0 + w / 2 + WALL_T + 0.3, -y0 - w / 2 - WALL_T - 0.3, 2)
+        for side, sign in (("n", 1), ("s", -1)):
+            walls.append((f"alcove-{side}", Footprint(round(x0 + d / 2, 3), round(yc + sign * (w + WALL_T) / 2, 3),
+                                                      round(d / 2, 4), WALL_T / 2)))
+    regions = _regions(rng, fx, fy, dividers)
+    boxes = _boxes(rng, goals, others, [f for _, f in regions], [f for _, f in walls], dividers, doors)
+    if boxes is None:
+        return None
+    found, blocked = boxes
+    start_room = Footprint((x0 + dividers[0] - WALL_T / 2) / 2, 0.0, (dividers[0] - WALL_T / 2 - x0) / 2, -y0)
+    carts = _carts(rng, robots, start_room, [f for _, f in walls], [f for _, f, _ in found])
+    if carts is None:
+        return None
+    return walls, regions, found, carts, n_rooms, blocked, alcove
+
+
+def _rooms(rng: np.random.Generator, fx: float, fy: float,
+           n_rooms: int) -> tuple[Named, list[float], list[tuple[float, float, float]]] | None:
+    """The outer walls and the dividers with their doorways: (walls, x of each divider's centre line,
+    doorways as (x, y centre, width)); None when the doorways do not fit."""
     free = fx - n_rooms * ROOM_MIN - (n_rooms - 1) * WALL_T
     widths = [ROOM_MIN + free * float(s) for s in rng.dirichlet(np.ones(n_rooms))]
     x0, y0 = -fx / 2, -fy / 2
-    walls: list[tuple[str, Footprint]] = [
+    walls: Named = [
         ("wall-s", Footprint(0.0, round(y0 - WALL_T / 2, 3), round(fx / 2 + WALL_T, 3), WALL_T / 2)),
         ("wall-n", Footprint(0.0, round(-y0 + WALL_T / 2, 3), round(fx / 2 + WALL_T, 3), WALL_T / 2)),
         ("wall-w", Footprint(round(x0 - WALL_T / 2, 3), 0.0, WALL_T / 2, round(fy / 2, 3))),
         ("wall-e", Footprint(round(-x0 + WALL_T / 2, 3), 0.0, WALL_T / 2, round(fy / 2, 3))),
     ]
-    dividers: list[float] = []  # x of each divider's centre line
-    doors: list[tuple[float, float, float]] = []  # (x, y centre, width)
+    dividers: list[float] = []
+    doors: list[tuple[float, float, float]] = []
     left = x0
     for k in range(n_rooms - 1):
         xd = round(left + widths[k] + WALL_T / 2, 3)
@@ -96,17 +129,15 @@ def _layout(rng: np.random.Generator, robots: int, goals: int, others: int):  # 
             walls.append((f"divider{k + 1}-{chr(ord('a') + j // 2)}",
                           Footprint(xd, round((lo + hi) / 2, 3), WALL_T / 2, round((hi - lo) / 2, 4))))
         doors += [(xd, (lo + hi) / 2, hi - lo) for lo, hi in spans]
-    alcove = rng.random() < ALCOVE
-    if alcove:
-        w, d = _u(rng, *ALCOVE_WIDTH, 2), _u(rng, *ALCOVE_DEPTH, 2)
-        yc = _u(rng, y0 + w / 2 + WALL_T + 0.3, -y0 - w / 2 - WALL_T - 0.3, 2)
-        for side, sign in (("n", 1), ("s", -1)):
-            walls.append((f"alcove-{side}", Footprint(round(x0 + d / 2, 3), round(yc + sign * (w + WALL_T) / 2, 3),
-                                                      round(d / 2, 4), WALL_T / 2)))
-    # regions: each room up to DOORWAY_SHARE past its east divider; the last room's goal region a part of it
+    return walls, dividers, doors
+
+
+def _regions(rng: np.random.Generator, fx: float, fy: float, dividers: list[float]) -> Named:
+    """Each room up to DOORWAY_SHARE past its east divider, and the goal region, a part of the last room."""
+    x0, y0 = -fx / 2, -fy / 2
     bounds = [x0, *(xd + DOORWAY_SHARE for xd in dividers), -x0]
-    regions: list[tuple[str, Footprint]] = []
-    for k in range(n_rooms - 1):
+    regions: Named = []
+    for k in range(len(dividers)):
         lo, hi = bounds[k], bounds[k + 1]
         regions.append(("start" if k == 0 else f"room{k + 1}",
                         Footprint(round((lo + hi) / 2, 3), 0.0, round((hi - lo) / 2, 4), round(fy / 2, 3))))
@@ -114,8 +145,14 @@ def _layout(rng: np.random.Generator, robots: int, goals: int, others: int):  # 
     gx, gy = _u(rng, *GOAL_SHARE) * (hi - lo) / 2, _u(rng, *GOAL_SHARE) * fy / 2
     gx, gy = round(gx, 2), round(gy, 2)
     regions.append(("goal", Footprint(_u(rng, lo + gx, hi - gx, 2), _u(rng, y0 + gy, -y0 - gy, 2), gx, gy)))
-    region_of_room = [f for _, f in regions]
-    wall_feet = [f for _, f in walls]
+    return regions
+
+
+def _boxes(rng: np.random.Generator, goals: int, others: int, region_of_room: list[Footprint],
+           wall_feet: list[Footprint], dividers: list[float],
+           doors: list[tuple[float, float, float]]) -> tuple[list[tuple[str, Footprint, float]], int] | None:
+    """The goal boxes in the start room, boxes blocking doorways (each doorway by chance, up to ``others``)
+    and the other boxes in random rooms; with the number of blockers (None when some box found no place)."""
     boxes: list[tuple[str, Footprint, float]] = []
     taken: list[Footprint] = []
 
@@ -141,10 +178,16 @@ def _layout(rng: np.random.Generator, robots: int, goals: int, others: int):  # 
                   wall_feet, taken, boxes):
             blocked += 1
     for k in range(blocked, others):
-        if not place(f"b{k + 1}", region_of_room[int(rng.integers(n_rooms))]):
+        if not place(f"b{k + 1}", region_of_room[int(rng.integers(len(dividers) + 1))]):
             return None
+    return boxes, blocked
+
+
+def _carts(rng: np.random.Generator, robots: int, start_room: Footprint, wall_feet: list[Footprint],
+           taken: list[Footprint]) -> list[Footprint] | None:
+    """The carts' footprints in the start room, clear of walls, boxes and each other (None when one found
+    no place)."""
     carts: list[Footprint] = []
-    start_room = Footprint((x0 + dividers[0] - WALL_T / 2) / 2, 0.0, (dividers[0] - WALL_T / 2 - x0) / 2, -y0)
     for _ in range(robots):
         for _ in range(ATTEMPTS):
             f = Footprint(_u(rng, start_room.x - start_room.hx, start_room.x + start_room.hx),
@@ -156,7 +199,7 @@ def _layout(rng: np.random.Generator, robots: int, goals: int, others: int):  # 
                 break
         else:
             return None
-    return walls, regions, boxes, carts, n_rooms, blocked, alcove
+    return carts
 
 
 def _doorways(rng: np.random.Generator, fy: float) -> list[tuple[float, float]] | None:

@@ -25,9 +25,11 @@ class Footprint:
 
     @property
     def disc(self) -> bool:
+        """Whether the footprint is a disc (else a box)."""
         return self.radius > 0
 
     def axes(self) -> tuple[tuple[float, float], tuple[float, float]]:
+        """The footprint's unit x and y axes in the world."""
         c, s = math.cos(math.radians(self.yaw)), math.sin(math.radians(self.yaw))
         return (c, s), (-s, c)
 
@@ -39,6 +41,7 @@ class Footprint:
         return abs(c) * self.hx + abs(s) * self.hy, abs(s) * self.hx + abs(c) * self.hy
 
     def to_local(self, px: float, py: float) -> tuple[float, float]:
+        """A world point in the footprint's frame."""
         (ax, ay), (bx, by) = self.axes()
         dx, dy = px - self.x, py - self.y
         return dx * ax + dy * ay, dx * bx + dy * by
@@ -51,6 +54,7 @@ class Footprint:
         return math.hypot(max(abs(lx) - self.hx, 0.0), max(abs(ly) - self.hy, 0.0))
 
     def corners(self) -> list[tuple[float, float]]:
+        """A box footprint's four corners in the world."""
         (ax, ay), (bx, by) = self.axes()
         return [(self.x + sx * self.hx * ax + sy * self.hy * bx, self.y + sx * self.hx * ay + sy * self.hy * by)
                 for sx, sy in ((1, 1), (-1, 1), (-1, -1), (1, -1))]

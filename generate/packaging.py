@@ -54,12 +54,15 @@ HANDOVER_Z = (0.25, 0.5)
 
 @dataclass(frozen=True)
 class Arm:
+    """An arm of a generated packaging cell: where it stands and how far it reaches."""
+
     name: str
     x: float
     y: float
     yaw: float
 
     def shoulder_distance(self, x: float, y: float, z: float) -> float:
+        """Distance from the arm's shoulder to a point (m)."""
         return math.dist((self.x, self.y, SHOULDER), (x, y, z))
 
 
@@ -72,11 +75,13 @@ class Item:
     height: float
 
     def shape(self) -> str:
+        """The ``.mrg`` shape of the body."""
         if self.foot.disc:
             return f"(cylinder {num(self.foot.radius)} {num(self.height)})"
         return f"(box {num(2 * self.foot.hx)} {num(2 * self.foot.hy)} {num(self.height)})"
 
     def decl(self) -> str:
+        """The ``.mrg`` declaration of the body."""
         where = pose(self.foot.x, self.foot.y, self.height / 2, self.foot.yaw)
         return f"({self.name} :shape {self.shape()} :pose {where})"
 
@@ -265,7 +270,8 @@ def reaches(arm: Arm, item: Item) -> bool:
     return arm.shoulder_distance(item.foot.x, item.foot.y, z) <= REACH
 
 
-def connected(arms: list[Arm], obj: Item, region: Item, handovers: list[tuple[str, tuple[float, float, float]]]) -> bool:
+def connected(arms: list[Arm], obj: Item, region: Item,
+              handovers: list[tuple[str, tuple[float, float, float]]]) -> bool:
     """Whether some arm reaches both ``obj`` and ``region``, or a handover point lies within REACH of an arm
     that reaches ``obj`` and of another arm that reaches ``region``."""
     pickers = [a for a in arms if reaches(a, obj)]

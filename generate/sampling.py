@@ -24,11 +24,13 @@ def usage_error(message: str) -> InputError:
 
 
 def check_count(name: str, value: int, low: int, high: int) -> None:
+    """A usage error unless ``value`` is an integer from ``low`` to ``high``."""
     if not isinstance(value, int) or isinstance(value, bool) or not low <= value <= high:
         raise usage_error(f"{name} must be an integer from {low} to {high} (got {value!r})")
 
 
 def check_seed(seed: int) -> None:
+    """A usage error unless ``seed`` is a non-negative integer."""
     if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
         raise usage_error(f"--seed must be a non-negative integer (got {seed!r})")
 

@@ -274,6 +274,7 @@ class CollisionWorld:
         self._selections.clear()
 
     def remove(self, name: str) -> None:
+        """Take object ``name`` out of the world."""
         self._selections.clear()  # first: managers hold raw pointers to the objects
         entry = self._entries.pop(name)
         del self._by_gid[entry.gid]
@@ -291,9 +292,11 @@ class CollisionWorld:
         self._version += 1
 
     def transform(self, name: str) -> np.ndarray:
+        """Object ``name``'s pose (a copy)."""
         return self._entries[name].transform.copy()
 
     def group_of(self, name: str) -> str:
+        """The group object ``name`` belongs to."""
         return self._entries[name].group
 
     def names(self, group: str | None = None) -> list[str]:

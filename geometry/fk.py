@@ -178,12 +178,6 @@ def fk_world(model: RobotModel, q: np.ndarray, base: BasePose, fingers: float | 
     return fk(model, q, base, fingers)
 
 
-def link_poses(model: RobotModel, q: np.ndarray, base: BasePose = None) -> dict[str, np.ndarray]:
-    """Link name → frame(s), from :func:`fk`."""
-    t = fk(model, q, base)
-    return {link.name: t[..., link.index, :, :] for link in model.links}
-
-
 def chain_frames(model: RobotModel, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Frames of the chain joints (``q.shape[:-1] + (dof, 4, 4)``) and of the end effector, base frame."""
     q = _as_q(model, q)

@@ -35,6 +35,8 @@ CHUNK = 128
 
 
 class IKStatus(str, enum.Enum):
+    """How an inverse kinematics solve ended."""
+
     SOLVED = "solved"
     #: the target is provably out of reach (beyond the arm's reach bound); no iteration ran
     UNREACHABLE = "unreachable"
@@ -57,6 +59,7 @@ class IKResult:
 
     @property
     def solved(self) -> bool:
+        """Whether ``q`` holds a solution."""
         return self.status is IKStatus.SOLVED
 
 
@@ -77,6 +80,7 @@ CACHE_SIZE = 200_000
 
 
 def clear_ik_cache() -> None:
+    """Forget every cached solve (for measurements and tests)."""
     _CACHE.clear()
 
 

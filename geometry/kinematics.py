@@ -143,17 +143,21 @@ class RobotModel:
 
     @property
     def dof(self) -> int:
+        """The number of joints of the chain (the configuration's length)."""
         return len(self.joints)
 
     @property
     def link_names(self) -> tuple[str, ...]:
+        """Every link's name, by index."""
         return tuple(link.name for link in self.links)
 
     @property
     def joint_names(self) -> tuple[str, ...]:
+        """The chain's joints' names, in configuration order."""
         return tuple(j.name for j in self.joints)
 
     def link_index(self, name: str) -> int:
+        """The index of the link called ``name``."""
         for link in self.links:
             if link.name == name:
                 return link.index

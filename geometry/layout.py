@@ -34,12 +34,16 @@ region and unreachable regions are warnings because the problem may still be sol
 from __future__ import annotations
 
 import os
-from typing import Iterable
+from typing import TYPE_CHECKING, Iterable
 
 from mrgc.errors import Diagnostic, InputError, Span
-from mrgc.geometry.collision import CollisionWorld
+from mrgc.geometry.collision import CollisionWorld, scene_world
 from mrgc.geometry.transforms import from_pose
 from mrgc.language.model import FixedObject, Mesh, MovableObject, Problem, RobotKind
+
+if TYPE_CHECKING:
+    from mrgc.geometry.arm import Arm
+    from mrgc.geometry.scene import SceneSpec
 
 #: penetration depth (m) above which two shapes overlap
 TOLERANCE = 1e-3
@@ -204,24 +208,26 @@ def region_diagnostics(problem: Problem) -> list[Diagnostic]:
 
 
 # ---------------------------------------------------------------------------------------------- robots
-def robot_diagnostics(problem: Problem) -> list[Diagnostic]:  # noqa: C901
+def robot_diagnostics(problem: Problem) -> list[Diagnostic]:
     """E266 for arms at home that overlap something, W272 for regions no robot reaches (none for a
     symbolic problem)."""
     if problem.symbolic:
         return []
-    import numpy as np
-
     from mrgc.geometry.arm import Arm
-    from mrgc.geometry.scene import half_extents, scene_from_problem
+    from mrgc.geometry.scene import scene_from_problem
 
     scene = scene_from_problem(problem)
     arms = [Arm(spec) for spec in scene.robots if spec.kind.base == "fixed"]
+    out = _arms_at_home(problem, scene, arms)
+    if arms and len(arms) == len(scene.robots):
+        out += _regions_out_of_reach(problem, scene, arms)
+    return out
+
+
+def _arms_at_home(problem: Problem, scene: SceneSpec, arms: list[Arm]) -> list[Diagnostic]:
+    """E266 for each arm at its home configuration overlapping an object (the deepest link per object)."""
     spans = _spans(problem)
-    world = CollisionWorld()
-    for body in scene.fixed:
-        world.add(body.name, body.shape, body.pose, "fixed")
-    for body in scene.movable:
-        world.add(body.name, body.shape, body.pose, "movable")
+    world = scene_world(scene)
     links: dict[str, list[str]] = {}
     for arm in arms:
         shapes, index = arm.probes
@@ -243,22 +249,26 @@ def robot_diagnostics(problem: Problem) -> list[Diagnostic]:  # noqa: C901
             what = "movable object" if target in world.names("movable") else "fixed object"
             out.append(_overlap("E266", f"robot '{arm.name}' ({link}) at its home configuration overlaps {what} "
                                         f"'{target}'", depth, spans, arm.name, target))
-    if arms and len(arms) == len(scene.robots):
-        shoulders = [(arm.base @ np.append(arm.model.shoulder, 1.0))[:3] for arm in arms]
-        region_spans = {r.name: r.span for r in problem.regions}
-        for region in scene.regions:
-            inv = np.linalg.inv(region.pose)
-            half = half_extents(region.shape)
-            far = True
-            for arm, shoulder in zip(arms, shoulders):
-                local = inv[:3, :3] @ shoulder + inv[:3, 3]
-                gap = float(np.linalg.norm(np.maximum(np.abs(local) - half, 0.0)))
-                if gap <= arm.model.reach:
-                    far = False
-                    break
-            if far:
-                out.append(Diagnostic(
-                    "W272", f"region '{region.name}' lies outside the workspace of every robot (farther from each "
-                            f"arm's shoulder than its reach): nothing can be placed in it or picked from it",
-                    region_spans.get(region.name), severity="warning"))
+    return out
+
+
+def _regions_out_of_reach(problem: Problem, scene: SceneSpec, arms: list[Arm]) -> list[Diagnostic]:
+    """W272 for each region farther from every arm's shoulder than its reach."""
+    import numpy as np
+
+    from mrgc.geometry.scene import half_extents
+
+    shoulders = [(arm.base @ np.append(arm.model.shoulder, 1.0))[:3] for arm in arms]
+    region_spans = {r.name: r.span for r in problem.regions}
+    out: list[Diagnostic] = []
+    for region in scene.regions:
+        inv = np.linalg.inv(region.pose)
+        half = half_extents(region.shape)
+        gaps = [float(np.linalg.norm(np.maximum(np.abs(inv[:3, :3] @ shoulder + inv[:3, 3]) - half, 0.0)))
+                for shoulder in shoulders]
+        if all(gap > arm.model.reach for arm, gap in zip(arms, gaps)):
+            out.append(Diagnostic(
+                "W272", f"region '{region.name}' lies outside the workspace of every robot (farther from each "
+                        f"arm's shoulder than its reach): nothing can be placed in it or picked from it",
+                region_spans.get(region.name), severity="warning"))
     return out

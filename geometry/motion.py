@@ -34,6 +34,8 @@ MAX_CHECKS = 20_000
 
 
 class MotionStatus(str, enum.Enum):
+    """How a motion-planning query ended."""
+
     SOLVED = "solved"
     NO_PATH = "no-path"              # no exact solution within the budget of validity checks
     INVALID_START = "invalid-start"  # the start is out of bounds or fails is_valid
@@ -52,6 +54,7 @@ class MotionResult:
 
     @property
     def solved(self) -> bool:
+        """Whether ``path`` holds a path."""
         return self.status is MotionStatus.SOLVED
 
 

@@ -209,16 +209,13 @@ class PlanarEvaluator:
         found = self._least_blocked(self.robot.start, q, None, (), frozenset({m.name}), self.movable - {m.name})
         return None if found is None else (q, found[1])
 
-    def _place(self, m: Body, g: str, region: str, q_pick: np.ndarray, want_free: bool) -> set[str] | None:  # noqa: C901
-        """The objects the chosen placement of m in region (grasp g) and its path hit, or None if none is
-        reachable; for ``want_free`` (goal pairs) a placement and path free of movable objects is preferred."""
-        robot = self.robot
-        shape = collision_shape(m.shape)
-        carried = (shape, robot.carry_transform(m.shape, g))
-        key = (m.name, g)
-        others = self.movable - {m.name}
-        if self._collides(robot.probe(q_pick, carried), ()):
-            return None  # M cannot be lifted to its carry pose where it was picked
+    def _place_candidates(self, m: Body, g: str, region: str, carried: tuple[CollisionShape, np.ndarray],
+                          others: frozenset[str]) -> tuple[list[tuple[np.ndarray, np.ndarray]],
+                                                            list[tuple[np.ndarray, np.ndarray]]]:
+        """(object pose, place base pose) pairs of m in region (grasp g) whose object pose and base pose
+        (carrying m) are free of fixed objects: the first ones free of ``others`` too, and a few that are
+        not."""
+        robot, shape = self.robot, carried[0]
         free: list[tuple[np.ndarray, np.ndarray]] = []
         blocked: list[tuple[np.ndarray, np.ndarray]] = []
         for pose in placements(m, self.scene.body(region)):
@@ -235,6 +232,19 @@ class PlanarEvaluator:
                 blocked.append((pose, q))
             if len(free) >= PLACE_FREE_TRIES + PLACE_FIXED_TRIES:
                 break
+        return free, blocked
+
+    def _place(self, m: Body, g: str, region: str, q_pick: np.ndarray, want_free: bool) -> set[str] | None:
+        """The objects the chosen placement of m in region (grasp g) and its path hit, or None if none is
+        reachable; for ``want_free`` (goal pairs) a placement and path free of movable objects is preferred."""
+        robot = self.robot
+        shape = collision_shape(m.shape)
+        carried = (shape, robot.carry_transform(m.shape, g))
+        key = (m.name, g)
+        others = self.movable - {m.name}
+        if self._collides(robot.probe(q_pick, carried), ()):
+            return None  # M cannot be lifted to its carry pose where it was picked
+        free, blocked = self._place_candidates(m, g, region, carried, others)
         if want_free:
             for _, q in free[:PLACE_FREE_TRIES]:
                 if self._path(q_pick, q, carried, key, others) is not None:
@@ -253,9 +263,16 @@ class PlanarEvaluator:
                 break
         if best is None:
             return None
+        return self._place_hits(q_pick, best, carried, key, others)
+
+    def _place_hits(self, q_pick: np.ndarray, best: tuple[Path, set[str], np.ndarray, np.ndarray],
+                    carried: tuple[CollisionShape, np.ndarray], key: tuple[str, str],
+                    others: frozenset[str]) -> set[str]:
+        """What the chosen place path (and the object at its placement) hits, the path's hits reduced: as
+        :meth:`_least_blocked`, first a path around the known occluders, then greedily."""
         path, hits, pose, q = best
-        at_place = self.world.probe_hits([(shape, pose)], against=others)
-        if hits - at_place - self.occluders and self.occluders & others:  # as _least_blocked: known occluders
+        at_place = self.world.probe_hits([(carried[0], pose)], against=others)
+        if hits - at_place - self.occluders and self.occluders & others:
             known = self._path(q_pick, q, carried, key, others - self.occluders - at_place)
             if known is not None:
                 path, hits = known, self._sweep(known, carried, others) | at_place

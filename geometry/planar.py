@@ -72,6 +72,7 @@ def planar_grasp(grasp: str) -> bool:
 
 
 def is_planar(spec: RobotSpec) -> bool:
+    """Whether the robot has a planar (driven) base."""
     return spec.kind.base == "planar"
 
 

@@ -175,6 +175,7 @@ class RobotEvaluator:
 
     # ------------------------------------------------------------ the predicates of one robot
     def run(self) -> RobotFacts:
+        """This robot's facts (see the module docstring), its handover configurations and counters."""
         r, scene = self.arm.name, self.scene
         near = {m.name: self.arm.in_reach(m.pose[:3, 3], margin=0.3) for m in scene.movable}
         picks = [(m.name, g, m.pose, False, "pick") for m in scene.movable if near[m.name]

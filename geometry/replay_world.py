@@ -71,6 +71,7 @@ class ReplayRobot:
 
     @property
     def dof(self) -> int:
+        """The length of the robot's configuration."""
         return len(self.joints) if not self.planar else 3
 
 
@@ -288,6 +289,7 @@ class ReplayScene:
 
     # ------------------------------------------------------------------ lifetime
     def close(self) -> None:
+        """Disconnect the private pybullet client (again: nothing)."""
         if self.cid >= 0:
             try:
                 self.pb.disconnect(physicsClientId=self.cid)

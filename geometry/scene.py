@@ -56,12 +56,14 @@ class SceneSpec:
         return self.grasp_specs[name]
 
     def body(self, name: str) -> Body:
+        """The movable object, fixed object or region called ``name``."""
         for b in (*self.movable, *self.fixed, *self.regions):
             if b.name == name:
                 return b
         raise KeyError(name)
 
     def robot(self, name: str) -> RobotSpec:
+        """The robot called ``name``."""
         return next(r for r in self.robots if r.name == name)
 
 
@@ -110,6 +112,7 @@ def half_extents(shape: Shape) -> np.ndarray:
 
 
 def mesh_half_extents(mesh: Mesh) -> np.ndarray:
+    """Half the extents of a mesh's axis-aligned bounding box about its origin."""
     extents: np.ndarray = np.abs(mesh_vertices(mesh)).max(axis=0)
     return extents
 

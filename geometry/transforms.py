@@ -15,6 +15,7 @@ from mrgc.language.model import Pose
 
 
 def translation(x: float, y: float, z: float) -> np.ndarray:
+    """The translation by ``(x, y, z)``."""
     t = np.eye(4)
     t[:3, 3] = (x, y, z)
     return t
@@ -41,6 +42,7 @@ def rpy_matrix(roll: float, pitch: float, yaw: float) -> np.ndarray:
 
 
 def from_xyz_rpy(xyz: Sequence[float], rpy: Sequence[float]) -> np.ndarray:
+    """The transform of a URDF origin: position ``xyz`` and fixed-axis roll-pitch-yaw ``rpy``."""
     t = np.eye(4)
     t[:3, :3] = rpy_matrix(*rpy)
     t[:3, 3] = xyz
@@ -55,6 +57,7 @@ def from_pose(pose: Pose) -> np.ndarray:
 
 
 def from_quaternion(position: Sequence[float], quat_xyzw: Sequence[float]) -> np.ndarray:
+    """The transform of a position and a unit quaternion ``(x, y, z, w)``."""
     x, y, z, w = quat_xyzw
     t = np.eye(4)
     t[:3, :3] = [

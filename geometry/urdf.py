@@ -78,6 +78,7 @@ class Urdf:
     lines: dict[ET.Element, int]
 
     def line(self, el: ET.Element) -> int:
+        """The line of the file an element starts on (1 when unknown)."""
         return self.lines.get(el, 1)
 
 
@@ -131,17 +132,11 @@ def _xml(data: bytes) -> tuple[ET.Element, dict[ET.Element, int]]:
 
 
 def _structure(path: str, root: ET.Element, lines: dict[ET.Element, int]) -> Urdf:
+    """The URDF's tree: links declared once, joints naming declared links, one parent per link, one root
+    and no cycle (UrdfError at the offending line otherwise); links in depth-first order."""
     if root.tag != "robot":
         raise UrdfError(f"the root element is <{root.tag}>, not <robot>", lines.get(root, 1))
-    links: dict[str, ET.Element] = {}
-    for el in root.findall("link"):
-        name = el.get("name")
-        if not name:
-            raise UrdfError("a <link> without a name", lines.get(el, 1))
-        if name in links:
-            raise UrdfError(f"link {name!r} is declared twice (first at line {lines.get(links[name], 1)})",
-                            lines.get(el, 1))
-        links[name] = el
+    links = _links(root, lines)
     joint_of: dict[str, UrdfJoint] = {}
     children: dict[str, list[str]] = {}
     for el in root.findall("joint"):
@@ -160,20 +155,40 @@ def _structure(path: str, root: ET.Element, lines: dict[ET.Element, int]) -> Urd
         if not roots and joint_of:
             raise UrdfError(_cycle(joint_of, next(iter(joint_of))), next(iter(joint_of.values())).line)
         raise UrdfError(f"expected one root link (a link no joint moves), found {roots or 'none'}")
+    order = _depth_first(roots[0], children, joint_of)
+    if len(order) != len(links):  # links not below the root: they hang in a joint cycle
+        stray = next(n for n in links if n not in set(order))
+        raise UrdfError(_cycle(joint_of, stray), joint_of[stray].line)
+    return Urdf(path, root.get("name", ""), tuple(order), joint_of, links, lines)
+
+
+def _links(root: ET.Element, lines: dict[ET.Element, int]) -> dict[str, ET.Element]:
+    """The ``<link>`` elements by name (UrdfError for a link without a name or declared twice)."""
+    links: dict[str, ET.Element] = {}
+    for el in root.findall("link"):
+        name = el.get("name")
+        if not name:
+            raise UrdfError("a <link> without a name", lines.get(el, 1))
+        if name in links:
+            raise UrdfError(f"link {name!r} is declared twice (first at line {lines.get(links[name], 1)})",
+                            lines.get(el, 1))
+        links[name] = el
+    return links
+
+
+def _depth_first(root: str, children: dict[str, list[str]], joint_of: dict[str, UrdfJoint]) -> list[str]:
+    """The links below ``root``, depth first, children in document order, each once."""
     order: list[str] = []
     seen: set[str] = set()
-    stack = [roots[0]]
-    while stack:  # depth first, children in document order; each link once
+    stack = [root]
+    while stack:
         name = stack.pop()
         if name in seen:  # pragma: no cover - one parent per link makes this impossible; kept as a guard
             raise UrdfError(_cycle(joint_of, name), joint_of[name].line)
         seen.add(name)
         order.append(name)
         stack.extend(reversed(children.get(name, [])))
-    if len(order) != len(links):  # links not below the root: they hang in a joint cycle
-        stray = next(n for n in links if n not in seen)
-        raise UrdfError(_cycle(joint_of, stray), joint_of[stray].line)
-    return Urdf(path, root.get("name", ""), tuple(order), joint_of, links, lines)
+    return order
 
 
 def _cycle(joint_of: dict[str, UrdfJoint], start: str) -> str:

@@ -106,6 +106,7 @@ class Grasps:
 
     @property
     def names(self) -> tuple[str, ...]:
+        """The declared names, in order."""
         return tuple(d.name for d in self.decls)
 
 

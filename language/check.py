@@ -67,6 +67,7 @@ class Checker:
         self._sorted_names: dict[str, tuple[dict[str, tuple[str, Span]], frozenset[str]]] = {}
 
     def err(self, code: str, message: str, span: Span) -> None:
+        """Record a diagnostic."""
         self.diags.append(Diagnostic(code, message, span))
 
     def _once(self, sections: Iterable[Any], label: Any) -> dict[str, Any]:
@@ -84,15 +85,9 @@ class Checker:
 
     # ------------------------------------------------------------ domains
     def domain(self, d: ast.DomainDef) -> Domain:
+        """A checked :class:`~mrgc.language.model.Domain` (diagnostics recorded, not raised)."""
         secs = self._once(d.sections, _domain_label)
-        reqs: tuple[str, ...] = ()
-        if "requirements" in secs:
-            req: ast.Requirements = secs["requirements"]
-            for flag, span in zip(req.flags, req.flag_spans or (req.span,) * len(req.flags)):
-                if flag not in REQUIREMENTS:
-                    hint = did_you_mean(flag, REQUIREMENTS) or f" (known: {', '.join(':' + r for r in REQUIREMENTS)})"
-                    self.err("E235", f"unknown requirement ':{flag}'{hint}", span)
-            reqs = tuple(dict.fromkeys(f for f in req.flags if f in REQUIREMENTS))
+        reqs = self._requirements(secs["requirements"]) if "requirements" in secs else ()
         kinds: dict[str, RobotKind] = {}
         for sec in d.sections:
             if isinstance(sec, ast.RobotKindDecl):
@@ -102,25 +97,36 @@ class Checker:
                              sec.span)
                 else:
                     kinds[sec.name] = kind
-        grasps: tuple[str, ...] = ()
-        specs: list[GraspSpec] = []
-        if "grasps" in secs:
-            seen: dict[str, Span] = {}
-            for decl in secs["grasps"].decls:
-                if decl.name in seen:
-                    self.err("E200", f"grasp '{decl.name}' declared twice (first at {seen[decl.name]})", decl.span)
-                    continue
-                seen[decl.name] = decl.span
-                if not decl.bare:
-                    spec = self.grasp(decl)
-                    if spec is not None:
-                        specs.append(spec)
-                elif kinds and decl.name not in BUILTIN_GRASPS:
-                    hint = did_you_mean(decl.name, BUILTIN_GRASPS) or f" (built in: {' '.join(BUILTIN_GRASPS)})"
-                    self.err("E243", f"grasp '{decl.name}' has no geometry: it is not built in and not declared "
-                             f"as ({decl.name} :approach AXIS :fingers AXIS){hint}", decl.span)
-            grasps = tuple(seen)
+        grasps, specs = self._grasps(secs["grasps"], bool(kinds)) if "grasps" in secs else ((), [])
         return Domain(d.name, reqs, tuple(kinds.values()), grasps, self.file, d.span, tuple(specs))
+
+    def _requirements(self, req: ast.Requirements) -> tuple[str, ...]:
+        """The known requirement flags, once each (E235 for the others)."""
+        for flag, span in zip(req.flags, req.flag_spans or (req.span,) * len(req.flags)):
+            if flag not in REQUIREMENTS:
+                hint = did_you_mean(flag, REQUIREMENTS) or f" (known: {', '.join(':' + r for r in REQUIREMENTS)})"
+                self.err("E235", f"unknown requirement ':{flag}'{hint}", span)
+        return tuple(dict.fromkeys(f for f in req.flags if f in REQUIREMENTS))
+
+    def _grasps(self, section: ast.Grasps, has_kinds: bool) -> tuple[tuple[str, ...], list[GraspSpec]]:
+        """The declared grasp names (E200 for repeats) and the geometry of those declared with it (E243 for a
+        bare name that is not built in, when the domain has robot kinds)."""
+        seen: dict[str, Span] = {}
+        specs: list[GraspSpec] = []
+        for decl in section.decls:
+            if decl.name in seen:
+                self.err("E200", f"grasp '{decl.name}' declared twice (first at {seen[decl.name]})", decl.span)
+                continue
+            seen[decl.name] = decl.span
+            if not decl.bare:
+                spec = self.grasp(decl)
+                if spec is not None:
+                    specs.append(spec)
+            elif has_kinds and decl.name not in BUILTIN_GRASPS:
+                hint = did_you_mean(decl.name, BUILTIN_GRASPS) or f" (built in: {' '.join(BUILTIN_GRASPS)})"
+                self.err("E243", f"grasp '{decl.name}' has no geometry: it is not built in and not declared "
+                         f"as ({decl.name} :approach AXIS :fingers AXIS){hint}", decl.span)
+        return tuple(seen), specs
 
     def grasp(self, d: ast.Decl) -> GraspSpec | None:
         """The geometry of a declared grasp ``(NAME :approach AXIS :fingers AXIS :depth D :offset (X Y Z))``."""
@@ -144,6 +150,8 @@ class Checker:
                          vals.get("offset", (0.0, 0.0, 0.0)), span=d.span)  # type: ignore[arg-type]
 
     def robot_kind(self, k: ast.RobotKindDecl) -> RobotKind:
+        """A checked robot kind: URDF and end effector (fixed base) or footprint (planar base), home, TCP, carry
+        pose."""
         what = f"robot kind '{k.name}'"
         table = self.props.table("robot-kind", what, k.props)
         vals = {key: self.props.read("robot-kind", prop) for key, prop in table.items()}
@@ -170,6 +178,7 @@ class Checker:
 
     # ------------------------------------------------------------ problems
     def problem(self, p: ast.ProblemDef, domain: Domain) -> Problem:
+        """A checked :class:`~mrgc.language.model.Problem` of ``domain`` (diagnostics recorded, not raised)."""
         secs = self._once(p.sections, _problem_label)
         decls: dict[str, tuple[ast.Decl, ...]] = {
             kind: secs[kind].decls if kind in secs else () for kind in SECTION_SORT

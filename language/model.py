@@ -70,10 +70,12 @@ class Pose:
 
     @property
     def yaw_rad(self) -> float:
+        """The yaw in radians."""
         return math.radians(self.yaw)
 
     @property
     def position(self) -> tuple[float, float, float]:
+        """``(x, y, z)``."""
         return (self.x, self.y, self.z)
 
 
@@ -199,6 +201,7 @@ class Domain:
     grasp_specs: tuple[GraspSpec, ...] = ()
 
     def kind(self, name: str) -> RobotKind:
+        """The robot kind called ``name``."""
         return next(k for k in self.robot_kinds if k.name == name)
 
     def grasp_spec(self, name: str) -> GraspSpec | None:

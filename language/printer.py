@@ -76,11 +76,13 @@ def number(x: float) -> str:
 
 
 def string(s: str) -> str:
+    """A string literal as the language writes it (escapes for ``\\``, ``"``, newlines and tabs)."""
     body = s.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n").replace("\t", "\\t")
     return f'"{body}"'
 
 
 def value(v: ast.Value | ast.Number | ast.Symbol | ast.String) -> str:
+    """A property value's canonical text."""
     if isinstance(v, ast.Number):
         return number(v.value)
     if isinstance(v, ast.Symbol):
@@ -91,16 +93,19 @@ def value(v: ast.Value | ast.Number | ast.Symbol | ast.String) -> str:
 
 
 def prop(p: ast.Property) -> str:
+    """A property's canonical text, ``:key value``."""
     return f":{p.key} {value(p.value)}"
 
 
 def decl(d: ast.Decl) -> str:
+    """A declaration's canonical text: its name, or ``(name :key value ...)``."""
     if d.bare and not d.props:
         return d.name
     return "(" + " ".join([d.name, *(prop(p) for p in d.props)]) + ")"
 
 
 def atom(a: ast.Atom) -> str:
+    """An atom's canonical text, ``(predicate arg ...)``."""
     return "(" + " ".join([a.predicate, *a.args]) + ")"
 
 

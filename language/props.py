@@ -62,6 +62,7 @@ class PropReader:
         self.file = file
 
     def err(self, code: str, message: str, span: Span) -> None:
+        """Record a diagnostic."""
         self.diags.append(Diagnostic(code, message, span))
 
     # ------------------------------------------------------------ property tables

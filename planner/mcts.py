@@ -27,6 +27,8 @@ SourceFactory = Callable[[set[str], set[str]], Callable[[int], list[Skeleton]]]
 
 @dataclass
 class Edge:
+    """An edge of the search tree: a skeleton for the steps before a node, with its value and visits."""
+
     skeleton: Skeleton
     value: float = 0.0
     visits: int = 0
@@ -35,11 +37,14 @@ class Edge:
 
     @property
     def prior(self) -> float:
+        """The edge's prior: skeletons moving fewer objects first."""
         return 1.0 / max(1, len(self.skeleton.moved))
 
 
 @dataclass
 class Node:
+    """A node of the search tree: the grounded suffix of the plan so far and the skeletons that may precede it."""
+
     suffix: list[GroundedStep]
     more: Callable[[int], list[Skeleton]]
     edges: list[Edge] = field(default_factory=list)
@@ -47,6 +52,7 @@ class Node:
     exhausted: bool = False  # the source has no more skeletons
 
     def refill(self, k: int) -> None:
+        """Ask for up to ``k`` more skeletons for this node's edges (none once exhausted)."""
         if self.exhausted:
             return
         new = self.more(k)
@@ -56,6 +62,7 @@ class Node:
 
     @property
     def open_edges(self) -> list[Edge]:
+        """The edges not yet known to fail."""
         return [e for e in self.edges if not e.dead]
 
 
@@ -90,6 +97,7 @@ class MCTS:
                                         "skeletons": len(self.root.edges), "nodes": 1, "memo_hits": 0}
 
     def q(self, node: Node, e: Edge) -> float:
+        """The edge's upper confidence bound (PUCT with the skeleton prior)."""
         return e.value / (e.visits + 1) + self.c * e.prior * math.sqrt(node.visits) / (e.visits + 1)
 
     def run(self, deadline: float, max_iterations: int = 10_000, anytime: bool = False) -> SearchResult:

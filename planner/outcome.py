@@ -65,9 +65,11 @@ class Failure:
     detail: str = ""
 
     def key(self) -> tuple[int, str, str, tuple[str, ...]]:
+        """What identifies the failure when failures are counted (everything but the detail)."""
         return (self.step, self.action, self.check, self.bodies)
 
     def line(self) -> str:
+        """The failure in one line."""
         bodies = f" [{', '.join(self.bodies)}]" if self.bodies else ""
         detail = f": {self.detail}" if self.detail else ""
         return f"step {self.step}, {self.action}: {self.check}{bodies}{detail}"
@@ -83,6 +85,7 @@ class BlockingCycle:
     edges: tuple[tuple[str, str, str], ...]
 
     def line(self) -> str:
+        """The cycle in one line."""
         ring = " -> ".join(self.objects + self.objects[:1])
         return f"blocking cycle {ring}: " + "; ".join(f"every pick of {o} is obstructed by {b} ({how})"
                                                        for o, b, how in self.edges)
@@ -99,6 +102,7 @@ class Why:
     rejected_plans: int = 0  # full plans the validator rejected
 
     def add(self, failure: Failure) -> None:
+        """Count one grounding failure."""
         self.failures[failure] += 1
 
     def top_failures(self, n: int = 10) -> list[tuple[Failure, int]]:
@@ -106,6 +110,7 @@ class Why:
         return sorted(self.failures.items(), key=lambda fc: (-fc[1], fc[0].key(), fc[0].detail))[:n]
 
     def lines(self, n: int = 10) -> list[str]:
+        """The reasons as the CLI prints them (the ``n`` most frequent failures)."""
         out = [f"why: {self.summary}"] if self.summary else []
         out += [f"  {r}" for r in self.facts]
         out += [f"  {c.line()}" for c in self.cycles]
@@ -118,6 +123,7 @@ class Why:
         return out
 
     def to_json(self, n: int = 20) -> dict[str, Any]:
+        """The reasons as the plan's ``why`` (the ``n`` most frequent failures)."""
         return {
             "summary": self.summary,
             "facts": list(self.facts),

@@ -54,6 +54,7 @@ class MotionModel:
     resolution: float = 0.01
 
     def to_json(self) -> dict[str, Any]:
+        """The motion model as the plan's ``motion_model``."""
         return {"arms": self.arms, "planar": self.planar,
                 "approach": {"configurations": self.approach_configurations, "back_off": self.approach_back_off},
                 "resolution": self.resolution}
@@ -94,12 +95,15 @@ class PlannedAction:
 
     @property
     def kind(self) -> str:
+        """``pick-place`` (one robot) or ``handover`` (two)."""
         return "handover" if self.pick_robot != self.place_robot else "pick-place"
 
     def robots(self) -> list[str]:
+        """The robots of the action (one, or the giver and the taker)."""
         return [self.pick_robot] if self.pick_robot == self.place_robot else [self.pick_robot, self.place_robot]
 
     def to_json(self) -> dict[str, Any]:
+        """The action as the plan's JSON holds it."""
         out: dict[str, Any] = {
             "kind": self.kind, "object": self.object, "region": self.region,
             "pick_robot": self.pick_robot, "place_robot": self.place_robot,
@@ -156,6 +160,7 @@ class Plan:
         return sum(len(step) for step in self.steps)
 
     def to_json(self) -> dict[str, Any]:
+        """The plan as its JSON file holds it (docs/plan.schema.json)."""
         return {
             "schema": SCHEMA,
             "mrgc_version": self.mrgc_version,
@@ -183,9 +188,11 @@ class Plan:
         return sorted(set(self.stats.get("robots", [])) - busy)
 
     def dumps(self) -> str:
+        """The plan file's text."""
         return json.dumps(self.to_json(), indent=1, sort_keys=False) + "\n"
 
     def summary(self) -> list[str]:
+        """The plan in a few lines, as ``mrgc plan`` prints it."""
         lines = [f"plan for {self.problem}: {self.status}"
                  + (f", makespan {self.makespan}, {self.motion_cost} objects moved" if self.steps else "")]
         for i, step in enumerate(self.steps, 1):
@@ -201,5 +208,6 @@ class Plan:
 
 
 def file_sha256(path: str) -> str:
+    """The sha256 of the file's bytes (hex)."""
     with open(path, "rb") as fh:
         return hashlib.sha256(fh.read()).hexdigest()

@@ -69,6 +69,7 @@ class Action:
         return self.pick_robot != self.place_robot
 
     def robots(self) -> tuple[str, ...]:
+        """The robots of the action (one, or the giver and the taker)."""
         return (self.pick_robot,) if not self.handover else (self.pick_robot, self.place_robot)
 
     def describe(self) -> str:

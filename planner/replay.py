@@ -224,10 +224,22 @@ class _Replayer(ActionReader):
         self.flush()
 
     # ------------------------------------------------------------------ sweeping a phase
-    def _sweep(self, t: int, phase: str, tracks: list[_Track], static: list[str], present: list[str]) -> None:  # noqa: C901
-        if not tracks or self.budget_spent:
+    def _sweep(self, t: int, phase: str, tracks: list[_Track], static: list[str], present: list[str]) -> None:
+        if not tracks or self.budget_spent or not self._within_budget(t, phase, tracks):
             return
-        rs = self.rs
+        others = self._stage(tracks, static, present)
+        times = np.unique(np.concatenate([sample_times(tr.configs, self.planar[tr.robot], self.resolution)
+                                          for tr in tracks]))
+        for s in times:
+            self._sample(t, phase, tracks, static, others, float(s))
+            if self.first_only and self._worst:
+                break
+        self.stop_if_found()
+
+    def _within_budget(self, t: int, phase: str, tracks: list[_Track]) -> bool:
+        """Whether the phase's motions can be checked: no motion longer than :data:`MAX_SAMPLES` samples,
+        the plan's samples in all at most :data:`MAX_PLAN_SAMPLES` ``[too-long]`` (then the rest of the
+        plan's motions are not checked)."""
         counts = [sample_count(tr.configs, self.planar[tr.robot], self.resolution) for tr in tracks]
         n = max(counts)
         if n > MAX_SAMPLES:
@@ -235,12 +247,19 @@ class _Replayer(ActionReader):
             self._v(t, tr.robot, "too-long",
                     f"{phase}: the {tr.label} motion of {tr.robot} is too long to check "
                     f"({n} samples at {self.resolution:g} rad or m each; at most {MAX_SAMPLES})")
-            return
+            return False
         if self.samples + sum(counts) * len(tracks) > MAX_PLAN_SAMPLES:
             self._v(t, None, "too-long", f"{phase}: the plan's motions need more than {MAX_PLAN_SAMPLES} robot "
                                          f"samples in all; the rest of the plan's motions are not checked")
             self.budget_spent = True
-            return
+            return False
+        return True
+
+    def _stage(self, tracks: list[_Track], static: list[str], present: list[str]) -> list[str]:
+        """Set the world up for a phase: robots not moving at home with open fingers, moving robots' fingers
+        at their opening, objects present where they are (the others and none held parked), bounding boxes
+        of what does not move; the objects present and not held."""
+        rs = self.rs
         for r in static:
             rs.set_config(r, self.home[r])
             rs.set_fingers(r, None)
@@ -255,29 +274,30 @@ class _Replayer(ActionReader):
         others = [o for o in present if o not in held]
         # bounding boxes: a pair whose boxes are apart cannot overlap, and is not asked of pybullet
         self._boxes = {b: self.rs.aabb(b) for b in (*self.fixed, *others, *static)}
-        times = np.unique(np.concatenate([sample_times(tr.configs, self.planar[tr.robot], self.resolution)
-                                          for tr in tracks]))
-        for s in times:
-            states = []
-            for tr in tracks:
-                q = config_at(tr.configs, float(s), self.planar[tr.robot])
-                rs.set_config(tr.robot, q)
-                self._boxes[tr.robot] = self.rs.aabb(tr.robot)
-                if tr.holding and tr.grasp and tr.carries:  # a handed-over object is where the giver holds it
-                    rs.set_pose(tr.holding, self.held_pose(tr.robot, q, tr.holding, tr.grasp))
-                    self._boxes[tr.holding] = self.rs.aabb(tr.holding)
-                states.append(where(tr.label, len(tr.configs), float(s)))
-            self.samples += len(tracks)
-            for tr, at in zip(tracks, states):
-                self._robot_scene(t, phase, tr, at, others, float(s))
-            for i, tr in enumerate(tracks):
-                for j in range(i + 1, len(tracks)):
-                    self._pair(t, phase, tr, states[i], tracks[j], states[j])
-                for r in static:
-                    self._pair(t, phase, tr, states[i], _Track(r, np.zeros((1, 1)), "home"), "at home")
-            if self.first_only and self._worst:
-                break
-        self.stop_if_found()
+        return others
+
+    def _sample(self, t: int, phase: str, tracks: list[_Track], static: list[str], others: list[str],
+                s: float) -> None:
+        """Every moving robot (and what it holds) at time ``s`` of the phase, checked against the scene, the
+        other moving robots and the robots at home."""
+        rs = self.rs
+        states = []
+        for tr in tracks:
+            q = config_at(tr.configs, s, self.planar[tr.robot])
+            rs.set_config(tr.robot, q)
+            self._boxes[tr.robot] = self.rs.aabb(tr.robot)
+            if tr.holding and tr.grasp and tr.carries:  # a handed-over object is where the giver holds it
+                rs.set_pose(tr.holding, self.held_pose(tr.robot, q, tr.holding, tr.grasp))
+                self._boxes[tr.holding] = self.rs.aabb(tr.holding)
+            states.append(where(tr.label, len(tr.configs), s))
+        self.samples += len(tracks)
+        for tr, at in zip(tracks, states):
+            self._robot_scene(t, phase, tr, at, others, s)
+        for i, tr in enumerate(tracks):
+            for j in range(i + 1, len(tracks)):
+                self._pair(t, phase, tr, states[i], tracks[j], states[j])
+            for r in static:
+                self._pair(t, phase, tr, states[i], _Track(r, np.zeros((1, 1)), "home"), "at home")
 
     def stop_if_found(self) -> None:
         """With ``first_only``, end the replay once a violation is known."""

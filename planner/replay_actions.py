@@ -73,16 +73,20 @@ class ActionGeometry:
 
     @property
     def obj(self) -> str:
+        """The object the action moves."""
         return self.action.object
 
     @property
     def handover(self) -> bool:
+        """Whether the action is a handover."""
         return self.action.handover
 
     def robot(self, role: str) -> str:
+        """The robot in ``role`` (``pick_robot`` or ``place_robot``)."""
         return str(getattr(self.action, role))
 
     def grasp(self, role: str | None) -> str | None:
+        """The grasp in ``role`` (``pick_grasp`` or ``place_grasp``; None for none)."""
         return None if role is None else str(getattr(self.action, role))
 
 
@@ -131,6 +135,7 @@ class ActionReader:
         return carry_transform(self.scene.robot(robot).kind, shape, grasp)
 
     def opening(self, obj: str, grasp: str) -> float:
+        """An arm's finger opening holding ``obj`` with ``grasp`` (the grasp specification's)."""
         return finger_opening(self.scene.grasp(grasp), self.shapes[obj])
 
     def fingers(self, robot: str, obj: str, grasp: str | None) -> float | None:

@@ -62,6 +62,7 @@ class CompileResult:
     stats: dict[str, Any] = field(default_factory=dict)
 
     def to_json(self) -> dict[str, Any]:
+        """The result as ``mrgc compile --format json`` prints it."""
         return {
             "problem": self.problem,
             "backend": self.backend,
@@ -120,6 +121,7 @@ class SkeletonSource:
             self.generator.done = True
 
     def next(self, k: int, time_limit: float | None = None) -> Batch:
+        """Up to ``k`` further skeletons, in (makespan, moved) order."""
         return self.generator.next(k, time_limit)
 
 

@@ -72,6 +72,7 @@ class ValidationReport:
     stats: dict[str, Any] = field(default_factory=dict)
 
     def lines(self) -> list[str]:
+        """The report as ``mrgc validate`` prints it: ``valid: ...``, or each violation and a count."""
         if self.ok:
             s = self.stats
             geo = (f"; replayed {s['configurations']} configurations, {s['distance_queries']} pybullet distance "
@@ -82,6 +83,7 @@ class ValidationReport:
         return [str(v) for v in self.violations] + [f"invalid: {n} violation{'s' * (n != 1)}"]
 
     def to_json(self) -> dict[str, Any]:
+        """The report as ``mrgc validate --format json`` prints it."""
         return {"ok": self.ok, "violations": [v.to_json() for v in self.violations], "stats": self.stats}
 
 
@@ -177,50 +179,71 @@ def _changed(problem: Problem, plan: PlanFile, problem_path: str | None) -> str:
             f"{file_digest[:12]}... now")
 
 
-def _names(problem: Problem, plan: PlanFile, out: list[Violation]) -> set[int]:  # noqa: C901
+@dataclass(frozen=True)
+class _Names:
+    """The names a problem declares, by what they name."""
+
+    robots: frozenset[str]
+    regions: frozenset[str]
+    objects: frozenset[str]
+    points: frozenset[str]
+    fixed: frozenset[str]
+
+    @classmethod
+    def of(cls, problem: Problem) -> _Names:
+        return cls(frozenset(r.name for r in problem.robots), frozenset(r.name for r in problem.regions),
+                   frozenset(m.name for m in problem.movable), frozenset(h.name for h in problem.handover_points),
+                   frozenset(f.name for f in problem.fixed))
+
+
+def _names(problem: Problem, plan: PlanFile, out: list[Violation]) -> set[int]:
     """Ids of the actions whose names all resolve (the others are reported and left out of later checks);
     unknown robots in ``waiting`` are reported too."""
-    robots = {r.name for r in problem.robots}
-    regions = {r.name for r in problem.regions}
-    objects = {m.name for m in problem.movable}
-    points = {h.name for h in problem.handover_points}
-    fixed = {f.name for f in problem.fixed}
+    names = _Names.of(problem)
     usable: set[int] = set()
     for t, s in enumerate(plan.steps, 1):
-        for r in s.waiting:
-            if r not in robots:
-                out.append(Violation(t, r, "unknown-name", f"no robot {r!r} (waiting)"))
+        out.extend(Violation(t, r, "unknown-name", f"no robot {r!r} (waiting)")
+                   for r in s.waiting if r not in names.robots)
         for a in s.actions:
-            bad = []
-            obj = a.object
-            if obj not in objects:
-                bad.append(f"{obj!r} is a fixed object, which never moves" if obj in fixed
-                           else f"no movable object {obj!r}")
-            if a.region not in regions:
-                bad.append(f"no region {a.region!r}")
-            for role, robot in (("pick robot", a.pick_robot), ("place robot", a.place_robot)):
-                if robot not in robots:
-                    bad.append(f"no robot {robot!r} ({role})")
-            if obj in objects:
-                allowed = problem.grasps_of(obj)
-                for grasp in dict.fromkeys((a.pick_grasp, a.place_grasp)):
-                    if grasp not in allowed:
-                        bad.append(f"grasp {grasp!r} is not allowed for {obj} (allowed: {', '.join(allowed)})")
-            if a.handover_point is not None and a.handover_point not in points:
-                bad.append(f"no handover point {a.handover_point!r}")
-            if bad:
-                for b in bad:
-                    out.append(Violation(t, obj, "unknown-name", b))
-                continue
-            kind = "handover" if a.handover else "pick-place"
-            if a.kind != kind:
-                out.append(Violation(t, obj, "action", f"kind {a.kind!r} but robots {a.pick_robot} and "
-                                                       f"{a.place_robot} make it a {kind}"))
-            if kind == "pick-place" and a.pick_grasp != a.place_grasp:
-                out.append(Violation(t, obj, "action", f"{a.pick_robot} picks with {a.pick_grasp} but places "
-                                                       f"with {a.place_grasp}: a robot cannot regrasp in hand"))
-            usable.add(id(a))
+            bad = _unknown_names(problem, names, a)
+            out.extend(Violation(t, a.object, "unknown-name", b) for b in bad)
+            if not bad:
+                _kind(t, a, out)
+                usable.add(id(a))
     return usable
+
+
+def _unknown_names(problem: Problem, names: _Names, a: Action) -> list[str]:
+    """What of action ``a`` names nothing the problem declares (or a grasp its object does not allow)."""
+    bad = []
+    obj = a.object
+    if obj not in names.objects:
+        bad.append(f"{obj!r} is a fixed object, which never moves" if obj in names.fixed
+                   else f"no movable object {obj!r}")
+    if a.region not in names.regions:
+        bad.append(f"no region {a.region!r}")
+    for role, robot in (("pick robot", a.pick_robot), ("place robot", a.place_robot)):
+        if robot not in names.robots:
+            bad.append(f"no robot {robot!r} ({role})")
+    if obj in names.objects:
+        allowed = problem.grasps_of(obj)
+        for grasp in dict.fromkeys((a.pick_grasp, a.place_grasp)):
+            if grasp not in allowed:
+                bad.append(f"grasp {grasp!r} is not allowed for {obj} (allowed: {', '.join(allowed)})")
+    if a.handover_point is not None and a.handover_point not in names.points:
+        bad.append(f"no handover point {a.handover_point!r}")
+    return bad
+
+
+def _kind(t: int, a: Action, out: list[Violation]) -> None:
+    """The action's ``kind`` matches its robots, and a pick-and-place keeps its grasp ``[action]``."""
+    kind = "handover" if a.handover else "pick-place"
+    if a.kind != kind:
+        out.append(Violation(t, a.object, "action", f"kind {a.kind!r} but robots {a.pick_robot} and "
+                                                    f"{a.place_robot} make it a {kind}"))
+    if kind == "pick-place" and a.pick_grasp != a.place_grasp:
+        out.append(Violation(t, a.object, "action", f"{a.pick_robot} picks with {a.pick_grasp} but places "
+                                                    f"with {a.place_grasp}: a robot cannot regrasp in hand"))
 
 
 def _structure(problem: Problem, plan: PlanFile, usable: set[int], out: list[Violation]) -> None:
@@ -254,10 +277,9 @@ def _structure(problem: Problem, plan: PlanFile, usable: set[int], out: list[Vio
                 out.append(Violation(t, r, "waiting", f"{r} is in no action of the step and not listed as waiting"))
 
 
-def _symbolic(problem: Problem, steps: list[tuple[Action, ...]], usable: set[int], out: list[Violation]) -> None:  # noqa: C901
+def _symbolic(problem: Problem, steps: list[tuple[Action, ...]], usable: set[int], out: list[Violation]) -> None:
+    """The checks of a symbolic plan against the problem's facts (module docstring)."""
     facts = {(f.predicate, f.args) for f in problem.init}
-    goal = problem.goal_regions
-    initial = problem.initial_regions
     moved_at: dict[str, int] = {}
     for t, step in enumerate(steps, 1):
         for a in step:
@@ -265,35 +287,50 @@ def _symbolic(problem: Problem, steps: list[tuple[Action, ...]], usable: set[int
                 moved_at.setdefault(a.object, t)
     for t, step in enumerate(steps, 1):
         for a in step:
-            if id(a) not in usable:
-                continue
-            o, re_, r1, r2, g1, g2 = a.object, a.region, a.pick_robot, a.place_robot, a.pick_grasp, a.place_grasp
-            need = [("reachable-pick", (o, g1, r1)), ("reachable-place", (o, re_, g2, r2))]
-            if r1 != r2:
-                need.insert(1, ("enable-goal-handover", (o, g1, g2, r1, r2)))
-                if o not in goal:
-                    out.append(Violation(t, o, "region", f"{o} is not a goal object: only goal objects are handed "
-                                                         f"over (enable-goal-handover)"))
-            for pred, args in need:
-                if (pred, args) not in facts:
-                    out.append(Violation(t, o, "unsupported", f"no fact ({pred} {' '.join(args)}) supports "
-                                                              f"'{a.describe()}'"))
-            target = goal.get(o, initial.get(o))
-            if target is not None and re_ != target:
-                why = "its goal region" if o in goal else "its own region (it is only moved out of the way)"
-                out.append(Violation(t, o, "region", f"{o} goes to {re_!r}, but the model moves it only into "
-                                                     f"{target!r}, {why}"))
-            for pred, args in facts:
-                if pred == "occludes-pick" and args[1:] == (o, g1, r1):
-                    when = moved_at.get(args[0])
-                    if when is None or when >= t:
-                        state = "never moves" if when is None else f"moves at step {when}"
-                        out.append(Violation(t, o, "pick-obstacle", f"{args[0]} blocks {r1} picking {o} with {g1} "
-                                                                    f"and {state}; it must move at an earlier step"))
-                elif pred == "occludes-goal-place" and args[1:] == (o, re_, g2, r2):
-                    when = moved_at.get(args[0])
-                    if when is None or when > t:
-                        state = "never moves" if when is None else f"moves at step {when}"
-                        out.append(Violation(t, o, "place-obstacle",
-                                             f"{args[0]} blocks {r2} placing {o} in {re_} with {g2} and {state}; "
-                                             f"it must move by step {t}"))
+            if id(a) in usable:
+                _supported(problem, facts, t, a, out)
+                _obstacles_moved(facts, moved_at, t, a, out)
+
+
+def _supported(problem: Problem, facts: set[tuple[str, tuple[str, ...]]], t: int, a: Action,
+               out: list[Violation]) -> None:
+    """Facts support action ``a`` ``[unsupported]``; only goal objects are handed over, and an object goes
+    only to its goal region or, outside the goal, within its own region ``[region]``."""
+    goal = problem.goal_regions
+    o, re_, r1, r2, g1, g2 = a.object, a.region, a.pick_robot, a.place_robot, a.pick_grasp, a.place_grasp
+    need = [("reachable-pick", (o, g1, r1)), ("reachable-place", (o, re_, g2, r2))]
+    if r1 != r2:
+        need.insert(1, ("enable-goal-handover", (o, g1, g2, r1, r2)))
+        if o not in goal:
+            out.append(Violation(t, o, "region", f"{o} is not a goal object: only goal objects are handed "
+                                                 f"over (enable-goal-handover)"))
+    for pred, args in need:
+        if (pred, args) not in facts:
+            out.append(Violation(t, o, "unsupported", f"no fact ({pred} {' '.join(args)}) supports "
+                                                      f"'{a.describe()}'"))
+    target = goal.get(o, problem.initial_regions.get(o))
+    if target is not None and re_ != target:
+        why = "its goal region" if o in goal else "its own region (it is only moved out of the way)"
+        out.append(Violation(t, o, "region", f"{o} goes to {re_!r}, but the model moves it only into "
+                                             f"{target!r}, {why}"))
+
+
+def _obstacles_moved(facts: set[tuple[str, tuple[str, ...]]], moved_at: dict[str, int], t: int, a: Action,
+                     out: list[Violation]) -> None:
+    """Every ``occludes-pick`` obstacle of action ``a`` moves at a strictly earlier step, every
+    ``occludes-goal-place`` obstacle no later ``[pick-obstacle]``, ``[place-obstacle]``."""
+    o, re_, r1, r2, g1, g2 = a.object, a.region, a.pick_robot, a.place_robot, a.pick_grasp, a.place_grasp
+    for pred, args in facts:
+        if pred == "occludes-pick" and args[1:] == (o, g1, r1):
+            when = moved_at.get(args[0])
+            if when is None or when >= t:
+                state = "never moves" if when is None else f"moves at step {when}"
+                out.append(Violation(t, o, "pick-obstacle", f"{args[0]} blocks {r1} picking {o} with {g1} "
+                                                            f"and {state}; it must move at an earlier step"))
+        elif pred == "occludes-goal-place" and args[1:] == (o, re_, g2, r2):
+            when = moved_at.get(args[0])
+            if when is None or when > t:
+                state = "never moves" if when is None else f"moves at step {when}"
+                out.append(Violation(t, o, "place-obstacle",
+                                     f"{args[0]} blocks {r2} placing {o} in {re_} with {g2} and {state}; "
+                                     f"it must move by step {t}"))

@@ -87,6 +87,7 @@ def _progress(label: str) -> Iterator[Any]:
 
 
 def cmd_render(args: argparse.Namespace) -> int:
+    """``mrgc render``: a replay, key frames, the scene, an HTML replay or a Gantt chart, by the output's extension."""
     from mrgc import outputs as files
     from mrgc.language.loader import parse_file
     from mrgc.render import outputs
@@ -145,6 +146,7 @@ def _written(kind: str, path: str, stats: dict[str, Any]) -> str:
 
 
 def cmd_graph(args: argparse.Namespace) -> int:
+    """``mrgc graph``: the collaborative manipulation task graph, drawn through Graphviz."""
     from mrgc import outputs as files
     from mrgc.language.loader import parse_file
     from mrgc.render import graph

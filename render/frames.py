@@ -97,6 +97,7 @@ class Timeline:
 
     @property
     def duration(self) -> float:
+        """The replay's length (s)."""
         return sum(p.duration for p in self.phases)
 
     def frames(self, fps: float) -> list[Frame]:
@@ -238,29 +239,16 @@ def _step_phases(world: World, t: int, n: int, acts: list[_Act], home: Mapping[s
     return out
 
 
-def _parse(world: World, a: Mapping[str, Any], t: int, source: str) -> _Act:  # noqa: C901
+def _parse(world: World, a: Mapping[str, Any], t: int, source: str) -> _Act:
     """One action of the plan, checked against the world (E510 when it does not fit)."""
     def fail(message: str) -> InputError:
         return InputError([Diagnostic(E_PLAN_FIT, f"{source}: step {t}: {message} (problem "
                                                   f"'{world.problem.name}')")])
 
     obj, region, giver, taker = a["object"], a["region"], a["pick_robot"], a["place_robot"]
-    if obj not in world.objects:
-        raise fail(f"object {obj!r} is not a movable object of the problem")
-    if region not in {b.name for b, _ in world.regions}:
-        raise fail(f"region {region!r} is not a region of the problem")
-    for r in (giver, taker):
-        if r not in world.robots:
-            raise fail(f"robot {r!r} is not a robot of the problem")
-    for r, g in ((giver, a["pick_grasp"]), (taker, a["place_grasp"])):
-        view = world.robots[r]
-        if not view.planar and g not in world.scene.grasp_specs:
-            raise fail(f"grasp {g!r} has no geometry in the problem's domain")
-        if view.planar:
-            from mrgc.geometry.planar import planar_grasp
-
-            if not planar_grasp(g):
-                raise fail(f"planar robot {r} cannot use grasp {g!r}")
+    problem = _names_misfit(world, a)
+    if problem:
+        raise fail(problem)
     pose = a.get("place_pose")
     if pose is None or np.asarray(pose, dtype=float).shape != (4, 4):
         raise fail(f"moving {obj} has no 4x4 place_pose")
@@ -269,15 +257,14 @@ def _parse(world: World, a: Mapping[str, Any], t: int, source: str) -> _Act:  # 
     if giver != taker:
         need["handover"] = (giver, 2)
     for name, (robot, count) in need.items():
-        qs = a.get("configs", {}).get(name)
-        arr = _configs(qs, world.robots[robot].home.size)
+        arr = _configs(a.get("configs", {}).get(name), world.robots[robot].home.size)
         if arr is None or len(arr) < count:
             raise fail(f"moving {obj}: configs.{name} must hold at least {count} configuration(s) of "
                        f"{world.robots[robot].home.size} values ({robot})")
         configs[name] = arr
-    paths: dict[str, np.ndarray] = {}
     from mrgc.planner.replay_actions import PATH_PHASES
 
+    paths: dict[str, np.ndarray] = {}
     for name, qs in (a.get("paths") or {}).items():
         if name not in PATH_PHASES:
             continue
@@ -289,6 +276,27 @@ def _parse(world: World, a: Mapping[str, Any], t: int, source: str) -> _Act:  # 
         paths[name] = arr
     return _Act(obj, region, giver, taker, a["pick_grasp"], a["place_grasp"], np.asarray(pose, dtype=float),
                 configs, paths, a.get("handover_point"))
+
+
+def _names_misfit(world: World, a: Mapping[str, Any]) -> str | None:
+    """Why the action's object, region, robots or grasps do not fit the world (None: they do)."""
+    obj, region, giver, taker = a["object"], a["region"], a["pick_robot"], a["place_robot"]
+    if obj not in world.objects:
+        return f"object {obj!r} is not a movable object of the problem"
+    if region not in {b.name for b, _ in world.regions}:
+        return f"region {region!r} is not a region of the problem"
+    for r in (giver, taker):
+        if r not in world.robots:
+            return f"robot {r!r} is not a robot of the problem"
+    for r, g in ((giver, a["pick_grasp"]), (taker, a["place_grasp"])):
+        if not world.robots[r].planar and g not in world.scene.grasp_specs:
+            return f"grasp {g!r} has no geometry in the problem's domain"
+        if world.robots[r].planar:
+            from mrgc.geometry.planar import planar_grasp
+
+            if not planar_grasp(g):
+                return f"planar robot {r} cannot use grasp {g!r}"
+    return None
 
 
 def _configs(qs: Any, dof: int) -> np.ndarray | None:

@@ -55,31 +55,12 @@ def build(world: World, frames: list[Frame], camera: Camera, fps: float,
 
 def _record(server: Any, world: World, frames: list[Frame], camera: Camera, fps: float,
             progress: Callable[[int, int], None] | None) -> str:
-    scene = server.scene
-    scene.set_up_direction("+z")
-    cam = server.initial_camera
-    cam.position = tuple(float(v) for v in camera.eye)
-    cam.look_at = tuple(float(v) for v in camera.target)
-    cam.up = tuple(float(v) for v in camera.up)
-    cam.fov = math.radians(camera.fov)
-    for part, pose in world.fixed:
-        _add(scene, f"/fixed/{part.name}", part, pose)
-    for body, colour in world.regions:
-        _add(scene, f"/regions/{body.name}", shape_drawable(body.name, body.shape, colour, REGION_ALPHA), body.pose)
-    first = frames[0]
-    handles: dict[str, Any] = {}
-    for name, part in world.objects.items():
-        handles[name] = _add(scene, f"/objects/{name}", part, first.poses[name])
-    for robot, q in first.configs.items():
-        for part, pose in world.robots[robot].part_poses(q, first.fingers.get(robot)):
-            handles[part.name] = _add(scene, f"/robots/{part.name}", part, pose)
-    # the caption floats above the middle of the scene, a fifth of the viewing distance up
-    top = camera.target + np.array([0.0, 0.0, 0.2 * float(np.linalg.norm(camera.eye - camera.target))])
-    label = scene.add_label("/caption", first.caption, position=tuple(float(v) for v in top),
-                            anchor="bottom-center", font_screen_scale=1.2)
+    """The replay as one HTML file: the scene at the first frame, then each frame's moves recorded one
+    ``1 / fps`` apart."""
+    handles, label = _first_frame(server, world, frames[0], camera)
     serializer = server.get_scene_serializer()
     last = dict.fromkeys(handles)
-    text = first.caption
+    text = frames[0].caption
     for i, frame in enumerate(frames[1:], 2):
         serializer.insert_sleep(1.0 / fps)
         for name, pose in frame.poses.items():
@@ -94,6 +75,33 @@ def _record(server: Any, world: World, frames: list[Frame], camera: Camera, fps:
     if len(frames) > 1:
         serializer.insert_sleep(1.5)  # hold the end before the replay loops
     return str(serializer.as_html())
+
+
+def _first_frame(server: Any, world: World, first: Frame, camera: Camera) -> tuple[dict[str, Any], Any]:
+    """The camera, the fixed bodies and regions, and the objects and robots at the first frame, with the
+    caption: the handles of what moves, by name, and the caption's label."""
+    scene = server.scene
+    scene.set_up_direction("+z")
+    cam = server.initial_camera
+    cam.position = tuple(float(v) for v in camera.eye)
+    cam.look_at = tuple(float(v) for v in camera.target)
+    cam.up = tuple(float(v) for v in camera.up)
+    cam.fov = math.radians(camera.fov)
+    for part, pose in world.fixed:
+        _add(scene, f"/fixed/{part.name}", part, pose)
+    for body, colour in world.regions:
+        _add(scene, f"/regions/{body.name}", shape_drawable(body.name, body.shape, colour, REGION_ALPHA), body.pose)
+    handles: dict[str, Any] = {}
+    for name, part in world.objects.items():
+        handles[name] = _add(scene, f"/objects/{name}", part, first.poses[name])
+    for robot, q in first.configs.items():
+        for part, pose in world.robots[robot].part_poses(q, first.fingers.get(robot)):
+            handles[part.name] = _add(scene, f"/robots/{part.name}", part, pose)
+    # the caption floats above the middle of the scene, a fifth of the viewing distance up
+    top = camera.target + np.array([0.0, 0.0, 0.2 * float(np.linalg.norm(camera.eye - camera.target))])
+    label = scene.add_label("/caption", first.caption, position=tuple(float(v) for v in top),
+                            anchor="bottom-center", font_screen_scale=1.2)
+    return handles, label
 
 
 def _move(handle: Any, pose: np.ndarray, last: dict[str, Any], name: str) -> None:

@@ -152,6 +152,7 @@ def conditional_rows() -> SkeletonModel:
 
 
 def at_most_one() -> SkeletonModel:
+    """A model with an at-most-one constraint and a known optimum."""
     m = SkeletonModel(name="amo")
     xs = [m.bool_var(f"x{i}") for i in range(4)]
     m.at_most_one.append(AtMostOne((xs[0], xs[1], xs[2]), "amo012"))
@@ -203,6 +204,7 @@ def lexicographic() -> SkeletonModel:
 
 
 def infeasible_bools() -> SkeletonModel:
+    """A model of booleans with no solution."""
     m = SkeletonModel(name="infeasible-bools")
     x, y, z = (m.bool_var(n) for n in "xyz")
     m.add([(x, 1), (y, 1), (z, 1)], lo=2)
@@ -512,9 +514,11 @@ class ConformanceReport:
 
     @property
     def ok(self) -> bool:
+        """Whether every check passed."""
         return not self.failed
 
     def lines(self) -> list[str]:
+        """The report in lines: a count, then each failed check with its message."""
         out = [f"backend {self.backend}: {len(self.passed)} of {len(self.passed) + len(self.failed)} checks passed"]
         out += [f"  {name}: {message}" for name, message in self.failed.items()]
         return out

@@ -57,10 +57,23 @@ def _steps(skeleton: Any) -> list[tuple[Action, ...]]:
 
 
 # ------------------------------------------------------------------ (a) checking one skeleton
-def check_skeleton(graph: TaskGraph, skeleton: Any) -> list[str]:  # noqa: C901
+def check_skeleton(graph: TaskGraph, skeleton: Any) -> list[str]:
     """Every way ``skeleton`` (an object with ``.steps``, or a list of steps) breaks the definitions."""
-    steps = _steps(skeleton)
     obstacles = _obstacles(graph)
+    bad, step_of, placed = _step_faults(obstacles, _steps(skeleton))
+    bad += [f"{o} is in M* but is not moved" for o in graph.must_move if o not in step_of]
+    obstructing = _obstacle_faults(obstacles, placed, step_of, bad)
+    must = set(graph.must_move)
+    for o, t in step_of.items():
+        if o not in must and o not in obstructing:
+            bad.append(f"{o} is not in M* and obstructs no selected action, but is moved (step {t})")
+    return bad
+
+
+def _step_faults(obstacles: dict[Action, tuple[frozenset[str], frozenset[str]]], steps: list[tuple[Action, ...]]
+                 ) -> tuple[list[str], dict[str, int], list[tuple[int, Action]]]:
+    """Faults of the steps themselves (empty steps, unknown actions, objects moved twice, busy robots), the
+    step each object moves at, and every (step, action)."""
     bad: list[str] = []
     step_of: dict[str, int] = {}
     placed: list[tuple[int, Action]] = []
@@ -81,9 +94,13 @@ def check_skeleton(graph: TaskGraph, skeleton: Any) -> list[str]:  # noqa: C901
                     bad.append(f"step {t}: robot {r} does two actions ('{busy[r]}' and '{a}')")
                 else:
                     busy[r] = a
-    for o in graph.must_move:
-        if o not in step_of:
-            bad.append(f"{o} is in M* but is not moved")
+    return bad, step_of, placed
+
+
+def _obstacle_faults(obstacles: dict[Action, tuple[frozenset[str], frozenset[str]]],
+                     placed: list[tuple[int, Action]], step_of: dict[str, int], bad: list[str]) -> set[str]:
+    """Add to ``bad`` the obstacles that do not move in time (pick: strictly earlier, place: no later); the
+    objects that obstruct a selected action."""
     obstructing: set[str] = set()
     for t, a in placed:
         pick, place = obstacles.get(a, (frozenset(), frozenset()))
@@ -98,11 +115,7 @@ def check_skeleton(graph: TaskGraph, skeleton: Any) -> list[str]:  # noqa: C901
                 bad.append(f"place obstacle {o} of '{a}' (step {t}) is never moved")
             elif not step_of[o] <= t:
                 bad.append(f"place obstacle {o} of '{a}' (step {t}) moves later, at step {step_of[o]}")
-    must = set(graph.must_move)
-    for o, t in step_of.items():
-        if o not in must and o not in obstructing:
-            bad.append(f"{o} is not in M* and obstructs no selected action, but is moved (step {t})")
-    return bad
+    return obstructing
 
 
 # ------------------------------------------------------------------ (b) brute force
@@ -187,7 +200,7 @@ def _assign(rel: list[list[tuple[int, str]]], step: list[int], k: int, m: int) -
     return False
 
 
-def feasible_action_sets(graph: TaskGraph) -> dict[frozenset[Action], int]:  # noqa: C901
+def feasible_action_sets(graph: TaskGraph) -> dict[frozenset[Action], int]:
     """Every action set that has a valid schedule, with its minimum makespan.
 
     Search over subsets: each object of the graph is either not moved or moved by one of its actions
@@ -203,23 +216,6 @@ def feasible_action_sets(graph: TaskGraph) -> dict[frozenset[Action], int]:  # n
     out: dict[frozenset[Action], int] = {}
     choice: dict[str, Action | None] = {}
 
-    def blockers(a: Action) -> frozenset[str]:
-        return obstacles[a][0] | obstacles[a][1]
-
-    def consistent(o: str) -> bool:
-        a = choice[o]
-        if a is not None:
-            for b in blockers(a):
-                if b in choice and choice[b] is None:
-                    return False
-                if b not in options:
-                    return False
-        else:
-            for c in choice.values():
-                if c is not None and o in blockers(c):
-                    return False
-        return True
-
     def dfs(k: int) -> None:
         if k == len(objects):
             selected = frozenset(a for a in choice.values() if a is not None)
@@ -233,12 +229,25 @@ def feasible_action_sets(graph: TaskGraph) -> dict[frozenset[Action], int]:  # n
             alternatives.insert(0, None)
         for a in alternatives:
             choice[o] = a
-            if consistent(o):
+            if _consistent(o, choice, obstacles, options):
                 dfs(k + 1)
             del choice[o]
 
     dfs(0)
     return out
+
+
+def _consistent(o: str, choice: dict[str, Action | None], obstacles: dict[Action, tuple[frozenset[str],
+                frozenset[str]]], options: dict[str, list[Action]]) -> bool:
+    """Whether the choice just made for ``o`` keeps the partial selection consistent: a chosen action's
+    obstacles are objects that may still move; an object left unmoved obstructs no chosen action."""
+    def blockers(a: Action) -> frozenset[str]:
+        return obstacles[a][0] | obstacles[a][1]
+
+    a = choice[o]
+    if a is not None:
+        return all(b in options and not (b in choice and choice[b] is None) for b in blockers(a))
+    return not any(c is not None and o in blockers(c) for c in choice.values())
 
 
 def oracle_keys(graph: TaskGraph) -> list[tuple[int, int]]:
@@ -248,7 +257,7 @@ def oracle_keys(graph: TaskGraph) -> list[tuple[int, int]]:
 
 
 # ------------------------------------------------------------------ Alg. 1 on raw facts
-def reference_task_graph(  # noqa: C901
+def reference_task_graph(
         robots: Sequence[str], grasps: Mapping[str, Sequence[str]], goal: Mapping[str, str],
         region: Mapping[str, str], facts: Iterable[tuple[str, ...]], must_move: Sequence[str],
         moved: Iterable[str] = ()) -> TaskGraph:
@@ -286,31 +295,17 @@ def reference_task_graph(  # noqa: C901
         target = goal.get(m, region.get(m))
         if target is None:
             return
-        for r1 in robots:
-            for g1 in grasps.get(m, ()):
-                if (m, g1, r1) not in pick:
-                    continue
-                found = []
-                if (m, target, g1, r1) in place:
-                    found.append(Action(m, target, r1, r1, g1, g1))
-                if m in goal:
-                    for r2 in robots:
-                        if r2 == r1:
-                            continue
-                        for g2 in grasps.get(m, ()):
-                            if (m, g1, g2, r1, r2) in hand and (m, target, g2, r2) in place:
-                                found.append(Action(m, target, r1, r2, g1, g2))
-                for a in found:
-                    p = tuple(mj for mj in movable if (mj, m, a.pick_grasp, a.pick_robot) in occ_pick)
-                    q = tuple(mj for mj in movable if m in goal
-                              and (mj, m, target, a.place_grasp, a.place_robot) in occ_place)
-                    if done & set(p + q):
-                        continue
-                    actions.append(a)
-                    bp.append(p)
-                    bl.append(q)
-                    for mj in p + q:
-                        add_object(mj)
+        for a in _actions_of(m, target, m in goal, robots, grasps.get(m, ()), pick, place, hand):
+            p = tuple(mj for mj in movable if (mj, m, a.pick_grasp, a.pick_robot) in occ_pick)
+            q = tuple(mj for mj in movable if m in goal
+                      and (mj, m, target, a.place_grasp, a.place_robot) in occ_place)
+            if done & set(p + q):
+                continue
+            actions.append(a)
+            bp.append(p)
+            bl.append(q)
+            for mj in p + q:
+                add_object(mj)
 
     for m in must_move:
         add_object(m)
@@ -323,6 +318,23 @@ def reference_task_graph(  # noqa: C901
         block_pick=tuple(bp),
         block_place=tuple(bl),
     )
+
+
+def _actions_of(m: str, target: str, is_goal: bool, robots: Sequence[str], grasps: Sequence[str],
+                pick: set[tuple[str, ...]], place: set[tuple[str, ...]], hand: set[tuple[str, ...]]) -> list[Action]:
+    """Object ``m``'s actions into ``target``, by picking robot and grasp: the direct one (same robot and
+    grasp), then the handovers (goal objects only)."""
+    out = []
+    for r1 in robots:
+        for g1 in grasps:
+            if (m, g1, r1) not in pick:
+                continue
+            if (m, target, g1, r1) in place:
+                out.append(Action(m, target, r1, r1, g1, g1))
+            if is_goal:
+                out += [Action(m, target, r1, r2, g1, g2) for r2 in robots if r2 != r1 for g2 in grasps
+                        if (m, g1, g2, r1, r2) in hand and (m, target, g2, r2) in place]
+    return out
 
 
 def graph_signature(graph: TaskGraph) -> tuple[frozenset[str], frozenset[str],

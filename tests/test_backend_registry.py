@@ -6,17 +6,16 @@ import builtins
 import itertools
 import subprocess
 import sys
-from pathlib import Path
 from typing import Any, Sequence
 
 import pytest
+from support import ROOT
 
 from mrgc import cli
 from mrgc.backends import registry
 from mrgc.backends.base import Backend, BackendInfo
 from mrgc.compiler.ir import Row, SkeletonModel, Solution, SolveStatus
 
-ROOT = Path(__file__).resolve().parent.parent
 CHAIN3 = str(ROOT / "domains" / "symbolic" / "chain-3.mrg")
 
 

@@ -15,6 +15,7 @@ from typing import Any
 
 from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
+from support import ROOT
 
 from mrgc import cli, parse_file, parse_string
 from mrgc.language.model import Problem
@@ -24,7 +25,6 @@ from mrgc.planner.plan import Plan
 from mrgc.planner.validate import validate
 from mrgc.testing import oracle
 
-ROOT = Path(__file__).resolve().parent.parent
 SYMBOLIC = ROOT / "domains" / "symbolic"
 PLACE_OBSTACLE = ROOT / "domains" / "packaging" / "pa3-place-obstacle.mrg"
 

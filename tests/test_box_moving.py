@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from support import ROOT
 
 from mrgc import parse_file, parse_string
 from mrgc.geometry.path_predicates import PlanarEvaluator
@@ -18,7 +19,6 @@ from mrgc.geometry.scene import SceneSpec, inside, scene_from_problem
 from mrgc.language.model import Fact, Problem
 from mrgc.planner.skeletons import compile_problem
 
-ROOT = Path(__file__).resolve().parent.parent
 BOX_MOVING = ROOT / "domains" / "box-moving"
 PROBLEMS = sorted(p for p in BOX_MOVING.glob("*.mrg") if p.name != "domain.mrg")
 

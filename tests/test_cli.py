@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-import shutil
 import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -75,7 +75,7 @@ def test_no_command_prints_help(capsys: pytest.CaptureFixture[str]) -> None:
 
 
 def test_installed_script(good: Path) -> None:
-    exe = shutil.which("mrgc") or str(Path(__file__).resolve().parent.parent / ".venv" / "bin" / "mrgc")
+    exe = str(Path(sys.executable).with_name("mrgc"))  # the console script installed beside this interpreter
     version = subprocess.run([exe, "--version"], capture_output=True, text=True)
     assert version.returncode == 0 and version.stdout.strip() == f"mrgc {__version__}"
     res = subprocess.run([exe, "check", str(good)], capture_output=True, text=True)

@@ -19,12 +19,12 @@ from pathlib import Path
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from support import ROOT
 
 from mrgc import cli, outputs, signals, workers
 from mrgc.errors import InputError, InternalError
 from mrgc.language.suggest import did_you_mean
 
-ROOT = Path(__file__).resolve().parent.parent
 SYMBOLIC = ROOT / "domains" / "symbolic"
 PACKAGING = ROOT / "domains" / "packaging"
 MRGC = [sys.executable, "-m", "mrgc.cli"]

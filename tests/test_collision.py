@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 from hypothesis import assume, example, given, settings
 from hypothesis import strategies as st
+from support import ROOT
 
 from mrgc import parse_file
 from mrgc.errors import InputError
@@ -22,8 +23,6 @@ from mrgc.geometry.replay_world import ReplayScene
 from mrgc.geometry.scene import SceneSpec, scene_from_problem
 from mrgc.geometry.transforms import rot_z, rpy_matrix, translation
 from mrgc.language.model import Box, Cylinder, Mesh, Sphere
-
-ROOT = Path(__file__).resolve().parent.parent
 
 
 def at(x: float, y: float = 0.0, z: float = 0.0, yaw: float = 0.0) -> np.ndarray:

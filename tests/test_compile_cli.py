@@ -12,10 +12,11 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from support import ROOT
+from support import run_cli as run
 
 from mrgc import cli
 
-ROOT = Path(__file__).resolve().parent.parent
 SYMBOLIC = ROOT / "domains" / "symbolic"
 CHAIN3 = str(SYMBOLIC / "chain-3.mrg")
 INFEASIBLE = str(SYMBOLIC / "infeasible.mrg")
@@ -29,12 +30,6 @@ A2 = ("o1", "goal", "r2", "r2", "side", "side")
 A3 = ("o1", "goal", "r1", "r2", "top", "side")
 B = ("o2", "start", "r1", "r1", "top", "top")
 C = ("o3", "start", "r2", "r2", "side", "side")
-
-
-def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
-    code = cli.main(list(argv))
-    cap = capsys.readouterr()
-    return code, cap.out, cap.err
 
 
 def compile_json(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, dict[str, Any]]:

@@ -17,8 +17,7 @@ import sys
 from pathlib import Path
 
 import pytest
-
-ROOT = Path(__file__).resolve().parent.parent
+from support import ROOT
 
 # two rooms (4 × 3 m) joined by a 0.8 m doorway at x = 0: (sx, sy, x, y) of each wall
 WALLS = [(4.2, 0.1, 0, -1.55), (4.2, 0.1, 0, 1.55), (0.1, 3.2, -2.05, 0), (0.1, 3.2, 2.05, 0),

@@ -11,6 +11,7 @@ from pathlib import Path
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from support import ROOT
 
 import mrgc
 from mrgc import cli
@@ -21,7 +22,6 @@ from mrgc.language.parens import unclosed_paren
 from mrgc.language.parser import parse_text
 from mrgc.language.suggest import by_meaning
 
-ROOT = Path(__file__).resolve().parent.parent
 FILES = sorted(p for p in (ROOT / "domains").glob("*/*.mrg")) + sorted((ROOT / "docs" / "tutorial").glob("*.mrg"))
 CHAIN3 = ROOT / "domains" / "symbolic" / "chain-3.mrg"
 

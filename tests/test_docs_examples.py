@@ -10,8 +10,8 @@ import sys
 from pathlib import Path
 
 import pytest
+from support import ROOT
 
-ROOT = Path(__file__).resolve().parent.parent
 PAGES = ["api.md", "testing.md"]
 
 

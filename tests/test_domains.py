@@ -6,17 +6,23 @@ import re
 from pathlib import Path
 
 import pytest
+from support import ROOT
 
 from mrgc import parse_file
 from mrgc.language.parser import parse_text
 from mrgc.language.printer import format_source
 
-ROOT = Path(__file__).resolve().parent.parent
 FILES = sorted((ROOT / "domains").rglob("*.mrg"))
 
 
-def test_there_are_shipped_domains() -> None:
-    assert len(list((ROOT / "domains" / "symbolic").glob("*.mrg"))) >= 7
+@pytest.mark.parametrize("folder,domain", [("symbolic", "abstract"), ("packaging", "packaging"),
+                                           ("box-moving", "box-moving")])
+def test_each_domain_folder_holds_its_domain_and_problems_of_it(folder: str, domain: str) -> None:
+    """domains/FOLDER/domain.mrg defines the domain, and every other file there holds problems of it."""
+    files = sorted((ROOT / "domains" / folder).glob("*.mrg"))
+    assert [d.name for d in parse_file(ROOT / "domains" / folder / "domain.mrg").domains] == [domain]
+    problems = [p for f in files if f.name != "domain.mrg" for p in parse_file(f).problems]
+    assert len(problems) >= 3 and {p.domain.name for p in problems} == {domain}
 
 
 @pytest.mark.parametrize("path", FILES, ids=lambda p: str(p.relative_to(ROOT)))

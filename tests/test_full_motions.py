@@ -3,16 +3,14 @@ and the validator, which then requires every path, accepts the plan."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import pytest
+from support import ROOT
 
 from mrgc import __version__, parse_file
 from mrgc.planner.plan import file_sha256
 from mrgc.planner.search import plan_problem
 from mrgc.planner.validate import validate
 
-ROOT = Path(__file__).resolve().parent.parent
 HANDOVER = ROOT / "domains" / "packaging" / "pa3-handover.mrg"
 
 

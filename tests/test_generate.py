@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from support import ROOT
 
 import mrgc
 from mrgc import cli
@@ -21,7 +22,6 @@ from mrgc.generate import PRESETS, box_moving, packaging, preset
 from mrgc.generate.packaging import SHIPPED, grid_benchmark
 from mrgc.language.model import Box, Cylinder, Pose, Problem
 
-ROOT = Path(__file__).resolve().parent.parent
 EPS = 1e-9
 SETTINGS = settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 

@@ -10,12 +10,12 @@ import runpy
 from pathlib import Path
 
 import pytest
+from support import ROOT
 
 from mrgc import cli
 from mrgc.language.codes import CODES, WARNINGS
 from mrgc.language.loader import MAX_BYTES
 
-ROOT = Path(__file__).resolve().parent.parent
 GOLDEN = ROOT / "tests" / "golden" / "errors"
 CASES = sorted(p.stem for p in GOLDEN.glob("E*.mrg"))
 WARNING_CASES = sorted(p.stem for p in GOLDEN.glob("W*.mrg"))

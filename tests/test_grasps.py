@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from support import ROOT
 
 from mrgc import cli, parse_file
 from mrgc.errors import InputError
@@ -23,7 +24,6 @@ from mrgc.language.model import AXES, BUILTIN_GRASPS, Box, Cylinder, Fact, Grasp
 from mrgc.language.parser import parse_text
 from mrgc.language.printer import format_source
 
-ROOT = Path(__file__).resolve().parent.parent
 PACKAGING = ROOT / "domains" / "packaging"
 
 KIND = '(:robot-kind panda :urdf "franka_panda/panda.urdf" :base fixed :end-effector "panda_hand")'

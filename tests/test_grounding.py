@@ -2,18 +2,15 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
+from support import ROOT
 
 from mrgc import parse_file
 from mrgc.geometry.grounding import Grounder, Status
 from mrgc.geometry.planar import to_se2
 from mrgc.geometry.scene import inside, scene_from_problem
 from mrgc.geometry.transforms import translation
-
-ROOT = Path(__file__).resolve().parent.parent
 
 
 @pytest.fixture()

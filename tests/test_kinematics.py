@@ -24,11 +24,6 @@ from mrgc.testing.pybullet_reference import pybullet_fk, pybullet_ik
 PANDA = "franka_panda/panda.urdf"
 
 
-@pytest.fixture(scope="module")
-def panda():
-    return load_robot_model(PANDA, "/nonexistent", "panda_hand")
-
-
 def unit_floats(n: int) -> st.SearchStrategy:
     return st.lists(st.floats(0.0, 1.0), min_size=n, max_size=n)
 

@@ -7,13 +7,12 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+from support import ROOT
 
 import mrgc
 from mrgc import cli
 from mrgc.generate import generate
 from mrgc.geometry.layout import TOLERANCE, arm_joints, layout_diagnostics, robot_diagnostics
-
-ROOT = Path(__file__).resolve().parent.parent
 
 CELL = """(define (domain cell)
   (:robot-kind panda :urdf "franka_panda/panda.urdf" :base fixed :end-effector "panda_hand"

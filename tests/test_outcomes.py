@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 import pytest
+from support import ROOT
 
 from mrgc import __version__, cli, parse_file
 from mrgc.compiler.skeleton import Skeleton
@@ -24,7 +25,6 @@ from mrgc.planner.outcome import EXIT_CODES, PlanStatus
 from mrgc.planner.plan import PlannedAction, file_sha256
 from mrgc.planner.search import plan_problem
 
-ROOT = Path(__file__).resolve().parent.parent
 PA3 = (ROOT / "domains" / "packaging" / "pa3-handover.mrg").read_text(encoding="utf-8")
 
 
@@ -191,13 +191,6 @@ class ScriptedGrounder:
                   skip: int = 0, packed: bool = False) -> Answer:
         return Answer(Status.OK, pose=np.eye(4))
 
-    def placements(self, obj: str, region: str, avoid: Any = (), volume: Any = None, key: str = "",
-                   packed: bool = False, prefer: Any = None) -> Any:
-        yield np.eye(4)
-
-    def comfortable(self, robot: str, obj: str, grasp: str) -> Any:
-        return lambda pose: 0.0
-
     def arm_volume(self, robot: str, configs: np.ndarray, holding: Any = None, grasp: Any = None) -> list[Any]:
         return [(f"arm:{robot}:{holding[0] if holding else ''}", None)]
 
@@ -236,7 +229,8 @@ def test_a_step_whose_robots_collide_is_split() -> None:
     each time which arms pick and place in the step (arms of the step are not at home then)."""
     grounder = ScriptedGrounder(["a", "b"], blocked_by={}, sweeps={}, crowded=frozenset({"b"}))
     reverse = ReverseGrounder(grounder, {"a": "goal", "b": "goal"})  # type: ignore[arg-type]
-    skeleton = Skeleton(((Action("a", "goal", "r1", "r1", "top", "top"), Action("b", "goal", "r2", "r2", "top", "top")),))
+    skeleton = Skeleton(((Action("a", "goal", "r1", "r1", "top", "top"),
+                          Action("b", "goal", "r2", "r2", "top", "top")),))
     result = reverse.ground(skeleton, [])
     assert result.outcome is Outcome.SUCCESS
     assert [s.moved for s in result.steps] == [("a",), ("b",)]
@@ -253,7 +247,8 @@ def test_a_step_is_not_split_for_other_failures(monkeypatch: pytest.MonkeyPatch)
     monkeypatch.setattr(ground_module, "_volumes_collide", lambda a, b: False)  # the script's volumes are tokens
     grounder = ScriptedGrounder(["a", "b", "c"], blocked_by={"b": {"c"}}, sweeps={"arm:r2:": {"c"}})
     reverse = ReverseGrounder(grounder, {"a": "goal", "b": "goal"})  # type: ignore[arg-type]
-    skeleton = Skeleton(((Action("a", "goal", "r1", "r1", "top", "top"), Action("b", "goal", "r2", "r2", "top", "top")),))
+    skeleton = Skeleton(((Action("a", "goal", "r1", "r1", "top", "top"),
+                          Action("b", "goal", "r2", "r2", "top", "top")),))
     result = reverse.ground(skeleton, [])
     assert result.outcome is Outcome.PARTIAL and result.must_move >= {"c"}
     assert len(result.steps) == 1 and result.steps[0].moved == ("a", "b")

@@ -6,6 +6,7 @@ import json
 from pathlib import Path
 
 import pytest
+from support import ROOT
 
 from mrgc import __version__, cli, parse_file
 from mrgc.compiler.skeleton import Skeleton
@@ -16,7 +17,6 @@ from mrgc.planner.plan import PlannedAction, file_sha256
 from mrgc.planner.search import plan_problem
 from mrgc.planner.validate import validate
 
-ROOT = Path(__file__).resolve().parent.parent
 GEOMETRIC = (sorted((ROOT / "domains" / "packaging").glob("pa*.mrg"))
              + sorted((ROOT / "domains" / "box-moving").glob("bo*.mrg")))
 

@@ -11,11 +11,11 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from support import ROOT, panda_model
 
 from mrgc import cli, parse_file
 from mrgc.geometry.collision import CollisionWorld, ConvexHull, collision_shape
 from mrgc.geometry.fk import fk_world
-from mrgc.geometry.kinematics import load_robot_model
 from mrgc.geometry.predicates import compute_facts
 from mrgc.geometry.scene import scene_from_problem
 from mrgc.geometry.transforms import rot_z, translation
@@ -23,7 +23,6 @@ from mrgc.language.model import Box, Fact
 from mrgc.planner.skeletons import compile_problem
 from mrgc.testing.pybullet_reference import pybullet_box_distance
 
-ROOT = Path(__file__).resolve().parent.parent
 PACKAGING = ROOT / "domains" / "packaging"
 
 SCENE = """
@@ -134,7 +133,7 @@ def test_facts_of_a_symbolic_problem_is_an_input_error(capsys: pytest.CaptureFix
     assert "error[E402]" in capsys.readouterr().err
 
 
-PANDA = load_robot_model("franka_panda/panda.urdf", str(PACKAGING), "panda_hand")
+PANDA = panda_model()
 LINKS = [link for link in PANDA.links if link.index != 0 and len(link.points) >= 4]
 SHAPES = [collision_shape(ConvexHull(np.asarray(link.points, dtype=float))) for link in LINKS]
 

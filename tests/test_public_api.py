@@ -19,13 +19,13 @@ from typing import Sequence
 
 import pytest
 from hypothesis import HealthCheck, event, given, settings
+from support import ROOT
 
 import mrgc
 import mrgc.testing
 from mrgc.testing import oracle
 from mrgc.testing.strategies import SymbolicCase, symbolic_problems
 
-ROOT = Path(__file__).resolve().parent.parent
 SYMBOLIC = ROOT / "domains" / "symbolic"
 CHAIN3 = SYMBOLIC / "chain-3.mrg"
 
@@ -69,25 +69,10 @@ class BranchAndBound(mrgc.Backend):
                 if self.deadline is not None and time.perf_counter() > self.deadline:
                     self.out_of_time = True
                     return False
-                smin = sum(c * (lo[v] if c > 0 else hi[v]) for v, c in row.terms)
-                smax = sum(c * (hi[v] if c > 0 else lo[v]) for v, c in row.terms)
-                if (row.hi is not None and smin > row.hi) or (row.lo is not None and smax < row.lo):
+                holds, tightened = _tighten(row, lo, hi)
+                if not holds:
                     return False
-                for v, c in row.terms:
-                    if row.hi is not None:  # c x <= hi - (the least the other terms can be)
-                        room = row.hi - (smin - c * (lo[v] if c > 0 else hi[v]))
-                        if c > 0 and hi[v] > room // c:
-                            hi[v], changed = room // c, True
-                        elif c < 0 and lo[v] < -(room // -c):
-                            lo[v], changed = -(room // -c), True
-                    if row.lo is not None:  # c x >= lo - (the most the other terms can be)
-                        need = row.lo - (smax - c * (hi[v] if c > 0 else lo[v]))
-                        if c > 0 and lo[v] < -(-need // c):
-                            lo[v], changed = -(-need // c), True
-                        elif c < 0 and hi[v] > need // c:
-                            hi[v], changed = need // c, True
-                    if lo[v] > hi[v]:
-                        return False
+                changed |= tightened
         return True
 
     def _search(self, lo: list[int], hi: list[int]) -> None:
@@ -139,6 +124,31 @@ def test_a_plugin_compiles_through_the_api_like_a_registered_backend() -> None:
     theirs = mrgc.compile(SYMBOLIC / "medium.mrg", backend="cpsat", skeletons=3)
     assert ours.backend == "bnb" and ours.status == theirs.status == "optimal"
     assert [s.key for s in ours.skeletons] == [s.key for s in theirs.skeletons]
+
+
+def _tighten(row: mrgc.Row, lo: list[int], hi: list[int]) -> tuple[bool, bool]:
+    """Tighten the bounds of the row's variables in place: (the row can hold, some bound changed)."""
+    changed = False
+    smin = sum(c * (lo[v] if c > 0 else hi[v]) for v, c in row.terms)
+    smax = sum(c * (hi[v] if c > 0 else lo[v]) for v, c in row.terms)
+    if (row.hi is not None and smin > row.hi) or (row.lo is not None and smax < row.lo):
+        return False, changed
+    for v, c in row.terms:
+        if row.hi is not None:  # c x <= hi - (the least the other terms can be)
+            room = row.hi - (smin - c * (lo[v] if c > 0 else hi[v]))
+            if c > 0 and hi[v] > room // c:
+                hi[v], changed = room // c, True
+            elif c < 0 and lo[v] < -(room // -c):
+                lo[v], changed = -(room // -c), True
+        if row.lo is not None:  # c x >= lo - (the most the other terms can be)
+            need = row.lo - (smax - c * (hi[v] if c > 0 else lo[v]))
+            if c > 0 and lo[v] < -(-need // c):
+                lo[v], changed = -(-need // c), True
+            elif c < 0 and hi[v] > need // c:
+                hi[v], changed = need // c, True
+        if lo[v] > hi[v]:
+            return False, changed
+    return True, changed
 
 
 # ---------------------------------------------------------------- a domain of one's own, property-tested

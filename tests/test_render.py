@@ -18,6 +18,7 @@ from headless_chromium import colour_share, screenshot_when
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from PIL import Image
+from support import ROOT, run_cli
 
 from mrgc import cli
 from mrgc.language.loader import parse_file
@@ -27,15 +28,12 @@ from mrgc.render.frames import PHASES, build_timeline, interpolate
 from mrgc.render.palette import GOAL_REGION, ROBOT_COLOURS, byte_colour
 from mrgc.render.world import World
 
-ROOT = Path(__file__).resolve().parent.parent
 HANDOVER = ROOT / "domains" / "packaging" / "pa3-handover.mrg"
 SMALL = ["--size", "160x120", "--fps", "4"]
 
 
-def run(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
-    code = cli.main([str(a) for a in args])
-    out = capsys.readouterr()
-    return code, out.out, out.err
+def run(args: list[str | Path], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
+    return run_cli(capsys, *args)
 
 
 @pytest.fixture(scope="session")

@@ -23,9 +23,9 @@ from typing import Iterator
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from support import run_cli
 
 import mrgc
-from mrgc import cli
 from mrgc.errors import Diagnostic, InputError
 from mrgc.language import ast
 from mrgc.language.codes import CODES
@@ -82,16 +82,6 @@ def try_load(fn, *args, **kwargs) -> tuple[mrgc.MrgFile | None, set[str]]:
         return None, check_error(exc)
     assert isinstance(mf, mrgc.MrgFile)
     return mf, set()
-
-
-def run_cli(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
-    capsys.readouterr()
-    rc = cli.main(list(argv))
-    out, err = capsys.readouterr()
-    # (source lines are echoed in snippets, but always behind a " N | " gutter)
-    bad = [ln for ln in err.splitlines() if ln.startswith(("mrgc: internal error", "Traceback"))]
-    assert not bad, err[-2000:]
-    return rc, out, err
 
 
 def sweep(capsys: pytest.CaptureFixture[str], folder: Path, data: str | bytes, *, limit: float = 10.0,

@@ -10,10 +10,10 @@ import shutil
 from pathlib import Path
 
 import pytest
+from support import ROOT
 
 from mrgc import cli
 
-ROOT = Path(__file__).resolve().parent.parent
 TUTORIAL = ROOT / "docs" / "tutorial.md"
 
 

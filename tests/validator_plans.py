@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from support import ROOT
 
 from mrgc.geometry.grasps import grasp_transform, pregrasp_transform
 from mrgc.geometry.transforms import translation
@@ -26,7 +27,6 @@ from mrgc.planner.plan import Plan, PlannedAction, file_sha256
 if TYPE_CHECKING:  # the grounding service (coal, IK) loads only when a plan is built
     from mrgc.geometry.grounding import Grounder
 
-ROOT = Path(__file__).resolve().parent.parent
 PA3 = str(ROOT / "domains" / "packaging" / "pa3-handover.mrg")
 LIFT_TO = 0.25  # m above the grasp a held object is lifted before it travels
 LIFT_STEP = 0.05

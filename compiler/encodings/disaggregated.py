@@ -17,10 +17,15 @@ from mrgc.compiler.task_graph import TaskGraph
 
 
 class DisaggregatedEncoding(PaperEncoding):
+    """The paper's encoding with its obstacle precedences (11)/(12) as big-M-free rows, one per obstacle and step
+    (docs/compiler.md)."""
+
     name = "disaggregated"
 
     def precedence(self, m: SkeletonModel, graph: TaskGraph, X: list[list[int]], of: dict[str, list[int]],
                    T: int) -> None:
+        """The obstacle precedences: ``Y_M@t + X_a@1 - X_a@(t+1) <= 1`` (pick) or ``... - X_a@t <= 1`` (place) for
+        every step t."""
         for a in range(len(graph.actions)):
             for o, strict in graph.obstacles(a):
                 for t in range(T):

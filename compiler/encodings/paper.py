@@ -18,15 +18,19 @@ from mrgc.compiler.task_graph import TaskGraph
 
 
 def action_label(graph: TaskGraph, i: int) -> str:
+    """The action's label in model names: object, region, robots and grasps."""
     a = graph.actions[i]
     return f"{a.obj},{a.region},{a.pick_robot},{a.place_robot},{a.pick_grasp},{a.place_grasp}"
 
 
 class PaperEncoding(Encoding):
+    """The paper's skeleton model: one boolean per action and step; the horizon grows until the model is feasible."""
+
     name = "paper"
     horizon_loop = True
 
-    def build(self, graph: TaskGraph, horizon: int) -> Encoded:  # noqa: C901
+    def build(self, graph: TaskGraph, horizon: int) -> Encoded:
+        """The model of horizon ``horizon`` (steps) for ``graph``."""
         T = horizon
         m = SkeletonModel(name=f"{self.name}-T{T}")
         A = range(len(graph.actions))
@@ -35,38 +39,9 @@ class PaperEncoding(Encoding):
         uses = {r: [a for a in A if r in graph.actions[a].robots] for r in graph.robots}
         must = set(graph.must_move)
 
-        for a in A:  # (1) "at or after t" is monotone
-            for t in range(T - 1):
-                m.add([(X[a][t], 1), (X[a][t + 1], -1)], lo=0, name=f"c1[{a},{t + 1}]")
-        for o in graph.objects:  # (3) objects outside M* move only while an action they block is pending
-            if o in must:
-                continue
-            blocked = graph.blocked_by(o)
-            for a2 in of[o]:
-                for t in range(T):
-                    m.add([(X[a2][t], 1)] + [(X[a][t], -1) for a in blocked], hi=0, name=f"c3[{o},{a2},{t + 1}]")
-        for r, acts in uses.items():  # (4) each robot at most one action at the last step
-            m.add([(X[a][T - 1], 1) for a in acts], hi=1, name=f"c4[{r}]")
-        m.add([(X[a][T - 1], 1) for a in A], lo=1, name="c5")  # (5) the last step is not empty
-        for t in range(T - 1):
-            for r, acts in uses.items():  # (6) each robot at most one action per step
-                m.add([(X[a][t], 1) for a in acts] + [(X[a][t + 1], -1) for a in acts], hi=1,
-                      name=f"c6[{r},{t + 1}]")
-            m.add([(X[a][t], 1) for a in A] + [(X[a][t + 1], -1) for a in A], lo=1, name=f"c7[{t + 1}]")  # (7)
-        handovers = [a for a in A if graph.actions[a].handover]
-        if graph.single_handover_point and len(handovers) > 1:  # one handover point: one handover per step
-            m.add([(X[a][T - 1], 1) for a in handovers], hi=1, name="handover-point")
-            for t in range(T - 1):
-                m.add([(X[a][t], 1) for a in handovers] + [(X[a][t + 1], -1) for a in handovers], hi=1,
-                      name=f"handover-point[{t + 1}]")
-        for o in graph.must_move:  # (8) M* is moved
-            m.add([(X[a][0], 1) for a in of[o]], lo=1, hi=1, name=f"c8[{o}]")
-        for a in A:  # (9) the obstacles of a selected action are moved
-            for o in graph.blockers(a):
-                m.add([(X[a2][0], 1) for a2 in of[o]] + [(X[a][0], -1)], lo=0, name=f"c9[{a},{o}]")
-        for o in graph.objects:  # (10) each object at most once
-            if o not in must and of[o]:
-                m.add([(X[a][0], 1) for a in of[o]], hi=1, name=f"c10[{o}]")
+        _monotone_and_pending(m, graph, X, of, must, T)
+        _per_step(m, graph, X, uses, T)
+        _moved(m, graph, X, of, must)
         self.precedence(m, graph, X, of, T)
         m.objectives.append(tuple((X[a][0], 1) for a in A))  # the number of moved objects
 
@@ -86,3 +61,52 @@ class PaperEncoding(Encoding):
                 terms = [(v, 1) for v in X[a]] + [(v, -1) for a2 in of[o] for v in X[a2]]
                 m.add_if([(X[a][0], True)], terms, lo=1 if strict else 0,
                          name=f"c{11 if strict else 12}[{a},{o}]", big_m=T + 1 if strict else T)
+
+
+def _monotone_and_pending(m: SkeletonModel, graph: TaskGraph, X: list[list[int]], of: dict[str, list[int]],
+                          must: set[str], T: int) -> None:
+    """(1) "at or after t" is monotone; (3) objects outside M* move only while an action they block is
+    pending."""
+    A = range(len(graph.actions))
+    for a in A:
+        for t in range(T - 1):
+            m.add([(X[a][t], 1), (X[a][t + 1], -1)], lo=0, name=f"c1[{a},{t + 1}]")
+    for o in graph.objects:
+        if o in must:
+            continue
+        blocked = graph.blocked_by(o)
+        for a2 in of[o]:
+            for t in range(T):
+                m.add([(X[a2][t], 1)] + [(X[a][t], -1) for a in blocked], hi=0, name=f"c3[{o},{a2},{t + 1}]")
+
+
+def _per_step(m: SkeletonModel, graph: TaskGraph, X: list[list[int]], uses: dict[str, list[int]], T: int) -> None:
+    """(4)-(7): each robot at most one action per step, no step empty; with one handover point, at most one
+    handover per step."""
+    A = range(len(graph.actions))
+    for r, acts in uses.items():  # (4) each robot at most one action at the last step
+        m.add([(X[a][T - 1], 1) for a in acts], hi=1, name=f"c4[{r}]")
+    m.add([(X[a][T - 1], 1) for a in A], lo=1, name="c5")  # (5) the last step is not empty
+    for t in range(T - 1):
+        for r, acts in uses.items():  # (6) each robot at most one action per step
+            m.add([(X[a][t], 1) for a in acts] + [(X[a][t + 1], -1) for a in acts], hi=1,
+                  name=f"c6[{r},{t + 1}]")
+        m.add([(X[a][t], 1) for a in A] + [(X[a][t + 1], -1) for a in A], lo=1, name=f"c7[{t + 1}]")  # (7)
+    handovers = [a for a in A if graph.actions[a].handover]
+    if graph.single_handover_point and len(handovers) > 1:  # one handover point: one handover per step
+        m.add([(X[a][T - 1], 1) for a in handovers], hi=1, name="handover-point")
+        for t in range(T - 1):
+            m.add([(X[a][t], 1) for a in handovers] + [(X[a][t + 1], -1) for a in handovers], hi=1,
+                  name=f"handover-point[{t + 1}]")
+
+
+def _moved(m: SkeletonModel, graph: TaskGraph, X: list[list[int]], of: dict[str, list[int]], must: set[str]) -> None:
+    """(8) M* is moved; (9) the obstacles of a selected action are moved; (10) each object at most once."""
+    for o in graph.must_move:
+        m.add([(X[a][0], 1) for a in of[o]], lo=1, hi=1, name=f"c8[{o}]")
+    for a in range(len(graph.actions)):
+        for o in graph.blockers(a):
+            m.add([(X[a2][0], 1) for a2 in of[o]] + [(X[a][0], -1)], lo=0, name=f"c9[{a},{o}]")
+    for o in graph.objects:
+        if o not in must and of[o]:
+            m.add([(X[a][0], 1) for a in of[o]], hi=1, name=f"c10[{o}]")

@@ -21,10 +21,13 @@ from mrgc.compiler.task_graph import TaskGraph
 
 
 class TimeOfMoveEncoding(Encoding):
+    """The time-of-move encoding (module docstring): one integer step per object, no horizon loop."""
+
     name = "time-of-move"
     horizon_loop = False
 
     def build(self, graph: TaskGraph, horizon: int) -> Encoded:
+        """The model for ``graph`` with steps up to ``horizon``."""
         H = horizon
         m = SkeletonModel(name=f"{self.name}-H{H}")
         A = range(len(graph.actions))
@@ -51,17 +54,7 @@ class TimeOfMoveEncoding(Encoding):
                 m.add([(y[a2], 1) for a2 in of[o]] + [(y[a], -1)], lo=0, name=f"obstacle[{a},{o}]")
                 m.add_if([(y[a], True)], [(tau[me], 1), (tau[o], -1)], lo=1 if strict else 0,
                          name=f"{'pick' if strict else 'place'}-before[{a},{o}]")
-        for r in graph.robots:
-            tasks = []
-            for o in graph.objects:
-                mine = [a for a in of[o] if r in graph.actions[a].robots]
-                if not mine:
-                    continue
-                busy = m.bool_var(f"busy({r},{o})")
-                m.add([(busy, 1)] + [(y[a], -1) for a in mine], lo=0, hi=0, name=f"busy[{r},{o}]")
-                tasks.append((busy, tau[o]))
-            if len(tasks) > 1:
-                m.no_overlap.append(NoOverlap(tuple(tasks), name=f"robot[{r}]"))
+        _one_object_per_step(m, graph, y, tau, of)
         handovers = [a for a in A if graph.actions[a].handover]
         if graph.single_handover_point and len(handovers) > 1:  # one handover point: one handover per step
             m.no_overlap.append(NoOverlap(tuple((y[a], tau[graph.actions[a].obj]) for a in handovers),
@@ -82,3 +75,20 @@ class TimeOfMoveEncoding(Encoding):
             return skeleton_from_schedule(graph, schedule)
 
         return Encoded(m, list(y), H, decode)
+
+
+def _one_object_per_step(m: SkeletonModel, graph: TaskGraph, y: list[int], tau: dict[str, int],
+                         of: dict[str, list[int]]) -> None:
+    """Per robot, the objects it handles occupy distinct steps: a no-overlap of unit tasks, one per object,
+    present when one of the robot's actions on it is selected."""
+    for r in graph.robots:
+        tasks = []
+        for o in graph.objects:
+            mine = [a for a in of[o] if r in graph.actions[a].robots]
+            if not mine:
+                continue
+            busy = m.bool_var(f"busy({r},{o})")
+            m.add([(busy, 1)] + [(y[a], -1) for a in mine], lo=0, hi=0, name=f"busy[{r},{o}]")
+            tasks.append((busy, tau[o]))
+        if len(tasks) > 1:
+            m.no_overlap.append(NoOverlap(tuple(tasks), name=f"robot[{r}]"))

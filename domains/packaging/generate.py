@@ -18,6 +18,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 
 
 def main() -> None:
+    """Write the shipped grid benchmarks into this folder."""
     for name, n, arms, seed in SHIPPED:
         with open(os.path.join(HERE, f"{name}.mrg"), "w", encoding="utf-8") as fh:
             fh.write(grid_benchmark(name, n, arms, seed))

@@ -37,6 +37,7 @@ class Method:
     title: str
 
     def entry(self) -> Callable[..., "Plan"]:
+        """The baseline's planning function (imported on first use)."""
         fn: Callable[..., Plan] = getattr(importlib.import_module(self.module), self.function)
         return fn
 

@@ -105,6 +105,8 @@ class SymbolicSteps:
 
     def ground(self, actions: tuple[Action, ...], fut: set[str], free: set[str], strict: bool, v_fut: list[Any],
                key: str, index: int) -> Attempt | Failure:
+        """Ground the step ``actions`` against the future volume (reverse search): an :class:`Attempt` or the
+        :class:`~mrgc.planner.outcome.Failure` that stopped it."""
         facts, same = self.facts, {a.obj for a in actions}
         hits: set[str] = set()
         for a in actions:

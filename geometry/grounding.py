@@ -21,7 +21,7 @@ from __future__ import annotations
 import enum
 import hashlib
 from dataclasses import dataclass, field
-from typing import Iterable, Sequence
+from typing import Callable, Iterable, Iterator, Sequence
 
 import numpy as np
 
@@ -52,6 +52,8 @@ NEIGHBOURHOOD = 0.10
 #: search costs all of them, at 0.5-1.5 ms a check (an arm holding an object, 1 cm steps), and a step tries
 #: several placements; 20,000 (motion.MAX_CHECKS) let one grounding run for minutes on a loaded machine
 TRANSFER_CHECKS = 4_000
+#: the share of an arm's reach bound that :meth:`Grounder.comfortable` placements keep within
+COMFORT = 0.85
 #: path answers (transfers, base paths) remembered per grounder
 REMEMBERED = 4096
 #: pairs of exchange configurations tried for a handover before the two arms are said to collide
@@ -231,9 +233,22 @@ class Grounder:
         corners and walls first, so that each object leaves the largest free space in the middle for the
         ones placed before it (the reverse search places the last object first); the middle-first lattice
         scatters them and leaves no room for a third or fourth."""
+        for pose in self.placements(obj, region, avoid, volume, samples, key, packed):
+            if skip == 0:
+                return Answer(Status.OK, pose=pose)
+            skip -= 1  # the caller wants a different placement than the ones it already tried
+        return Answer(Status.NO_PLACEMENT)
+
+    def placements(self, obj: str, region: str, avoid: Iterable[str] = (), volume: Volume | None = None,
+                   samples: int = 200, key: str = "", packed: bool = False,
+                   prefer: Callable[[np.ndarray], float] | None = None) -> Iterator[np.ndarray]:
+        """The poses :meth:`placement` would return with ``skip`` 0, 1, 2 ..., in that order, each checked
+        once (asking :meth:`placement` for the k-th checks the first k again).  ``prefer`` (a rank of a pose,
+        e.g. :meth:`comfortable`'s) orders the grid and lattice candidates by rank, keeping their order
+        among equal ranks."""
         body, reg = self.scene.body(obj), self.scene.body(region)
         if not isinstance(reg.shape, Box):
-            return Answer(Status.NO_PLACEMENT)
+            return
         rng = np.random.default_rng(seed_for("placement", obj, region, key, seed=self.seed))
         h_o, h_r = half_extents(body.shape), half_extents(reg.shape)
         vol_world = self._volume_world(volume) if volume else None
@@ -247,6 +262,10 @@ class Grounder:
         fixed: list[tuple[float, float, float]] = [(0.0, a * room[0], b * room[1]) for a, b in lattice]
         if packed:
             fixed = _packing_grid(h_r[:2] - min(h_o[0], h_o[1])) + fixed
+        if prefer is not None:  # accepted ones first in their order, then the others by the preference's rank
+            rank = {c: prefer(reg.pose @ translation(c[1], c[2], -h_r[2] + h_o[2] + LIFT) @ rot_z(c[0]))
+                    for c in fixed}
+            fixed = sorted(fixed, key=lambda c: rank[c])  # stable
         for k in range(len(fixed) + samples):
             if k < len(fixed):
                 yaw, x, y = fixed[k]
@@ -266,11 +285,25 @@ class Grounder:
                 continue
             if vol_world is not None and vol_world.probe_collides(probe, against="volume"):
                 continue
-            if skip > 0:  # the caller wants a different placement than the ones it already tried
-                skip -= 1
-                continue
-            return Answer(Status.OK, pose=pose)
-        return Answer(Status.NO_PLACEMENT)
+            yield pose
+            if volume:  # the caller may have asked other placements meanwhile: the world holds ours again
+                vol_world = self._volume_world(volume)
+
+    def comfortable(self, robot: str, obj: str, grasp: str, share: float = COMFORT) -> Callable[[np.ndarray], float]:
+        """A rank of placements of ``obj`` for ``robot`` holding it with ``grasp``: 0 where the end effector
+        lies within ``share`` of the arm's reach bound from the shoulder, else its distance from the shoulder
+        (nearer first).  A bin at the edge of an arm's reach is reachable in its near part only, and IK at
+        its far corners fails after every restart."""
+        arm = self.arm(robot) if not self.is_planar(robot) else None
+        spec = self.scene.grasp_specs.get(grasp)
+        if arm is None or spec is None:
+            return lambda pose: 0.0
+        g_t = grasp_transform(spec, self.scene.body(obj).shape)
+
+        def rank(pose: np.ndarray) -> float:
+            far = float(np.linalg.norm(arm.ee_target(pose @ g_t)[:3, 3] - arm.model.shoulder))
+            return 0.0 if far <= share * arm.model.reach else far
+        return rank
 
     def _volume_world(self, volume: Volume) -> CollisionWorld:
         """A collision world holding ``volume`` (group "volume") for placements (V_fut), kept between calls:

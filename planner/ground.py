@@ -249,17 +249,18 @@ class ReverseGrounder:
             start, lift = answer.configs[1], False  # the taker's transfer starts at the exchange
         last: Failure | None = None
         tried = 0  # placements that failed for another reason than being out of the arm's reach
-        for k in range(PLACEMENT_TRIES + OUT_OF_REACH_TRIES):
+        # goal bins are shared by several objects: packed from the corners; elsewhere (moving an obstacle
+        # aside) the middle of the region first, nearest the arms that reach it
+        spots = g.placements(a.obj, a.region, avoid=avoid, volume=v_fut, key=key,
+                             packed=self.goal.get(a.obj) == a.region,
+                             prefer=g.comfortable(a.place_robot, a.obj, a.place_grasp))
+        for _ in range(PLACEMENT_TRIES + OUT_OF_REACH_TRIES):
             if tried >= PLACEMENT_TRIES:
                 break
-            # goal bins are shared by several objects: packed from the corners; elsewhere (moving an obstacle
-            # aside) the middle of the region first, nearest the arms that reach it
-            spot = g.placement(a.obj, a.region, avoid=avoid, volume=v_fut, key=key, skip=k,
-                               packed=self.goal.get(a.obj) == a.region)
-            if not spot.ok:
+            pose = next(spots, None)
+            if pose is None:
                 return last or Failure(0, "", f"placement: no free pose of {a.obj} in {a.region}")
-            assert spot.pose is not None
-            place = g.place(a.place_robot, a.obj, a.place_grasp, spot.pose, avoid=avoid, busy=busy.get("place", []))
+            place = g.place(a.place_robot, a.obj, a.place_grasp, pose, avoid=avoid, busy=busy.get("place", []))
             if not place.ok:
                 last = _failed(f"place by {a.place_robot}", place)
                 tried += place.status is not Status.NO_IK
@@ -272,11 +273,11 @@ class ReverseGrounder:
             if not carry.ok:
                 last = _failed(f"carry to the placement by {a.place_robot}", carry)
                 continue
-            planned.place_pose = _matrix(spot.pose)
+            planned.place_pose = _matrix(pose)
             planned.configs["place"] = _configs(place.configs)
             planned.paths["to-place"] = _configs(np.array(carry.path))
             if self.full:
-                transits = self._transits(a, planned, avoid, busy, {**(placed or {}), a.obj: spot.pose})
+                transits = self._transits(a, planned, avoid, busy, {**(placed or {}), a.obj: pose})
                 if isinstance(transits, Failure):
                     last = transits
                     continue

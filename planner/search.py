@@ -14,19 +14,19 @@ verdict (``validation``).
 from __future__ import annotations
 
 import time
-from typing import Any, Callable
+from typing import TYPE_CHECKING, Any, Callable
 
 from mrgc.compiler.enumerate import EXHAUSTED
 from mrgc.compiler.facts import FactBase
 from mrgc.compiler.skeleton import Skeleton
-from mrgc.geometry.grounding import Grounder
-from mrgc.geometry.scene import scene_from_problem
 from mrgc.language.model import Problem
-from mrgc.planner.ground import GroundedStep, Grounding, Outcome, ReverseGrounder, moved_objects
-from mrgc.planner.mcts import MCTS
 from mrgc.planner.outcome import BlockingCycle, Failure, PlanStatus, Why
 from mrgc.planner.plan import Plan, PlannedAction, planner_motion_model
 from mrgc.planner.skeletons import DEFAULT_BACKEND, DEFAULT_ENCODING, SkeletonSource, must_move, problem_facts
+
+if TYPE_CHECKING:  # the geometric modules load numpy and coal: a symbolic problem never imports them
+    from mrgc.geometry.grounding import Grounder
+    from mrgc.planner.ground import GroundedStep, Grounding
 
 #: a search log line sink (``mrgc plan --verbose`` prints them)
 Log = Callable[[str], None]
@@ -98,6 +98,11 @@ def plan_problem(problem: Problem, problem_file: str, sha256: str, version: str,
             why.summary = f"skeleton generation did not finish within {time_limit:g} s"
         stats["skeleton_seconds"] = round(time.perf_counter() - t0 - facts_seconds, 4)
     else:
+        from mrgc.geometry.grounding import Grounder
+        from mrgc.geometry.scene import scene_from_problem
+        from mrgc.planner.ground import Outcome, ReverseGrounder
+        from mrgc.planner.mcts import MCTS
+
         scene = scene_from_problem(problem)
         grounder = Grounder(scene, seed=seed)
         reverse = ReverseGrounder(grounder, problem.goal_regions, full=motions == "full")
@@ -167,6 +172,7 @@ def _referee(problem: Problem, problem_file: str, plan: Plan, result: Grounding,
              verdicts: dict[str, Any]) -> Grounding:
     """The validator's verdict on a complete grounded plan: SUCCESS stays SUCCESS only when it accepts it;
     otherwise the grounding is a failure (named by the validator's first violation)."""
+    from mrgc.planner.ground import Grounding, Outcome
     from mrgc.planner.validate import validate
 
     candidate = Plan(plan.problem, plan.problem_file, plan.problem_sha256, plan.mrgc_version, plan.backend,
@@ -209,6 +215,8 @@ def _summary(status: PlanStatus, ended: str, time_limit: float, max_iterations: 
 
 
 def _log_line(elapsed: float, n: int, skel: Skeleton, suffix: list[GroundedStep], result: Grounding) -> str:
+    from mrgc.planner.ground import Outcome, moved_objects
+
     head = f"[t={elapsed:.1f}s] skeleton {n} (makespan {skel.makespan}, moves {len(skel.moved)}"
     head += f", under a suffix of {len(suffix)} step{'s' * (len(suffix) != 1)})" if suffix else ")"
     if result.outcome is Outcome.SUCCESS:

@@ -191,6 +191,13 @@ class ScriptedGrounder:
                   skip: int = 0, packed: bool = False) -> Answer:
         return Answer(Status.OK, pose=np.eye(4))
 
+    def placements(self, obj: str, region: str, avoid: Any = (), volume: Any = None, key: str = "",
+                   packed: bool = False, prefer: Any = None) -> Any:
+        yield np.eye(4)
+
+    def comfortable(self, robot: str, obj: str, grasp: str) -> Any:
+        return lambda pose: 0.0
+
     def arm_volume(self, robot: str, configs: np.ndarray, holding: Any = None, grasp: Any = None) -> list[Any]:
         return [(f"arm:{robot}:{holding[0] if holding else ''}", None)]
 

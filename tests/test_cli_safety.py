@@ -19,7 +19,7 @@ from pathlib import Path
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from support import ROOT
+from support import ROOT, run_cli
 
 from mrgc import cli, outputs, signals, workers
 from mrgc.errors import InputError, InternalError
@@ -42,13 +42,10 @@ def mrgc(capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch):  
     """``mrgc ARGV`` in this process (``cli.main``), run from ``cwd``: as ``run`` but without the start-up."""
 
     def call(*argv: str | Path, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
-        capsys.readouterr()
         with monkeypatch.context() as m:
             if cwd is not None:
                 m.chdir(cwd)
-            code = cli.main([str(a) for a in argv])
-        out, err = capsys.readouterr()
-        assert "Traceback" not in err and "internal error" not in err, err[-2000:]
+            code, out, err = run_cli(capsys, *argv)
         return subprocess.CompletedProcess(list(argv), code, out, err)
 
     return call

@@ -26,13 +26,13 @@ from typing import Callable, Iterable, Iterator, Sequence
 import numpy as np
 
 from mrgc.geometry.arm import Arm
-from mrgc.geometry.collision import CollisionShape, CollisionWorld, collision_shape
+from mrgc.geometry.collision import CollisionShape, CollisionWorld, collision_shape, scene_world
+from mrgc.geometry.conventions import APPROACH_SAMPLES, ARM_PLACE_LIFT, lattice_offsets, refine, se2, seed_for, to_se2
 from mrgc.geometry.grasps import APPROACH, finger_opening, fits, grasp_transform, pregrasp_transform
 from mrgc.geometry.ik import solve_ik_many
 from mrgc.geometry.lattice import LatticePlanner, box_corners
 from mrgc.geometry.motion import MAX_CHECKS, plan_joint_path
-from mrgc.geometry.planar import DiscGrid, PlanarRobot, is_planar, scene_bounds, se2, to_se2
-from mrgc.geometry.predicates import APPROACH_SAMPLES, LIFT, refine, scene_world, seed_for
+from mrgc.geometry.planar import DiscGrid, PlanarRobot, is_planar, scene_bounds
 from mrgc.geometry.scene import SceneSpec, half_extents, inside
 from mrgc.geometry.transforms import rot_z, translation
 from mrgc.language.model import Box, Shape
@@ -257,13 +257,11 @@ class Grounder:
         # first the 3 × 3 lattice phase 1 uses (so a placement the facts relied on is tried first), then
         # random positions and the four yaws
         room = np.maximum(h_r[:2] - h_o[:2], 0) * 0.9
-        lattice = sorted(((a, b) for a in (-1.0, 0.0, 1.0) for b in (-1.0, 0.0, 1.0)),
-                         key=lambda ab: (ab[0] ** 2 + ab[1] ** 2, ab))
-        fixed: list[tuple[float, float, float]] = [(0.0, a * room[0], b * room[1]) for a, b in lattice]
+        fixed: list[tuple[float, float, float]] = [(0.0, a * room[0], b * room[1]) for a, b in lattice_offsets(3)]
         if packed:
             fixed = _packing_grid(h_r[:2] - min(h_o[0], h_o[1])) + fixed
         if prefer is not None:  # accepted ones first in their order, then the others by the preference's rank
-            rank = {c: prefer(reg.pose @ translation(c[1], c[2], -h_r[2] + h_o[2] + LIFT) @ rot_z(c[0]))
+            rank = {c: prefer(reg.pose @ translation(c[1], c[2], -h_r[2] + h_o[2] + ARM_PLACE_LIFT) @ rot_z(c[0]))
                     for c in fixed}
             fixed = sorted(fixed, key=lambda c: rank[c])  # stable
         for k in range(len(fixed) + samples):
@@ -272,7 +270,7 @@ class Grounder:
             else:
                 yaw = (np.pi / 2) * (k % 4)
                 x, y = rng.uniform(-1, 1, 2) * np.maximum(h_r[:2] - min(h_o[0], h_o[1]), 0)
-            pose = reg.pose @ translation(x, y, -h_r[2] + h_o[2] + LIFT) @ rot_z(yaw)
+            pose = reg.pose @ translation(x, y, -h_r[2] + h_o[2] + ARM_PLACE_LIFT) @ rot_z(yaw)
             if not inside(reg, body.shape, pose):
                 continue
             probe = [(shape, pose)]

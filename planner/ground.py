@@ -23,9 +23,8 @@ import numpy as np
 from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action
 from mrgc.geometry.collision import CollisionWorld
+from mrgc.geometry.conventions import refine, to_se2
 from mrgc.geometry.grounding import BUSY, Answer, Grounder, Status, Volume
-from mrgc.geometry.predicates import refine
-from mrgc.geometry.planar import to_se2
 from mrgc.planner.outcome import Failure
 from mrgc.planner.plan import PlannedAction
 

@@ -12,7 +12,7 @@ grounds steps) and answers:
 - :meth:`arm_volume` / :meth:`base_volume`: the swept volume of configurations or a path, and
   :meth:`hits`: which objects a volume overlaps.
 
-Every answer carries a :class:`Status`; failures are values, never exceptions.  Seeds derive from the
+Every answer carries a :class:`GroundStatus`; failures are values, never exceptions.  Seeds derive from the
 query, so the same queries in the same order give the same answers.
 """
 
@@ -68,7 +68,9 @@ CONTACT_START = 1.5
 BUSY = "another robot of the step moves there in the same phase"
 
 
-class Status(str, enum.Enum):
+class GroundStatus(str, enum.Enum):
+    """How a geometric query of the grounding ended (its value is what a failure line says)."""
+
     OK = "ok"
     NO_PLACEMENT = "no placement"
     NO_IK = "no inverse kinematics"
@@ -81,7 +83,7 @@ class Status(str, enum.Enum):
 class Answer:
     """A status and, when OK, the values found (``pose``, ``configs``, ``path``), plus what blocked."""
 
-    status: Status
+    status: GroundStatus
     pose: np.ndarray | None = None
     configs: np.ndarray | None = None  # (C, dof): approach configurations, pre-grasp first
     path: list[np.ndarray] = field(default_factory=list)
@@ -92,7 +94,7 @@ class Answer:
 
     @property
     def ok(self) -> bool:
-        return self.status is Status.OK
+        return self.status is GroundStatus.OK
 
 
 class Grounder:
@@ -235,9 +237,9 @@ class Grounder:
         scatters them and leaves no room for a third or fourth."""
         for pose in self.placements(obj, region, avoid, volume, samples, key, packed):
             if skip == 0:
-                return Answer(Status.OK, pose=pose)
+                return Answer(GroundStatus.OK, pose=pose)
             skip -= 1  # the caller wants a different placement than the ones it already tried
-        return Answer(Status.NO_PLACEMENT)
+        return Answer(GroundStatus.NO_PLACEMENT)
 
     def placements(self, obj: str, region: str, avoid: Iterable[str] = (), volume: Volume | None = None,
                    samples: int = 200, key: str = "", packed: bool = False,
@@ -319,11 +321,11 @@ class Grounder:
         spec = self.scene.grasp_specs.get(grasp)
         arm = self.arm(robot)
         if spec is None or not fits(spec, self.scene.body(obj).shape, arm.spec.kind):
-            return Answer(Status.NO_IK)  # no geometry, or the gripper does not open wide enough
+            return Answer(GroundStatus.NO_IK)  # no geometry, or the gripper does not open wide enough
         g_t = grasp_transform(spec, self.scene.body(obj).shape)
         avoid = tuple(a for a in avoid if a != obj)
         blockers: set[str] = set()
-        status = Status.NO_IK
+        status = GroundStatus.NO_IK
         moving = self._busy_world(busy) if busy else None
         clash: tuple[str, Volume] | None = None  # the last attempt's collision not with ``avoid``: told at the end
         phase = key.split(":")[0]  # "pick", "place" or "handover"
@@ -336,7 +338,7 @@ class Grounder:
             q = solve_ik_many(arm.model, arm.ee_target(pose @ g_t)[None], seed, q_init=start)[0]
             if not q.solved:
                 if q.status.value == "unreachable":
-                    return Answer(Status.NO_IK)  # provably out of reach: no other seed helps
+                    return Answer(GroundStatus.NO_IK)  # provably out of reach: no other seed helps
                 continue
             if approach:
                 pre = solve_ik_many(arm.model, arm.ee_target(pose @ pregrasp_transform(g_t))[None], seed,
@@ -359,18 +361,18 @@ class Grounder:
             self.queries += 1
             if self.world.probe_collides(volume, against=("fixed", *self._others_home(robot, partner, phase)),
                                          ignore=() if held else (obj,)):
-                status, clash = Status.COLLISION, ("fixed", volume)
+                status, clash = GroundStatus.COLLISION, ("fixed", volume)
                 continue
             hit = self.world.probe_hits(volume, against=avoid) if avoid else set()
             if hit:
                 blockers |= hit
-                status = Status.COLLISION
+                status = GroundStatus.COLLISION
                 continue
             if moving is not None and moving.probe_collides(volume, against="volume"):
                 # another robot of the step moves there meanwhile: another IK seed
-                status, clash = Status.COLLISION, ("moving", volume)
+                status, clash = GroundStatus.COLLISION, ("moving", volume)
                 continue
-            return Answer(Status.OK, pose=pose, configs=configs)
+            return Answer(GroundStatus.OK, pose=pose, configs=configs)
         detail = ""
         if clash is not None and not blockers:
             detail = self._clash_detail(robot, partner, phase, clash, ignore=() if held else (obj,))
@@ -408,7 +410,7 @@ class Grounder:
         # random starts: from home IK finds the same solution every time) and tries it against every
         # configuration of the other arm drawn so far, until a pair does not collide
         found: dict[str, list[np.ndarray]] = {giver: [], taker: []}
-        failed = Answer(Status.COLLISION)
+        failed = Answer(GroundStatus.COLLISION)
         worlds: list[CollisionWorld] = []  # the taker's configurations, one world each
         for attempt in range(HANDOVER_PAIRS):
             key = f"handover:{point}" + (f":{attempt}" if attempt else "")
@@ -427,7 +429,7 @@ class Grounder:
                 worlds.append(world)
                 for q in found[giver]:  # the new taker configuration against the giver's earlier ones
                     if not world.probe_collides(self.arm_volume(giver, q[None], grasp=(obj, g1)), against="taker"):
-                        return Answer(Status.OK, pose=pose, configs=np.stack([q, b.configs[-1]]))
+                        return Answer(GroundStatus.OK, pose=pose, configs=np.stack([q, b.configs[-1]]))
             if not a.ok:
                 failed = a
             else:
@@ -436,10 +438,10 @@ class Grounder:
                 volume = self.arm_volume(giver, a.configs[-1:], grasp=(obj, g1))
                 for q, world in zip(found[taker], worlds):  # the new giver configuration against every taker's
                     if not world.probe_collides(volume, against="taker"):
-                        return Answer(Status.OK, pose=pose, configs=np.stack([a.configs[-1], q]))
+                        return Answer(GroundStatus.OK, pose=pose, configs=np.stack([a.configs[-1], q]))
         if not (found[giver] and found[taker]):  # one arm never got there: why (its last attempt)
             return Answer(failed.status, blockers=failed.blockers, detail=failed.detail)
-        return Answer(Status.COLLISION, detail="the two arms collide at every exchange drawn")
+        return Answer(GroundStatus.COLLISION, detail="the two arms collide at every exchange drawn")
 
     # ------------------------------------------------------------ paths
     def arm_path(self, robot: str, start: np.ndarray, goal: np.ndarray, holding: tuple[str, str] | None = None,
@@ -462,7 +464,7 @@ class Grounder:
 
         res = plan_joint_path(arm.model.lower, arm.model.upper, start, goal, valid, max_checks=max_checks,
                               seed=seed_for(robot, "arm-path", seed=self.seed), resolution=resolution)
-        return Answer(Status.OK if res.solved else Status.NO_PATH, path=list(res.path))
+        return Answer(GroundStatus.OK if res.solved else GroundStatus.NO_PATH, path=list(res.path))
 
     def transfer(self, robot: str, obj: str, grasp: str, start: np.ndarray, goal: np.ndarray,
                  avoid: Iterable[str] = (), lift: bool = False, busy: Volume = (), partner: str | None = None
@@ -521,13 +523,13 @@ class Grounder:
         if lift:
             up = self._lift(robot, back[0], self.lift_height(obj))
             if up is None:
-                return Answer(Status.NO_IK)
+                return Answer(GroundStatus.NO_IK)
             first = joint_line(up[:2], PATH_RESOLUTION)  # the object leaves what it rests on: arm alone
             blocked = hits(first, holding=None)
             if blocked is None:  # held from the end of the first centimetre on
                 blocked = hits(first[-1:])
             if blocked is not None:
-                return Answer(Status.COLLISION, blockers=blocked, detail=BUSY if crossed[0] else "")
+                return Answer(GroundStatus.COLLISION, blockers=blocked, detail=BUSY if crossed[0] else "")
             # then centimetre by centimetre as far as the way up is free (an arm waiting at home above the
             # table may stop it early; the carry goes on from there)
             top = 1
@@ -537,12 +539,12 @@ class Grounder:
         line = joint_line(np.stack([back[-1], np.asarray(goal, dtype=float)]), PATH_RESOLUTION)
         blocked = hits(line)
         if blocked is None:
-            return Answer(Status.OK, path=[*back, *line[1:]])
+            return Answer(GroundStatus.OK, path=[*back, *line[1:]])
         planned = self.arm_path(robot, back[-1], np.asarray(goal, dtype=float), holding=held, avoid=others,
                                 resolution=PATH_RESOLUTION, busy=busy, partner=partner, max_checks=TRANSFER_CHECKS)
         if not planned.ok:
-            return Answer(Status.NO_PATH, blockers=blocked, detail=BUSY if crossed[0] else "")
-        return Answer(Status.OK, path=[*back, *planned.path[1:]])
+            return Answer(GroundStatus.NO_PATH, blockers=blocked, detail=BUSY if crossed[0] else "")
+        return Answer(GroundStatus.OK, path=[*back, *planned.path[1:]])
 
     def transit(self, robot: str, start: np.ndarray, goal: np.ndarray, avoid: Iterable[str] = (),
                 busy: Volume = (), via: np.ndarray | None = None, partner: str | None = None,
@@ -565,16 +567,16 @@ class Grounder:
 
         back = joint_line(np.asarray(via if via is not None else [start], dtype=float), PATH_RESOLUTION)
         if not free(back):
-            return Answer(Status.COLLISION)
+            return Answer(GroundStatus.COLLISION)
         line = joint_line(np.stack([back[-1], np.asarray(goal, dtype=float)]), PATH_RESOLUTION)
         if free(line):
-            return Answer(Status.OK, path=[*back, *line[1:]])
+            return Answer(GroundStatus.OK, path=[*back, *line[1:]])
         planned = self.arm_path(robot, back[-1], np.asarray(goal, dtype=float), avoid=tuple(avoid),
                                 resolution=PATH_RESOLUTION, busy=busy, partner=partner, max_checks=TRANSFER_CHECKS,
                                 phase=phase)
         if not planned.ok:
-            return Answer(Status.NO_PATH)
-        return Answer(Status.OK, path=[*back, *planned.path[1:]])
+            return Answer(GroundStatus.NO_PATH)
+        return Answer(GroundStatus.OK, path=[*back, *planned.path[1:]])
 
     def lift_height(self, obj: str) -> float:
         """How far to raise ``obj`` straight up from where it rests before carrying it off: until its bottom
@@ -639,7 +641,7 @@ class Grounder:
         obstacles = frozenset([b.name for b in self.scene.fixed]
                               + [a for a in movers if np.array_equal(self.poses[a], self.scene.body(a).pose)])
         if not self._grids[robot].connected(np.asarray(start), np.asarray(goal), obstacles):
-            return Answer(Status.NO_PATH)  # not even the footprint's inscribed disc gets through
+            return Answer(GroundStatus.NO_PATH)  # not even the footprint's inscribed disc gets through
 
         sweep = None
         if busy:
@@ -669,7 +671,7 @@ class Grounder:
         occupied = lattice.occupancy(parts, bodies)
         res = lattice.plan(occupied, np.asarray(start, dtype=float), np.asarray(goal, dtype=float), valid,
                            PATH_RESOLUTION, PATH_RESOLUTION)
-        return Answer(Status.OK if res.solved else Status.NO_PATH, path=list(res.path))
+        return Answer(GroundStatus.OK if res.solved else GroundStatus.NO_PATH, path=list(res.path))
 
 
 class _PieceWorld:

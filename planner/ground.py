@@ -24,7 +24,7 @@ from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action
 from mrgc.geometry.collision import CollisionWorld
 from mrgc.geometry.conventions import refine, to_se2
-from mrgc.geometry.grounding import BUSY, Answer, Grounder, Status, Volume
+from mrgc.geometry.grounding import BUSY, Answer, Grounder, GroundStatus, Volume
 from mrgc.planner.outcome import Failure
 from mrgc.planner.plan import PlannedAction
 
@@ -262,7 +262,7 @@ class ReverseGrounder:
             place = g.place(a.place_robot, a.obj, a.place_grasp, pose, avoid=avoid, busy=busy.get("place", []))
             if not place.ok:
                 last = _failed(f"place by {a.place_robot}", place)
-                tried += place.status is not Status.NO_IK
+                tried += place.status is not GroundStatus.NO_IK
                 continue
             tried += 1
             assert place.configs is not None
@@ -387,7 +387,7 @@ class ReverseGrounder:
             if ans.ok:
                 return point, ans
             failure = _failed(f"handover at {point}", ans)
-            if ans.status is Status.COLLISION and not ans.blockers and not ans.detail.startswith(("hits", BUSY)):
+            if ans.status is GroundStatus.COLLISION and not ans.blockers and not ans.detail.startswith(("hits", BUSY)):
                 failure = replace(failure, check=f"handover at {point}: the two arms collide",
                                   bodies=tuple(sorted((a.pick_robot, a.place_robot))))
         return failure

@@ -7,7 +7,7 @@ import pytest
 from support import ROOT
 
 from mrgc import parse_file
-from mrgc.geometry.grounding import Grounder, Status
+from mrgc.geometry.grounding import Grounder, GroundStatus
 from mrgc.geometry.planar import to_se2
 from mrgc.geometry.scene import inside, scene_from_problem
 from mrgc.geometry.transforms import translation
@@ -32,20 +32,20 @@ def test_placement_avoids_a_swept_volume(pa3: Grounder) -> None:
     region = pa3.scene.body("start")
     volume = [(pa3.shape("o1"), region.pose @ translation(x, y, -0.09)) for x in np.linspace(-0.15, 0.15, 7)
               for y in np.linspace(-0.15, 0.15, 7)]
-    assert pa3.placement("o2", "start", volume=volume, samples=40).status is Status.NO_PLACEMENT
+    assert pa3.placement("o2", "start", volume=volume, samples=40).status is GroundStatus.NO_PLACEMENT
     assert pa3.placement("o2", "start", volume=volume[:1], samples=40).ok
 
 
 def test_pick_reports_the_objects_in_the_way(pa3: Grounder) -> None:
     blocked = pa3.pick("r1", "o1", "side-x+", avoid=["o2", "o3"])
-    assert blocked.status is Status.COLLISION and "o2" in blocked.blockers
+    assert blocked.status is GroundStatus.COLLISION and "o2" in blocked.blockers
     free = pa3.pick("r1", "o1", "top", avoid=["o2", "o3"])
     assert free.ok and free.configs is not None and free.configs.shape == (5, 7)
     assert pa3.arm("r1").model.within_limits(free.configs).all()
     # the last configuration puts the tool at the grasp
     tool = pa3.arm("r1").tool_world(free.configs[-1])
     assert np.linalg.norm(tool[:3, 3] - (pa3.poses["o1"][:3, 3] + [0, 0, 0.04])) < 1e-3
-    assert pa3.pick("r2", "o1", "top").status is Status.NO_IK  # out of r2's reach
+    assert pa3.pick("r2", "o1", "top").status is GroundStatus.NO_IK  # out of r2's reach
 
 
 def test_moving_an_object_clears_the_way(pa3: Grounder) -> None:
@@ -60,7 +60,7 @@ def test_handover_and_place(pa3: Grounder) -> None:
     target = pa3.placement("o1", "bin-b")
     assert target.ok and target.pose is not None
     assert pa3.place("r2", "o1", "top", target.pose).ok
-    assert pa3.place("r1", "o1", "top", target.pose).status is Status.NO_IK
+    assert pa3.place("r1", "o1", "top", target.pose).status is GroundStatus.NO_IK
 
 
 def test_transfer_lifts_then_carries_to_the_pre_place(pa3: Grounder) -> None:
@@ -92,7 +92,7 @@ def test_transfer_names_what_blocks_it(pa3: Grounder) -> None:
     # an object put right above o1 is in the way of the lift
     pa3.move("o2", pa3.poses["o1"] @ translation(0, 0, 0.15))
     blocked = pa3.transfer("r1", "o1", "top", pick.configs[-1], pick.configs[0], avoid=["o2"], lift=True)
-    assert blocked.status is Status.COLLISION and blocked.blockers == {"o2"}
+    assert blocked.status is GroundStatus.COLLISION and blocked.blockers == {"o2"}
 
 
 def test_packed_placements_fill_a_bin_from_its_corners(pa3: Grounder) -> None:

@@ -19,7 +19,7 @@ from support import ROOT
 from mrgc import __version__, cli, parse_file
 from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action
-from mrgc.geometry.grounding import BUSY, Answer, Status
+from mrgc.geometry.grounding import BUSY, Answer, GroundStatus
 from mrgc.planner.ground import GroundedStep, Outcome, ReverseGrounder
 from mrgc.planner.outcome import EXIT_CODES, PlanStatus
 from mrgc.planner.plan import PlannedAction, file_sha256
@@ -175,21 +175,21 @@ class ScriptedGrounder:
     def pick(self, robot: str, obj: str, grasp: str, avoid: Any = (), busy: Any = ()) -> Answer:
         hit = self.blocked_by.get(obj, set()) & set(avoid)
         if hit:
-            return Answer(Status.COLLISION, blockers=hit)
+            return Answer(GroundStatus.COLLISION, blockers=hit)
         if obj in self.crowded and busy:
-            return Answer(Status.COLLISION, detail=BUSY)
-        return Answer(Status.OK, configs=np.array([[0.0], [1.0]]))
+            return Answer(GroundStatus.COLLISION, detail=BUSY)
+        return Answer(GroundStatus.OK, configs=np.array([[0.0], [1.0]]))
 
     def place(self, robot: str, obj: str, grasp: str, pose: np.ndarray, avoid: Any = (), busy: Any = ()) -> Answer:
-        return Answer(Status.OK, configs=np.array([[1.0], [0.0]]))
+        return Answer(GroundStatus.OK, configs=np.array([[1.0], [0.0]]))
 
     def transfer(self, robot: str, obj: str, grasp: str, start: np.ndarray, goal: np.ndarray, avoid: Any = (),
                  lift: bool = False, busy: Any = (), partner: Any = None) -> Answer:
-        return Answer(Status.OK, path=[np.asarray(start), np.asarray(goal)])
+        return Answer(GroundStatus.OK, path=[np.asarray(start), np.asarray(goal)])
 
     def placement(self, obj: str, region: str, avoid: Any = (), volume: Any = None, key: str = "",
                   skip: int = 0, packed: bool = False) -> Answer:
-        return Answer(Status.OK, pose=np.eye(4))
+        return Answer(GroundStatus.OK, pose=np.eye(4))
 
     def placements(self, obj: str, region: str, avoid: Any = (), volume: Any = None, key: str = "",
                    packed: bool = False, prefer: Any = None) -> Any:

@@ -35,10 +35,6 @@ class BatchOutcome(enum.StrEnum):
     ERROR = "error"
 
 
-#: the former name of ``BatchOutcome.EXHAUSTED``, kept while planner/search.py still imports it
-EXHAUSTED = BatchOutcome.EXHAUSTED
-
-
 @dataclass
 class Batch:
     """What one call of :meth:`SkeletonGenerator.next` produced."""

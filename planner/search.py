@@ -16,7 +16,7 @@ from __future__ import annotations
 import time
 from typing import TYPE_CHECKING, Any, Callable
 
-from mrgc.compiler.enumerate import EXHAUSTED
+from mrgc.compiler.enumerate import BatchOutcome
 from mrgc.compiler.facts import FactBase
 from mrgc.compiler.skeleton import Skeleton
 from mrgc.language.model import Problem
@@ -89,7 +89,7 @@ def plan_problem(problem: Problem, problem_file: str, sha256: str, version: str,
         if first:
             plan.status = PlanStatus.SOLVED
             plan.steps = [[_planned(a) for a in step] for step in first[0].steps]
-        elif more.state["outcome"] == EXHAUSTED:  # type: ignore[attr-defined]
+        elif more.state["outcome"] is BatchOutcome.EXHAUSTED:  # type: ignore[attr-defined]
             plan.status = PlanStatus.INFEASIBLE
             why.facts = infeasible_reasons(roots[0])
             why.summary = "infeasible by the facts"
@@ -130,7 +130,7 @@ def plan_problem(problem: Problem, problem_file: str, sha256: str, version: str,
             plan.status = PlanStatus.INTERRUPTED
         elif result.ended in ("time limit", "iteration limit") or time.perf_counter() >= deadline:
             plan.status = PlanStatus.TIME_LIMIT
-        elif root_state["count"] == 0 and root_state["outcome"] == EXHAUSTED:
+        elif root_state["count"] == 0 and root_state["outcome"] is BatchOutcome.EXHAUSTED:
             plan.status = PlanStatus.INFEASIBLE
             why.facts = infeasible_reasons(roots[0])
             why.cycles = _cycles_with_evidence(roots[0], grounder)

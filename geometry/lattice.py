@@ -36,6 +36,7 @@ from typing import Callable, Hashable, Sequence, Union
 import numpy as np
 
 from mrgc.geometry.collision import CollisionShape
+from mrgc.geometry.conventions import wrap_angle
 from mrgc.geometry.motion import MotionResult, MotionStatus
 from mrgc.geometry.scene import outline
 from mrgc.language.model import Shape
@@ -109,17 +110,12 @@ def _normals(poly: np.ndarray) -> np.ndarray:
     return np.stack([-e[:, 1], e[:, 0]], axis=1)
 
 
-def wrap(angle: float) -> float:
-    """``angle`` in [-π, π)."""
-    return (float(angle) + math.pi) % (2 * math.pi) - math.pi
-
-
 def interpolate(a: np.ndarray, b: np.ndarray, resolution: float, yaw_resolution: float) -> list[np.ndarray]:
     """The states of the straight motion from ``a`` to ``b`` (yaw the short way round), ``a`` excluded, ``b``
     included, no step longer than the resolutions."""
-    d = np.array([b[0] - a[0], b[1] - a[1], wrap(b[2] - a[2])])
+    d = np.array([b[0] - a[0], b[1] - a[1], wrap_angle(b[2] - a[2])])
     n = max(1, math.ceil(math.hypot(d[0], d[1]) / resolution - 1e-9), math.ceil(abs(d[2]) / yaw_resolution - 1e-9))
-    return [np.array([a[0] + d[0] * s, a[1] + d[1] * s, wrap(a[2] + d[2] * s)]) for s in np.arange(1, n + 1) / n]
+    return [np.array([a[0] + d[0] * s, a[1] + d[1] * s, wrap_angle(a[2] + d[2] * s)]) for s in np.arange(1, n + 1) / n]
 
 
 class LatticePlanner:
@@ -140,7 +136,7 @@ class LatticePlanner:
     # ------------------------------------------------------------------------------------ lattice states
     def state(self, k: int, i: int, j: int) -> np.ndarray:
         return np.array([self.xmin + (i + 0.5) * self.cell, self.ymin + (j + 0.5) * self.cell,
-                         wrap(self.headings[k])])
+                         wrap_angle(self.headings[k])])
 
     def _near(self, q: np.ndarray) -> list[tuple[int, int, int]]:
         """Lattice states near ``q``, nearest first (position, then heading)."""
@@ -245,8 +241,8 @@ class LatticePlanner:
         def result(status: MotionStatus, path: list[np.ndarray] | None = None) -> MotionResult:
             return MotionResult(status, path or [], time.perf_counter() - t0, checks[0])
 
-        p0 = np.array([start[0], start[1], wrap(start[2])], dtype=float)
-        p1 = np.array([goal[0], goal[1], wrap(goal[2])], dtype=float)
+        p0 = np.array([start[0], start[1], wrap_angle(start[2])], dtype=float)
+        p1 = np.array([goal[0], goal[1], wrap_angle(goal[2])], dtype=float)
         if not ok(p0):
             return result(MotionStatus.INVALID_START)
         if not ok(p1):

@@ -11,7 +11,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from mrgc.geometry.collision import CollisionWorld, collision_shape
-from mrgc.geometry.lattice import LatticePlanner, hull2d, interpolate, wrap
+from mrgc.geometry.conventions import wrap_angle
+from mrgc.geometry.lattice import LatticePlanner, hull2d, interpolate
 from mrgc.geometry.motion import MotionStatus
 from mrgc.geometry.planar import se2
 from mrgc.geometry.transforms import rot_z, translation
@@ -54,9 +55,9 @@ def plan(obstacles, start, goal, parts=((ROBOT, LIFT),)):
 def assert_valid_path(res, start, goal, valid) -> None:
     assert res.status is MotionStatus.SOLVED
     assert np.allclose(res.path[0], start) and np.allclose(res.path[-1][:2], goal[:2])
-    assert abs(wrap(res.path[-1][2] - goal[2])) < 1e-9
+    assert abs(wrap_angle(res.path[-1][2] - goal[2])) < 1e-9
     for a, b in zip(res.path, res.path[1:]):  # dense: no step longer than the resolution
-        assert math.hypot(b[0] - a[0], b[1] - a[1]) <= 0.01 + 1e-9 and abs(wrap(b[2] - a[2])) <= 0.01 + 1e-9
+        assert math.hypot(b[0] - a[0], b[1] - a[1]) <= 0.01 + 1e-9 and abs(wrap_angle(b[2] - a[2])) <= 0.01 + 1e-9
     assert all(valid(q) for q in res.path)
 
 
@@ -99,7 +100,7 @@ def test_interpolate_turns_the_short_way_and_keeps_steps_small() -> None:
     states = interpolate(a, b, 0.01, 0.01)
     assert np.allclose(states[-1], [0.05, 0.0, -3.0])
     yaws = [a[2]] + [q[2] for q in states]
-    assert max(abs(wrap(v - u)) for u, v in zip(yaws, yaws[1:])) <= 0.01 + 1e-9
+    assert max(abs(wrap_angle(v - u)) for u, v in zip(yaws, yaws[1:])) <= 0.01 + 1e-9
     assert len(states) == math.ceil((2 * math.pi - 6.0) / 0.01 - 1e-9)
 
 

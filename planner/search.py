@@ -27,6 +27,7 @@ from mrgc.planner.skeletons import DEFAULT_BACKEND, DEFAULT_ENCODING, SkeletonSo
 if TYPE_CHECKING:  # the geometric modules load numpy and coal: a symbolic problem never imports them
     from mrgc.geometry.grounding import Grounder
     from mrgc.planner.ground import GroundedStep, Grounding
+    from mrgc.planner.mcts import SearchResult
 
 #: a search log line sink (``mrgc plan --verbose`` prints them)
 Log = Callable[[str], None]
@@ -59,43 +60,10 @@ def plan_problem(problem: Problem, problem_file: str, sha256: str, version: str,
     plan.why = why
     stats: dict[str, Any] = {"robots": [r.name for r in problem.robots], "facts": len(facts),
                              "facts_seconds": round(facts_seconds, 4)}
+    sources = _Sources(base, _order(problem), backend, encoding, max_makespan, seed, deadline)
     start = must_move(problem, facts)
-    roots: list[SkeletonSource] = []
-
-    def sources(need: set[str], moved: set[str]) -> Callable[[int], list[Skeleton]]:
-        src = SkeletonSource(base, sorted(need, key=_order(problem)), sorted(moved), backend, encoding,
-                             max_makespan, seed)
-        if not roots:
-            roots.append(src)
-        state = {"count": 0, "outcome": ""}
-
-        def more(k: int) -> list[Skeleton]:
-            left = max(0.01, deadline - time.perf_counter())
-            batch = src.next(k, time_limit=left)
-            state["count"] += len(batch.skeletons)
-            state["outcome"] = batch.outcome
-            return batch.skeletons
-
-        more.state = state  # type: ignore[attr-defined]
-        return more
-
-    def infeasible_reasons(source: SkeletonSource) -> list[str]:
-        return list(source.reasons) or ["no task skeleton exists under the facts (the skeleton model is infeasible "
-                                        "at every horizon)"]
-
     if problem.symbolic:
-        more = sources(set(start), set())
-        first = more(1)
-        if first:
-            plan.status = PlanStatus.SOLVED
-            plan.steps = [[_planned(a) for a in step] for step in first[0].steps]
-        elif more.state["outcome"] is BatchOutcome.EXHAUSTED:  # type: ignore[attr-defined]
-            plan.status = PlanStatus.INFEASIBLE
-            why.facts = infeasible_reasons(roots[0])
-            why.summary = "infeasible by the facts"
-        else:
-            plan.status = PlanStatus.TIME_LIMIT
-            why.summary = f"skeleton generation did not finish within {time_limit:g} s"
+        _conclude_symbolic(plan, why, sources(set(start), set()), time_limit)
         stats["skeleton_seconds"] = round(time.perf_counter() - t0 - facts_seconds, 4)
     else:
         from mrgc.geometry.grounding import Grounder
@@ -121,23 +89,7 @@ def plan_problem(problem: Problem, problem_file: str, sha256: str, version: str,
 
         search = MCTS(ground, sources, set(start), c=c, alpha=alpha, k=skeletons)
         result = search.run(deadline, max_iterations=max_iterations, anytime=anytime)
-        root_state = search.root.more.state  # type: ignore[attr-defined]
-        if result.steps is not None:
-            plan.steps = [s.actions for s in result.steps]
-            plan.status = PlanStatus.SOLVED if result.ended != "interrupted" else PlanStatus.INTERRUPTED
-            plan.validation = _verdict_of(plan, validation)
-        elif result.ended == "interrupted":
-            plan.status = PlanStatus.INTERRUPTED
-        elif result.ended in ("time limit", "iteration limit") or time.perf_counter() >= deadline:
-            plan.status = PlanStatus.TIME_LIMIT
-        elif root_state["count"] == 0 and root_state["outcome"] is BatchOutcome.EXHAUSTED:
-            plan.status = PlanStatus.INFEASIBLE
-            why.facts = infeasible_reasons(roots[0])
-            why.cycles = _cycles_with_evidence(roots[0], grounder)
-            if why.cycles:  # the cycles are told with their evidence instead
-                why.facts = [f for f in why.facts if not f.startswith("blocking cycle")]
-        else:
-            plan.status = PlanStatus.EXHAUSTED
+        _conclude_search(plan, why, result, sources.root, grounder, validation, deadline)
         stats.update({k: (round(v, 4) if isinstance(v, float) else v) for k, v in result.stats.items()})
         stats["iterations"] = result.iterations
         stats["geometric_queries"] = grounder.queries
@@ -146,6 +98,96 @@ def plan_problem(problem: Problem, problem_file: str, sha256: str, version: str,
     stats["seconds"] = round(time.perf_counter() - t0, 4)
     plan.stats = stats
     return plan
+
+
+class _Skeletons:
+    """One skeleton source as the search asks it (:class:`~mrgc.planner.mcts.Node`'s ``more``): called with
+    ``k``, the next ``k`` skeletons within the time left; it counts the skeletons it gave and keeps why its
+    last batch stopped."""
+
+    def __init__(self, source: SkeletonSource, deadline: float) -> None:
+        self.source = source
+        self.deadline = deadline
+        self.count = 0
+        self.outcome: BatchOutcome | None = None
+
+    def __call__(self, k: int) -> list[Skeleton]:
+        left = max(0.01, self.deadline - time.perf_counter())
+        batch = self.source.next(k, time_limit=left)
+        self.count += len(batch.skeletons)
+        self.outcome = batch.outcome
+        return batch.skeletons
+
+    @property
+    def infeasible(self) -> bool:
+        """The source gave no skeleton and has none: the skeleton model is infeasible at every horizon."""
+        return self.count == 0 and self.outcome is BatchOutcome.EXHAUSTED
+
+    def reasons(self) -> list[str]:
+        """Why no skeleton exists: the facts' explanation, or the model's infeasibility."""
+        return list(self.source.reasons) or ["no task skeleton exists under the facts (the skeleton model is "
+                                             "infeasible at every horizon)"]
+
+
+class _Sources:
+    """The search's skeleton sources (``sources(M*, moved)``), one per request; the first one made (the
+    root's, for M* = the objects that must move) is kept as :attr:`root`."""
+
+    def __init__(self, base: FactBase, order: Callable[[str], int], backend: str, encoding: str,
+                 max_makespan: int | None, seed: int, deadline: float) -> None:
+        self.base, self.order = base, order
+        self.backend, self.encoding, self.max_makespan, self.seed = backend, encoding, max_makespan, seed
+        self.deadline = deadline
+        self.roots: list[_Skeletons] = []
+
+    def __call__(self, need: set[str], moved: set[str]) -> _Skeletons:
+        src = SkeletonSource(self.base, sorted(need, key=self.order), sorted(moved), self.backend, self.encoding,
+                             self.max_makespan, self.seed)
+        more = _Skeletons(src, self.deadline)
+        if not self.roots:
+            self.roots.append(more)
+        return more
+
+    @property
+    def root(self) -> _Skeletons:
+        """The first source made: the root's."""
+        return self.roots[0]
+
+
+def _conclude_symbolic(plan: Plan, why: Why, more: _Skeletons, time_limit: float) -> None:
+    """A symbolic problem's plan: the best skeleton, else why there is none."""
+    first = more(1)
+    if first:
+        plan.status = PlanStatus.SOLVED
+        plan.steps = [[_planned(a) for a in step] for step in first[0].steps]
+    elif more.infeasible:
+        plan.status = PlanStatus.INFEASIBLE
+        why.facts = more.reasons()
+        why.summary = "infeasible by the facts"
+    else:
+        plan.status = PlanStatus.TIME_LIMIT
+        why.summary = f"skeleton generation did not finish within {time_limit:g} s"
+
+
+def _conclude_search(plan: Plan, why: Why, result: SearchResult, root: _Skeletons, grounder: Grounder,
+                     validation: dict[str, Any], deadline: float) -> None:
+    """The plan's status (and steps, verdict, reasons) from how the search ended."""
+    if result.steps is not None:
+        plan.steps = [s.actions for s in result.steps]
+        plan.status = PlanStatus.SOLVED if result.ended != "interrupted" else PlanStatus.INTERRUPTED
+        plan.validation = _verdict_of(plan, validation)
+    elif result.ended == "interrupted":
+        plan.status = PlanStatus.INTERRUPTED
+    elif result.ended in ("time limit", "iteration limit") or time.perf_counter() >= deadline:
+        plan.status = PlanStatus.TIME_LIMIT
+    elif root.infeasible:
+        plan.status = PlanStatus.INFEASIBLE
+        why.facts = root.reasons()
+        why.cycles = _cycles_with_evidence(root.source, grounder)
+        if why.cycles:  # the cycles are told with their evidence instead
+            why.facts = [f for f in why.facts if not f.startswith("blocking cycle")]
+    else:
+        plan.status = PlanStatus.EXHAUSTED
 
 
 def _cycles_with_evidence(source: SkeletonSource, grounder: Grounder, per_edge: int = 2) -> list[BlockingCycle]:

@@ -85,7 +85,8 @@ _SIGNS = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-
 
 def box_corners(shape: CollisionShape) -> np.ndarray:
     """The 8 corners of a collision shape's bounding box, in the shape's frame."""
-    return shape.center + _SIGNS * shape.half
+    corners: np.ndarray = shape.center + _SIGNS * shape.half
+    return corners
 
 
 def _footprint(body: Placed) -> tuple[np.ndarray, float, float]:
@@ -135,6 +136,7 @@ class LatticePlanner:
 
     # ------------------------------------------------------------------------------------ lattice states
     def state(self, k: int, i: int, j: int) -> np.ndarray:
+        """The base pose ``(x, y, yaw)`` of lattice state ``(k, i, j)``: heading ``k``, cell ``(i, j)``."""
         return np.array([self.xmin + (i + 0.5) * self.cell, self.ymin + (j + 0.5) * self.cell,
                          wrap_angle(self.headings[k])])
 
@@ -286,8 +288,8 @@ class LatticePlanner:
         """Lattice states from a start to a goal (inclusive), fewest moves, or None when none connect."""
         dist = np.full(free.shape, -1, dtype=np.int32)
         front = np.zeros(free.shape, dtype=bool)
-        for g in goals:
-            front[g] = True
+        for goal in goals:
+            front[goal] = True
         dist[front] = 0
         open_ = free & ~front  # free states not reached yet
         grown, plane = np.zeros_like(front), np.zeros_like(front)

@@ -21,7 +21,7 @@ from __future__ import annotations
 import enum
 import hashlib
 from dataclasses import dataclass, field
-from typing import Callable, Iterable, Iterator, Sequence
+from typing import Callable, Hashable, Iterable, Iterator, Sequence
 
 import numpy as np
 
@@ -30,7 +30,7 @@ from mrgc.geometry.collision import CollisionShape, CollisionWorld, collision_sh
 from mrgc.geometry.conventions import APPROACH_SAMPLES, ARM_PLACE_LIFT, lattice_offsets, refine, se2, seed_for, to_se2
 from mrgc.geometry.grasps import APPROACH, finger_opening, fits, grasp_transform, pregrasp_transform
 from mrgc.geometry.ik import solve_ik_many
-from mrgc.geometry.lattice import LatticePlanner, box_corners
+from mrgc.geometry.lattice import Body, LatticePlanner, box_corners
 from mrgc.geometry.motion import MAX_CHECKS, plan_joint_path
 from mrgc.geometry.planar import DiscGrid, PlanarRobot, is_planar, scene_bounds
 from mrgc.geometry.scene import SceneSpec, half_extents, inside
@@ -38,6 +38,8 @@ from mrgc.geometry.transforms import rot_z, translation
 from mrgc.language.model import Box, Shape
 
 Volume = list[tuple[CollisionShape, np.ndarray]]  # shapes at world transforms
+#: a volume as the queries read it (what other robots sweep meanwhile, ``busy``): any sequence of pieces
+Pieces = Sequence[tuple[CollisionShape, np.ndarray]]
 
 #: largest step (m of translation, rad of turn) between checked states of a planar path, and largest joint
 #: motion (rad) between the configurations of an arm's transfer: the validator's
@@ -94,6 +96,7 @@ class Answer:
 
     @property
     def ok(self) -> bool:
+        """The query succeeded."""
         return self.status is GroundStatus.OK
 
 
@@ -158,16 +161,19 @@ class Grounder:
 
     # ------------------------------------------------------------ state
     def arm(self, robot: str) -> Arm:
+        """The arm ``robot`` (its model, home and probes), made once."""
         if robot not in self._arms:
             self._arms[robot] = Arm(self.scene.robot(robot))
         return self._arms[robot]
 
     def planar(self, robot: str) -> PlanarRobot:
+        """The planar robot ``robot``, made once."""
         if robot not in self._planar:
             self._planar[robot] = PlanarRobot(self.scene.robot(robot))
         return self._planar[robot]
 
     def is_planar(self, robot: str) -> bool:
+        """Whether ``robot`` is a planar (mobile) robot rather than an arm."""
         return is_planar(self.scene.robot(robot))
 
     def move(self, obj: str, pose: np.ndarray) -> None:
@@ -176,6 +182,7 @@ class Grounder:
         self.world.set_transform(obj, pose)
 
     def shape(self, obj: str) -> CollisionShape:
+        """The collision shape of body ``obj``."""
         return collision_shape(self.scene.body(obj).shape)
 
     # ------------------------------------------------------------ volumes
@@ -310,14 +317,14 @@ class Grounder:
         see :class:`_PieceWorld`."""
         return self._vol_world.holding(volume)
 
-    def _busy_world(self, volume: Volume) -> CollisionWorld:
+    def _busy_world(self, volume: Pieces) -> CollisionWorld:
         """The same for what other robots of a step sweep meanwhile (another world: both are used at once)."""
         return self._moving_world.holding(volume)
 
     # ------------------------------------------------------------ arm configurations
     def _approach(self, robot: str, obj: str, grasp: str, pose: np.ndarray, key: str,
                   avoid: Iterable[str], attempts: int = 8, approach: bool = True, held: bool = False,
-                  busy: Volume = (), partner: str | None = None, from_home: bool = True) -> Answer:
+                  busy: Pieces = (), partner: str | None = None, from_home: bool = True) -> Answer:
         spec = self.scene.grasp_specs.get(grasp)
         arm = self.arm(robot)
         if spec is None or not fits(spec, self.scene.body(obj).shape, arm.spec.kind):
@@ -336,14 +343,14 @@ class Grounder:
             start = arm.home if attempt == 0 and from_home else np.random.default_rng(seed).uniform(
                 arm.model.lower, arm.model.upper)
             q = solve_ik_many(arm.model, arm.ee_target(pose @ g_t)[None], seed, q_init=start)[0]
-            if not q.solved:
+            if not q.solved or q.q is None:  # (q is None exactly when the solve failed)
                 if q.status.value == "unreachable":
                     return Answer(GroundStatus.NO_IK)  # provably out of reach: no other seed helps
                 continue
             if approach:
                 pre = solve_ik_many(arm.model, arm.ee_target(pose @ pregrasp_transform(g_t))[None], seed,
                                     q_init=q.q[None], restarts=2)[0]
-                if not pre.solved:
+                if not pre.solved or pre.q is None:
                     continue
                 s = np.linspace(0.0, 1.0, APPROACH_SAMPLES)[:, None]
                 configs = pre.q[None] * (1 - s) + q.q[None] * s
@@ -390,19 +397,19 @@ class Grounder:
         named = sorted({f"{h[1:].split(':')[0]} at home" if h.startswith("@") else h for h in hit})
         return "hits " + ", ".join(named) if named else ""
 
-    def pick(self, robot: str, obj: str, grasp: str, avoid: Iterable[str] = (), busy: Volume = ()) -> Answer:
+    def pick(self, robot: str, obj: str, grasp: str, avoid: Iterable[str] = (), busy: Pieces = ()) -> Answer:
         """Approach configurations for ``robot`` to grasp ``obj`` (at its current pose) with ``grasp``,
         free of fixed objects, of ``avoid`` and of ``busy`` (what other robots sweep meanwhile); ``blockers``
         names the avoided objects that were in the way."""
         return self._approach(robot, obj, grasp, self.poses[obj], "pick", avoid, busy=busy)
 
     def place(self, robot: str, obj: str, grasp: str, pose: np.ndarray, avoid: Iterable[str] = (),
-              busy: Volume = ()) -> Answer:
+              busy: Pieces = ()) -> Answer:
         """Approach configurations for ``robot`` holding ``obj`` with ``grasp`` to put it at ``pose``."""
         return self._approach(robot, obj, grasp, pose, "place", avoid, held=True, busy=busy)
 
     def handover(self, obj: str, point: str, giver: str, g1: str, taker: str, g2: str,
-                 avoid: Iterable[str] = (), busy: Volume = ()) -> Answer:
+                 avoid: Iterable[str] = (), busy: Pieces = ()) -> Answer:
         """Both arms' configurations holding ``obj`` at handover point ``point`` (configs: giver, taker)."""
         pose = translation(*self.scene.handover_points[point])
         # as in phase 1, a handover is checked at the exchange configurations (no approach).  Each round draws
@@ -446,7 +453,7 @@ class Grounder:
     # ------------------------------------------------------------ paths
     def arm_path(self, robot: str, start: np.ndarray, goal: np.ndarray, holding: tuple[str, str] | None = None,
                  avoid: Iterable[str] = (), max_checks: int = MAX_CHECKS, resolution: float = 0.05,
-                 busy: Volume = (), partner: str | None = None, phase: str = "*") -> Answer:
+                 busy: Pieces = (), partner: str | None = None, phase: str = "*") -> Answer:
         """A joint-space path (RRTConnect, at most ``max_checks`` validity checks: no clock decides) free of
         fixed objects, ``avoid`` and ``busy`` (and of the held object's collisions with them)."""
         arm = self.arm(robot)
@@ -467,7 +474,7 @@ class Grounder:
         return Answer(GroundStatus.OK if res.solved else GroundStatus.NO_PATH, path=list(res.path))
 
     def transfer(self, robot: str, obj: str, grasp: str, start: np.ndarray, goal: np.ndarray,
-                 avoid: Iterable[str] = (), lift: bool = False, busy: Volume = (), partner: str | None = None
+                 avoid: Iterable[str] = (), lift: bool = False, busy: Pieces = (), partner: str | None = None
                  ) -> Answer:
         """:meth:`_transfer`, remembered: the same question (same configurations, objects at the same poses,
         the same moving robots and arms at home) gets the same answer without a second search (the reverse
@@ -491,12 +498,13 @@ class Grounder:
         self._paths[key] = answer
 
     def _transfer(self, robot: str, obj: str, grasp: str, start: np.ndarray, goal: np.ndarray,
-                  avoid: Iterable[str] = (), lift: bool = False, busy: Volume = (), partner: str | None = None
+                  avoid: Iterable[str] = (), lift: bool = False, busy: Pieces = (), partner: str | None = None
                   ) -> Answer:
         """How ``robot`` carries ``obj`` (held with ``grasp``) from configuration ``start`` to ``goal``: when
         ``lift`` (``start`` grasps the object where it rests), first straight up by :meth:`lift_height`
-        (tool poses every centimetre, each by IK from the one before; as far as the way up is free); then the straight joint-space line
-        (the validator's reading of a plan that gives no transfer) or, when that line collides, an
+        (tool poses every centimetre, each by IK from the one before; as far as the way up is free); then the
+        straight joint-space line (the validator's reading of a plan that gives no transfer) or, when that line
+        collides, an
         RRTConnect path (a budget of checks, seeded from the query).  Free of fixed objects, of the other arms
         at home, of ``avoid`` and of ``busy`` (what other robots sweep meanwhile).
         ``path`` is every configuration, ``start`` first, no joint moving more than
@@ -547,7 +555,7 @@ class Grounder:
         return Answer(GroundStatus.OK, path=[*back, *planned.path[1:]])
 
     def transit(self, robot: str, start: np.ndarray, goal: np.ndarray, avoid: Iterable[str] = (),
-                busy: Volume = (), via: np.ndarray | None = None, partner: str | None = None,
+                busy: Pieces = (), via: np.ndarray | None = None, partner: str | None = None,
                 phase: str = "*") -> Answer:
         """An empty-handed motion of ``robot`` (fingers fully open, as the validator replays it) from
         ``start`` to ``goal``: along ``via`` first when given (configurations, ``start`` first, joined by
@@ -605,7 +613,7 @@ class Grounder:
         for dz in np.arange(1, round(height / 0.01) + 1) * 0.01:
             target = arm.ee_target(translation(0.0, 0.0, float(dz)) @ tool)
             ik = solve_ik_many(arm.model, target[None], 0, q_init=out[-1], restarts=0)[0]
-            if not ik.solved or float(np.abs(ik.q - out[-1]).max()) > 0.2:
+            if not ik.solved or ik.q is None or float(np.abs(ik.q - out[-1]).max()) > 0.2:
                 break  # as high as the arm goes straight up (at the edge of its reach: less)
             out.append(ik.q)
         return np.array(out) if len(out) > 1 else None
@@ -661,7 +669,7 @@ class Grounder:
         if holding is not None:
             body = self.scene.body(holding[0])
             parts.append((body.shape, pr.carry_transform(body.shape, holding[1])))
-        bodies = [(b.name, b.shape, b.pose) for b in self.scene.fixed]
+        bodies: list[tuple[Hashable, Body, np.ndarray]] = [(b.name, b.shape, b.pose) for b in self.scene.fixed]
         bodies += [((a, self.poses[a].tobytes()), self.scene.body(a).shape, self.poses[a]) for a in movers]
         for r in others:
             other = self.planar(r.lstrip("@"))
@@ -684,7 +692,7 @@ class _PieceWorld:
         self.world = CollisionWorld()
         self.pieces: dict[int, tuple[CollisionShape, np.ndarray]] = {}
 
-    def holding(self, volume: Volume | Sequence[tuple[CollisionShape, np.ndarray]]) -> CollisionWorld:
+    def holding(self, volume: Pieces) -> CollisionWorld:
         want = {id(piece): piece for piece in volume}
         for key in [k for k in self.pieces if k not in want]:
             self.world.remove(f"v{key}")
@@ -703,7 +711,7 @@ def _packing_grid(room: np.ndarray, cells: int = 15) -> list[tuple[float, float,
     axes = [np.linspace(-r, r, max(1, min(cells, int(2 * r / 0.01) + 1))) for r in room]
     scale = np.maximum(room, 1e-9)
     def level(x: float, y: float) -> float:
-        return -round(abs(x) / scale[0] + abs(y) / scale[1], 9)
+        return float(-round(abs(x) / scale[0] + abs(y) / scale[1], 9))  # numpy's round, as before
 
     # the points of one level (the four corners, ...) at one yaw before the next yaw: a place that fails
     # at one corner (out of reach) is tried at the others before another yaw

@@ -226,8 +226,8 @@ class LatticePlanner:
         return occ
 
     # ------------------------------------------------------------------------------------ search
-    def plan(self, occupied: np.ndarray, start: Sequence[float], goal: Sequence[float], valid: Validity,
-             resolution: float, yaw_resolution: float) -> MotionResult:
+    def plan(self, occupied: np.ndarray, start: Sequence[float] | np.ndarray, goal: Sequence[float] | np.ndarray,
+             valid: Validity, resolution: float, yaw_resolution: float) -> MotionResult:
         """A path from ``start`` to ``goal`` through free lattice states, every state of it (at the
         resolutions) accepted by ``valid``; the first state is ``start``, the last ``goal``."""
         t0 = time.perf_counter()

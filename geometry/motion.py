@@ -27,6 +27,8 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 Validity = Callable[[np.ndarray], bool]
+#: joint values (bounds, configurations): a sequence of floats or a 1-D array
+Vector = Sequence[float] | np.ndarray
 
 #: default budget of one solve: calls to the validity test before RRTConnect gives up (no path)
 #: (docs/geometry.md, "Motion planning").
@@ -78,9 +80,9 @@ def _seed(ou: Any, seed: int) -> None:
     ou.RNG.setSeed(int(seed) % (2**31 - 2) + 1)
 
 
-def plan_joint_path(lower: Sequence[float], upper: Sequence[float], start: Sequence[float],
-                    goal: Sequence[float], is_valid: Validity, max_checks: int = MAX_CHECKS, seed: int = 0,
-                    resolution: float = 0.05, simplify: bool = False) -> MotionResult:
+def plan_joint_path(lower: Vector, upper: Vector, start: Vector, goal: Vector, is_valid: Validity,
+                    max_checks: int = MAX_CHECKS, seed: int = 0, resolution: float = 0.05,
+                    simplify: bool = False) -> MotionResult:
     """A collision-free path in the box ``lower <= q <= upper`` from ``start`` to ``goal`` (RRTConnect).
 
     ``is_valid(q)`` gets a fresh float array of the joint values; ``resolution`` is the largest step

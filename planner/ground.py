@@ -34,9 +34,14 @@ PLACEMENT_TRIES = 6  # placements sampled per place before the step gives up
 OUT_OF_REACH_TRIES = 30
 #: paths replayed in another path's phase (the validator's execution model): name -> phase
 PATH_PHASE = {"taker-to-handover": "to-handover", "giver-home": "home"}
+#: each robot's volume at every sample of every phase of its motions: robot -> phase -> volumes
+Motions = dict[str, dict[str, list[Volume]]]
 
 
 class Outcome(str, enum.Enum):
+    """How grounding a skeleton ended: every step grounded, a suffix grounded (other objects must move
+    first: M*), or a failure."""
+
     SUCCESS = "success"
     PARTIAL = "partial"
     FAIL = "fail"
@@ -83,6 +88,8 @@ class ReverseGrounder:
         self.movable = [b.name for b in grounder.scene.movable]
 
     def ground(self, skeleton: Skeleton, suffix: list[GroundedStep], key: str = "") -> Grounding:
+        """Ground ``skeleton``'s steps, last first, before the already grounded ``suffix`` (see the module
+        docstring); ``key`` tells this query's seeds from other groundings'."""
         fut_objs = {o for s in suffix for o in s.moved}
         skel_objs = set(skeleton.moved)
         out_objs = set(self.movable) - fut_objs - skel_objs
@@ -153,28 +160,20 @@ class ReverseGrounder:
                  key: str, index: int) -> GroundedStep | Failure:
         actions: list[PlannedAction] = []
         step_volume: Volume = []
-        motions: dict[str, dict[str, list[Volume]]] = {}  # robot -> phase -> volume at each sample
+        motions: Motions = {}  # robot -> phase -> volume at each sample
         placed: dict[str, np.ndarray] = {}  # objects of this step already placed by its earlier actions
         for a in step:
             avoid_a = sorted((avoid | same) - {a.obj})
             # what the other robots of the step sweep in each phase: this action's motions keep clear of it
-            busy: dict[str, Volume] = {}
-            for robot, phases in motions.items():
-                if robot not in (a.pick_robot, a.place_robot):
-                    for phase, samples in phases.items():
-                        busy.setdefault(phase, []).extend(p for vol in samples for p in vol)
+            busy = _swept_by_others(motions, (a.pick_robot, a.place_robot))
             action = self._action(a, avoid_a, v_fut + step_volume, f"{key}:{a.obj}", placed, busy)
             if isinstance(action, Failure):
                 return replace(action, step=index, action=label(a))
             mine = self._motions(action)
-            # robots of one step move at once: phase by phase (pick, handover, place; drives), samples paired
-            # by index as the validator replays them, they must not collide with each other
-            for robot, phases in mine.items():
-                for other, their in motions.items():
-                    phase = _phases_collide(phases, their)
-                    if other != robot and phase:
-                        return Failure(index, label(a), f"{phase}: robots of the step collide",
-                                       tuple(sorted((robot, other))))
+            clash = _robots_collide(mine, motions)
+            if clash:
+                phase, robots = clash
+                return Failure(index, label(a), f"{phase}: robots of the step collide", robots)
             for robot, phases in mine.items():
                 motions.setdefault(robot, {}).update(phases)
             for phases in mine.values():  # the step's volume is every sample of every motion
@@ -187,28 +186,31 @@ class ReverseGrounder:
             actions.append(action)
         return GroundedStep(actions, step_volume, tuple(a.obj for a in step))
 
-    def _motions(self, action: PlannedAction) -> dict[str, dict[str, list[Volume]]]:
+    def _motions(self, action: PlannedAction) -> Motions:
         """Each robot's volume at every sample of every phase of a planned action, arm approaches on the
         validator's finer interpolation (so later placements keep clear between samples too)."""
         g, obj = self.g, action.object
-        out: dict[str, dict[str, list[Volume]]] = {}
+        out: Motions = {}
         if g.is_planar(action.pick_robot):
-            held = {"to-pick": None, "to-place": (obj, action.pick_grasp), "home": None}
-            out[action.pick_robot] = {ph: [g.base_volume(action.pick_robot, [q], held[ph]) for q in np.array(path)]
+            carried = {"to-pick": None, "to-place": (obj, action.pick_grasp), "home": None}
+            out[action.pick_robot] = {ph: [g.base_volume(action.pick_robot, [q], carried[ph]) for q in np.array(path)]
                                       for ph, path in action.paths.items()}
             return out
         out.setdefault(action.pick_robot, {})["pick"] = [
-            g.arm_volume(action.pick_robot, q[None], grasp=(obj, action.pick_grasp)) for q in refine(np.array(action.configs["pick"]))]
+            g.arm_volume(action.pick_robot, q[None], grasp=(obj, action.pick_grasp))
+            for q in refine(np.array(action.configs["pick"]))]
         if "handover" in action.configs:
             giver, taker = np.array(action.configs["handover"])
-            out[action.pick_robot]["handover"] = [g.arm_volume(action.pick_robot, giver[None], (obj, action.pick_grasp))]
+            out[action.pick_robot]["handover"] = [
+                g.arm_volume(action.pick_robot, giver[None], (obj, action.pick_grasp))]
             out.setdefault(action.place_robot, {})["handover"] = [
                 g.arm_volume(action.place_robot, taker[None], (obj, action.place_grasp))]
         # the paths (every configuration: they are already at the validator's resolution); holding the
         # object on the transfers, empty-handed (fingers fully open) otherwise
         for phase, robot, grasp in (("to-handover", action.pick_robot, action.pick_grasp),
                                     ("to-place", action.place_robot, action.place_grasp),
-                                    ("to-pick", action.pick_robot, None), ("taker-to-handover", action.place_robot, None),
+                                    ("to-pick", action.pick_robot, None),
+                                    ("taker-to-handover", action.place_robot, None),
                                     ("home", action.place_robot, None), ("giver-home", action.pick_robot, None)):
             if phase in action.paths:
                 held = (obj, grasp) if grasp is not None else None
@@ -233,19 +235,10 @@ class ReverseGrounder:
         assert pick.configs is not None
         start, lift = pick.configs[-1], True  # the place transfer starts at the grasp
         if a.handover:
-            hand = self._handover(a, avoid, busy.get("handover", []))
-            if isinstance(hand, Failure):
-                return hand
-            point, answer = hand
-            assert answer.configs is not None
-            planned.handover_point = point
-            planned.configs["handover"] = _configs(answer.configs)
-            giver = g.transfer(a.pick_robot, a.obj, a.pick_grasp, pick.configs[-1], answer.configs[0], avoid,
-                               lift=True, busy=busy.get("to-handover", []), partner=a.place_robot)
-            if not giver.ok:
-                return _failed(f"carry to the handover by {a.pick_robot}", giver)
-            planned.paths["to-handover"] = _configs(np.array(giver.path))
-            start, lift = answer.configs[1], False  # the taker's transfer starts at the exchange
+            exchange = self._hand_over(a, planned, pick.configs[-1], avoid, busy)
+            if isinstance(exchange, Failure):
+                return exchange
+            start, lift = exchange, False  # the taker's transfer starts at the exchange
         last: Failure | None = None
         tried = 0  # placements that failed for another reason than being out of the arm's reach
         # goal bins are shared by several objects: packed from the corners; elsewhere (moving an obstacle
@@ -283,6 +276,26 @@ class ReverseGrounder:
             return planned
         assert last is not None
         return last
+
+    def _hand_over(self, a: Action, planned: PlannedAction, grasped: np.ndarray, avoid: list[str],
+                   busy: dict[str, Volume]) -> np.ndarray | Failure:
+        """A handover action's exchange (both arms at a handover point) and the giver's carry there from
+        ``grasped`` (its pick configuration), into ``planned``; the taker's configuration at the exchange."""
+        g = self.g
+        hand = self._handover(a, avoid, busy.get("handover", []))
+        if isinstance(hand, Failure):
+            return hand
+        point, answer = hand
+        assert answer.configs is not None
+        planned.handover_point = point
+        planned.configs["handover"] = _configs(answer.configs)
+        giver = g.transfer(a.pick_robot, a.obj, a.pick_grasp, grasped, answer.configs[0], avoid,
+                           lift=True, busy=busy.get("to-handover", []), partner=a.place_robot)
+        if not giver.ok:
+            return _failed(f"carry to the handover by {a.pick_robot}", giver)
+        planned.paths["to-handover"] = _configs(np.array(giver.path))
+        taker: np.ndarray = answer.configs[1]
+        return taker
 
     def _transits(self, a: Action, planned: PlannedAction, avoid: list[str], busy: dict[str, Volume],
                   new: dict[str, np.ndarray]) -> None | Failure:
@@ -405,6 +418,29 @@ def _failed(what: str, answer: Answer) -> Failure:
     return Failure(0, "", f"{what}: {answer.status.value}", tuple(sorted(answer.blockers)), answer.detail)
 
 
+def _swept_by_others(motions: Motions, robots: tuple[str, ...]) -> dict[str, Volume]:
+    """What the step's robots other than ``robots`` sweep in each phase (every sample of their motions)."""
+    busy: dict[str, Volume] = {}
+    for robot, phases in motions.items():
+        if robot not in robots:
+            for phase, samples in phases.items():
+                busy.setdefault(phase, []).extend(p for vol in samples for p in vol)
+    return busy
+
+
+def _robots_collide(mine: Motions, motions: Motions) -> tuple[str, tuple[str, ...]] | None:
+    """Robots of one step move at once: phase by phase (pick, handover, place; drives), samples paired by
+    index as the validator replays them, they must not collide with each other.  The first phase where a
+    robot of ``mine`` (an action's motions) collides with another robot of ``motions`` (the step's actions
+    grounded before), and the two robots; None when none does."""
+    for robot, phases in mine.items():
+        for other, their in motions.items():
+            phase = _phases_collide(phases, their)
+            if other != robot and phase:
+                return phase, tuple(sorted((robot, other)))
+    return None
+
+
 def _phases_collide(mine: dict[str, list[Volume]], theirs: dict[str, list[Volume]]) -> str:
     """The first phase both robots move in where they collide, their samples paired by index (resampled);
     "" when they never do."""
@@ -429,4 +465,5 @@ def _volumes_collide(a: Volume, b: Volume) -> bool:
 
 
 def moved_objects(steps: Iterable[GroundedStep]) -> set[str]:
+    """The objects the grounded steps move."""
     return {o for s in steps for o in s.moved}

@@ -42,9 +42,7 @@ from functools import cached_property
 import numpy as np
 
 from mrgc.geometry.collision import CollisionShape, collision_shape
-from mrgc.geometry.conventions import PLANAR_LIFT, lattice_offsets, wrap_angle, yaw_of
-from mrgc.geometry.conventions import se2 as se2  # the floor frames, imported from here by grounding
-from mrgc.geometry.conventions import to_se2 as to_se2
+from mrgc.geometry.conventions import PLANAR_LIFT, lattice_offsets, se2, to_se2, wrap_angle, yaw_of
 from mrgc.geometry.scene import Body, RobotSpec, SceneSpec, half_extents, inside, outline
 from mrgc.geometry.transforms import from_pose, rot_z, translation
 from mrgc.language.model import Box, Cylinder, RobotKind, Shape

@@ -25,12 +25,8 @@ import time
 import numpy as np
 
 from mrgc.geometry.arm import Arm
-from mrgc.geometry.collision import CollisionWorld
-from mrgc.geometry.collision import scene_world as scene_world  # re-exported: grounding imports it from here
-from mrgc.geometry.conventions import APPROACH_SAMPLES as APPROACH_SAMPLES  # re-exported (grounding)
-from mrgc.geometry.conventions import ARM_PLACE_LIFT, lattice_offsets
-from mrgc.geometry.conventions import refine as refine  # re-exported (grounding)
-from mrgc.geometry.conventions import seed_for as seed_for  # re-exported (grounding)
+from mrgc.geometry.collision import CollisionWorld, scene_world
+from mrgc.geometry.conventions import APPROACH_SAMPLES, ARM_PLACE_LIFT, lattice_offsets, refine, seed_for
 from mrgc.geometry.facts import FactsResult, RobotFacts
 from mrgc.geometry.grasps import finger_opening, fits, grasp_transform, pregrasp_transform
 from mrgc.geometry.ik import solve_ik_many
@@ -40,8 +36,6 @@ from mrgc.geometry.transforms import translation
 from mrgc.language.model import Box, Fact
 from mrgc.workers import map_in_workers, worker_count
 
-#: the old name of :data:`~mrgc.geometry.conventions.ARM_PLACE_LIFT`, which grounding imports from here
-LIFT = ARM_PLACE_LIFT
 PLACEMENT_GRID = 3  # placements tried per region: a GRID × GRID lattice, centre first
 IK_SEEDS = 3  # IK solutions tried per target when looking for one free of movable objects
 IK_ITERS = 100  # Levenberg-Marquardt iterations per solve (reachable targets converge in far fewer)

@@ -69,7 +69,8 @@ class RobotView:
         self.planar = self.spec.kind.base == "planar"
         self._scene = scene
         if self.planar:
-            from mrgc.geometry.planar import PlanarRobot, to_se2
+            from mrgc.geometry.conventions import to_se2
+            from mrgc.geometry.planar import PlanarRobot
 
             self.mobile = PlanarRobot(self.spec)
             self.home: np.ndarray = to_se2(self.spec.base)
@@ -107,7 +108,7 @@ class RobotView:
     def held_pose(self, q: np.ndarray, shape: Shape, grasp: str) -> np.ndarray:
         """Where an object of ``shape`` held with ``grasp`` is when the robot is at ``q``."""
         if self.planar:
-            from mrgc.geometry.planar import se2
+            from mrgc.geometry.conventions import se2
 
             return se2(q[0], q[1], q[2]) @ self.mobile.carry_transform(shape, grasp)  # type: ignore[no-any-return]
         from mrgc.geometry.fk import ee_pose

@@ -7,8 +7,8 @@ import pytest
 from support import ROOT
 
 from mrgc import parse_file
+from mrgc.geometry.conventions import to_se2
 from mrgc.geometry.grounding import Grounder, GroundStatus
-from mrgc.geometry.planar import to_se2
 from mrgc.geometry.scene import inside, scene_from_problem
 from mrgc.geometry.transforms import translation
 

@@ -11,10 +11,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from mrgc.geometry.collision import CollisionWorld, collision_shape
-from mrgc.geometry.conventions import wrap_angle
+from mrgc.geometry.conventions import se2, wrap_angle
 from mrgc.geometry.lattice import LatticePlanner, hull2d, interpolate
 from mrgc.geometry.motion import MotionStatus
-from mrgc.geometry.planar import se2
 from mrgc.geometry.transforms import rot_z, translation
 from mrgc.language.model import Box
 

@@ -27,7 +27,7 @@ import numpy as np
 
 from mrgc.geometry.arm import Arm
 from mrgc.geometry.collision import CollisionShape, CollisionWorld, collision_shape, scene_world
-from mrgc.geometry.conventions import APPROACH_SAMPLES, ARM_PLACE_LIFT, lattice_offsets, refine, se2, seed_for, to_se2
+from mrgc.geometry.conventions import APPROACH_SAMPLES, ARM_PLACE_LIFT, lattice_offsets, se2, seed_for, to_se2
 from mrgc.geometry.grasps import APPROACH, finger_opening, fits, grasp_transform, pregrasp_transform
 from mrgc.geometry.ik import solve_ik_many
 from mrgc.geometry.lattice import Body, LatticePlanner, box_corners
@@ -58,6 +58,14 @@ TRANSFER_CHECKS = 4_000
 COMFORT = 0.85
 #: path answers (transfers, base paths) remembered per grounder
 REMEMBERED = 4096
+#: largest joint motion (rad) between the configurations of an approach that are checked: half the
+#: validator's resolution, so that the validator, sampling at other times, does not find the fingers deeper
+#: in a neighbour than the 1 mm it tolerates where the planner found them clear (a 5-sample approach checked
+#: at 4 times its samples let the validator reject whole plans for 1.1 mm finger overlaps)
+APPROACH_CHECK = PATH_RESOLUTION / 2
+#: IK attempts (each with its restarts) after which a pose none of them solved is called out of reach, as
+#: phase 1 does (predicates.IK_SEEDS); attempts that solve it but collide go on to other branches
+IK_GIVE_UP = 3
 #: pairs of exchange configurations tried for a handover before the two arms are said to collide
 HANDOVER_PAIRS = 6
 #: an approach's last segment starts at most this many equal shares of the back-off from the grasp (the
@@ -346,28 +354,19 @@ class Grounder:
             if not q.solved or q.q is None:  # (q is None exactly when the solve failed)
                 if q.status.value == "unreachable":
                     return Answer(GroundStatus.NO_IK)  # provably out of reach: no other seed helps
+                if attempt + 1 >= IK_GIVE_UP and status is GroundStatus.NO_IK:
+                    return Answer(GroundStatus.NO_IK)  # no start converged (phase 1 gives up after as many)
                 continue
-            if approach:
-                pre = solve_ik_many(arm.model, arm.ee_target(pose @ pregrasp_transform(g_t))[None], seed,
-                                    q_init=q.q[None], restarts=2)[0]
-                if not pre.solved or pre.q is None:
-                    continue
-                s = np.linspace(0.0, 1.0, APPROACH_SAMPLES)[:, None]
-                configs = pre.q[None] * (1 - s) + q.q[None] * s
-                # pre-grasp and grasp from different IK branches swing the tool off the approach line: the
-                # contact segment must start near the grasp (the validator's rule, with a margin)
-                near = arm.tool_world(configs[-2][None])[0][:3, 3]
-                if np.linalg.norm(near - (pose @ g_t)[:3, 3]) > CONTACT_START * APPROACH / (APPROACH_SAMPLES - 1):
-                    continue
-            else:
-                configs = np.asarray(q.q)[None]
-            # checked on a 4× finer interpolation than the configurations kept (the validator's resolution),
-            # with the object in hand when placing
-            volume = self.arm_volume(robot, refine(configs), holding=(obj, grasp) if held else None,
+            configs = self._approach_configs(arm, pose @ g_t, q.q, seed) if approach else np.asarray(q.q)[None]
+            if configs is None:
+                continue
+            # checked at every APPROACH_CHECK of joint motion (finer than the validator samples), with the
+            # object in hand when placing
+            volume = self.arm_volume(robot, joint_line(configs, APPROACH_CHECK),
+                                     holding=(obj, grasp) if held else None,
                                      grasp=(obj, grasp))
             self.queries += 1
-            if self.world.probe_collides(volume, against=("fixed", *self._others_home(robot, partner, phase)),
-                                         ignore=() if held else (obj,)):
+            if self._fixed_clash(robot, obj, grasp, configs, volume, held, self._others_home(robot, partner, phase)):
                 status, clash = GroundStatus.COLLISION, ("fixed", volume)
                 continue
             hit = self.world.probe_hits(volume, against=avoid) if avoid else set()
@@ -384,6 +383,35 @@ class Grounder:
         if clash is not None and not blockers:
             detail = self._clash_detail(robot, partner, phase, clash, ignore=() if held else (obj,))
         return Answer(status, blockers=blockers, detail=detail)
+
+    def _fixed_clash(self, robot: str, obj: str, grasp: str, configs: np.ndarray, volume: Volume, held: bool,
+                     homes: tuple[str, ...]) -> bool:
+        """Whether an approach (``configs``, swept as ``volume``) hits a fixed object or an arm at home
+        (``homes``), or, picking, the object it picks before its contact segment (the last one: the validator
+        exempts the picked object there only)."""
+        if self.world.probe_collides(volume, against=("fixed", *homes), ignore=() if held else (obj,)):
+            return True
+        if held or len(configs) < 3:
+            return False
+        early = self.arm_volume(robot, joint_line(configs[:-1], APPROACH_CHECK), grasp=(obj, grasp))
+        return self.world.probe_collides(early, against=(obj,))
+
+    @staticmethod
+    def _approach_configs(arm: Arm, tool: np.ndarray, q: np.ndarray, seed: int) -> np.ndarray | None:
+        """The approach to grasp configuration ``q`` (tool at ``tool``): the pre-grasp by IK from ``q``, then
+        :data:`APPROACH_SAMPLES` configurations to ``q``; None when the pre-grasp has no solution, or when
+        pre-grasp and grasp come from different IK branches and swing the tool off the approach line (the
+        contact segment must start near the grasp: the validator's rule, with a margin)."""
+        pre = solve_ik_many(arm.model, arm.ee_target(tool @ pregrasp_transform(np.eye(4)))[None], seed,
+                            q_init=q[None], restarts=2)[0]
+        if not pre.solved or pre.q is None:
+            return None
+        s = np.linspace(0.0, 1.0, APPROACH_SAMPLES)[:, None]
+        configs: np.ndarray = pre.q[None] * (1 - s) + q[None] * s
+        near = arm.tool_world(configs[-2][None])[0][:3, 3]
+        if np.linalg.norm(near - tool[:3, 3]) > CONTACT_START * APPROACH / (APPROACH_SAMPLES - 1):
+            return None
+        return configs
 
     def _clash_detail(self, robot: str, partner: str | None, phase: str, clash: tuple[str, Volume],
                       ignore: tuple[str, ...]) -> str:
@@ -691,8 +719,12 @@ class _PieceWorld:
     def __init__(self) -> None:
         self.world = CollisionWorld()
         self.pieces: dict[int, tuple[CollisionShape, np.ndarray]] = {}
+        self.last: tuple[object, int] | None = None  # the list last held and its length
 
     def holding(self, volume: Pieces) -> CollisionWorld:
+        if self.last is not None and self.last[0] is volume and self.last[1] == len(volume):
+            return self.world  # the same list, unchanged (lists of volumes only grow by concatenation)
+        self.last = (volume, len(volume))
         want = {id(piece): piece for piece in volume}
         for key in [k for k in self.pieces if k not in want]:
             self.world.remove(f"v{key}")

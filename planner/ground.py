@@ -15,6 +15,7 @@ objects not moved in S' plus the M_out objects that obstruct S'; otherwise it fa
 from __future__ import annotations
 
 import enum
+import time
 from dataclasses import dataclass, field, replace
 from typing import Iterable
 
@@ -25,7 +26,7 @@ from mrgc.compiler.task_graph import Action
 from mrgc.geometry.collision import CollisionWorld
 from mrgc.geometry.conventions import refine, to_se2
 from mrgc.geometry.grounding import BUSY, Answer, Grounder, GroundStatus, Volume
-from mrgc.planner.outcome import Failure
+from mrgc.planner.outcome import DeadlineReached, Failure
 from mrgc.planner.plan import PlannedAction
 
 PLACEMENT_TRIES = 6  # placements sampled per place before the step gives up
@@ -79,13 +80,18 @@ def _configs(c: np.ndarray | None) -> list[list[float]]:
 class ReverseGrounder:
     """Grounds skeletons on a scene (see the module docstring)."""
 
-    def __init__(self, grounder: Grounder, goal: dict[str, str], full: bool = False) -> None:
+    def __init__(self, grounder: Grounder, goal: dict[str, str], full: bool = False,
+                 deadline: float | None = None) -> None:
         self.g = grounder
         self.goal = goal
         #: arms' empty-handed motions planned too (``mrgc plan --motions full``): home -> pre-grasp, release
         #: -> home, and for a handover the taker's way to the exchange and the giver's way home
         self.full = full
         self.movable = [b.name for b in grounder.scene.movable]
+        #: the search's time limit (``time.perf_counter()``): past it, a grounding stops with
+        #: :class:`DeadlineReached` before its next action (wall-clock time only ends the search; it never
+        #: decides what a grounding finds)
+        self.deadline = deadline
 
     def ground(self, skeleton: Skeleton, suffix: list[GroundedStep], key: str = "") -> Grounding:
         """Ground ``skeleton``'s steps, last first, before the already grounded ``suffix`` (see the module
@@ -163,6 +169,7 @@ class ReverseGrounder:
         motions: Motions = {}  # robot -> phase -> volume at each sample
         placed: dict[str, np.ndarray] = {}  # objects of this step already placed by its earlier actions
         for a in step:
+            self._on_time()
             avoid_a = sorted((avoid | same) - {a.obj})
             # what the other robots of the step sweep in each phase: this action's motions keep clear of it
             busy = _swept_by_others(motions, (a.pick_robot, a.place_robot))
@@ -220,6 +227,11 @@ class ReverseGrounder:
             g.arm_volume(action.place_robot, q[None], (obj, action.place_grasp))
             for q in refine(np.array(action.configs["place"]))]
         return out
+
+    def _on_time(self) -> None:
+        """Raise :class:`DeadlineReached` when the search's time limit has passed."""
+        if self.deadline is not None and time.perf_counter() > self.deadline:
+            raise DeadlineReached()
 
     def _action(self, a: Action, avoid: list[str], v_fut: Volume, key: str,
                 placed: dict[str, np.ndarray] | None = None,

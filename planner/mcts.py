@@ -20,6 +20,7 @@ from typing import Callable
 
 from mrgc.compiler.skeleton import Skeleton
 from mrgc.planner.ground import GroundedStep, Grounding, Outcome, moved_objects
+from mrgc.planner.outcome import DeadlineReached
 
 # makes a skeleton source for (M*, moved objects): returns a callable giving the next k skeletons
 SourceFactory = Callable[[set[str], set[str]], Callable[[int], list[Skeleton]]]
@@ -115,6 +116,8 @@ class MCTS:
                     return SearchResult(self.best, it, self.stats, "solved")
         except KeyboardInterrupt:
             return SearchResult(self.best, it, self.stats, "interrupted")
+        except DeadlineReached:  # the time limit passed during a grounding
+            return SearchResult(self.best, it, self.stats, "time limit")
         return SearchResult(self.best, max_iterations, self.stats, "iteration limit")
 
     def _iterate(self, anytime: bool) -> bool:
@@ -158,9 +161,11 @@ class MCTS:
             edge.dead = True
             return None, 0.0
         t0 = time.perf_counter()
-        result = self.ground(edge.skeleton, node.suffix)
+        try:
+            result = self.ground(edge.skeleton, node.suffix)
+        finally:  # a grounding stopped by the time limit counts its time too
+            self.stats["grounding_seconds"] += time.perf_counter() - t0
         self.stats["groundings"] += 1
-        self.stats["grounding_seconds"] += time.perf_counter() - t0
         if result.outcome is Outcome.FAIL:
             self.memo.add(memo_key)
             edge.dead = True

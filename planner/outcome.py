@@ -75,6 +75,11 @@ class Failure:
         return f"step {self.step}, {self.action}: {self.check}{bodies}{detail}"
 
 
+class DeadlineReached(Exception):
+    """Raised inside a grounding when the search's time limit has passed: the search stops there (a
+    grounding of one skeleton can take a minute on a loaded machine; the limit is the user's)."""
+
+
 @dataclass(frozen=True)
 class BlockingCycle:
     """Objects that must each move strictly before the next (every action of one is obstructed by the next

@@ -73,7 +73,7 @@ def plan_problem(problem: Problem, problem_file: str, sha256: str, version: str,
 
         scene = scene_from_problem(problem)
         grounder = Grounder(scene, seed=seed)
-        reverse = ReverseGrounder(grounder, problem.goal_regions, full=motions == "full")
+        reverse = ReverseGrounder(grounder, problem.goal_regions, full=motions == "full", deadline=deadline)
         count = [0]
         validation: dict[str, Any] = {}
 

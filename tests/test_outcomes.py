@@ -259,3 +259,18 @@ def test_a_step_is_not_split_for_other_failures(monkeypatch: pytest.MonkeyPatch)
     result = reverse.ground(skeleton, [])
     assert result.outcome is Outcome.PARTIAL and result.must_move >= {"c"}
     assert len(result.steps) == 1 and result.steps[0].moved == ("a", "b")
+
+
+def test_a_grounding_stops_at_the_search_deadline() -> None:
+    """Past the deadline a grounding stops before its next action (the search then ends at its time limit)."""
+    import time
+
+    from mrgc.planner.outcome import DeadlineReached
+
+    grounder = ScriptedGrounder(["a"], blocked_by={}, sweeps={})
+    skeleton = Skeleton(((Action("a", "goal", "r1", "r1", "top", "top"),),))
+    late = ReverseGrounder(grounder, {"a": "goal"}, deadline=time.perf_counter() - 1.0)  # type: ignore[arg-type]
+    with pytest.raises(DeadlineReached):
+        late.ground(skeleton, [])
+    early = ReverseGrounder(grounder, {"a": "goal"}, deadline=time.perf_counter() + 3600.0)  # type: ignore[arg-type]
+    assert early.ground(skeleton, []).outcome is Outcome.SUCCESS

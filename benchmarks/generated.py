@@ -18,6 +18,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -103,7 +104,21 @@ def category(row: dict[str, object]) -> str:
         if "no robot can place" in facts:
             return "infeasible: a goal object fits its bin for nobody"
         return "infeasible: other"
+    if out in ("time limit", "exhausted"):
+        failures = why.get("grounding_failures") or []
+        if failures:  # the most frequent grounding failure names the kind
+            return f"{out}: mostly {failure_kind(failures[0])}"
     return out
+
+
+def failure_kind(failure: dict[str, object]) -> str:
+    """A grounding failure without its names (robots, objects, regions, points): its kind, to count."""
+    check = re.sub(r" by r\d+| at h\d+| of o\d+ in [\w-]+", "", str(failure.get("check", "")))
+    if str(failure.get("action", "")).startswith("validator"):
+        return "the validator rejected the plan"
+    if str(failure.get("detail", "")).startswith("another robot of the step"):
+        return f"{check} (robots of one step)"
+    return check
 
 
 def report(path: Path) -> None:

@@ -51,6 +51,8 @@ def normal_form(terms: Terms) -> tuple[list[int], list[int]]:
 
 
 class CpSatBackend(Backend):
+    """The skeleton model as a CP-SAT model message, solved by OR-Tools (module docstring)."""
+
     info = BackendInfo(
         name="cpsat",
         title="OR-Tools CP-SAT",

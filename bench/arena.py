@@ -89,7 +89,8 @@ def _study(conn: sqlite3.Connection, db: ResultsDB, name: str) -> int:
             "INSERT INTO runs (experimentid, plannerid, time, solved, status, valid, makespan, objects_moved, "
             "arm_path, base_path, wall_time, memory, seed) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
             [(experiment, planners[str(r["method"])],
-              r["planning_seconds"] if r["planning_seconds"] is not None else r["wall_seconds"], int(bool(r["success"])),
+              r["planning_seconds"] if r["planning_seconds"] is not None else r["wall_seconds"],
+              int(bool(r["success"])),
               STATUS_VALUES.index(str(r["status"])), r["valid"], r["makespan"], r["objects_moved"], r["arm_path"],
               r["base_path"], r["wall_seconds"], r["peak_mb"], r["seed"]) for r in rs])
     return len(runs)

@@ -51,6 +51,7 @@ def _missing(p: argparse.ArgumentParser) -> int:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
+    """``mrgc bench run``: run the study's unfinished runs with a progress line per run, then a summary."""
     from mrgc.bench.progress import Progress
     from mrgc.bench.run import DEFAULT_DB, run_study
 
@@ -77,6 +78,7 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 
 def cmd_report(args: argparse.Namespace) -> int:
+    """``mrgc bench report``: tables on standard output; figures and a Planner Arena database on request."""
     from mrgc.bench.db import ResultsDB
     from mrgc.bench.report import render
     from mrgc.bench.run import DEFAULT_DB

@@ -87,6 +87,7 @@ class ResultsDB:
             raise InputError([Diagnostic(E_DB, f"'{path}' holds no results")])
 
     def close(self) -> None:
+        """Close the connection."""
         self.conn.close()
 
     def __enter__(self) -> "ResultsDB":
@@ -99,11 +100,13 @@ class ResultsDB:
     def begin_study(self, name: str, path: str, text: str, specs: dict[str, dict[str, Any]],
                     skips: dict[str, tuple[str, int]], updated: str) -> None:
         """Record the study and its method specs; E603 if a method changed under the same name."""
-        known = {r["method"]: r["spec"] for r in self.conn.execute("SELECT method, spec FROM methods WHERE study = ?", (name,))}
+        known = {r["method"]: r["spec"]
+                 for r in self.conn.execute("SELECT method, spec FROM methods WHERE study = ?", (name,))}
         for method, spec in specs.items():
             text_spec = json.dumps(spec, sort_keys=True)
             if method in known and known[method] != text_spec:
-                n = self.conn.execute("SELECT COUNT(*) FROM runs WHERE study = ? AND method = ?", (name, method)).fetchone()[0]
+                n = self.conn.execute("SELECT COUNT(*) FROM runs WHERE study = ? AND method = ?",
+                                      (name, method)).fetchone()[0]
                 if n:
                     raise InputError([Diagnostic(E_DB, f"method '{method}' of study '{name}' changed since its {n} "
                                                  f"recorded run(s) in {self.path} (was {known[method]}, now "
@@ -144,6 +147,7 @@ class ResultsDB:
             yield dict(r)
 
     def skips(self, study: str) -> list[tuple[str, str, int]]:
+        """The methods skipped in ``study``: (method, reason, runs), by method."""
         return [(r["method"], r["reason"], r["runs"])
                 for r in self.conn.execute("SELECT method, reason, runs FROM skips WHERE study = ? ORDER BY method",
                                            (study,))]

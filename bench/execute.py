@@ -25,7 +25,8 @@ from dataclasses import dataclass, field
 from datetime import datetime, timezone
 
 from mrgc.bench.instances import Instance
-from mrgc.bench.runner import ProcessResult, read_text as _read, run_limited
+from mrgc.bench.runner import ProcessResult, run_limited
+from mrgc.bench.runner import read_text as _read
 from mrgc.bench.study import Limits
 
 SHIM = """\
@@ -58,10 +59,12 @@ class RunTask:
 
     @property
     def compile_only(self) -> bool:
+        """Whether the run only generates skeletons (``mrgc compile``)."""
         return self.args[0] == "compile"
 
     @property
     def stem(self) -> str:
+        """The base name of the run's files: instance and seed."""
         return f"{self.instance.name}-s{self.seed}"
 
 
@@ -83,10 +86,12 @@ class RawRun:
 
     @property
     def cancelled(self) -> bool:
+        """Whether a process of the run was killed because the study was interrupted."""
         return self.plan.killed == "cancelled" or (self.validate is not None and self.validate.killed == "cancelled")
 
 
 def now() -> str:
+    """The current UTC time, ISO 8601 to the second (a run's start and end)."""
     return datetime.now(timezone.utc).isoformat(timespec="seconds")
 
 

@@ -28,9 +28,11 @@ class Executor(Protocol):
     #: whether runs execute elsewhere (their files come back as texts)
     remote: bool
 
-    def results(self, tasks: Iterable[RunTask]) -> Iterator[RawRun]: ...
+    def results(self, tasks: Iterable[RunTask]) -> Iterator[RawRun]:
+        """Execute ``tasks``, yielding each finished run (in the order they end)."""
 
-    def close(self) -> None: ...
+    def close(self) -> None:
+        """Stop: kill the running runs and wait for them."""
 
     def __enter__(self) -> "Executor": ...
 
@@ -60,6 +62,7 @@ class LocalExecutor:
         self.threads: list[threading.Thread] = []
 
     def results(self, tasks: Iterable[RunTask]) -> Iterator[RawRun]:
+        """Run ``tasks`` on ``jobs`` threads (a run each at a time); yield runs as they end, but cancelled ones."""
         todo: queue.Queue[RunTask] = queue.Queue()
         for t in tasks:
             todo.put(t)
@@ -96,6 +99,7 @@ class LocalExecutor:
                 yield item
 
     def close(self) -> None:
+        """Cancel the running runs (their processes are killed) and wait for the threads."""
         self.cancel.set()
         for th in self.threads:
             th.join()

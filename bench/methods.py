@@ -61,8 +61,6 @@ def option_flag(key: str) -> str:
 def check_methods(study: Study) -> tuple[list[Diagnostic], dict[str, str]]:
     """Located errors in the study's methods, and the methods this mrgc cannot run → why (to skip them)."""
     from mrgc.backends.registry import names as backend_names
-    from mrgc.compiler.encodings import ENCODINGS
-    from mrgc.language.suggest import did_you_mean
 
     diags: list[Diagnostic] = []
     skip: dict[str, str] = {}
@@ -70,32 +68,41 @@ def check_methods(study: Study) -> tuple[list[Diagnostic], dict[str, str]]:
     tables = {"plan": _options("plan"), "compile": _options("compile")}
     backends = backend_names()
     for m in study.methods:
-        def err(message: str) -> None:
-            diags.append(Diagnostic(E_STUDY_SCHEMA, f"method '{m.name}': {message}", m.span))
-
-        if m.backend is not None and m.backend not in backends:
-            err(f"unknown backend '{m.backend}'{did_you_mean(m.backend, backends)} (known: {', '.join(backends)})")
-        if m.encoding is not None and m.encoding not in ENCODINGS:
-            err(f"unknown encoding '{m.encoding}'{did_you_mean(m.encoding, ENCODINGS)} "
-                f"(known: {', '.join(ENCODINGS)})")
-        command = "compile" if m.compile else "plan"
-        table = tables[command]
-        for key, value in m.options:
-            flag = option_flag(key)
-            action = table.get(flag)
-            if flag in RESERVED:
-                err(f"option '{key}' is set by the study itself (seeds:, limits:, backend:, encoding:, planner:)")
-            elif action is None:
-                known = sorted(s.lstrip("-") for s in table if s not in RESERVED and s.startswith("--"))
-                err(f"mrgc {command} has no option {flag}{did_you_mean(key.replace('_', '-'), known)}")
-            else:
-                problem = _bad_value(action, value)
-                if problem:
-                    err(f"option '{key}': {problem}")
+        diags += [Diagnostic(E_STUDY_SCHEMA, f"method '{m.name}': {message}", m.span)
+                  for message in _method_problems(m, tables, backends)]
         if not m.compile and offered is not None and m.planner not in offered:
             skip[m.name] = (f"planner '{m.planner}' is not offered by this mrgc "
                             f"(mrgc plan offers: {', '.join(offered)})")
     return diags, skip
+
+
+def _method_problems(m: Method, tables: dict[str, dict[str, argparse.Action]], backends: list[str]) -> list[str]:
+    """What is wrong with the method's backend, encoding and options (given the option tables of ``mrgc
+    plan`` and ``mrgc compile`` and the backends' names)."""
+    from mrgc.compiler.encodings import ENCODINGS
+    from mrgc.language.suggest import did_you_mean
+
+    out: list[str] = []
+    if m.backend is not None and m.backend not in backends:
+        out.append(f"unknown backend '{m.backend}'{did_you_mean(m.backend, backends)} (known: {', '.join(backends)})")
+    if m.encoding is not None and m.encoding not in ENCODINGS:
+        out.append(f"unknown encoding '{m.encoding}'{did_you_mean(m.encoding, ENCODINGS)} "
+                   f"(known: {', '.join(ENCODINGS)})")
+    command = "compile" if m.compile else "plan"
+    table = tables[command]
+    for key, value in m.options:
+        flag = option_flag(key)
+        action = table.get(flag)
+        if flag in RESERVED:
+            out.append(f"option '{key}' is set by the study itself (seeds:, limits:, backend:, encoding:, planner:)")
+        elif action is None:
+            known = sorted(s.lstrip("-") for s in table if s not in RESERVED and s.startswith("--"))
+            out.append(f"mrgc {command} has no option {flag}{did_you_mean(key.replace('_', '-'), known)}")
+        else:
+            problem = _bad_value(action, value)
+            if problem:
+                out.append(f"option '{key}': {problem}")
+    return out
 
 
 def _bad_value(action: argparse.Action, value: Any) -> str:

@@ -109,6 +109,7 @@ class RunResult:
     plan_file: str | None = None
 
     def to_row(self) -> dict[str, Any]:
+        """The result as a database row (column -> value)."""
         return asdict(self)
 
 
@@ -134,7 +135,8 @@ def classify(raw: RawRun, method_index: int = 0, plan_file: str | None = None) -
             status, detail = RunStatus.INVALID, f"{len(lines)} violation(s): " + "; ".join(lines[:3])
         elif v.exit_code == 2:
             valid = False
-            status, detail = RunStatus.INVALID, "the validator could not use the plan file: " + _last_line(raw.validate_stderr)
+            status = RunStatus.INVALID
+            detail = "the validator could not use the plan file: " + _last_line(raw.validate_stderr)
         else:
             status = RunStatus.CRASH
             detail = f"the validator ended with {_ending(v.exit_code, v.signal)}: {_last_line(raw.validate_stderr)}"
@@ -148,7 +150,8 @@ def classify(raw: RawRun, method_index: int = 0, plan_file: str | None = None) -
         instance_file=inst.path, instance_sha256=inst.sha256, method=task.method, method_index=method_index,
         seed=task.seed, status=status.value, success=status is RunStatus.SOLVED, detail=detail,
         exit_code=proc.exit_code, signal=proc.signal, wall_seconds=round(proc.seconds, 3),
-        validate_seconds=validate_seconds, peak_mb=round(max(proc.peak_mb, raw.validate.peak_mb if raw.validate else 0), 1),
+        validate_seconds=validate_seconds,
+        peak_mb=round(max(proc.peak_mb, raw.validate.peak_mb if raw.validate else 0), 1),
         valid=valid, plan_status=(data or {}).get("status") if not task.compile_only else (data or {}).get("status"),
         stderr_tail=tail, command=" ".join(["mrgc", *proc.argv[3:]]), time_limit=task.limits.time,
         wall_limit=task.limits.wall_seconds, memory_limit_mb=task.limits.memory_mb,

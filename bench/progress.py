@@ -37,8 +37,8 @@ class Progress:
         self.bar: Any = None
         if use_rich and total:
             from rich.console import Console
-            from rich.progress import (BarColumn, MofNCompleteColumn, Progress as Bar, TextColumn,
-                                       TimeElapsedColumn, TimeRemainingColumn)
+            from rich.progress import BarColumn, MofNCompleteColumn, TextColumn, TimeElapsedColumn, TimeRemainingColumn
+            from rich.progress import Progress as Bar
 
             self.bar = Bar(TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),
                            TextColumn("solved {task.fields[solved]}"), TimeElapsedColumn(),
@@ -47,6 +47,7 @@ class Progress:
             self.bar.start()
 
     def update(self, r: RunResult) -> None:
+        """Count a finished run and print its line."""
         self.done += 1
         self.solved += r.success
         line = describe(r)
@@ -60,6 +61,7 @@ class Progress:
               flush=True)
 
     def close(self) -> None:
+        """Stop the progress bar (if any)."""
         if self.bar is not None:
             self.bar.stop()
             self.bar = None

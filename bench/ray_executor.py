@@ -69,6 +69,7 @@ class RayExecutor:
         self.pending: list[Any] = []
 
     def results(self, tasks: Iterable[RunTask]) -> Iterator[RawRun]:
+        """Submit ``tasks`` as Ray tasks (one CPU each); yield runs as they end, except cancelled ones."""
         ray = self.ray
         remote = ray.remote(num_cpus=1, max_retries=0)(_run_remote)
         self.pending = [remote.remote(t) for t in tasks]
@@ -80,6 +81,7 @@ class RayExecutor:
                     yield raw
 
     def close(self) -> None:
+        """Cancel the pending tasks and wait (at most 10 s) for them to end."""
         for ref in self.pending:
             try:
                 self.ray.cancel(ref)

@@ -1,7 +1,8 @@
 """Reports of a results database: tables shaped like the paper's Table I/II, as Markdown or CSV.
 
-One row per instance set and method (``wide``: one row per instance set, a column per measure and method) (sets in study order, methods in study order): runs, success rate
-(solved and valid, per cent of the runs), and over the **solved** runs the mean ± standard error of the
+One row per instance set and method (``wide``: one row per instance set, a column per measure and method)
+(sets in study order, methods in study order): runs, success rate (solved and valid, per cent of the
+runs), and over the **solved** runs the mean ± standard error of the
 mean (sample standard deviation / sqrt(n); no ± for a single run) of planning time, makespan, objects moved
 (the paper's "motion cost") and path length (:mod:`mrgc.bench.outcome`).  A second table counts the
 outcomes, so that no failure is hidden behind a success rate; methods a study skipped are listed with
@@ -15,7 +16,7 @@ import io
 import math
 from collections import Counter
 from dataclasses import dataclass, field
-from typing import Any, Iterable
+from typing import Any, Callable, Iterable
 
 from mrgc.bench.db import COLUMNS, ResultsDB
 from mrgc.bench.outcome import RunStatus
@@ -35,6 +36,7 @@ class Stat:
 
     @staticmethod
     def of(values: Iterable[float | None]) -> "Stat":
+        """Count, mean and standard error of the known values (None values are left out)."""
         xs = [float(v) for v in values if v is not None]
         if not xs:
             return Stat(0, None, None)
@@ -45,6 +47,7 @@ class Stat:
         return Stat(len(xs), mean, math.sqrt(var / len(xs)))
 
     def text(self, digits: int, unit: str = "") -> str:
+        """``mean ± se unit`` with ``digits`` decimals; a dash when no value is known."""
         if self.mean is None:
             return _DASH
         out = f"{self.mean:.{digits}f}" + (f" ± {self.se:.{digits}f}" if self.se is not None else "")
@@ -69,9 +72,11 @@ class Row:
 
     @property
     def success(self) -> float:
+        """Percentage of runs solved."""
         return 100.0 * self.solved / self.runs if self.runs else 0.0
 
     def path_text(self) -> str:
+        """Path length: arm radians and base metres, each when known; a dash when neither is."""
         parts = [s.text(1, unit) for s, unit in ((self.arm_path, "rad"), (self.base_path, "m")) if s.mean is not None]
         return " + ".join(parts) if parts else _DASH
 
@@ -144,8 +149,9 @@ def wide(db: ResultsDB, study: str | None = None) -> str:
         methods = list(dict.fromkeys(r.method for r in rows))
         sets = list(dict.fromkeys(r.instance_set for r in rows))
         cell = {(r.instance_set, r.method): r for r in rows}
-        measures = [("success %", lambda r: f"{r.success:.1f}"), ("time (s)", lambda r: r.time.text(2)),
-                    ("makespan", lambda r: r.makespan.text(1)), ("moved", lambda r: r.moved.text(1))]
+        measures: list[tuple[str, Callable[[Row], str]]] = [
+            ("success %", lambda r: f"{r.success:.1f}"), ("time (s)", lambda r: r.time.text(2)),
+            ("makespan", lambda r: r.makespan.text(1)), ("moved", lambda r: r.moved.text(1))]
         header = ["instance"] + [f"{title} {m}" for title, _ in measures for m in methods]
         body = [[s] + [f(cell[s, m]) if (s, m) in cell else _DASH for _, f in measures for m in methods] for s in sets]
         parts.append(f"## Study {name}\n\n" + "\n".join(_table(header, body, 1)) + "\n")

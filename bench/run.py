@@ -45,6 +45,7 @@ class StudySummary:
     skipped: dict[str, tuple[str, int]] = field(default_factory=dict)
 
     def lines(self) -> list[str]:
+        """The summary printed at the end of ``bench run``."""
         out = [f"study {self.study}: {self.total} runs, {self.already} already recorded, {self.ran} run now"
                + (": " + ", ".join(f"{n} {s}" for s, n in self.outcomes.most_common()) if self.ran else "")]
         out += [f"skipped method {m} ({n} runs): {why}" for m, (why, n) in self.skipped.items()]

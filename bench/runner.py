@@ -55,6 +55,7 @@ class ProcessResult:
     stderr_path: str
 
     def stderr_tail(self, chars: int = TAIL_CHARS) -> str:
+        """The last ``chars`` characters of the process's standard error."""
         return tail(self.stderr_path, chars)
 
 

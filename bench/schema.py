@@ -73,13 +73,16 @@ class Reader:
         self.set_names: list[str] = []
 
     def span(self, node: Any) -> Span:
+        """The node's place in the study file."""
         s, e = node.start_mark, node.end_mark
         return Span(self.path, s.line + 1, s.column + 1, e.line + 1, e.column + 1)
 
     def error(self, node: Any, message: str) -> None:
+        """Record a problem located at ``node``."""
         self.diags.append(Diagnostic(E_STUDY_SCHEMA, message, self.span(node)))
 
     def value(self, node: Any) -> Any:
+        """The node's plain-data value (None, with an error, for anything a safe loader refuses)."""
         from yaml.constructor import ConstructorError, SafeConstructor
 
         try:
@@ -123,6 +126,7 @@ class Reader:
         return value
 
     def name(self, node: Any, what: str) -> str | None:
+        """A name (letters, digits, ``_ . + -``), or None with an error."""
         value = self.scalar(node, what, (str, int))
         if value is None:
             return None
@@ -133,6 +137,7 @@ class Reader:
         return value
 
     def seeds(self, node: Any, what: str) -> tuple[int, ...] | None:
+        """A list of distinct seeds (:func:`parse_seeds`), or None with an error."""
         seeds = parse_seeds(self.value(node))
         if seeds is None:
             self.error(node, f"{what} must be a seed (integer >= 0), a range 'a..b' (a <= b) or a list of those")
@@ -142,6 +147,7 @@ class Reader:
         return seeds
 
     def study(self, root: Any) -> Study | None:
+        """The study of the document ``root``; None when it is empty or has an error."""
         if root is None:
             return None
         top = self.mapping(root, "the study", STUDY_KEYS)
@@ -162,6 +168,7 @@ class Reader:
         return Study(name, self.path, "", tuple(instances), tuple(methods), seeds, limits, description or "")
 
     def limits(self, node: Any, base: Limits) -> Limits | None:
+        """``base`` with the limits the node gives; None when it is not a mapping."""
         m = self.mapping(node, "limits", LIMIT_KEYS)
         if m is None:
             return None
@@ -182,6 +189,7 @@ class Reader:
         return out
 
     def sequence(self, node: Any, what: str) -> list[Any]:
+        """The items of a non-empty list node (none, with an error, for anything else)."""
         import yaml
 
         if not isinstance(node, yaml.SequenceNode) or not node.value:
@@ -190,6 +198,7 @@ class Reader:
         return list(node.value)
 
     def instances(self, node: Any) -> list[InstanceSpec]:
+        """The entries of ``instances``, set names unique."""
         out: list[InstanceSpec] = []
         names: dict[str, Any] = {}
         for item in self.sequence(node, "instances"):
@@ -204,6 +213,7 @@ class Reader:
         return out
 
     def instance(self, node: Any) -> InstanceSpec | None:
+        """One entry of ``instances`` (a file, a glob or a generator call), or None with errors."""
         m = self.mapping(node, "an instance", None)
         if m is None:
             return None
@@ -213,23 +223,11 @@ class Reader:
             return None
         kind = kinds[0]
         if kind != "generate":
-            allowed = FILE_KEYS if kind == "file" else GLOB_KEYS
-            for key, (knode, _) in m.items():
-                if key not in allowed:
-                    from mrgc.language.suggest import did_you_mean
-
-                    self.error(knode, f"a {kind} instance: unknown key '{key}'{did_you_mean(key, allowed)} "
-                               f"(known: {', '.join(allowed)})")
+            self.file_keys(m, kind)
         source = self.scalar(m[kind][1], kind, (str,))
         if source is None:
             return None
-        if kind == "file":
-            default = os.path.splitext(os.path.basename(source))[0]
-        elif kind == "glob":
-            default = re.sub(r"[^A-Za-z0-9_.+-]+", "-", source).strip("-.") or "glob"
-        else:
-            default = source
-        name = self.name(m["name"][1], "name") if "name" in m else default
+        name = self.name(m["name"][1], "name") if "name" in m else _default_name(kind, source)
         problem = self.name(m["problem"][1], "problem") if "problem" in m else None
         if name is None or not _NAME.match(name):
             if "name" not in m:
@@ -239,20 +237,37 @@ class Reader:
         if kind != "generate":
             return InstanceSpec(kind, name, source, problem, span=span)
         seeds = self.seeds(m["seeds"][1], "seeds") if "seeds" in m else (0,)
-        options: list[tuple[str, Any]] = []
-        for key, (knode, vnode) in m.items():
-            if key in GENERATE_KEYS:
-                continue
-            value = self.value(vnode)
-            if value is None or isinstance(value, (list, dict)):
-                self.error(vnode, f"generator option '{key}' must be a number, a word or true/false")
-                continue
-            options.append((key, value))
+        options = self.options(m, "generator option", GENERATE_KEYS)
         if seeds is None:
             return None
         return InstanceSpec("generate", name, source, None, tuple(options), seeds, span)
 
+    def file_keys(self, m: dict[str, tuple[Any, Any]], kind: str) -> None:
+        """An error per key a ``file:`` or ``glob:`` instance (``kind``) does not know."""
+        allowed = FILE_KEYS if kind == "file" else GLOB_KEYS
+        for key, (knode, _) in m.items():
+            if key not in allowed:
+                from mrgc.language.suggest import did_you_mean
+
+                self.error(knode, f"a {kind} instance: unknown key '{key}'{did_you_mean(key, allowed)} "
+                           f"(known: {', '.join(allowed)})")
+
+    def options(self, m: dict[str, tuple[Any, Any]], what: str, skip: tuple[str, ...] = ()) -> list[tuple[str, Any]]:
+        """(key, value) of the mapping's entries but those in ``skip``; an error (``what 'key' must be ...``)
+        for each value that is not a number, a word or true/false."""
+        out: list[tuple[str, Any]] = []
+        for key, (_, vnode) in m.items():
+            if key in skip:
+                continue
+            value = self.value(vnode)
+            if value is None or isinstance(value, (list, dict)):
+                self.error(vnode, f"{what} '{key}' must be a number, a word or true/false")
+                continue
+            out.append((key, value))
+        return out
+
     def methods(self, node: Any, limits: Limits) -> list[Method]:
+        """The entries of ``methods``, names unique; ``limits`` are the study's."""
         out: list[Method] = []
         names: set[str] = set()
         for item in self.sequence(node, "methods"):
@@ -267,6 +282,7 @@ class Reader:
         return out
 
     def method(self, node: Any, limits: Limits) -> Method | None:
+        """One entry of ``methods``, or None with errors; its limits default to ``limits``."""
         m = self.mapping(node, "a method", METHOD_KEYS)
         if m is None:
             return None
@@ -282,13 +298,7 @@ class Reader:
         encoding = self.name(m["encoding"][1], "encoding") if "encoding" in m else None
         options: list[tuple[str, Any]] = []
         if "options" in m:
-            om = self.mapping(m["options"][1], "options", None)
-            for key, (knode, vnode) in (om or {}).items():
-                value = self.value(vnode)
-                if value is None or isinstance(value, (list, dict)):
-                    self.error(vnode, f"option '{key}' must be a number, a word or true/false")
-                    continue
-                options.append((key, value))
+            options = self.options(self.mapping(m["options"][1], "options", None) or {}, "option")
         own = self.limits(m["limits"][1], limits) if "limits" in m else limits
         only: list[str] = []
         if "only" in m:
@@ -304,3 +314,13 @@ class Reader:
             return None
         return Method(name, planner, compile_only, backend, encoding, tuple(options), own, tuple(only),
                       self.span(node))
+
+
+def _default_name(kind: str, source: str) -> str:
+    """The instance set's name when the entry gives none: the file's stem, the glob's pattern made a name
+    (``glob`` if nothing is left), the generator's kind."""
+    if kind == "file":
+        return os.path.splitext(os.path.basename(source))[0]
+    if kind == "glob":
+        return re.sub(r"[^A-Za-z0-9_.+-]+", "-", source).strip("-.") or "glob"
+    return source

@@ -56,9 +56,11 @@ class Limits:
 
     @property
     def wall_seconds(self) -> float:
+        """The runner's wall-clock limit: ``wall``, else ``2 * time + 30`` seconds."""
         return self.wall if self.wall is not None else 2 * self.time + 30
 
     def to_json(self) -> dict[str, float]:
+        """The limits as stored in the results database."""
         return {"time": self.time, "wall": self.wall_seconds, "memory_mb": self.memory_mb}
 
 
@@ -95,6 +97,7 @@ class Method:
     span: Span | None = field(default=None, compare=False)
 
     def runs_on(self, instance_set: str) -> bool:
+        """Whether the method runs on the instance set named ``instance_set``."""
         return not self.only or instance_set in self.only
 
     def spec(self) -> dict[str, Any]:
@@ -126,6 +129,7 @@ class Study:
 
     @property
     def folder(self) -> str:
+        """The folder of the study file: relative paths in it start there."""
         return os.path.dirname(os.path.abspath(self.path))
 
 

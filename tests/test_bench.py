@@ -22,7 +22,8 @@ from dataclasses import replace
 from pathlib import Path
 
 import pytest
-from hypothesis import given, strategies as st
+from hypothesis import given
+from hypothesis import strategies as st
 
 from mrgc.bench import ResultsDB, RunStatus, parse_study, render, run_study
 from mrgc.bench.execute import RunTask, execute_run, mrgc_argv
@@ -129,7 +130,8 @@ def test_a_valid_study_and_its_methods_as_mrgc_command_lines() -> None:
         args = build_parser().parse_args([*method_args(m)[:1], "x.mrg", *method_args(m)[1:]])
         assert args.backend == (m.backend or "cpsat")
     bad = parse_study("study: d\ninstances: [{file: a.mrg}]\nmethods:\n  - {name: A, options: {skeleton: 3}}\n"
-                      "  - {name: B, backend: cplex, options: {anytime: 3}}\n  - {name: C, options: {seed: 1}}\n", "s.yaml")
+                      "  - {name: B, backend: cplex, options: {anytime: 3}}\n  - {name: C, options: {seed: 1}}\n",
+                      "s.yaml")
     diags, _ = check_methods(bad)
     text = "\n".join(d.message for d in diags)
     assert "no option --skeleton (did you mean 'skeletons'?)" in text and "unknown backend 'cplex'" in text
@@ -343,7 +345,8 @@ def test_without_ray_the_ray_executor_says_how_to_get_it(tmp_path: Path) -> None
     symbolic_copy(tmp_path / "p", "chain-3")
     study = write_study(tmp_path / "s.yaml", "study: noray\ninstances: [{file: p/chain-3.mrg}]\nmethods: [{name: O}]\n")
     code = ("import sys; sys.modules['ray'] = None\nfrom mrgc.cli import main\n"
-            f"sys.exit(main(['bench', 'run', {str(study)!r}, '--db', {str(tmp_path / 'r.db')!r}, '--executor', 'ray']))")
+            f"sys.exit(main(['bench', 'run', {str(study)!r}, '--db', {str(tmp_path / 'r.db')!r}, "
+            "'--executor', 'ray']))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert out.returncode == 4 and "pip install 'mrgc[ray]'" in out.stderr and "Traceback" not in out.stderr
 

@@ -94,8 +94,9 @@ class Twin(CpSatBackend):
     def _solve(self, time_limit: float | None) -> Solution:
         sol = super()._solve(time_limit)
         name, values = self.reference.solve(time_limit)
-        expected = {"OPTIMAL": SolveStatus.OPTIMAL, "FEASIBLE": SolveStatus.FEASIBLE, "INFEASIBLE": SolveStatus.INFEASIBLE,
-                    "UNKNOWN": SolveStatus.TIME_LIMIT}.get(name, SolveStatus.ERROR)
+        statuses = {"OPTIMAL": SolveStatus.OPTIMAL, "FEASIBLE": SolveStatus.FEASIBLE,
+                    "INFEASIBLE": SolveStatus.INFEASIBLE, "UNKNOWN": SolveStatus.TIME_LIMIT}
+        expected = statuses.get(name, SolveStatus.ERROR)
         assert (sol.status, sol.values) == (expected, values), name
         Twin.compared.append("solve")
         return sol

@@ -502,8 +502,8 @@ class Grounder:
         return Answer(GroundStatus.OK if res.solved else GroundStatus.NO_PATH, path=list(res.path))
 
     def transfer(self, robot: str, obj: str, grasp: str, start: np.ndarray, goal: np.ndarray,
-                 avoid: Iterable[str] = (), lift: bool = False, busy: Pieces = (), partner: str | None = None
-                 ) -> Answer:
+                 avoid: Iterable[str] = (), lift: bool = False, busy: Pieces = (), partner: str | None = None,
+                 lower: bool = False) -> Answer:
         """:meth:`_transfer`, remembered: the same question (same configurations, objects at the same poses,
         the same moving robots and arms at home) gets the same answer without a second search (the reverse
         search asks again when it splits a step or grounds a skeleton that shares a suffix)."""
@@ -512,10 +512,10 @@ class Grounder:
         for part in (np.asarray(start, dtype=float), np.asarray(goal, dtype=float),
                      *(self.poses[o] for o in sorted(self.poses)), *(t for _, t in busy)):
             digest.update(np.ascontiguousarray(part).tobytes())
-        key = ("transfer", robot, obj, grasp, avoid, lift, partner, tuple(id(shape) for shape, _ in busy),
+        key = ("transfer", robot, obj, grasp, avoid, lift, lower, partner, tuple(id(shape) for shape, _ in busy),
                tuple(sorted(self._away.items())), digest.digest())
         if key not in self._paths:
-            self._remember(key, self._transfer(robot, obj, grasp, start, goal, avoid, lift, busy, partner))
+            self._remember(key, self._transfer(robot, obj, grasp, start, goal, avoid, lift, busy, partner, lower))
         return self._paths[key]
 
     def _remember(self, key: tuple[object, ...], answer: Answer) -> None:
@@ -526,14 +526,15 @@ class Grounder:
         self._paths[key] = answer
 
     def _transfer(self, robot: str, obj: str, grasp: str, start: np.ndarray, goal: np.ndarray,
-                  avoid: Iterable[str] = (), lift: bool = False, busy: Pieces = (), partner: str | None = None
-                  ) -> Answer:
+                  avoid: Iterable[str] = (), lift: bool = False, busy: Pieces = (), partner: str | None = None,
+                  lower: bool = False) -> Answer:
         """How ``robot`` carries ``obj`` (held with ``grasp``) from configuration ``start`` to ``goal``: when
         ``lift`` (``start`` grasps the object where it rests), first straight up by :meth:`lift_height`
         (tool poses every centimetre, each by IK from the one before; as far as the way up is free); then the
         straight joint-space line (the validator's reading of a plan that gives no transfer) or, when that line
-        collides, an
-        RRTConnect path (a budget of checks, seeded from the query).  Free of fixed objects, of the other arms
+        collides, an RRTConnect path (a budget of checks, seeded from the query); with ``lower``, that
+        motion ends as high above ``goal`` and the carry comes straight down onto it (so the arm crosses
+        a bin above what will stand in it, not through it).  Free of fixed objects, of the other arms
         at home, of ``avoid`` and of ``busy`` (what other robots sweep meanwhile).
         ``path`` is every configuration, ``start`` first, no joint moving more than
         :data:`PATH_RESOLUTION` between two; ``blockers`` the avoided objects in the way."""
@@ -572,15 +573,31 @@ class Grounder:
             while top + 1 < len(up) and hits(joint_line(up[top:top + 2], PATH_RESOLUTION)) is None:
                 top += 1
             back = joint_line(up[:top + 1], PATH_RESOLUTION)
-        line = joint_line(np.stack([back[-1], np.asarray(goal, dtype=float)]), PATH_RESOLUTION)
+        # with ``lower``, the carry ends above the goal and comes straight down onto it (the mirror of the lift)
+        tail = self._descent(robot, np.asarray(goal, dtype=float), self.lift_height(obj), hits) if lower \
+            else np.asarray(goal, dtype=float)[None]
+        line = joint_line(np.stack([back[-1], tail[0]]), PATH_RESOLUTION)
         blocked = hits(line)
         if blocked is None:
-            return Answer(GroundStatus.OK, path=[*back, *line[1:]])
-        planned = self.arm_path(robot, back[-1], np.asarray(goal, dtype=float), holding=held, avoid=others,
+            return Answer(GroundStatus.OK, path=[*back, *line[1:], *tail[1:]])
+        planned = self.arm_path(robot, back[-1], tail[0], holding=held, avoid=others,
                                 resolution=PATH_RESOLUTION, busy=busy, partner=partner, max_checks=TRANSFER_CHECKS)
         if not planned.ok:
             return Answer(GroundStatus.NO_PATH, blockers=blocked, detail=BUSY if crossed[0] else "")
-        return Answer(GroundStatus.OK, path=[*back, *planned.path[1:]])
+        return Answer(GroundStatus.OK, path=[*back, *planned.path[1:], *tail[1:]])
+
+    def _descent(self, robot: str, goal: np.ndarray, height: float,
+                 hits: Callable[[np.ndarray], set[str] | None]) -> np.ndarray:
+        """Configurations coming straight down onto ``goal`` from up to ``height`` above it (the tool's pose
+        at ``goal`` raised centimetre by centimetre, as far as IK follows and ``hits`` finds the way free),
+        ``goal`` last, at :data:`PATH_RESOLUTION`; ``goal`` alone when not even one centimetre is free."""
+        up = self._lift(robot, goal, height)
+        if up is None:
+            return goal[None]
+        top = 0
+        while top + 1 < len(up) and hits(joint_line(up[top:top + 2], PATH_RESOLUTION)) is None:
+            top += 1
+        return joint_line(up[:top + 1][::-1], PATH_RESOLUTION)
 
     def transit(self, robot: str, start: np.ndarray, goal: np.ndarray, avoid: Iterable[str] = (),
                 busy: Pieces = (), via: np.ndarray | None = None, partner: str | None = None,

@@ -273,7 +273,7 @@ class ReverseGrounder:
             assert place.configs is not None
             carry = g.transfer(a.place_robot, a.obj, a.place_grasp, start, place.configs[0], avoid, lift=lift,
                                busy=busy.get("to-place", []),
-                               partner=a.pick_robot if a.pick_robot != a.place_robot else None)
+                               partner=a.pick_robot if a.pick_robot != a.place_robot else None, lower=True)
             if not carry.ok:
                 last = _failed(f"carry to the placement by {a.place_robot}", carry)
                 continue

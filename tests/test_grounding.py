@@ -161,3 +161,23 @@ def test_a_transfer_lifts_the_object_clear_of_taller_neighbours(pa3: Grounder) -
     assert np.abs(tools - tools[0]).max() < 2e-3  # straight up all the way
     volume = pa3.arm_volume("r1", path[1:], holding=("o1", "top"))
     assert pa3.hits(volume, among=["o2", "o3"]) == set()
+
+
+def test_a_transfer_with_lower_comes_straight_down_onto_its_goal(pa3: Grounder) -> None:
+    """The taker carries o1 from the exchange to above the pre-place and comes straight down onto it: the
+    path ends at the pre-place, and over its last centimetres the tool only descends."""
+    hand = pa3.handover("o1", "h1", "r1", "top", "r2", "side-x+")
+    target = pa3.placement("o1", "bin-b")
+    assert hand.ok and hand.configs is not None and target.ok and target.pose is not None
+    place = pa3.place("r2", "o1", "side-x+", target.pose)
+    assert place.ok and place.configs is not None
+    carry = pa3.transfer("r2", "o1", "side-x+", hand.configs[1], place.configs[0], lower=True)
+    assert carry.ok
+    path = np.array(carry.path)
+    assert np.allclose(path[0], hand.configs[1]) and np.allclose(path[-1], place.configs[0])
+    assert np.abs(np.diff(path, axis=0)).max() <= 0.01 + 1e-9
+    tools = pa3.arm("r2").tool_world(path)[:, :3, 3]
+    z = tools[:, 2]
+    above = next(i for i in range(len(z) - 1, -1, -1) if z[i] >= z[-1] + 0.05 - 1e-4)  # 5 cm above the end
+    assert np.abs(tools[above:, :2] - tools[-1, :2]).max() < 2e-3  # straight down from there
+    assert np.all(np.diff(z[above:]) <= 1e-4)

@@ -184,7 +184,7 @@ class ScriptedGrounder:
         return Answer(GroundStatus.OK, configs=np.array([[1.0], [0.0]]))
 
     def transfer(self, robot: str, obj: str, grasp: str, start: np.ndarray, goal: np.ndarray, avoid: Any = (),
-                 lift: bool = False, busy: Any = (), partner: Any = None) -> Answer:
+                 lift: bool = False, busy: Any = (), partner: Any = None, lower: bool = False) -> Answer:
         return Answer(GroundStatus.OK, path=[np.asarray(start), np.asarray(goal)])
 
     def placement(self, obj: str, region: str, avoid: Any = (), volume: Any = None, key: str = "",

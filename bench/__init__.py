@@ -35,7 +35,8 @@ if TYPE_CHECKING:
     from mrgc.bench.outcome import RunResult, RunStatus
     from mrgc.bench.report import Row, aggregate, render
     from mrgc.bench.run import DEFAULT_DB, StudySummary, run_study
-    from mrgc.bench.study import InstanceSpec, Limits, Method, Study, load_study, parse_study
+    from mrgc.bench.schema import load_study, parse_study
+    from mrgc.bench.study import InstanceSpec, Limits, Method, Study
 
 #: public name -> the module defining it (loaded on first use: ``mrgc`` builds its parser with
 #: :mod:`mrgc.bench.command`, and that must not load the rest of the package)
@@ -44,7 +45,7 @@ _API = {
     "RunStatus": "outcome",
     "Row": "report", "aggregate": "report", "render": "report", "DEFAULT_DB": "run", "StudySummary": "run",
     "run_study": "run", "InstanceSpec": "study", "Limits": "study", "Method": "study", "Study": "study",
-    "load_study": "study", "parse_study": "study",
+    "load_study": "schema", "parse_study": "schema",
 }
 
 

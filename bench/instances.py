@@ -1,10 +1,10 @@
 """Instances: a study's ``instances:`` entries expanded into checked problem files with content hashes.
 
 - ``file:`` is one instance, ``glob:`` one per match (sorted), both relative to the study file's folder;
-- ``generate:`` runs ``mrgc generate KIND --option value ... --seed S`` (the command line's own parser and
-  code, in this process) once per generator seed and writes ``WORK/instances/SET/SET-sS.mrg``, rewriting
-  the file only when its text changed.  The generator is deterministic, so a study regenerates the same
-  files on every machine.
+- ``generate:`` runs ``mrgc generate KIND --option value ... --seed S`` (the command line's own parser
+  and code, :mod:`mrgc.commands`, in this process) once per generator seed and writes
+  ``WORK/instances/SET/SET-sS.mrg``, rewriting the file only when its text changed.  The generator is
+  deterministic, so a study regenerates the same files on every machine.
 
 Every instance is parsed and checked once here (a bad file is reported before any run starts, exit 2),
 which also gives the robots' base types for the path-length measure.  An instance's **content hash** is
@@ -127,7 +127,7 @@ def generator_args(spec: InstanceSpec, seed: int) -> list[str]:
 def generate(spec: InstanceSpec, seed: int) -> str:
     """The text ``mrgc generate`` prints for the entry and ``seed`` (run in this process); InputError E602
     located at the entry when the command line rejects the call."""
-    from mrgc.cli import build_parser
+    from mrgc.commands import build_parser
 
     args = generator_args(spec, seed)
     err, out = io.StringIO(), io.StringIO()

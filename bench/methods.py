@@ -1,12 +1,12 @@
 """Methods as command lines: a study's method becomes ``mrgc plan ...`` or ``mrgc compile ...`` arguments.
 
 The options a method may give are the options of the installed ``mrgc plan`` / ``mrgc compile`` (read from
-the command line's own parser, so a planner option added to ``mrgc plan`` is usable in studies at once);
-an unknown option, a value of the wrong type, an unknown backend or encoding is a located study error
-(E601).  A planner that this mrgc does not offer (``planner: ap1`` before ``mrgc plan --planner ap1``
-exists) is *not* an error: the spec stays valid for the mrgc that offers it, and ``bench run`` skips that
-method's runs with the reason, storing none of them, so that a later ``bench run`` of the same study runs
-them (docs/bench.md).
+the command line's own parser, :mod:`mrgc.commands`, so a planner option added to ``mrgc plan`` is usable
+in studies at once); an unknown option, a value of the wrong type, an unknown backend or encoding is a
+located study error (E601).  A planner that this mrgc does not offer (``planner: ap1`` before ``mrgc plan
+--planner ap1`` exists) is *not* an error: the spec stays valid for the mrgc that offers it, and ``bench
+run`` skips that method's runs with the reason, storing none of them, so that a later ``bench run`` of the
+same study runs them (docs/bench.md).
 """
 
 from __future__ import annotations
@@ -26,14 +26,9 @@ RESERVED = {"-o", "--output", "--seed", "--time-limit", "--format", "--problem",
 
 
 def _command_parser(command: str) -> argparse.ArgumentParser:
-    from mrgc.cli import build_parser
+    from mrgc.commands import build_parser, subcommands
 
-    parser = build_parser()
-    for action in parser._actions:
-        if isinstance(action, argparse._SubParsersAction):
-            found: argparse.ArgumentParser = action.choices[command]
-            return found
-    raise AssertionError("mrgc's parser has no subcommands")  # pragma: no cover
+    return subcommands(build_parser()).choices[command]
 
 
 def _options(command: str) -> dict[str, argparse.Action]:

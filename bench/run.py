@@ -20,7 +20,8 @@ from mrgc.bench.execute import RawRun, RunTask, now
 from mrgc.bench.instances import expand_instances
 from mrgc.bench.methods import check_methods, method_args
 from mrgc.bench.outcome import RunResult, RunStatus, classify
-from mrgc.bench.study import Study, load_study
+from mrgc.bench.schema import load_study
+from mrgc.bench.study import Study
 from mrgc.errors import Diagnostic, InputError
 
 #: the database ``bench run`` and ``bench report`` use without ``--db``

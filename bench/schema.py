@@ -1,4 +1,5 @@
-"""The checks of a study file's schema (:mod:`mrgc.bench.study` documents it), on the composed YAML tree so
+"""Reading a study file (:func:`load_study`, :func:`parse_study`) and the checks of its schema
+(:mod:`mrgc.bench.study` documents it and defines what a checked study is), on the composed YAML tree so
 that every error is located at ``file:line:col`` (code E601), all of them reported at once.
 
 Also the readers of the schema's small value languages: seed ranges (``"0..19"``) and memory sizes
@@ -12,13 +13,14 @@ import re
 from dataclasses import replace
 from typing import Any
 
-from mrgc.bench.study import E_STUDY_SCHEMA, InstanceSpec, Limits, Method, Study
-from mrgc.errors import Diagnostic, Span
+from mrgc.bench.study import E_STUDY_READ, E_STUDY_SCHEMA, InstanceSpec, Limits, Method, Study
+from mrgc.errors import Diagnostic, InputError, Span
 
 _NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.+-]*$")
 _RANGE = re.compile(r"^\s*(\d+)\s*\.\.\s*(\d+)\s*$")
 _SIZE = re.compile(r"^\s*(\d+(?:\.\d+)?)\s*([KMGT]i?B?|)\s*$", re.IGNORECASE)
 _UNITS = {"": 1.0, "k": 1 / 1024, "m": 1.0, "g": 1024.0, "t": 1024.0 ** 2}
+_MAX_BYTES = 1 << 20
 
 STUDY_KEYS = ("study", "description", "seeds", "limits", "instances", "methods")
 LIMIT_KEYS = ("time", "wall", "memory")
@@ -62,6 +64,44 @@ def parse_megabytes(value: Any) -> float | None:
             mb = float(m.group(1)) * _UNITS[m.group(2)[:1].lower()]
             return mb if mb > 0 else None
     return None
+
+
+def load_study(path: str | os.PathLike[str]) -> Study:
+    """Read and check a study file; :class:`~mrgc.errors.InputError` lists every problem found (E600/E601)."""
+    path = os.fspath(path)
+    try:
+        with open(path, "rb") as fh:
+            data = fh.read(_MAX_BYTES + 1)
+    except OSError as exc:
+        raise InputError([Diagnostic(E_STUDY_READ, f"cannot read study '{path}': {exc.strerror or exc}")]) from None
+    if len(data) > _MAX_BYTES:
+        raise InputError([Diagnostic(E_STUDY_READ, f"study '{path}' is larger than {_MAX_BYTES} bytes")])
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise InputError([Diagnostic(E_STUDY_READ, f"study '{path}' is not UTF-8 text (byte {exc.start})")]) from None
+    return parse_study(text, path)
+
+
+def parse_study(text: str, path: str = "<study>") -> Study:
+    """Check the text of a study file named ``path`` (relative paths in it resolve against its folder)."""
+    import yaml
+
+    try:
+        root = yaml.compose(text, Loader=yaml.SafeLoader)
+    except yaml.MarkedYAMLError as exc:
+        mark = exc.problem_mark or exc.context_mark
+        span = Span(path, mark.line + 1, mark.column + 1, mark.line + 1, mark.column + 2) if mark else None
+        raise InputError([Diagnostic(E_STUDY_READ, f"study is not YAML: {exc.problem or exc}", span)],
+                         {path: text}) from None
+    except yaml.YAMLError as exc:
+        raise InputError([Diagnostic(E_STUDY_READ, f"study is not YAML: {exc}")], {path: text}) from None
+    reader = Reader(path)
+    study = reader.study(root)
+    if reader.diags or study is None:
+        diags = reader.diags or [Diagnostic(E_STUDY_SCHEMA, "the study is empty", Span(path, 1, 1, 1, 2))]
+        raise InputError(diags, {path: text})
+    return replace(study, text=text)
 
 
 class Reader:

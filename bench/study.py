@@ -1,8 +1,8 @@
 """Study files: which instances, which methods, which seeds, under which per-run limits (docs/bench.md).
 
-A study is a YAML file read with pyyaml's safe loader (plain data only: no tags that build objects).  Its
-schema, checked here with every error located at ``file:line:col`` (code E601, E600 for a file that is not
-YAML at all)::
+A study is a YAML file read with pyyaml's safe loader (plain data only: no tags that build objects) by
+:func:`mrgc.bench.schema.load_study`.  Its schema, checked there with every error located at
+``file:line:col`` (code E601, E600 for a file that is not YAML at all)::
 
     study: smoke                  # the study's name: part of every run's key in the results database
     description: free text        # optional
@@ -23,23 +23,21 @@ YAML at all)::
       - {name: Ap1, planner: ap1}
       - {name: cpsat-tom, compile: true, backend: cpsat, encoding: time-of-move, only: [PA5]}
 
-Nothing here touches the file system beyond reading the study file: expanding instance entries into files
-is :mod:`mrgc.bench.instances`, turning methods into command lines :mod:`mrgc.bench.methods`; the checks
-of the schema are :mod:`mrgc.bench.schema`.
+This module holds what a checked study is (the data types below, which the rest of :mod:`mrgc.bench`
+reads); reading and checking a study file is :mod:`mrgc.bench.schema`, expanding instance entries into
+files :mod:`mrgc.bench.instances`, turning methods into command lines :mod:`mrgc.bench.methods`.
 """
 
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from typing import Any
 
-from mrgc.errors import Diagnostic, InputError, Span
+from mrgc.errors import Span
 
 #: diagnostic codes of study files
 E_STUDY_READ, E_STUDY_SCHEMA = "E600", "E601"
-
-_MAX_BYTES = 1 << 20
 
 
 @dataclass(frozen=True)
@@ -131,43 +129,3 @@ class Study:
     def folder(self) -> str:
         """The folder of the study file: relative paths in it start there."""
         return os.path.dirname(os.path.abspath(self.path))
-
-
-def load_study(path: str | os.PathLike[str]) -> Study:
-    """Read and check a study file; :class:`~mrgc.errors.InputError` lists every problem found (E600/E601)."""
-    path = os.fspath(path)
-    try:
-        with open(path, "rb") as fh:
-            data = fh.read(_MAX_BYTES + 1)
-    except OSError as exc:
-        raise InputError([Diagnostic(E_STUDY_READ, f"cannot read study '{path}': {exc.strerror or exc}")]) from None
-    if len(data) > _MAX_BYTES:
-        raise InputError([Diagnostic(E_STUDY_READ, f"study '{path}' is larger than {_MAX_BYTES} bytes")])
-    try:
-        text = data.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        raise InputError([Diagnostic(E_STUDY_READ, f"study '{path}' is not UTF-8 text (byte {exc.start})")]) from None
-    return parse_study(text, path)
-
-
-def parse_study(text: str, path: str = "<study>") -> Study:
-    """Check the text of a study file named ``path`` (relative paths in it resolve against its folder)."""
-    import yaml
-
-    try:
-        root = yaml.compose(text, Loader=yaml.SafeLoader)
-    except yaml.MarkedYAMLError as exc:
-        mark = exc.problem_mark or exc.context_mark
-        span = Span(path, mark.line + 1, mark.column + 1, mark.line + 1, mark.column + 2) if mark else None
-        raise InputError([Diagnostic(E_STUDY_READ, f"study is not YAML: {exc.problem or exc}", span)],
-                         {path: text}) from None
-    except yaml.YAMLError as exc:
-        raise InputError([Diagnostic(E_STUDY_READ, f"study is not YAML: {exc}")], {path: text}) from None
-    from mrgc.bench.schema import Reader
-
-    reader = Reader(path)
-    study = reader.study(root)
-    if reader.diags or study is None:
-        diags = reader.diags or [Diagnostic(E_STUDY_SCHEMA, "the study is empty", Span(path, 1, 1, 1, 2))]
-        raise InputError(diags, {path: text})
-    return replace(study, text=text)

@@ -67,8 +67,7 @@ def check(path: str | os.PathLike[str], *, allow_outside: Sequence[str] = ()) ->
     return CheckReport(mf, tuple(warnings))
 
 
-def load_problem(source: ProblemSource, *, name: str | None = None,
-                 allow_outside: Sequence[str] = ()) -> "Problem":
+def load_problem(source: ProblemSource, *, name: str | None = None, allow_outside: Sequence[str] = ()) -> "Problem":
     """The checked problem ``source`` stands for: itself, or problem ``name`` (default: the only one) of the
     file at that path."""
     return _resolve(source, name, allow_outside)[0]
@@ -110,8 +109,14 @@ def _checked_layout(problem: "Problem", robots: bool = True) -> list[Diagnostic]
 
 
 # ---------------------------------------------------------------- phase 1
-def compute_facts(source: ProblemSource, *, name: str | None = None, seed: int = 0, workers: int | None = None,
-                  allow_outside: Sequence[str] = ()) -> "FactsResult":
+def compute_facts(
+    source: ProblemSource,
+    *,
+    name: str | None = None,
+    seed: int = 0,
+    workers: int | None = None,
+    allow_outside: Sequence[str] = (),
+) -> "FactsResult":
     """Phase 1: every geometric fact of a geometric problem (``.facts``, sorted) and timing statistics
     (``.stats``); ``workers`` processes (default one per robot).  InputError E402 for a symbolic problem."""
     from mrgc.planner.phase1 import compute_problem_facts
@@ -124,10 +129,19 @@ def compute_facts(source: ProblemSource, *, name: str | None = None, seed: int =
 
 
 # ---------------------------------------------------------------- skeletons
-def compile(source: ProblemSource, *, name: str | None = None, backend: BackendSpec = DEFAULT_BACKEND,  # noqa: A001
-            encoding: str = DEFAULT_ENCODING, skeletons: int = 1, max_makespan: int | None = None,
-            time_limit: float | None = None, facts: Iterable["Fact"] | None = None, seed: int = 0,
-            allow_outside: Sequence[str] = ()) -> "CompileResult":
+def compile(  # noqa: A001
+    source: ProblemSource,
+    *,
+    name: str | None = None,
+    backend: BackendSpec = DEFAULT_BACKEND,
+    encoding: str = DEFAULT_ENCODING,
+    skeletons: int = 1,
+    max_makespan: int | None = None,
+    time_limit: float | None = None,
+    facts: Iterable["Fact"] | None = None,
+    seed: int = 0,
+    allow_outside: Sequence[str] = (),
+) -> "CompileResult":
     """The first ``skeletons`` task skeletons of a problem in (makespan, objects moved) order, with a status
     (``optimal``, ``infeasible``, ``time limit``, ``error``), the compiler's reasons when there is none, and
     statistics (``stats``: task-graph size, solver calls, seconds per phase).  ``facts`` default to the
@@ -137,16 +151,33 @@ def compile(source: ProblemSource, *, name: str | None = None, backend: BackendS
     problem = load_problem(source, name=name, allow_outside=allow_outside)
     _checked_layout(problem, robots=facts is None and needs_facts(problem))
     fact_list, facts_seconds = problem_facts(problem, facts, seed=seed)
-    result = compile_problem(problem, backend=backend, encoding=encoding, skeletons=skeletons,
-                             max_makespan=max_makespan, time_limit=time_limit, facts=fact_list, seed=seed)
+    result = compile_problem(
+        problem,
+        backend=backend,
+        encoding=encoding,
+        skeletons=skeletons,
+        max_makespan=max_makespan,
+        time_limit=time_limit,
+        facts=fact_list,
+        seed=seed,
+    )
     result.stats["facts_seconds"] = round(facts_seconds, 6)
     return result
 
 
-def export_model(source: ProblemSource, path: str | os.PathLike[str], *, name: str | None = None,
-                 backend: BackendSpec = DEFAULT_BACKEND, encoding: str = DEFAULT_ENCODING, horizon: int | None = None,
-                 max_makespan: int | None = None, facts: Iterable["Fact"] | None = None, seed: int = 0,
-                 allow_outside: Sequence[str] = ()) -> int:
+def export_model(
+    source: ProblemSource,
+    path: str | os.PathLike[str],
+    *,
+    name: str | None = None,
+    backend: BackendSpec = DEFAULT_BACKEND,
+    encoding: str = DEFAULT_ENCODING,
+    horizon: int | None = None,
+    max_makespan: int | None = None,
+    facts: Iterable["Fact"] | None = None,
+    seed: int = 0,
+    allow_outside: Sequence[str] = (),
+) -> int:
     """Write the skeleton model of a problem to ``path`` in the backend's format (its extension: ``.lp`` /
     ``.mps`` for ``mip``, ``.smt2`` for ``smt``, ``.pbtxt`` for ``cpsat``) and return its horizon.
 
@@ -166,17 +197,35 @@ def export_model(source: ProblemSource, path: str | os.PathLike[str], *, name: s
     _checked_layout(problem, robots=facts is None and needs_facts(problem))
     fact_list, _ = problem_facts(problem, facts, seed=seed)
     if horizon is None:
-        result = compile(problem, backend=backend, encoding=encoding, max_makespan=max_makespan, facts=fact_list,
-                         seed=seed)
+        result = compile(
+            problem, backend=backend, encoding=encoding, max_makespan=max_makespan, facts=fact_list, seed=seed
+        )
         horizon = result.skeletons[0].makespan if result.skeletons else None  # none: the limit
-    return write_model(problem, os.fspath(path), backend=backend, encoding=encoding, horizon=horizon,
-                       facts=fact_list, max_makespan=max_makespan)
+    return write_model(
+        problem,
+        os.fspath(path),
+        backend=backend,
+        encoding=encoding,
+        horizon=horizon,
+        facts=fact_list,
+        max_makespan=max_makespan,
+    )
 
 
 # ---------------------------------------------------------------- planning
-def plan(source: ProblemSource, *, name: str | None = None, planner: str = "mcts",
-         backend: str = DEFAULT_BACKEND, encoding: str = DEFAULT_ENCODING, seed: int = 0, time_limit: float = 60.0,
-         log: Callable[[str], None] | None = None, allow_outside: Sequence[str] = (), **options: Any) -> "Plan":
+def plan(
+    source: ProblemSource,
+    *,
+    name: str | None = None,
+    planner: str = "mcts",
+    backend: str = DEFAULT_BACKEND,
+    encoding: str = DEFAULT_ENCODING,
+    seed: int = 0,
+    time_limit: float = 60.0,
+    log: Callable[[str], None] | None = None,
+    allow_outside: Sequence[str] = (),
+    **options: Any,
+) -> "Plan":
     """Plan a problem end to end: phase 1 (unless the file holds its facts), task skeletons, then the
     planner's search; a geometric plan counts only once the independent validator accepted it.
 
@@ -198,14 +247,30 @@ def plan(source: ProblemSource, *, name: str | None = None, planner: str = "mcts
     digest = problem_digest(problem)
     problem_file = path if path is not None else (problem.source or "<string>")
     sha256 = file_sha256(path) if path is not None else digest
-    result = plan_with(planner, problem, problem_file, sha256, __version__, backend=backend, encoding=encoding,
-                       seed=seed, time_limit=time_limit, log=log, **options)
+    result = plan_with(
+        planner,
+        problem,
+        problem_file,
+        sha256,
+        __version__,
+        backend=backend,
+        encoding=encoding,
+        seed=seed,
+        time_limit=time_limit,
+        log=log,
+        **options,
+    )
     result.problem_digest = digest
     return result
 
 
-def validate(source: ProblemSource, plan: "Plan | Mapping[str, Any] | str | os.PathLike[str]", *,
-             name: str | None = None, allow_outside: Sequence[str] = ()) -> "ValidationReport":
+def validate(
+    source: ProblemSource,
+    plan: "Plan | Mapping[str, Any] | str | os.PathLike[str]",
+    *,
+    name: str | None = None,
+    allow_outside: Sequence[str] = (),
+) -> "ValidationReport":
     """Independently re-check ``plan`` (a :class:`~mrgc.planner.plan.Plan`, parsed plan JSON, or the path of
     a plan file) against a problem: a :class:`~mrgc.planner.validate.ValidationReport` whose ``ok`` is the
     verdict and whose ``violations`` list every way the plan fails (docs/validator.md).  A plan file that
@@ -249,5 +314,16 @@ def backends() -> "list[BackendRecord]":
     return records()
 
 
-__all__ = ["BackendSpec", "CheckReport", "ProblemSource", "backends", "check", "compile",
-           "compute_facts", "export_model", "load_problem", "plan", "validate"]
+__all__ = [
+    "BackendSpec",
+    "CheckReport",
+    "ProblemSource",
+    "backends",
+    "check",
+    "compile",
+    "compute_facts",
+    "export_model",
+    "load_problem",
+    "plan",
+    "validate",
+]

@@ -76,8 +76,11 @@ def main(argv: Sequence[str] | None = None) -> int:
             # ArgumentError): the signal still ends the run
             print(f"mrgc: {signals.describe()}; nothing written", file=sys.stderr)
             return signals.exit_code()
-        print(f"mrgc: internal error[E070]: {type(exc).__name__}: {exc} "
-              "(please report this with the input that caused it)", file=sys.stderr)
+        print(
+            f"mrgc: internal error[E070]: {type(exc).__name__}: {exc} "
+            "(please report this with the input that caused it)",
+            file=sys.stderr,
+        )
         return ExitCode.INTERNAL
     finally:
         signals.uninstall()

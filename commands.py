@@ -24,6 +24,7 @@ from mrgc.limits import count, number
 if TYPE_CHECKING:
     from mrgc.language.loader import MrgFile
 
+
 class _Parser(argparse.ArgumentParser):
     """argparse whose usage errors are one ``error[E000]`` line and exit code 2."""
 
@@ -198,28 +199,53 @@ def cmd_compile(args: argparse.Namespace) -> int:
         _warn(mf.path, mf.text, found.warnings)
         facts, facts_seconds = found.facts, float(found.stats["seconds"])
     with signals.activity(f"generating skeletons of {problem.name} with {args.backend}"):
-        result = api.compile(problem, backend=args.backend, encoding=args.encoding, skeletons=args.skeletons,
-                             max_makespan=args.max_makespan, time_limit=args.time_limit, facts=facts, seed=args.seed)
+        result = api.compile(
+            problem,
+            backend=args.backend,
+            encoding=args.encoding,
+            skeletons=args.skeletons,
+            max_makespan=args.max_makespan,
+            time_limit=args.time_limit,
+            facts=facts,
+            seed=args.seed,
+        )
     if facts is not None:
         result.stats["facts_seconds"] = round(facts_seconds, 6)
     if args.emit:
-        horizon = args.horizon if args.horizon is not None else (
-            result.skeletons[0].makespan if result.skeletons else None)
-        with signals.activity(f"writing the model to {args.emit}"), \
-                outputs.atomic_path(args.emit, inputs_of(mf), option="--emit") as tmp:
-            horizon = api.export_model(problem, tmp, backend=args.backend, encoding=args.encoding, horizon=horizon,
-                                       max_makespan=args.max_makespan, facts=facts, seed=args.seed)
+        horizon = (
+            args.horizon if args.horizon is not None else (result.skeletons[0].makespan if result.skeletons else None)
+        )
+        with (
+            signals.activity(f"writing the model to {args.emit}"),
+            outputs.atomic_path(args.emit, inputs_of(mf), option="--emit") as tmp,
+        ):
+            horizon = api.export_model(
+                problem,
+                tmp,
+                backend=args.backend,
+                encoding=args.encoding,
+                horizon=horizon,
+                max_makespan=args.max_makespan,
+                facts=facts,
+                seed=args.seed,
+            )
         result.stats["emitted_horizon"] = horizon
     if args.format == "json":
         print(json.dumps(result.to_json(), indent=2))
     else:
         n = len(result.skeletons)
-        print(f"problem {result.problem}: backend {result.backend}, encoding {result.encoding}: "
-              f"{result.status}, {n} skeleton{'s' * (n != 1)} "
-              f"({result.stats.get('objects', 0)} objects, {result.stats.get('actions', 0)} actions in the task graph, "
-              f"{result.stats.get('total_seconds', 0):.3f} s"
-              + (f"; phase 1: {result.stats['facts']} facts in {result.stats['facts_seconds']:.2f} s"
-                 if result.stats.get("facts_seconds") else "") + ")")
+        print(
+            f"problem {result.problem}: backend {result.backend}, encoding {result.encoding}: "
+            f"{result.status}, {n} skeleton{'s' * (n != 1)} "
+            f"({result.stats.get('objects', 0)} objects, {result.stats.get('actions', 0)} actions in the task graph, "
+            f"{result.stats.get('total_seconds', 0):.3f} s"
+            + (
+                f"; phase 1: {result.stats['facts']} facts in {result.stats['facts_seconds']:.2f} s"
+                if result.stats.get("facts_seconds")
+                else ""
+            )
+            + ")"
+        )
         for i, sk in enumerate(result.skeletons, 1):
             print(f"skeleton {i}: makespan {sk.makespan}, moves {len(sk.moved)} ({' '.join(sk.moved)})")
             for line in sk.describe():
@@ -252,9 +278,12 @@ def cmd_facts(args: argparse.Namespace) -> int:
         for asset, data in doc.assets.items():  # local meshes and URDFs the output refers to, copied beside it
             _write_asset(asset, data, inputs_of(mf))
         write_text(args.output, doc.text, inputs_of(mf))
-        print(f"{args.output}: {len(result.facts)} facts ({int(result.stats['ik_solves'])} IK solves, "
-              f"{int(result.stats['workers'])} workers"
-              + (f"; {len(doc.assets)} mesh/URDF files copied beside it" if doc.assets else "") + ")")
+        print(
+            f"{args.output}: {len(result.facts)} facts ({int(result.stats['ik_solves'])} IK solves, "
+            f"{int(result.stats['workers'])} workers"
+            + (f"; {len(doc.assets)} mesh/URDF files copied beside it" if doc.assets else "")
+            + ")"
+        )
     else:
         sys.stdout.write(doc.text)
     if args.stats:
@@ -293,11 +322,25 @@ def cmd_plan(args: argparse.Namespace) -> int:
     problem = mf.problem(args.problem)
     check_output(args.output, inputs_of(mf))
     log = (lambda line: print(line, file=sys.stderr, flush=True)) if args.verbose else None
-    with _progress(f"planning {problem.name} (phase 1, then the tree search; at most {args.time_limit:g} s)"), \
-            signals.activity(f"planning {problem.name}"):
-        plan = api.plan(problem, planner=args.planner, backend=args.backend, encoding=args.encoding, seed=args.seed,
-                        time_limit=args.time_limit, log=log, c=args.c, alpha=args.alpha, skeletons=args.skeletons,
-                        max_makespan=args.max_makespan, anytime=args.anytime, motions=args.motions)
+    with (
+        _progress(f"planning {problem.name} (phase 1, then the tree search; at most {args.time_limit:g} s)"),
+        signals.activity(f"planning {problem.name}"),
+    ):
+        plan = api.plan(
+            problem,
+            planner=args.planner,
+            backend=args.backend,
+            encoding=args.encoding,
+            seed=args.seed,
+            time_limit=args.time_limit,
+            log=log,
+            c=args.c,
+            alpha=args.alpha,
+            skeletons=args.skeletons,
+            max_makespan=args.max_makespan,
+            anytime=args.anytime,
+            motions=args.motions,
+        )
     status = PlanStatus(plan.status)
     # a signal ends the run as interrupted even where the search did not see it (never a verdict, never a file)
     interrupted = status is PlanStatus.INTERRUPTED or signals.received() is not None
@@ -313,13 +356,18 @@ def cmd_plan(args: argparse.Namespace) -> int:
     for line in plan.summary():
         print(line, file=out)
     st = plan.stats
-    print(f"  {st.get('seconds', 0):.2f} s: facts {st.get('facts_seconds', 0):.2f} s, skeletons "
-          f"{st.get('skeleton_seconds', 0):.2f} s, grounding {st.get('grounding_seconds', 0):.2f} s; "
-          f"{st.get('skeletons', 0)} skeletons, {st.get('groundings', 0)} grounded, {st.get('nodes', 0)} nodes",
-          file=out)
+    print(
+        f"  {st.get('seconds', 0):.2f} s: facts {st.get('facts_seconds', 0):.2f} s, skeletons "
+        f"{st.get('skeleton_seconds', 0):.2f} s, grounding {st.get('grounding_seconds', 0):.2f} s; "
+        f"{st.get('skeletons', 0)} skeletons, {st.get('groundings', 0)} grounded, {st.get('nodes', 0)} nodes",
+        file=out,
+    )
     if plan.validation:
-        print(f"  validated: {plan.validation['plans_checked']} complete plan(s) replayed by the validator, "
-              f"the returned one valid", file=out)
+        print(
+            f"  validated: {plan.validation['plans_checked']} complete plan(s) replayed by the validator, "
+            f"the returned one valid",
+            file=out,
+        )
     if interrupted:
         return signals.exit_code()
     return EXIT_CODES[status]
@@ -332,8 +380,9 @@ def cmd_validate(args: argparse.Namespace) -> int:
     from mrgc.api import validate
     from mrgc.planner.validate import load_plan
 
-    report = validate(args.file, load_plan(args.plan), name=args.problem,
-                      allow_outside=getattr(args, "allow_outside", None) or ())
+    report = validate(
+        args.file, load_plan(args.plan), name=args.problem, allow_outside=getattr(args, "allow_outside", None) or ()
+    )
     if args.format == "json":
         print(json.dumps(report.to_json(), indent=2))
     else:
@@ -347,8 +396,9 @@ def cmd_generate(args: argparse.Namespace) -> int:
     from mrgc.generate import generate
     from mrgc.generate.document import domain_path
 
-    text = generate(args.kind, seed=args.seed, preset_name=args.preset, robots=args.robots, goals=args.goals,
-                    others=args.others)
+    text = generate(
+        args.kind, seed=args.seed, preset_name=args.preset, robots=args.robots, goals=args.goals, others=args.others
+    )
     if not args.output:
         sys.stdout.write(text)
         return ExitCode.OK
@@ -384,9 +434,13 @@ def add_seed(p: argparse.ArgumentParser, metavar: str | None = None) -> None:
 
 def add_allow_outside(p: argparse.ArgumentParser) -> None:
     """``--allow-outside PATH``: a folder tree meshes and URDFs may come from besides the problem's own."""
-    p.add_argument("--allow-outside", action="append", metavar="PATH",
-                   help="also read mesh and URDF files under this folder (default: only the problem file's "
-                        "folder tree and pybullet_data; repeatable)")
+    p.add_argument(
+        "--allow-outside",
+        action="append",
+        metavar="PATH",
+        help="also read mesh and URDF files under this folder (default: only the problem file's "
+        "folder tree and pybullet_data; repeatable)",
+    )
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -405,22 +459,30 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("fmt", help="print a .mrg file in canonical form")
     p.add_argument("files", nargs="+", metavar="FILE")
     mode = p.add_mutually_exclusive_group()
-    mode.add_argument("--check", action="store_true",
-                      help="exit 1 if a file is not canonically formatted, printing the unified diff to its "
-                           "canonical form")
-    mode.add_argument("--diff", action="store_true",
-                      help="print the unified diff of each file to its canonical form (exit 0)")
+    mode.add_argument(
+        "--check",
+        action="store_true",
+        help="exit 1 if a file is not canonically formatted, printing the unified diff to its canonical form",
+    )
+    mode.add_argument(
+        "--diff", action="store_true", help="print the unified diff of each file to its canonical form (exit 0)"
+    )
     mode.add_argument("--write", action="store_true", help="rewrite files in place")
     p.set_defaults(func=cmd_fmt)
 
-    p = sub.add_parser("facts",
-                       help="phase 1: compute the geometric facts of a problem and write it with :init completed")
+    p = sub.add_parser(
+        "facts", help="phase 1: compute the geometric facts of a problem and write it with :init completed"
+    )
     p.add_argument("file", metavar="FILE")
     p.add_argument("-o", "--output", metavar="OUT", help="write here (default: standard output)")
     p.add_argument("--problem", help="which problem of the file (default: its only one)")
     add_seed(p)
-    p.add_argument("--workers", type=count("--workers"), default=None,
-                   help="processes (default: one per robot; capped at one per robot and one per core)")
+    p.add_argument(
+        "--workers",
+        type=count("--workers"),
+        default=None,
+        help="processes (default: one per robot; capped at one per robot and one per core)",
+    )
     p.add_argument("--stats", action="store_true", help="also print timing statistics as JSON")
     add_allow_outside(p)
     p.set_defaults(func=cmd_facts)
@@ -429,20 +491,37 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("file", metavar="FILE")
     p.add_argument("--problem", help="which problem of the file (default: its only one)")
     p.add_argument("--backend", default="cpsat", help="mip | smt | pysmt | cpsat (default cpsat; see mrgc backends)")
-    p.add_argument("--encoding", default="time-of-move",
-                   help="paper | disaggregated | time-of-move (default time-of-move)")
-    p.add_argument("--skeletons", type=count("--skeletons"), default=1, metavar="K",
-                   help="how many skeletons (default 1)")
-    p.add_argument("--max-makespan", type=count("--max-makespan"), default=None, metavar="T",
-                   help="horizon limit (default and cap: the number of objects in the task graph)")
-    p.add_argument("--time-limit", type=number("--time-limit", positive=True), default=None, metavar="S",
-                   help="seconds for the whole search")
+    p.add_argument(
+        "--encoding", default="time-of-move", help="paper | disaggregated | time-of-move (default time-of-move)"
+    )
+    p.add_argument(
+        "--skeletons", type=count("--skeletons"), default=1, metavar="K", help="how many skeletons (default 1)"
+    )
+    p.add_argument(
+        "--max-makespan",
+        type=count("--max-makespan"),
+        default=None,
+        metavar="T",
+        help="horizon limit (default and cap: the number of objects in the task graph)",
+    )
+    p.add_argument(
+        "--time-limit",
+        type=number("--time-limit", positive=True),
+        default=None,
+        metavar="S",
+        help="seconds for the whole search",
+    )
     add_seed(p)
     add_allow_outside(p)
     p.add_argument("--emit", metavar="PATH", help="also write the model: .lp/.mps (mip), .smt2 (smt), .pbtxt (cpsat)")
-    p.add_argument("--horizon", type=count("--horizon"), default=None, metavar="T",
-                   help="the model --emit writes: horizon T (paper, disaggregated: exactly T steps; time-of-move: "
-                        "at most T); default: the first skeleton's makespan, else the horizon limit")
+    p.add_argument(
+        "--horizon",
+        type=count("--horizon"),
+        default=None,
+        metavar="T",
+        help="the model --emit writes: horizon T (paper, disaggregated: exactly T steps; time-of-move: "
+        "at most T); default: the first skeleton's makespan, else the horizon limit",
+    )
     p.add_argument("--format", choices=["text", "json"], default="text")
     p.set_defaults(func=cmd_compile)
 
@@ -450,24 +529,40 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("file", metavar="FILE")
     p.add_argument("--problem", help="which problem of the file (default: its only one)")
     p.add_argument("-o", "--output", metavar="PLAN", help="write the plan JSON here (default: standard output)")
-    p.add_argument("--planner", default="mcts", metavar="NAME",
-                   help="mcts (the paper's method, default) | ap1 (its baseline Ap1; docs/baselines.md)")
+    p.add_argument(
+        "--planner",
+        default="mcts",
+        metavar="NAME",
+        help="mcts (the paper's method, default) | ap1 (its baseline Ap1; docs/baselines.md)",
+    )
     p.add_argument("--backend", default="cpsat")
     p.add_argument("--encoding", default="time-of-move")
     add_seed(p)
     p.add_argument("--time-limit", type=number("--time-limit", positive=True), default=60.0, metavar="S")
-    p.add_argument("--skeletons", type=count("--skeletons"), default=5, metavar="K",
-                   help="skeletons per generator call (default 5)")
+    p.add_argument(
+        "--skeletons",
+        type=count("--skeletons"),
+        default=5,
+        metavar="K",
+        help="skeletons per generator call (default 5)",
+    )
     p.add_argument("--max-makespan", type=count("--max-makespan"), default=None, metavar="T")
     p.add_argument("-c", type=number("-c"), default=1.0, help="PUCT exploration constant (default 1)")
-    p.add_argument("--alpha", type=number("--alpha"), default=1.0,
-                   help="reward weight of fewer moved objects (default 1)")
-    p.add_argument("--anytime", action="store_true",
-                   help="keep searching after the first plan until the time limit; return the best "
-                        "(makespan, then objects moved)")
-    p.add_argument("--motions", choices=["configurations", "full"], default="configurations",
-                   help="arms' motion model: configurations (the paper's packaging model: approaches, exchanges, "
-                        "transfers; default) or full (every motion planned as a path; docs/validator.md)")
+    p.add_argument(
+        "--alpha", type=number("--alpha"), default=1.0, help="reward weight of fewer moved objects (default 1)"
+    )
+    p.add_argument(
+        "--anytime",
+        action="store_true",
+        help="keep searching after the first plan until the time limit; return the best (makespan, then objects moved)",
+    )
+    p.add_argument(
+        "--motions",
+        choices=["configurations", "full"],
+        default="configurations",
+        help="arms' motion model: configurations (the paper's packaging model: approaches, exchanges, "
+        "transfers; default) or full (every motion planned as a path; docs/validator.md)",
+    )
     p.add_argument("-v", "--verbose", action="store_true", help="print a search log line per grounded skeleton")
     add_allow_outside(p)
     p.set_defaults(func=cmd_plan)
@@ -482,12 +577,17 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("generate", help="write a random problem: packaging (arms, table, bins) or box-moving (rooms)")
     p.add_argument("kind", choices=["packaging", "box-moving"])
-    p.add_argument("--robots", type=int, default=None, metavar="N",
-                   help="arms 2-6 (packaging), carts 1-4 (box-moving); default 2")
+    p.add_argument(
+        "--robots", type=int, default=None, metavar="N", help="arms 2-6 (packaging), carts 1-4 (box-moving); default 2"
+    )
     p.add_argument("--goals", type=int, default=None, metavar="G", help="goal objects (default 3)")
     p.add_argument("--others", type=int, default=None, metavar="K", help="other objects (default 2)")
-    p.add_argument("--preset", metavar="NAME", help="a suite of the paper: pa5, pa7, pa10, pa18 (--robots 2-6) "
-                   "(packaging), bo8 (box-moving); fixes the counts (docs/generators.md)")
+    p.add_argument(
+        "--preset",
+        metavar="NAME",
+        help="a suite of the paper: pa5, pa7, pa10, pa18 (--robots 2-6) "
+        "(packaging), bo8 (box-moving); fixes the counts (docs/generators.md)",
+    )
     add_seed(p, "S")
     p.add_argument("-o", "--output", metavar="FILE", help="write here (default: standard output)")
     p.set_defaults(func=cmd_generate)

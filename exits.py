@@ -30,19 +30,19 @@ class ExitCode(enum.IntEnum):
 MEANINGS: dict[ExitCode, str] = {
     ExitCode.OK: "success (`check`: every file is fine; `fmt --check`: every file is canonical)",
     ExitCode.NO_PLAN: "infeasible: no task skeleton exists under the facts (`plan`, `compile`; the reasons are "
-                      "printed and, for `plan`, in the plan's `why`); `fmt --check`: some file would be "
-                      "reformatted; `validate`: the plan is invalid",
+    "printed and, for `plan`, in the plan's `why`); `fmt --check`: some file would be "
+    "reformatted; `validate`: the plan is invalid",
     ExitCode.INPUT: "input error: a bad `.mrg` file (any `E0xx`–`E2xx` code below), a bad plan file (`E5xx`), a "
-                    "bad study file or results database (`E6xx`, `mrgc bench`) or a bad command line (`E000`)",
+    "bad study file or results database (`E6xx`, `mrgc bench`) or a bad command line (`E000`)",
     ExitCode.TIME_LIMIT: "time limit reached before an answer",
     ExitCode.MISSING_BACKEND: "a needed backend (solver or geometry library) is not installed; `bench run "
-                              "--executor ray` without Ray",
+    "--executor ray` without Ray",
     ExitCode.EXHAUSTED: "`plan`: every skeleton was tried and none could be grounded into a plan the validator "
-                        "accepts (the grounding-failure summary says why)",
+    "accepts (the grounding-failure summary says why)",
     ExitCode.INTERNAL: "internal error (`E070`): a bug in mrgc",
     ExitCode.INTERRUPTED: "interrupted (Ctrl-C, SIGINT): the command stops, says what it was doing, and writes "
-                          "nothing (no output file is created or changed); `plan` also prints what its search had "
-                          "(best plan, statistics, reasons)",
+    "nothing (no output file is created or changed); `plan` also prints what its search had "
+    "(best plan, statistics, reasons)",
     ExitCode.TERMINATED: "terminated (SIGTERM): as 130",
 }
 

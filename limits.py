@@ -41,8 +41,9 @@ def count(option: str, lo: int | None = None, hi: int | None = None) -> Callable
         try:
             value = _int_text(text.strip())
         except ValueError:
-            raise argparse.ArgumentTypeError(f"must be a whole number from {low} to {high:,} (got {_shown(text)})") \
-                from None
+            raise argparse.ArgumentTypeError(
+                f"must be a whole number from {low} to {high:,} (got {_shown(text)})"
+            ) from None
         if not low <= value <= high:
             raise argparse.ArgumentTypeError(f"must be a whole number from {low} to {high:,} (got {value})")
         return value
@@ -51,8 +52,9 @@ def count(option: str, lo: int | None = None, hi: int | None = None) -> Callable
     return parse
 
 
-def number(option: str, lo: float | None = None, hi: float | None = None, *,
-           positive: bool = False) -> Callable[[str], float]:
+def number(
+    option: str, lo: float | None = None, hi: float | None = None, *, positive: bool = False
+) -> Callable[[str], float]:
     """An argparse type: a finite float in [lo, hi] (default: ``BOUNDS[option]``); ``positive`` excludes
     ``lo`` itself (a duration of 0 s is no duration)."""
     blo, bhi = BOUNDS.get(option, (lo, hi))

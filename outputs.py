@@ -64,20 +64,27 @@ def check_output(path: str, inputs: Iterable[str] = (), *, option: str = "-o") -
     except FileNotFoundError:
         st = None
     except (OSError, ValueError) as exc:
-        raise _refuse(E_UNWRITABLE, f"{option} {path}: cannot be written: "
-                                    f"{getattr(exc, 'strerror', None) or exc}") from None
+        raise _refuse(
+            E_UNWRITABLE, f"{option} {path}: cannot be written: {getattr(exc, 'strerror', None) or exc}"
+        ) from None
     if st is not None:
         if stat.S_ISDIR(st.st_mode):
             raise _refuse(E_UNWRITABLE, f"{option} {path}: is a folder; name a file inside it")
         if not stat.S_ISREG(st.st_mode):
-            raise _refuse(E_UNWRITABLE, f"{option} {path}: is not a regular file ({_kind(st.st_mode)}); "
-                                        f"leave out {option} to write to standard output")
+            raise _refuse(
+                E_UNWRITABLE,
+                f"{option} {path}: is not a regular file ({_kind(st.st_mode)}); "
+                f"leave out {option} to write to standard output",
+            )
         me = (st.st_dev, st.st_ino)
         for inp in inputs:
             if _identity(inp) == me:
                 same = "" if os.path.abspath(inp) == os.path.abspath(path) else f" (the same file as {inp})"
-                raise _refuse(E_IS_INPUT, f"{option} {path}: is an input of this command{same}; "
-                                          f"writing it would destroy the input: choose another output file")
+                raise _refuse(
+                    E_IS_INPUT,
+                    f"{option} {path}: is an input of this command{same}; "
+                    f"writing it would destroy the input: choose another output file",
+                )
     folder = os.path.dirname(real)
     if not os.path.isdir(folder):
         raise _refuse(E_UNWRITABLE, f"{option} {path}: folder {os.path.dirname(path) or '.'} does not exist")
@@ -87,8 +94,12 @@ def check_output(path: str, inputs: Iterable[str] = (), *, option: str = "-o") -
 
 
 def _kind(mode: int) -> str:
-    for test, name in ((stat.S_ISFIFO, "a FIFO"), (stat.S_ISCHR, "a character device"),
-                       (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket")):
+    for test, name in (
+        (stat.S_ISFIFO, "a FIFO"),
+        (stat.S_ISCHR, "a character device"),
+        (stat.S_ISBLK, "a block device"),
+        (stat.S_ISSOCK, "a socket"),
+    ):
         if test(mode):
             return name
     return "a special file"  # pragma: no cover
@@ -157,8 +168,9 @@ def _temp_file(real: str, path: str, option: str) -> tuple[int, str]:
     try:
         return tempfile.mkstemp(prefix=f".{base}.", suffix=f".mrgc-tmp{os.path.splitext(base)[1]}", dir=folder)
     except OSError as exc:
-        raise _refuse(E_UNWRITABLE, f"{option} {path}: cannot create a file in {folder}: "
-                                    f"{exc.strerror or exc}") from None
+        raise _refuse(
+            E_UNWRITABLE, f"{option} {path}: cannot create a file in {folder}: {exc.strerror or exc}"
+        ) from None
 
 
 def _commit(fd: int, tmp: str, real: str, path: str, option: str) -> None:

@@ -76,8 +76,12 @@ def map_in_workers(fn: Callable[[T], R], jobs: Sequence[T], workers: int) -> lis
     if workers <= 1 or len(jobs) <= 1:
         return [fn(j) for j in jobs]
     before = {p.pid for p in multiprocessing.active_children()}
-    pool = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("fork"),
-                               initializer=_init_worker, initargs=(os.getpid(),))
+    pool = ProcessPoolExecutor(
+        max_workers=workers,
+        mp_context=multiprocessing.get_context("fork"),
+        initializer=_init_worker,
+        initargs=(os.getpid(),),
+    )
     mine: list[multiprocessing.process.BaseProcess] = []
     try:
         # forks happen while submitting: block the signals so a child never runs the parent's handlers

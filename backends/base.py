@@ -54,8 +54,9 @@ def solver_library(info: BackendInfo) -> Iterator[None]:
     try:
         yield
     except ImportError as exc:
-        raise MissingBackendError(f"backend '{info.name}' needs {info.distribution}: pip install '{info.pip}' "
-                                  f"({exc})") from None
+        raise MissingBackendError(
+            f"backend '{info.name}' needs {info.distribution}: pip install '{info.pip}' ({exc})"
+        ) from None
 
 
 class Backend(ABC):
@@ -101,14 +102,16 @@ class Backend(ABC):
         try:
             sol = self._solve(time_limit)
         except Exception as exc:  # noqa: BLE001 - a failing solver is an outcome, not a crash
-            return Solution(SolveStatus.ERROR, message=f"{self.name}: {type(exc).__name__}: {exc}",
-                            seconds=time.perf_counter() - t0)
+            return Solution(
+                SolveStatus.ERROR, message=f"{self.name}: {type(exc).__name__}: {exc}", seconds=time.perf_counter() - t0
+            )
         seconds = time.perf_counter() - t0
         if sol.status in (SolveStatus.OPTIMAL, SolveStatus.FEASIBLE):
             bad = self.model.violated(sol.values)
             if bad:
-                return Solution(SolveStatus.ERROR, message=f"{self.name} returned a solution violating {bad[:3]}",
-                                seconds=seconds)
+                return Solution(
+                    SolveStatus.ERROR, message=f"{self.name} returned a solution violating {bad[:3]}", seconds=seconds
+                )
             objective = tuple(self.model.evaluate(o, sol.values) for o in self.model.objectives)
             return Solution(sol.status, sol.values, objective, seconds, sol.message)
         return Solution(sol.status, (), (), seconds, sol.message)

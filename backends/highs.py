@@ -62,13 +62,17 @@ class HighsBackend(Backend):
         h.setOptionValue("threads", int(self.threads))
         h.setOptionValue("mip_rel_gap", 0.0)
         n = len(model.vars)
-        h.addVars(n, np.array([v.lb for v in model.vars], dtype=np.float64),
-                  np.array([v.ub for v in model.vars], dtype=np.float64))
+        h.addVars(
+            n,
+            np.array([v.lb for v in model.vars], dtype=np.float64),
+            np.array([v.ub for v in model.vars], dtype=np.float64),
+        )
         if n:
-            h.changeColsIntegrality(n, np.arange(n, dtype=np.int32),
-                                    np.full(n, int(hs.HighsVarType.kInteger), dtype=np.uint8))
+            h.changeColsIntegrality(
+                n, np.arange(n, dtype=np.int32), np.full(n, int(hs.HighsVarType.kInteger), dtype=np.uint8)
+            )
         cost = np.zeros(n)
-        for v, c in (model.objectives[0] if model.objectives else ()):
+        for v, c in model.objectives[0] if model.objectives else ():
             cost[v] += c
         h.changeColsCost(n, np.arange(n, dtype=np.int32), cost)
         for i, name in enumerate(lp_names([v.name for v in model.vars])):
@@ -91,8 +95,15 @@ class HighsBackend(Backend):
             for v, c in r.terms:
                 index.append(v)
                 value.append(c)
-        self.h.addRows(len(rows), lower, upper, len(index), np.array(starts, dtype=np.int32),
-                       np.array(index, dtype=np.int32), np.array(value, dtype=np.float64))
+        self.h.addRows(
+            len(rows),
+            lower,
+            upper,
+            len(index),
+            np.array(starts, dtype=np.int32),
+            np.array(index, dtype=np.int32),
+            np.array(value, dtype=np.float64),
+        )
         names = lp_names([f"{r.name or 'row'}#{self.rows + k}" for k, r in enumerate(rows)])
         for k, name in enumerate(names):
             self.h.passRowName(self.rows + k, name)

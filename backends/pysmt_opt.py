@@ -68,15 +68,20 @@ class PysmtBackend(Backend):
 
         ctx = wrapper.z3.Context()
         logic = str(self.solver.logic)
-        self.solver.z3 = (wrapper.z3.SolverFor(logic, ctx=ctx) if logic in wrapper.Z3Solver.SOLVERFOR_LOGIC_NAMES
-                          else wrapper.z3.Solver(ctx=ctx))
+        self.solver.z3 = (
+            wrapper.z3.SolverFor(logic, ctx=ctx)
+            if logic in wrapper.Z3Solver.SOLVERFOR_LOGIC_NAMES
+            else wrapper.z3.Solver(ctx=ctx)
+        )
         self.solver.options(self.solver)  # the random seed, on the new solver
         self.solver.converter = wrapper.Z3Converter(self.env, z3_ctx=ctx)
 
     def _sum(self, terms: Terms) -> Any:
         mgr = self.mgr
-        parts = [mgr.Ite(self.x[v], mgr.Int(c), mgr.Int(0)) if self.is_bool[v] else mgr.Times(mgr.Int(c), self.x[v])
-                 for v, c in terms]
+        parts = [
+            mgr.Ite(self.x[v], mgr.Int(c), mgr.Int(0)) if self.is_bool[v] else mgr.Times(mgr.Int(c), self.x[v])
+            for v, c in terms
+        ]
         return mgr.Plus(parts) if parts else mgr.Int(0)
 
     def _row(self, row: Row) -> Any:

@@ -47,8 +47,9 @@ def backend_class(name: str) -> type[Backend]:
     if name not in table:
         from mrgc.language.suggest import did_you_mean
 
-        raise InputError([Diagnostic("E301", f"unknown backend '{name}'{did_you_mean(name, table)} "
-                                     f"(installed: {', '.join(table)})")])
+        raise InputError(
+            [Diagnostic("E301", f"unknown backend '{name}'{did_you_mean(name, table)} (installed: {', '.join(table)})")]
+        )
     module, _, cls = table[name].partition(":")
     found: Any = getattr(importlib.import_module(module), cls)
     return found  # type: ignore[no-any-return]
@@ -74,16 +75,18 @@ def describe() -> list[dict[str, Any]]:
     rows = []
     for name in names():
         info = backend_class(name).info
-        rows.append({
-            "name": name,
-            "title": info.title,
-            "installed": installed(info),
-            "library": info.distribution,
-            "version": version(info),
-            "features": sorted(f.value for f in info.features),
-            "encodings": list(info.encodings),
-            "exports": list(info.exports),
-        })
+        rows.append(
+            {
+                "name": name,
+                "title": info.title,
+                "installed": installed(info),
+                "library": info.distribution,
+                "version": version(info),
+                "features": sorted(f.value for f in info.features),
+                "encodings": list(info.encodings),
+                "exports": list(info.exports),
+            }
+        )
     return rows
 
 
@@ -104,16 +107,34 @@ class BackendRecord:
 
     def to_json(self) -> dict[str, Any]:
         """The record as ``mrgc backends --format json`` prints it."""
-        return {"name": self.name, "title": self.title, "installed": self.installed, "library": self.library,
-                "version": self.version, "features": list(self.features), "encodings": list(self.encodings),
-                "exports": list(self.exports)}
+        return {
+            "name": self.name,
+            "title": self.title,
+            "installed": self.installed,
+            "library": self.library,
+            "version": self.version,
+            "features": list(self.features),
+            "encodings": list(self.encodings),
+            "exports": list(self.exports),
+        }
 
 
 def records() -> list[BackendRecord]:
     """Every registered backend (the built-in ones, then plug-ins of the ``mrgc.backends`` entry-point
     group), in registry order; looking them up imports no solver library."""
-    return [BackendRecord(r["name"], r["title"], r["installed"], r["library"], r["version"], tuple(r["features"]),
-                          tuple(r["encodings"]), tuple(r["exports"])) for r in describe()]
+    return [
+        BackendRecord(
+            r["name"],
+            r["title"],
+            r["installed"],
+            r["library"],
+            r["version"],
+            tuple(r["features"]),
+            tuple(r["encodings"]),
+            tuple(r["exports"]),
+        )
+        for r in describe()
+    ]
 
 
 def feature_table() -> str:
@@ -123,8 +144,13 @@ def feature_table() -> str:
     lines = [header]
     for name in names():
         info = backend_class(name).info
-        lines.append([name, *["native" if f in info.features else "lowered" for f in feats],
-                      " ".join("." + e for e in info.exports) or "-"])
+        lines.append(
+            [
+                name,
+                *["native" if f in info.features else "lowered" for f in feats],
+                " ".join("." + e for e in info.exports) or "-",
+            ]
+        )
     widths = [max(len(r[i]) for r in lines) for i in range(len(header))]
     return "\n".join("  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in lines)
 
@@ -135,6 +161,13 @@ def check_export(backend: str | type[Backend], path: str) -> None:
     info = (backend if isinstance(backend, type) else backend_class(backend)).info
     ext = os.path.splitext(path)[1].lstrip(".").lower()
     if ext not in info.exports:
-        raise InputError([Diagnostic("E300", f"backend '{info.name}' cannot write .{ext} files "
-                                     f"(it writes: {', '.join('.' + e for e in info.exports) or 'none'})",
-                                     notes=tuple(feature_table().splitlines()))])
+        raise InputError(
+            [
+                Diagnostic(
+                    "E300",
+                    f"backend '{info.name}' cannot write .{ext} files "
+                    f"(it writes: {', '.join('.' + e for e in info.exports) or 'none'})",
+                    notes=tuple(feature_table().splitlines()),
+                )
+            ]
+        )

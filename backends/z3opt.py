@@ -70,8 +70,10 @@ class Z3Backend(Backend):
 
     def _sum(self, terms: Terms) -> Any:
         z3 = _z3()
-        parts = [z3.If(self.x[v], z3.IntVal(c, self.ctx), z3.IntVal(0, self.ctx)) if self.is_bool[v]
-                 else self.x[v] * c for v, c in terms]
+        parts = [
+            z3.If(self.x[v], z3.IntVal(c, self.ctx), z3.IntVal(0, self.ctx)) if self.is_bool[v] else self.x[v] * c
+            for v, c in terms
+        ]
         return z3.Sum(parts) if parts else z3.IntVal(0, self.ctx)
 
     def _row(self, row: Row) -> list[Any]:
@@ -117,7 +119,8 @@ class Z3Backend(Backend):
             return Solution(SolveStatus.ERROR, message=f"z3: {reason}")
         m = self.opt.model()
         values = tuple(
-            (1 if z3.is_true(m.eval(x, model_completion=True)) else 0) if b
+            (1 if z3.is_true(m.eval(x, model_completion=True)) else 0)
+            if b
             else m.eval(x, model_completion=True).as_long()
             for x, b in zip(self.x, self.is_bool)
         )

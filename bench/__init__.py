@@ -41,11 +41,23 @@ if TYPE_CHECKING:
 #: public name -> the module defining it (loaded on first use: ``mrgc`` builds its parser with
 #: :mod:`mrgc.bench.command`, and that must not load the rest of the package)
 _API = {
-    "ResultsDB": "db", "export_planner_arena": "arena", "write_figures": "figures", "RunResult": "outcome",
+    "ResultsDB": "db",
+    "export_planner_arena": "arena",
+    "write_figures": "figures",
+    "RunResult": "outcome",
     "RunStatus": "outcome",
-    "Row": "report", "aggregate": "report", "render": "report", "DEFAULT_DB": "run", "StudySummary": "run",
-    "run_study": "run", "InstanceSpec": "study", "Limits": "study", "Method": "study", "Study": "study",
-    "load_study": "schema", "parse_study": "schema",
+    "Row": "report",
+    "aggregate": "report",
+    "render": "report",
+    "DEFAULT_DB": "run",
+    "StudySummary": "run",
+    "run_study": "run",
+    "InstanceSpec": "study",
+    "Limits": "study",
+    "Method": "study",
+    "Study": "study",
+    "load_study": "schema",
+    "parse_study": "schema",
 }
 
 

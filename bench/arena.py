@@ -68,8 +68,9 @@ def _study(conn: sqlite3.Connection, db: ResultsDB, name: str) -> int:
     specs = dict(db.conn.execute("SELECT method, spec FROM methods WHERE study = ?", (name,)).fetchall())
     planners: dict[str, int] = {}
     for method in dict.fromkeys(r["method"] for r in runs):
-        cur = conn.execute("INSERT INTO plannerConfigs (name, settings) VALUES (?, ?)",
-                           (method, specs.get(method, json.dumps({}))))
+        cur = conn.execute(
+            "INSERT INTO plannerConfigs (name, settings) VALUES (?, ?)", (method, specs.get(method, json.dumps({})))
+        )
         planners[method] = int(cur.lastrowid or 0)
     sets: dict[str, list[dict[str, Any]]] = {}
     for r in runs:
@@ -79,18 +80,41 @@ def _study(conn: sqlite3.Connection, db: ResultsDB, name: str) -> int:
         cur = conn.execute(
             "INSERT INTO experiments (name, totaltime, timelimit, memorylimit, runcount, version, hostname, "
             "cpuinfo, date, seed, setup) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
-            (f"{name}: {set_name}", sum(float(r["wall_seconds"] or 0) for r in rs),
-             max(float(r["time_limit"]) for r in rs), max(float(r["memory_limit_mb"]) for r in rs),
-             per_method, "mrgc " + ", ".join(sorted({str(r["mrgc_version"]) for r in rs})),
-             ", ".join(sorted({str(r["host"]) for r in rs})), None, min(str(r["started"]) for r in rs),
-             ",".join(str(s) for s in sorted({int(r["seed"]) for r in rs})), text[0] if text else ""))
+            (
+                f"{name}: {set_name}",
+                sum(float(r["wall_seconds"] or 0) for r in rs),
+                max(float(r["time_limit"]) for r in rs),
+                max(float(r["memory_limit_mb"]) for r in rs),
+                per_method,
+                "mrgc " + ", ".join(sorted({str(r["mrgc_version"]) for r in rs})),
+                ", ".join(sorted({str(r["host"]) for r in rs})),
+                None,
+                min(str(r["started"]) for r in rs),
+                ",".join(str(s) for s in sorted({int(r["seed"]) for r in rs})),
+                text[0] if text else "",
+            ),
+        )
         experiment = cur.lastrowid
         conn.executemany(
             "INSERT INTO runs (experimentid, plannerid, time, solved, status, valid, makespan, objects_moved, "
             "arm_path, base_path, wall_time, memory, seed) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
-            [(experiment, planners[str(r["method"])],
-              r["planning_seconds"] if r["planning_seconds"] is not None else r["wall_seconds"],
-              int(bool(r["success"])),
-              STATUS_VALUES.index(str(r["status"])), r["valid"], r["makespan"], r["objects_moved"], r["arm_path"],
-              r["base_path"], r["wall_seconds"], r["peak_mb"], r["seed"]) for r in rs])
+            [
+                (
+                    experiment,
+                    planners[str(r["method"])],
+                    r["planning_seconds"] if r["planning_seconds"] is not None else r["wall_seconds"],
+                    int(bool(r["success"])),
+                    STATUS_VALUES.index(str(r["status"])),
+                    r["valid"],
+                    r["makespan"],
+                    r["objects_moved"],
+                    r["arm_path"],
+                    r["base_path"],
+                    r["wall_seconds"],
+                    r["peak_mb"],
+                    r["seed"],
+                )
+                for r in rs
+            ],
+        )
     return len(runs)

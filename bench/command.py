@@ -24,24 +24,45 @@ def add_bench_parser(sub: Any) -> None:
     r.add_argument("study", metavar="STUDY.yaml")
     r.add_argument("--db", default=None, metavar="PATH", help="results database (default mrgc-bench.db)")
     r.add_argument("--jobs", "-j", type=int, default=1, metavar="N", help="runs at a time (default 1)")
-    r.add_argument("--executor", choices=["local", "ray"], default="local",
-                   help="local processes (default) or Ray tasks (pip install 'mrgc[ray]')")
+    r.add_argument(
+        "--executor",
+        choices=["local", "ray"],
+        default="local",
+        help="local processes (default) or Ray tasks (pip install 'mrgc[ray]')",
+    )
     r.add_argument("--address", default=None, metavar="A", help="Ray cluster address (default: start Ray here)")
-    r.add_argument("--work", default=None, metavar="DIR",
-                   help="folder for generated instances and run files (default: DB name + '-files')")
-    r.add_argument("--retry", nargs="+", default=[], metavar="STATUS",
-                   help="also re-run recorded runs with these statuses (e.g. crash error)")
+    r.add_argument(
+        "--work",
+        default=None,
+        metavar="DIR",
+        help="folder for generated instances and run files (default: DB name + '-files')",
+    )
+    r.add_argument(
+        "--retry",
+        nargs="+",
+        default=[],
+        metavar="STATUS",
+        help="also re-run recorded runs with these statuses (e.g. crash error)",
+    )
     r.set_defaults(func=cmd_run)
 
     q = inner.add_parser("report", help="tables (Markdown, CSV) and figures of a results database")
     q.add_argument("--db", default=None, metavar="PATH", help="results database (default mrgc-bench.db)")
     q.add_argument("--study", default=None, help="only this study (default: every study in the database)")
-    q.add_argument("--format", choices=["markdown", "wide", "csv", "runs"], default="markdown",
-                   help="markdown (default): a row per instance set and method; wide: the paper's layout; "
-                        "csv: the same numbers; runs: every run as CSV")
+    q.add_argument(
+        "--format",
+        choices=["markdown", "wide", "csv", "runs"],
+        default="markdown",
+        help="markdown (default): a row per instance set and method; wide: the paper's layout; "
+        "csv: the same numbers; runs: every run as CSV",
+    )
     q.add_argument("--figures", default=None, metavar="DIR", help="also write PNG figures here (matplotlib)")
-    q.add_argument("--planner-arena", default=None, metavar="OUT.db",
-                   help="also write the runs as an OMPL benchmark database (Planner Arena reads it)")
+    q.add_argument(
+        "--planner-arena",
+        default=None,
+        metavar="OUT.db",
+        help="also write the runs as an OMPL benchmark database (Planner Arena reads it)",
+    )
     q.set_defaults(func=cmd_report)
 
 
@@ -66,9 +87,17 @@ def cmd_run(args: argparse.Namespace) -> int:
         progress.append(Progress(args.study, todo, args.jobs))
 
     try:
-        summary = run_study(args.study, args.db or DEFAULT_DB, jobs=args.jobs, executor=args.executor,
-                            address=args.address, work=args.work, retry=args.retry, on_start=started,
-                            on_result=lambda r: progress[0].update(r))
+        summary = run_study(
+            args.study,
+            args.db or DEFAULT_DB,
+            jobs=args.jobs,
+            executor=args.executor,
+            address=args.address,
+            work=args.work,
+            retry=args.retry,
+            on_start=started,
+            on_result=lambda r: progress[0].update(r),
+        )
     finally:
         for p in progress:
             p.close()
@@ -88,9 +117,16 @@ def cmd_report(args: argparse.Namespace) -> int:
             from mrgc.errors import Diagnostic, InputError
             from mrgc.language.suggest import did_you_mean
 
-            raise InputError([Diagnostic("E000", f"no study '{args.study}' in {db.path}"
-                                         f"{did_you_mean(args.study, db.studies())} "
-                                         f"(studies: {', '.join(db.studies()) or 'none'})")])
+            raise InputError(
+                [
+                    Diagnostic(
+                        "E000",
+                        f"no study '{args.study}' in {db.path}"
+                        f"{did_you_mean(args.study, db.studies())} "
+                        f"(studies: {', '.join(db.studies()) or 'none'})",
+                    )
+                ]
+            )
         sys.stdout.write(render(db, args.format, args.study))
         if args.figures:
             from mrgc.bench.figures import write_figures

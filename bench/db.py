@@ -30,23 +30,48 @@ SCHEMA_VERSION = 1
 E_DB = "E603"
 
 _COLUMNS: list[tuple[str, str]] = [
-    ("study", "TEXT NOT NULL"), ("instance", "TEXT NOT NULL"), ("instance_set", "TEXT NOT NULL"),
-    ("set_index", "INTEGER NOT NULL"), ("instance_file", "TEXT NOT NULL"), ("instance_sha256", "TEXT NOT NULL"),
-    ("method", "TEXT NOT NULL"), ("method_index", "INTEGER NOT NULL"), ("seed", "INTEGER NOT NULL"),
-    ("status", "TEXT NOT NULL"), ("success", "INTEGER NOT NULL"), ("detail", "TEXT"), ("exit_code", "INTEGER"),
-    ("signal", "INTEGER"), ("planning_seconds", "REAL"), ("facts_seconds", "REAL"), ("wall_seconds", "REAL"),
-    ("validate_seconds", "REAL"), ("peak_mb", "REAL"), ("makespan", "INTEGER"), ("objects_moved", "INTEGER"),
-    ("arm_path", "REAL"), ("base_path", "REAL"), ("valid", "INTEGER"), ("plan_status", "TEXT"),
-    ("stderr_tail", "TEXT"), ("command", "TEXT"), ("time_limit", "REAL"), ("wall_limit", "REAL"),
-    ("memory_limit_mb", "REAL"), ("mrgc_version", "TEXT"), ("host", "TEXT"), ("started", "TEXT"),
-    ("finished", "TEXT"), ("plan_file", "TEXT"),
+    ("study", "TEXT NOT NULL"),
+    ("instance", "TEXT NOT NULL"),
+    ("instance_set", "TEXT NOT NULL"),
+    ("set_index", "INTEGER NOT NULL"),
+    ("instance_file", "TEXT NOT NULL"),
+    ("instance_sha256", "TEXT NOT NULL"),
+    ("method", "TEXT NOT NULL"),
+    ("method_index", "INTEGER NOT NULL"),
+    ("seed", "INTEGER NOT NULL"),
+    ("status", "TEXT NOT NULL"),
+    ("success", "INTEGER NOT NULL"),
+    ("detail", "TEXT"),
+    ("exit_code", "INTEGER"),
+    ("signal", "INTEGER"),
+    ("planning_seconds", "REAL"),
+    ("facts_seconds", "REAL"),
+    ("wall_seconds", "REAL"),
+    ("validate_seconds", "REAL"),
+    ("peak_mb", "REAL"),
+    ("makespan", "INTEGER"),
+    ("objects_moved", "INTEGER"),
+    ("arm_path", "REAL"),
+    ("base_path", "REAL"),
+    ("valid", "INTEGER"),
+    ("plan_status", "TEXT"),
+    ("stderr_tail", "TEXT"),
+    ("command", "TEXT"),
+    ("time_limit", "REAL"),
+    ("wall_limit", "REAL"),
+    ("memory_limit_mb", "REAL"),
+    ("mrgc_version", "TEXT"),
+    ("host", "TEXT"),
+    ("started", "TEXT"),
+    ("finished", "TEXT"),
+    ("plan_file", "TEXT"),
 ]
 COLUMNS = [name for name, _ in _COLUMNS]
 
 _SCHEMA = f"""
 CREATE TABLE IF NOT EXISTS runs (
     id INTEGER PRIMARY KEY,
-    {', '.join(f'{n} {t}' for n, t in _COLUMNS)},
+    {", ".join(f"{n} {t}" for n, t in _COLUMNS)},
     UNIQUE (study, instance_sha256, method, seed)
 );
 CREATE TABLE IF NOT EXISTS studies (name TEXT PRIMARY KEY, path TEXT, text TEXT, updated TEXT);
@@ -74,8 +99,15 @@ class ResultsDB:
             raise InputError([Diagnostic(E_DB, f"'{path}' is not a results database: {exc}")]) from None
         if version > SCHEMA_VERSION or (tables and "runs" not in tables) or (version == 0 and tables):
             self.conn.close()
-            raise InputError([Diagnostic(E_DB, f"'{path}' is not a results database of this mrgc "
-                                         f"(schema {version}; this mrgc reads {SCHEMA_VERSION})")])
+            raise InputError(
+                [
+                    Diagnostic(
+                        E_DB,
+                        f"'{path}' is not a results database of this mrgc "
+                        f"(schema {version}; this mrgc reads {SCHEMA_VERSION})",
+                    )
+                ]
+            )
         if not readonly:
             self.conn.execute("PRAGMA journal_mode = WAL")
             self.conn.execute("PRAGMA synchronous = NORMAL")
@@ -97,26 +129,44 @@ class ResultsDB:
         self.close()
 
     # ------------------------------------------------------------ writing
-    def begin_study(self, name: str, path: str, text: str, specs: dict[str, dict[str, Any]],
-                    skips: dict[str, tuple[str, int]], updated: str) -> None:
+    def begin_study(
+        self,
+        name: str,
+        path: str,
+        text: str,
+        specs: dict[str, dict[str, Any]],
+        skips: dict[str, tuple[str, int]],
+        updated: str,
+    ) -> None:
         """Record the study and its method specs; E603 if a method changed under the same name."""
-        known = {r["method"]: r["spec"]
-                 for r in self.conn.execute("SELECT method, spec FROM methods WHERE study = ?", (name,))}
+        known = {
+            r["method"]: r["spec"]
+            for r in self.conn.execute("SELECT method, spec FROM methods WHERE study = ?", (name,))
+        }
         for method, spec in specs.items():
             text_spec = json.dumps(spec, sort_keys=True)
             if method in known and known[method] != text_spec:
-                n = self.conn.execute("SELECT COUNT(*) FROM runs WHERE study = ? AND method = ?",
-                                      (name, method)).fetchone()[0]
+                n = self.conn.execute(
+                    "SELECT COUNT(*) FROM runs WHERE study = ? AND method = ?", (name, method)
+                ).fetchone()[0]
                 if n:
-                    raise InputError([Diagnostic(E_DB, f"method '{method}' of study '{name}' changed since its {n} "
-                                                 f"recorded run(s) in {self.path} (was {known[method]}, now "
-                                                 f"{text_spec}): give the changed method a new name, or use another "
-                                                 "--db")])
+                    raise InputError(
+                        [
+                            Diagnostic(
+                                E_DB,
+                                f"method '{method}' of study '{name}' changed since its {n} "
+                                f"recorded run(s) in {self.path} (was {known[method]}, now "
+                                f"{text_spec}): give the changed method a new name, or use another "
+                                "--db",
+                            )
+                        ]
+                    )
         with self.conn:
             self.conn.execute("INSERT OR REPLACE INTO studies VALUES (?, ?, ?, ?)", (name, path, text, updated))
             for method, spec in specs.items():
-                self.conn.execute("INSERT OR REPLACE INTO methods VALUES (?, ?, ?)",
-                                  (name, method, json.dumps(spec, sort_keys=True)))
+                self.conn.execute(
+                    "INSERT OR REPLACE INTO methods VALUES (?, ?, ?)", (name, method, json.dumps(spec, sort_keys=True))
+                )
             self.conn.execute("DELETE FROM skips WHERE study = ?", (name,))
             for method, (reason, runs) in skips.items():
                 self.conn.execute("INSERT INTO skips VALUES (?, ?, ?, ?)", (name, method, reason, runs))
@@ -125,15 +175,20 @@ class ResultsDB:
         """Write one finished run (replacing an earlier row of the same key: a retried run) and commit."""
         row = result.to_row()
         with self.conn:
-            self.conn.execute(f"INSERT OR REPLACE INTO runs ({', '.join(COLUMNS)}) VALUES "
-                              f"({', '.join('?' for _ in COLUMNS)})", [row[c] for c in COLUMNS])
+            self.conn.execute(
+                f"INSERT OR REPLACE INTO runs ({', '.join(COLUMNS)}) VALUES ({', '.join('?' for _ in COLUMNS)})",
+                [row[c] for c in COLUMNS],
+            )
 
     # ------------------------------------------------------------ reading
     def finished(self, study: str) -> dict[RunKey, str]:
         """The keys of the study's recorded runs → their status."""
-        return {(r["study"], r["instance_sha256"], r["method"], r["seed"]): r["status"]
-                for r in self.conn.execute("SELECT study, instance_sha256, method, seed, status FROM runs "
-                                           "WHERE study = ?", (study,))}
+        return {
+            (r["study"], r["instance_sha256"], r["method"], r["seed"]): r["status"]
+            for r in self.conn.execute(
+                "SELECT study, instance_sha256, method, seed, status FROM runs WHERE study = ?", (study,)
+            )
+        }
 
     def studies(self) -> list[str]:
         """Study names in the order they were first run."""
@@ -142,15 +197,21 @@ class ResultsDB:
     def runs(self, study: str | None = None) -> Iterator[dict[str, Any]]:
         """The recorded runs (all studies, or one) in a stable order."""
         where, args = ("WHERE study = ?", (study,)) if study is not None else ("", ())
-        for r in self.conn.execute(f"SELECT {', '.join(COLUMNS)} FROM runs {where} ORDER BY study, set_index, "
-                                   "instance, method_index, method, seed", args):
+        for r in self.conn.execute(
+            f"SELECT {', '.join(COLUMNS)} FROM runs {where} ORDER BY study, set_index, "
+            "instance, method_index, method, seed",
+            args,
+        ):
             yield dict(r)
 
     def skips(self, study: str) -> list[tuple[str, str, int]]:
         """The methods skipped in ``study``: (method, reason, runs), by method."""
-        return [(r["method"], r["reason"], r["runs"])
-                for r in self.conn.execute("SELECT method, reason, runs FROM skips WHERE study = ? ORDER BY method",
-                                           (study,))]
+        return [
+            (r["method"], r["reason"], r["runs"])
+            for r in self.conn.execute(
+                "SELECT method, reason, runs FROM skips WHERE study = ? ORDER BY method", (study,)
+            )
+        ]
 
 
 class WriterLock:
@@ -166,8 +227,9 @@ class WriterLock:
         try:
             self.fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
         except OSError as exc:
-            raise InputError([Diagnostic(E_DB, f"cannot write a results database at {self.path[:-5]}: "
-                                         f"{exc.strerror or exc}")]) from None
+            raise InputError(
+                [Diagnostic(E_DB, f"cannot write a results database at {self.path[:-5]}: {exc.strerror or exc}")]
+            ) from None
         try:
             fcntl.flock(self.fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:

@@ -136,8 +136,15 @@ def execute_run(task: RunTask, cancel: threading.Event | None = None, remote: bo
         started = now()
 
         def limited(argv: list[str], out: str, err: str) -> ProcessResult:
-            return run_limited(mrgc_argv(argv), wall=task.limits.wall_seconds, memory_mb=task.limits.memory_mb,
-                               stdout=out, stderr=err, cancel=cancel, env=env)
+            return run_limited(
+                mrgc_argv(argv),
+                wall=task.limits.wall_seconds,
+                memory_mb=task.limits.memory_mb,
+                stdout=out,
+                stderr=err,
+                cancel=cancel,
+                env=env,
+            )
 
         proc = limited(args, stem + (".compile.json" if task.compile_only else ".out"), stem + ".err")
         text = _read(plan_path) if proc.killed is None else None

@@ -81,8 +81,10 @@ class LocalExecutor:
             finally:
                 done.put(None)
 
-        self.threads = [threading.Thread(target=work, name=f"mrgc-bench-{i}", daemon=True)
-                        for i in range(min(self.jobs, todo.qsize()))]
+        self.threads = [
+            threading.Thread(target=work, name=f"mrgc-bench-{i}", daemon=True)
+            for i in range(min(self.jobs, todo.qsize()))
+        ]
         for th in self.threads:
             th.start()
         running = len(self.threads)

@@ -36,9 +36,14 @@ def write_figures(db: ResultsDB, folder: str, study: str | None = None) -> list[
         methods = list(dict.fromkeys(r.method for r in rows))
         sets = list(dict.fromkeys(r.instance_set for r in rows))
         written.append(_success(plt, name, rows, methods, sets, folder))
-        times = {m: sorted(r["planning_seconds"] for r in runs
-                           if r["method"] == m and r["success"] and r["planning_seconds"] is not None)
-                 for m in methods}
+        times = {
+            m: sorted(
+                r["planning_seconds"]
+                for r in runs
+                if r["method"] == m and r["success"] and r["planning_seconds"] is not None
+            )
+            for m in methods
+        }
         totals = {m: sum(1 for r in runs if r["method"] == m) for m in methods}
         written.append(_ecdf(plt, name, times, totals, folder))
         written.append(_cactus(plt, name, times, folder))

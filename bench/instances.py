@@ -67,9 +67,14 @@ def expand_instances(study: Study, work: str) -> list[Instance]:
             clash = seen_names.get(inst.name) or seen_hash.get(inst.sha256)
             if clash is not None:
                 what = "name" if inst.name in seen_names else "content"
-                diags.append(Diagnostic(E_INSTANCE, f"instance '{inst.name}' ({path}) has the same {what} as "
-                                        f"instance '{clash}': each run is keyed by the instance's content",
-                                        spec.span))
+                diags.append(
+                    Diagnostic(
+                        E_INSTANCE,
+                        f"instance '{inst.name}' ({path}) has the same {what} as "
+                        f"instance '{clash}': each run is keyed by the instance's content",
+                        spec.span,
+                    )
+                )
                 continue
             seen_names[inst.name] = inst.name
             seen_hash[inst.sha256] = inst.name
@@ -81,6 +86,7 @@ def expand_instances(study: Study, work: str) -> list[Instance]:
 
 def _files(study: Study, spec: InstanceSpec, work: str) -> list[tuple[str, str]]:
     """(instance name, path) of the entry's files."""
+
     def missing(message: str) -> InputError:
         return InputError([Diagnostic(E_INSTANCE, message, spec.span)])
 
@@ -90,11 +96,13 @@ def _files(study: Study, spec: InstanceSpec, work: str) -> list[tuple[str, str]]
             raise missing(f"instance file '{spec.source}' not found (looked for {path})")
         return [(spec.name, path)]
     if spec.kind == "glob":
-        paths = sorted(p for p in globbing.glob(os.path.join(study.folder, spec.source), recursive=True)
-                       if os.path.isfile(p) and p.endswith(".mrg") and os.path.basename(p) != "domain.mrg")
+        paths = sorted(
+            p
+            for p in globbing.glob(os.path.join(study.folder, spec.source), recursive=True)
+            if os.path.isfile(p) and p.endswith(".mrg") and os.path.basename(p) != "domain.mrg"
+        )
         if not paths:
-            raise missing(f"glob '{spec.source}' matches no problem file (.mrg, domain.mrg excluded) "
-                          f"in {study.folder}")
+            raise missing(f"glob '{spec.source}' matches no problem file (.mrg, domain.mrg excluded) in {study.folder}")
         return [(re.sub(r"[^A-Za-z0-9_.+-]", "-", os.path.splitext(os.path.basename(p))[0]), p) for p in paths]
     folder = os.path.join(work, "instances", spec.name)
     os.makedirs(folder, exist_ok=True)
@@ -161,5 +169,6 @@ def _instance(name: str, spec: InstanceSpec, index: int, path: str) -> Instance:
         if os.path.dirname(os.path.abspath(src)) == os.path.dirname(os.path.abspath(path)):
             files.append((os.path.basename(src), data.decode("utf-8")))
     bases = tuple((r.name, problem.domain.kind(r.kind).base if r.kind else "") for r in problem.robots)
-    return Instance(name, spec.name, index, os.path.abspath(path), spec.problem, digest.hexdigest(), bases,
-                    tuple(files))
+    return Instance(
+        name, spec.name, index, os.path.abspath(path), spec.problem, digest.hexdigest(), bases, tuple(files)
+    )

@@ -21,8 +21,22 @@ from mrgc.errors import Diagnostic
 DEFAULT_PLANNER = "mcts"
 
 #: options the runner sets itself; a method may not give them in ``options``
-RESERVED = {"-o", "--output", "--seed", "--time-limit", "--format", "--problem", "--backend", "--encoding",
-            "--planner", "--emit", "-h", "--help", "-v", "--verbose"}
+RESERVED = {
+    "-o",
+    "--output",
+    "--seed",
+    "--time-limit",
+    "--format",
+    "--problem",
+    "--backend",
+    "--encoding",
+    "--planner",
+    "--emit",
+    "-h",
+    "--help",
+    "-v",
+    "--verbose",
+}
 
 
 def _command_parser(command: str) -> argparse.ArgumentParser:
@@ -63,11 +77,12 @@ def check_methods(study: Study) -> tuple[list[Diagnostic], dict[str, str]]:
     tables = {"plan": _options("plan"), "compile": _options("compile")}
     backends = backend_names()
     for m in study.methods:
-        diags += [Diagnostic(E_STUDY_SCHEMA, f"method '{m.name}': {message}", m.span)
-                  for message in _method_problems(m, tables, backends)]
+        diags += [
+            Diagnostic(E_STUDY_SCHEMA, f"method '{m.name}': {message}", m.span)
+            for message in _method_problems(m, tables, backends)
+        ]
         if not m.compile and offered is not None and m.planner not in offered:
-            skip[m.name] = (f"planner '{m.planner}' is not offered by this mrgc "
-                            f"(mrgc plan offers: {', '.join(offered)})")
+            skip[m.name] = f"planner '{m.planner}' is not offered by this mrgc (mrgc plan offers: {', '.join(offered)})"
     return diags, skip
 
 
@@ -81,8 +96,9 @@ def _method_problems(m: Method, tables: dict[str, dict[str, argparse.Action]], b
     if m.backend is not None and m.backend not in backends:
         out.append(f"unknown backend '{m.backend}'{did_you_mean(m.backend, backends)} (known: {', '.join(backends)})")
     if m.encoding is not None and m.encoding not in ENCODINGS:
-        out.append(f"unknown encoding '{m.encoding}'{did_you_mean(m.encoding, ENCODINGS)} "
-                   f"(known: {', '.join(ENCODINGS)})")
+        out.append(
+            f"unknown encoding '{m.encoding}'{did_you_mean(m.encoding, ENCODINGS)} (known: {', '.join(ENCODINGS)})"
+        )
     command = "compile" if m.compile else "plan"
     table = tables[command]
     for key, value in m.options:

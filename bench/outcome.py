@@ -62,8 +62,12 @@ class RunStatus(str, enum.Enum):
 
 
 #: the plan statuses mrgc plan writes, their exit codes, and what they are as a run
-PLAN_STATUS = {"solved": (0, RunStatus.SOLVED), "infeasible": (1, RunStatus.INFEASIBLE),
-               "time limit": (3, RunStatus.TIME_LIMIT), "exhausted": (5, RunStatus.EXHAUSTED)}
+PLAN_STATUS = {
+    "solved": (0, RunStatus.SOLVED),
+    "infeasible": (1, RunStatus.INFEASIBLE),
+    "time limit": (3, RunStatus.TIME_LIMIT),
+    "exhausted": (5, RunStatus.EXHAUSTED),
+}
 #: exit codes of a command rejected as input
 INPUT_EXITS = {2, 4}
 
@@ -142,21 +146,44 @@ def classify(raw: RawRun, method_index: int = 0, plan_file: str | None = None) -
             detail = f"the validator ended with {_ending(v.exit_code, v.signal)}: {_last_line(raw.validate_stderr)}"
     elif status is RunStatus.SOLVED and not task.compile_only:
         status, detail = RunStatus.CRASH, "the plan says solved but was not validated"
-    measures = _measures(data, task.compile_only, dict(inst.bases)) if data is not None else dict.fromkeys(
-        ("planning_seconds", "facts_seconds", "makespan", "objects_moved", "arm_path", "base_path"))
+    measures = (
+        _measures(data, task.compile_only, dict(inst.bases))
+        if data is not None
+        else dict.fromkeys(("planning_seconds", "facts_seconds", "makespan", "objects_moved", "arm_path", "base_path"))
+    )
     tail = raw.plan_stderr if raw.validate is None or status is not RunStatus.CRASH else raw.validate_stderr
     return RunResult(
-        study=task.study, instance=inst.name, instance_set=inst.set, set_index=inst.set_index,
-        instance_file=inst.path, instance_sha256=inst.sha256, method=task.method, method_index=method_index,
-        seed=task.seed, status=status.value, success=status is RunStatus.SOLVED, detail=detail,
-        exit_code=proc.exit_code, signal=proc.signal, wall_seconds=round(proc.seconds, 3),
+        study=task.study,
+        instance=inst.name,
+        instance_set=inst.set,
+        set_index=inst.set_index,
+        instance_file=inst.path,
+        instance_sha256=inst.sha256,
+        method=task.method,
+        method_index=method_index,
+        seed=task.seed,
+        status=status.value,
+        success=status is RunStatus.SOLVED,
+        detail=detail,
+        exit_code=proc.exit_code,
+        signal=proc.signal,
+        wall_seconds=round(proc.seconds, 3),
         validate_seconds=validate_seconds,
         peak_mb=round(max(proc.peak_mb, raw.validate.peak_mb if raw.validate else 0), 1),
-        valid=valid, plan_status=(data or {}).get("status") if not task.compile_only else (data or {}).get("status"),
-        stderr_tail=tail, command=" ".join(["mrgc", *proc.argv[3:]]), time_limit=task.limits.time,
-        wall_limit=task.limits.wall_seconds, memory_limit_mb=task.limits.memory_mb,
-        mrgc_version=str((data or {}).get("mrgc_version") or raw.mrgc_version), host=raw.host,
-        started=raw.started, finished=raw.finished, plan_file=plan_file, **measures)
+        valid=valid,
+        plan_status=(data or {}).get("status") if not task.compile_only else (data or {}).get("status"),
+        stderr_tail=tail,
+        command=" ".join(["mrgc", *proc.argv[3:]]),
+        time_limit=task.limits.time,
+        wall_limit=task.limits.wall_seconds,
+        memory_limit_mb=task.limits.memory_mb,
+        mrgc_version=str((data or {}).get("mrgc_version") or raw.mrgc_version),
+        host=raw.host,
+        started=raw.started,
+        finished=raw.finished,
+        plan_file=plan_file,
+        **measures,
+    )
 
 
 def _plan_status(raw: RawRun, data: dict[str, Any] | None) -> tuple[RunStatus, str]:
@@ -192,17 +219,24 @@ def why_detail(why: dict[str, Any], failures: int = 3, limit: int = 1000) -> str
     parts += [str(f) for f in why.get("facts") or []][:3]
     cycles = why.get("cycles") or []
     if cycles:
-        parts.append(f"{len(cycles)} blocking cycle(s): " + ", ".join(
-            " -> ".join(map(str, c.get("objects", []))) for c in cycles[:3] if isinstance(c, dict)))
+        parts.append(
+            f"{len(cycles)} blocking cycle(s): "
+            + ", ".join(" -> ".join(map(str, c.get("objects", []))) for c in cycles[:3] if isinstance(c, dict))
+        )
     if why.get("rejected_plans"):
         parts.append(f"{why['rejected_plans']} complete plan(s) rejected by the validator")
     top = [f for f in why.get("grounding_failures") or [] if isinstance(f, dict)][:failures]
     if top:
-        parts.append("most frequent grounding failures: " + "; ".join(
-            f"{f.get('count')} x step {f.get('step')}, {f.get('action')}: {f.get('check')}"
-            + (f" ({f['detail']})" if f.get("detail") else "") for f in top))
+        parts.append(
+            "most frequent grounding failures: "
+            + "; ".join(
+                f"{f.get('count')} x step {f.get('step')}, {f.get('action')}: {f.get('check')}"
+                + (f" ({f['detail']})" if f.get("detail") else "")
+                for f in top
+            )
+        )
     text = "; ".join(parts)
-    return text if len(text) <= limit else text[:limit - 3] + "..."
+    return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
 def _ending(code: int | None, sig: int | None) -> str:
@@ -236,13 +270,23 @@ def _measures(data: dict[str, Any], compile_only: bool, bases: dict[str, str]) -
     if compile_only:
         skeletons = data.get("skeletons") or []
         first = skeletons[0] if skeletons else {}
-        return {"planning_seconds": _num(stats.get("total_seconds")), "facts_seconds": _num(stats.get("facts_seconds")),
-                "makespan": first.get("makespan"), "objects_moved": len(first["moved"]) if first else None,
-                "arm_path": None, "base_path": None}
+        return {
+            "planning_seconds": _num(stats.get("total_seconds")),
+            "facts_seconds": _num(stats.get("facts_seconds")),
+            "makespan": first.get("makespan"),
+            "objects_moved": len(first["moved"]) if first else None,
+            "arm_path": None,
+            "base_path": None,
+        }
     arm, base = path_lengths(data, bases)
-    return {"planning_seconds": _num(stats.get("seconds")), "facts_seconds": _num(stats.get("facts_seconds")),
-            "makespan": data.get("makespan"), "objects_moved": data.get("motion_cost"),
-            "arm_path": arm, "base_path": base}
+    return {
+        "planning_seconds": _num(stats.get("seconds")),
+        "facts_seconds": _num(stats.get("facts_seconds")),
+        "makespan": data.get("makespan"),
+        "objects_moved": data.get("motion_cost"),
+        "arm_path": arm,
+        "base_path": base,
+    }
 
 
 def _num(value: Any) -> float | None:
@@ -250,8 +294,14 @@ def _num(value: Any) -> float | None:
 
 
 #: which robot of an action follows each named path (docs/validator.md, the execution model)
-PATH_ROBOT = {"to-pick": "pick_robot", "to-handover": "pick_robot", "taker-to-handover": "place_robot",
-              "to-place": "place_robot", "home": "place_robot", "giver-home": "pick_robot"}
+PATH_ROBOT = {
+    "to-pick": "pick_robot",
+    "to-handover": "pick_robot",
+    "taker-to-handover": "place_robot",
+    "to-place": "place_robot",
+    "home": "place_robot",
+    "giver-home": "pick_robot",
+}
 
 
 def path_lengths(plan: dict[str, Any], bases: dict[str, str]) -> tuple[float | None, float | None]:
@@ -277,5 +327,7 @@ def path_lengths(plan: dict[str, Any], bases: dict[str, str]) -> tuple[float | N
                 dims = 2 if kind == "planar" else None
                 totals[kind] += sum(math.dist(a[:dims], b[:dims]) for a, b in zip(qs, qs[1:]))
     kinds = set(bases.values())
-    return (round(totals["fixed"], 4) if "fixed" in kinds else None,
-            round(totals["planar"], 4) if "planar" in kinds else None)
+    return (
+        round(totals["fixed"], 4) if "fixed" in kinds else None,
+        round(totals["planar"], 4) if "planar" in kinds else None,
+    )

@@ -27,8 +27,9 @@ def describe(r: RunResult) -> str:
 class Progress:
     """Reports finished runs (module docstring).  ``rich`` None: decide by whether ``stream`` is a terminal."""
 
-    def __init__(self, study: str, total: int, jobs: int = 1, stream: TextIO | None = None,
-                 rich: bool | None = None) -> None:
+    def __init__(
+        self, study: str, total: int, jobs: int = 1, stream: TextIO | None = None, rich: bool | None = None
+    ) -> None:
         self.study, self.total, self.jobs = study, total, max(1, jobs)
         self.stream = stream or sys.stdout
         self.done = self.solved = 0
@@ -40,9 +41,16 @@ class Progress:
             from rich.progress import BarColumn, MofNCompleteColumn, TextColumn, TimeElapsedColumn, TimeRemainingColumn
             from rich.progress import Progress as Bar
 
-            self.bar = Bar(TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),
-                           TextColumn("solved {task.fields[solved]}"), TimeElapsedColumn(),
-                           TextColumn("ETA"), TimeRemainingColumn(), console=Console(stderr=True))
+            self.bar = Bar(
+                TextColumn("[bold]{task.description}"),
+                BarColumn(),
+                MofNCompleteColumn(),
+                TextColumn("solved {task.fields[solved]}"),
+                TimeElapsedColumn(),
+                TextColumn("ETA"),
+                TimeRemainingColumn(),
+                console=Console(stderr=True),
+            )
             self.task = self.bar.add_task(study, total=total, solved=0)
             self.bar.start()
 
@@ -57,8 +65,9 @@ class Progress:
             return
         elapsed = time.monotonic() - self.start
         eta = elapsed / self.done * (self.total - self.done)
-        print(f"[{self.done}/{self.total}, {self.solved} solved, ETA {_clock(eta)}] {line}", file=self.stream,
-              flush=True)
+        print(
+            f"[{self.done}/{self.total}, {self.solved} solved, ETA {_clock(eta)}] {line}", file=self.stream, flush=True
+        )
 
     def close(self) -> None:
         """Stop the progress bar (if any)."""

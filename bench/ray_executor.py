@@ -34,8 +34,9 @@ def _check_reachable(address: str) -> None:
     try:
         socket.create_connection((m.group(1), int(m.group(2))), timeout=5).close()
     except OSError as exc:
-        raise InputError([Diagnostic("E000", f"--address {address}: no Ray cluster answers there "
-                                     f"({exc.strerror or exc})")]) from None
+        raise InputError(
+            [Diagnostic("E000", f"--address {address}: no Ray cluster answers there ({exc.strerror or exc})")]
+        ) from None
 
 
 def _run_remote(task: RunTask) -> RawRun:

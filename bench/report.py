@@ -93,16 +93,27 @@ def aggregate(runs: Iterable[dict[str, Any]]) -> list[Row]:
     for key in sorted(groups, key=lambda k: (order[k][0], order[k][1], k[1], order[k][2], k[2])):
         rs = groups[key]
         ok = [r for r in rs if r["success"]]
-        out.append(Row(*key, runs=len(rs), solved=len(ok), outcomes=Counter(r["status"] for r in rs),
-                       time=Stat.of(r["planning_seconds"] for r in ok), makespan=Stat.of(r["makespan"] for r in ok),
-                       moved=Stat.of(r["objects_moved"] for r in ok), arm_path=Stat.of(r["arm_path"] for r in ok),
-                       base_path=Stat.of(r["base_path"] for r in ok)))
+        out.append(
+            Row(
+                *key,
+                runs=len(rs),
+                solved=len(ok),
+                outcomes=Counter(r["status"] for r in rs),
+                time=Stat.of(r["planning_seconds"] for r in ok),
+                makespan=Stat.of(r["makespan"] for r in ok),
+                moved=Stat.of(r["objects_moved"] for r in ok),
+                arm_path=Stat.of(r["arm_path"] for r in ok),
+                base_path=Stat.of(r["base_path"] for r in ok),
+            )
+        )
     return out
 
 
 def _table(header: list[str], rows: list[list[str]], right: int) -> list[str]:
-    lines = ["| " + " | ".join(header) + " |",
-             "| " + " | ".join(["---"] * right + ["---:"] * (len(header) - right)) + " |"]
+    lines = [
+        "| " + " | ".join(header) + " |",
+        "| " + " | ".join(["---"] * right + ["---:"] * (len(header) - right)) + " |",
+    ]
     return lines + ["| " + " | ".join(r) + " |" for r in rows]
 
 
@@ -120,17 +131,50 @@ def markdown(db: ResultsDB, study: str | None = None) -> str:
         hosts = sorted({r["host"] for r in runs})
         versions = sorted({r["mrgc_version"] for r in runs})
         limits = sorted({(r["time_limit"], r["wall_limit"], r["memory_limit_mb"]) for r in runs})
-        parts.append(f"{len(runs)} runs: {len({r['instance'] for r in runs})} instances in "
-                     f"{len({r['instance_set'] for r in runs})} sets, {len({r['method'] for r in runs})} methods, "
-                     f"seeds {_seeds(seeds)}; mrgc {', '.join(versions)} on {', '.join(hosts)}; limits per run: "
-                     + "; ".join(f"planner {t:g} s, wall {w:g} s, memory {m:g} MiB" for t, w, m in limits) + ".\n")
-        parts.append("Success: solved and accepted by `mrgc validate`.  Other columns: mean ± standard error over "
-                     "the solved runs.  Objects moved is the paper's motion cost; path length sums the motions "
-                     "each plan lists (docs/bench.md).\n")
-        body = [[r.instance_set, r.method, str(r.runs), f"{r.success:.1f}", r.time.text(2), r.makespan.text(1),
-                 r.moved.text(1), r.path_text()] for r in rows]
-        parts.append("\n".join(_table(["instance", "method", "runs", "success %", "planning time (s)", "makespan",
-                                       "objects moved", "path length"], body, 2)) + "\n")
+        parts.append(
+            f"{len(runs)} runs: {len({r['instance'] for r in runs})} instances in "
+            f"{len({r['instance_set'] for r in runs})} sets, {len({r['method'] for r in runs})} methods, "
+            f"seeds {_seeds(seeds)}; mrgc {', '.join(versions)} on {', '.join(hosts)}; limits per run: "
+            + "; ".join(f"planner {t:g} s, wall {w:g} s, memory {m:g} MiB" for t, w, m in limits)
+            + ".\n"
+        )
+        parts.append(
+            "Success: solved and accepted by `mrgc validate`.  Other columns: mean ± standard error over "
+            "the solved runs.  Objects moved is the paper's motion cost; path length sums the motions "
+            "each plan lists (docs/bench.md).\n"
+        )
+        body = [
+            [
+                r.instance_set,
+                r.method,
+                str(r.runs),
+                f"{r.success:.1f}",
+                r.time.text(2),
+                r.makespan.text(1),
+                r.moved.text(1),
+                r.path_text(),
+            ]
+            for r in rows
+        ]
+        parts.append(
+            "\n".join(
+                _table(
+                    [
+                        "instance",
+                        "method",
+                        "runs",
+                        "success %",
+                        "planning time (s)",
+                        "makespan",
+                        "objects moved",
+                        "path length",
+                    ],
+                    body,
+                    2,
+                )
+            )
+            + "\n"
+        )
         statuses = [s.value for s in RunStatus if any(r.outcomes[s.value] for r in rows)]
         counts = [[r.instance_set, r.method, *(str(r.outcomes[s]) for s in statuses)] for r in rows]
         parts.append("Outcomes (runs):\n")
@@ -150,8 +194,11 @@ def wide(db: ResultsDB, study: str | None = None) -> str:
         sets = list(dict.fromkeys(r.instance_set for r in rows))
         cell = {(r.instance_set, r.method): r for r in rows}
         measures: list[tuple[str, Callable[[Row], str]]] = [
-            ("success %", lambda r: f"{r.success:.1f}"), ("time (s)", lambda r: r.time.text(2)),
-            ("makespan", lambda r: r.makespan.text(1)), ("moved", lambda r: r.moved.text(1))]
+            ("success %", lambda r: f"{r.success:.1f}"),
+            ("time (s)", lambda r: r.time.text(2)),
+            ("makespan", lambda r: r.makespan.text(1)),
+            ("moved", lambda r: r.moved.text(1)),
+        ]
         header = ["instance"] + [f"{title} {m}" for title, _ in measures for m in methods]
         body = [[s] + [f(cell[s, m]) if (s, m) in cell else _DASH for _, f in measures for m in methods] for s in sets]
         parts.append(f"## Study {name}\n\n" + "\n".join(_table(header, body, 1)) + "\n")
@@ -170,9 +217,27 @@ def csv_text(db: ResultsDB, study: str | None = None) -> str:
     out = io.StringIO()
     w = csv.writer(out, lineterminator="\n")
     statuses = [s.value for s in RunStatus]
-    w.writerow(["study", "instance", "method", "runs", "solved", "success_pct", "time_mean", "time_se",
-                "makespan_mean", "makespan_se", "moved_mean", "moved_se", "arm_path_mean", "arm_path_se",
-                "base_path_mean", "base_path_se", *("n_" + s.replace(" ", "_") for s in statuses)])
+    w.writerow(
+        [
+            "study",
+            "instance",
+            "method",
+            "runs",
+            "solved",
+            "success_pct",
+            "time_mean",
+            "time_se",
+            "makespan_mean",
+            "makespan_se",
+            "moved_mean",
+            "moved_se",
+            "arm_path_mean",
+            "arm_path_se",
+            "base_path_mean",
+            "base_path_se",
+            *("n_" + s.replace(" ", "_") for s in statuses),
+        ]
+    )
 
     def num(x: float | None) -> str:
         return "" if x is None else f"{x:.6g}"
@@ -180,8 +245,18 @@ def csv_text(db: ResultsDB, study: str | None = None) -> str:
     for name in [study] if study is not None else db.studies():
         for r in aggregate(db.runs(name)):
             stats = [num(v) for s in (r.time, r.makespan, r.moved, r.arm_path, r.base_path) for v in (s.mean, s.se)]
-            w.writerow([r.study, r.instance_set, r.method, r.runs, r.solved, f"{r.success:.1f}", *stats,
-                        *(r.outcomes[s] for s in statuses)])
+            w.writerow(
+                [
+                    r.study,
+                    r.instance_set,
+                    r.method,
+                    r.runs,
+                    r.solved,
+                    f"{r.success:.1f}",
+                    *stats,
+                    *(r.outcomes[s] for s in statuses),
+                ]
+            )
     return out.getvalue()
 
 

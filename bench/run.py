@@ -47,8 +47,10 @@ class StudySummary:
 
     def lines(self) -> list[str]:
         """The summary printed at the end of ``bench run``."""
-        out = [f"study {self.study}: {self.total} runs, {self.already} already recorded, {self.ran} run now"
-               + (": " + ", ".join(f"{n} {s}" for s, n in self.outcomes.most_common()) if self.ran else "")]
+        out = [
+            f"study {self.study}: {self.total} runs, {self.already} already recorded, {self.ran} run now"
+            + (": " + ", ".join(f"{n} {s}" for s, n in self.outcomes.most_common()) if self.ran else "")
+        ]
         out += [f"skipped method {m} ({n} runs): {why}" for m, (why, n) in self.skipped.items()]
         return out
 
@@ -75,10 +77,18 @@ def study_tasks(study: Study, work: str) -> tuple[list[RunTask], dict[str, tuple
     return tasks, skipped
 
 
-def run_study(study: Study | str, db: str = DEFAULT_DB, *, jobs: int = 1, executor: str = "local",
-              address: str | None = None, work: str | None = None, retry: Iterable[str] = (),
-              on_result: Callable[[RunResult], None] | None = None,
-              on_start: Callable[[int, int], None] | None = None) -> StudySummary:
+def run_study(
+    study: Study | str,
+    db: str = DEFAULT_DB,
+    *,
+    jobs: int = 1,
+    executor: str = "local",
+    address: str | None = None,
+    work: str | None = None,
+    retry: Iterable[str] = (),
+    on_result: Callable[[RunResult], None] | None = None,
+    on_start: Callable[[int, int], None] | None = None,
+) -> StudySummary:
     """Run the study's unfinished runs and record them in ``db`` (module docstring).
 
     ``on_start(total, to_run)`` is called once the runs are known, ``on_result`` after each run is
@@ -93,14 +103,25 @@ def run_study(study: Study | str, db: str = DEFAULT_DB, *, jobs: int = 1, execut
         raise InputError([Diagnostic("E000", f"unknown executor '{executor}' (choose from {', '.join(EXECUTORS)})")])
     bad = sorted(set(retry) - {s.value for s in RunStatus})
     if bad:
-        raise InputError([Diagnostic("E000", f"--retry: unknown status '{bad[0]}' "
-                                     f"(choose from {', '.join(s.value for s in RunStatus)})")])
+        raise InputError(
+            [
+                Diagnostic(
+                    "E000", f"--retry: unknown status '{bad[0]}' (choose from {', '.join(s.value for s in RunStatus)})"
+                )
+            ]
+        )
     work = work or default_work(db)
     method_index = {m.name: i for i, m in enumerate(study.methods)}
     with WriterLock(db), ResultsDB(db) as results:
         tasks, skipped = study_tasks(study, work)
-        results.begin_study(study.name, os.path.abspath(study.path), study.text,
-                            {m.name: m.spec() for m in study.methods if m.name not in skipped}, skipped, now())
+        results.begin_study(
+            study.name,
+            os.path.abspath(study.path),
+            study.text,
+            {m.name: m.spec() for m in study.methods if m.name not in skipped},
+            skipped,
+            now(),
+        )
         finished = results.finished(study.name)
         todo = [t for t in tasks if finished.get((t.study, t.instance.sha256, t.method, t.seed)) in (None, *retry)]
         summary = StudySummary(study.name, len(tasks), len(tasks) - len(todo), skipped=skipped)
@@ -131,8 +152,12 @@ def _keep_files(raw: RawRun) -> str | None:
     t = raw.task
     os.makedirs(t.out_dir, exist_ok=True)
     stem = os.path.join(t.out_dir, t.stem)
-    texts = {(".compile.json" if t.compile_only else ".plan.json"): raw.plan_text, ".err": raw.plan_stderr,
-             ".validate.json": raw.validate_text, ".validate.err": raw.validate_stderr if raw.validate else None}
+    texts = {
+        (".compile.json" if t.compile_only else ".plan.json"): raw.plan_text,
+        ".err": raw.plan_stderr,
+        ".validate.json": raw.validate_text,
+        ".validate.err": raw.validate_stderr if raw.validate else None,
+    }
     for suffix, text in texts.items():
         if text is not None:
             with open(stem + suffix, "w", encoding="utf-8") as fh:

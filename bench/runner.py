@@ -91,7 +91,7 @@ def group_members(pgid: int) -> list[int]:
                 stat = fh.read()
         except OSError:
             continue
-        fields = stat[stat.rfind(b")") + 2:].split()
+        fields = stat[stat.rfind(b")") + 2 :].split()
         if len(fields) > 2 and int(fields[2]) == pgid and fields[0] != b"Z":
             out.append(int(entry))
     return out
@@ -142,16 +142,25 @@ def _kill_group(pgid: int) -> None:
         pass
 
 
-def run_limited(argv: list[str], *, wall: float, memory_mb: float, stdout: str, stderr: str,
-                cwd: str | None = None, cancel: threading.Event | None = None,
-                env: dict[str, str] | None = None) -> ProcessResult:
+def run_limited(
+    argv: list[str],
+    *,
+    wall: float,
+    memory_mb: float,
+    stdout: str,
+    stderr: str,
+    cwd: str | None = None,
+    cancel: threading.Event | None = None,
+    env: dict[str, str] | None = None,
+) -> ProcessResult:
     """Run ``argv`` to its end or to a limit (module docstring); standard output and error go to files."""
     killed: str | None = None
     peak = 0.0
     with open(stdout, "wb") as out, open(stderr, "wb") as err:
         start = time.monotonic()
-        proc = subprocess.Popen(argv, stdin=subprocess.DEVNULL, stdout=out, stderr=err, cwd=cwd, env=env,
-                                start_new_session=True)
+        proc = subprocess.Popen(
+            argv, stdin=subprocess.DEVNULL, stdout=out, stderr=err, cwd=cwd, env=env, start_new_session=True
+        )
     pgid = proc.pid
     try:
         next_sample = next_pss = start
@@ -186,5 +195,6 @@ def run_limited(argv: list[str], *, wall: float, memory_mb: float, stdout: str, 
         proc.returncode = os.waitstatus_to_exitcode(status)
     seconds = time.monotonic() - start
     code = proc.returncode
-    return ProcessResult(tuple(argv), code if code >= 0 else None, -code if code < 0 else None, seconds, peak,
-                         killed, stdout, stderr)
+    return ProcessResult(
+        tuple(argv), code if code >= 0 else None, -code if code < 0 else None, seconds, peak, killed, stdout, stderr
+    )

@@ -19,7 +19,7 @@ from mrgc.errors import Diagnostic, InputError, Span
 _NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.+-]*$")
 _RANGE = re.compile(r"^\s*(\d+)\s*\.\.\s*(\d+)\s*$")
 _SIZE = re.compile(r"^\s*(\d+(?:\.\d+)?)\s*([KMGT]i?B?|)\s*$", re.IGNORECASE)
-_UNITS = {"": 1.0, "k": 1 / 1024, "m": 1.0, "g": 1024.0, "t": 1024.0 ** 2}
+_UNITS = {"": 1.0, "k": 1 / 1024, "m": 1.0, "g": 1024.0, "t": 1024.0**2}
 _MAX_BYTES = 1 << 20
 
 STUDY_KEYS = ("study", "description", "seeds", "limits", "instances", "methods")
@@ -92,8 +92,9 @@ def parse_study(text: str, path: str = "<study>") -> Study:
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
         span = Span(path, mark.line + 1, mark.column + 1, mark.line + 1, mark.column + 2) if mark else None
-        raise InputError([Diagnostic(E_STUDY_READ, f"study is not YAML: {exc.problem or exc}", span)],
-                         {path: text}) from None
+        raise InputError(
+            [Diagnostic(E_STUDY_READ, f"study is not YAML: {exc.problem or exc}", span)], {path: text}
+        ) from None
     except yaml.YAMLError as exc:
         raise InputError([Diagnostic(E_STUDY_READ, f"study is not YAML: {exc}")], {path: text}) from None
     reader = Reader(path)
@@ -159,8 +160,15 @@ class Reader:
         """The node's value if it is of one of ``types`` (a bool counts only where bool is listed)."""
         value = self.value(node)
         if value is None or not isinstance(value, types) or (isinstance(value, bool) and bool not in types):
-            want = ("true or false" if types == (bool,) else "a number" if float in types
-                    else "a name" if str in types and int in types else "text")
+            want = (
+                "true or false"
+                if types == (bool,)
+                else "a number"
+                if float in types
+                else "a name"
+                if str in types and int in types
+                else "text"
+            )
             self.error(node, f"{what} must be {want}")
             return None
         return value
@@ -289,8 +297,10 @@ class Reader:
             if key not in allowed:
                 from mrgc.language.suggest import did_you_mean
 
-                self.error(knode, f"a {kind} instance: unknown key '{key}'{did_you_mean(key, allowed)} "
-                           f"(known: {', '.join(allowed)})")
+                self.error(
+                    knode,
+                    f"a {kind} instance: unknown key '{key}'{did_you_mean(key, allowed)} (known: {', '.join(allowed)})",
+                )
 
     def options(self, m: dict[str, tuple[Any, Any]], what: str, skip: tuple[str, ...] = ()) -> list[tuple[str, Any]]:
         """(key, value) of the mapping's entries but those in ``skip``; an error (``what 'key' must be ...``)
@@ -352,8 +362,7 @@ class Reader:
                     only.append(set_name)
         if name is None or planner is None or own is None:
             return None
-        return Method(name, planner, compile_only, backend, encoding, tuple(options), own, tuple(only),
-                      self.span(node))
+        return Method(name, planner, compile_only, backend, encoding, tuple(options), own, tuple(only), self.span(node))
 
 
 def _default_name(kind: str, source: str) -> str:

@@ -99,8 +99,7 @@ def main(argv: list[str] | None = None) -> None:
     hull = make_links(1, rng)[0]
     row("hull–box `probe_collides` (overlapping)", lambda i: pair.probe_collides([(hull, translation(0.1, 0, 0))]))
     rotations = [rot_z(a) @ translation(0.1, 0, 0) for a in np.linspace(0, math.pi, batches)]
-    row("hull–box `probe_collides` (new pose each call)",
-        lambda i: pair.probe_collides([(hull, rotations[i])]))
+    row("hull–box `probe_collides` (new pose each call)", lambda i: pair.probe_collides([(hull, rotations[i])]))
     row("`set_transform` (one object)", lambda i: pair.set_transform("b", rotations[i]))
 
     # link hulls against the scene
@@ -110,28 +109,42 @@ def main(argv: list[str] | None = None) -> None:
         probes = [list(zip(links, c)) for c in configs]
         hits = sum(bool(world.probe_collides(p)) for p in probes)
         note = f"{hits}/{batches} configurations collide"
-        row(f"{n_links} link hulls vs {args.boxes} boxes + table: `probe_collides`",
-            lambda i, probes=probes: world.probe_collides(probes[i]), note)
-        row(f"{n_links} link hulls vs {args.boxes} boxes + table: `probe_hits`",
-            lambda i, probes=probes: world.probe_hits(probes[i]), note)
-        row(f"{n_links} link hulls vs {args.boxes} boxes + table: `batch_collides`",
-            lambda i, links=links, configs=configs: world.batch_collides(links, configs[i]), note)
+        row(
+            f"{n_links} link hulls vs {args.boxes} boxes + table: `probe_collides`",
+            lambda i, probes=probes: world.probe_collides(probes[i]),
+            note,
+        )
+        row(
+            f"{n_links} link hulls vs {args.boxes} boxes + table: `probe_hits`",
+            lambda i, probes=probes: world.probe_hits(probes[i]),
+            note,
+        )
+        row(
+            f"{n_links} link hulls vs {args.boxes} boxes + table: `batch_collides`",
+            lambda i, links=links, configs=configs: world.batch_collides(links, configs[i]),
+            note,
+        )
 
     # swept volume: 30 configurations of a 7-link chain
     links = make_links(7, rng)
     sweeps = [np.array([chain(7, np.random.default_rng(1000 * i + k)) for k in range(30)]) for i in range(batches)]
-    row("sweep of 30 configurations × 7 links: `batch_hits`",
-        lambda i: world.batch_hits(links, sweeps[i]), "")
+    row("sweep of 30 configurations × 7 links: `batch_hits`", lambda i: world.batch_hits(links, sweeps[i]), "")
 
     # colliding_with: which of the 20 objects does one object hit
     names = world.names("movable")
-    row(f"`colliding_with` one object vs {args.boxes} objects + table",
-        lambda i: world.colliding_with(names[i % len(names)]))
-    row("`colliding_with` one object vs movables, ignoring 3",
-        lambda i: world.colliding_with(names[i % len(names)], against="movable", ignore=names[:3]))
+    row(
+        f"`colliding_with` one object vs {args.boxes} objects + table",
+        lambda i: world.colliding_with(names[i % len(names)]),
+    )
+    row(
+        "`colliding_with` one object vs movables, ignoring 3",
+        lambda i: world.colliding_with(names[i % len(names)], against="movable", ignore=names[:3]),
+    )
 
-    print(f"# Collision query costs\n\n`{' '.join([sys.executable.rsplit('/', 1)[-1], *sys.argv])}`  "
-          f"(boxes={args.boxes}, {batches} batches × {args.repeat} calls, seed {args.seed})\n")
+    print(
+        f"# Collision query costs\n\n`{' '.join([sys.executable.rsplit('/', 1)[-1], *sys.argv])}`  "
+        f"(boxes={args.boxes}, {batches} batches × {args.repeat} calls, seed {args.seed})\n"
+    )
     print("| query | median µs | p90 µs | note |\n|---|---:|---:|---|")
     for name, med, p90, note in rows:
         print(f"| {name} | {med:.1f} | {p90:.1f} | {note} |")

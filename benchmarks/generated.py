@@ -32,14 +32,31 @@ def instances(packaging: int, box_moving: int) -> list[tuple[str, list[str]]]:
     pa = []
     for i in range(packaging):
         robots, goals, others = 2 + i % 3, 3 + (i // 3) % 3, 2 + (7 * i) % 12
-        pa.append((f"pa-r{robots}-g{goals}-o{others}-i{i}",
-                   ["packaging", "--robots", str(robots), "--goals", str(goals), "--others", str(others),
-                    "--seed", str(1000 + i)]))
+        pa.append(
+            (
+                f"pa-r{robots}-g{goals}-o{others}-i{i}",
+                [
+                    "packaging",
+                    "--robots",
+                    str(robots),
+                    "--goals",
+                    str(goals),
+                    "--others",
+                    str(others),
+                    "--seed",
+                    str(1000 + i),
+                ],
+            )
+        )
     bo = []
     for i in range(box_moving):
         others = 2 + i % 5
-        bo.append((f"bo-r2-g2-o{others}-i{i}",
-                   ["box-moving", "--robots", "2", "--goals", "2", "--others", str(others), "--seed", str(1000 + i)]))
+        bo.append(
+            (
+                f"bo-r2-g2-o{others}-i{i}",
+                ["box-moving", "--robots", "2", "--goals", "2", "--others", str(others), "--seed", str(1000 + i)],
+            )
+        )
     out: list[tuple[str, list[str]]] = []
     ratio = max(1, round(len(pa) / max(1, len(bo))))
     while pa or bo:
@@ -60,19 +77,30 @@ def run_one(name: str, gen: list[str], seed: int, limit: float, work: Path) -> d
             return {"outcome": "generator error", "detail": made.stderr.strip()[-300:]}
     t0 = time.perf_counter()
     try:
-        proc = mrgc("plan", str(src), "--seed", str(seed), "--time-limit", str(limit), "-o", str(plan),
-                    timeout=limit * 3 + 300)
+        proc = mrgc(
+            "plan", str(src), "--seed", str(seed), "--time-limit", str(limit), "-o", str(plan), timeout=limit * 3 + 300
+        )
     except subprocess.TimeoutExpired:
         return {"outcome": "crash", "detail": "plan process hung past 3x its time limit"}
     wall = time.perf_counter() - t0
     if not plan.exists():
-        return {"outcome": "crash", "exit": proc.returncode, "seconds": round(wall, 2),
-                "detail": proc.stderr.strip()[-300:]}
+        return {
+            "outcome": "crash",
+            "exit": proc.returncode,
+            "seconds": round(wall, 2),
+            "detail": proc.stderr.strip()[-300:],
+        }
     data = json.loads(plan.read_text(encoding="utf-8"))
-    row: dict[str, object] = {"exit": proc.returncode, "status": data["status"], "seconds": round(wall, 2),
-                              "planner_seconds": data["stats"].get("seconds"), "facts_seconds":
-                              data["stats"].get("facts_seconds"), "makespan": data["makespan"],
-                              "moved": data["motion_cost"], "why": data.get("why", {})}
+    row: dict[str, object] = {
+        "exit": proc.returncode,
+        "status": data["status"],
+        "seconds": round(wall, 2),
+        "planner_seconds": data["stats"].get("seconds"),
+        "facts_seconds": data["stats"].get("facts_seconds"),
+        "makespan": data["makespan"],
+        "moved": data["motion_cost"],
+        "why": data.get("why", {}),
+    }
     if data["status"] == "solved":
         check = mrgc("validate", str(src), str(plan), timeout=600)
         row["valid"] = check.returncode == 0
@@ -131,9 +159,11 @@ def report(path: Path) -> None:
         solved = [r for r in mine if r["outcome"] == "solved, valid"]
         secs = sorted(float(r["seconds"]) for r in solved)
         med = secs[len(secs) // 2] if secs else float("nan")
-        print(f"\n{'packaging' if family == 'pa' else 'box-moving'}: {len(mine)} runs "
-              f"({len({r['instance'] for r in mine})} instances), solved and valid {len(solved)} "
-              f"({100 * len(solved) / len(mine):.0f} %), median wall time of those {med:.1f} s\n")
+        print(
+            f"\n{'packaging' if family == 'pa' else 'box-moving'}: {len(mine)} runs "
+            f"({len({r['instance'] for r in mine})} instances), solved and valid {len(solved)} "
+            f"({100 * len(solved) / len(mine):.0f} %), median wall time of those {med:.1f} s\n"
+        )
         print("| outcome | runs |\n| --- | --- |")
         for cat, n in sorted(cats.items(), key=lambda kv: -kv[1]):
             print(f"| {cat} | {n} |")
@@ -162,8 +192,13 @@ def main() -> None:
         for seed in args.seeds:
             if (name, seed) in done:
                 continue
-            row = {"instance": name, "generate": "mrgc generate " + " ".join(gen), "seed": seed,
-                   "time_limit": args.time_limit, **run_one(name, gen, seed, args.time_limit, work)}
+            row = {
+                "instance": name,
+                "generate": "mrgc generate " + " ".join(gen),
+                "seed": seed,
+                "time_limit": args.time_limit,
+                **run_one(name, gen, seed, args.time_limit, work),
+            }
             with open(args.out, "a", encoding="utf-8") as fh:
                 fh.write(json.dumps(row) + "\n")
                 fh.flush()

@@ -67,12 +67,17 @@ def main() -> None:
     q1000 = rng.uniform(model.lower, model.upper, size=(1000, model.dof))
     F.fk(model, q1)  # warm the plan cache
     rows.append(("FK all links, N=1", f"{per_call(lambda: F.fk(model, q1), 2000) * 1e6:.1f} µs/config", ""))
-    rows.append(("FK all links, N=1000", f"{per_call(lambda: F.fk(model, q1000), 20) / 1000 * 1e6:.2f} µs/config",
-                 ""))
-    rows.append(("FK end effector, N=1000",
-                 f"{per_call(lambda: F.ee_pose(model, q1000), 20) / 1000 * 1e6:.2f} µs/config", ""))
-    rows.append(("pybullet FK (getLinkStates), N=1",
-                 f"{per_call(lambda: pybullet_fk(model, q1[0]), 500) * 1e6:.1f} µs/config", ""))
+    rows.append(("FK all links, N=1000", f"{per_call(lambda: F.fk(model, q1000), 20) / 1000 * 1e6:.2f} µs/config", ""))
+    rows.append(
+        ("FK end effector, N=1000", f"{per_call(lambda: F.ee_pose(model, q1000), 20) / 1000 * 1e6:.2f} µs/config", "")
+    )
+    rows.append(
+        (
+            "pybullet FK (getLinkStates), N=1",
+            f"{per_call(lambda: pybullet_fk(model, q1[0]), 500) * 1e6:.1f} µs/config",
+            "",
+        )
+    )
 
     targets = F.ee_pose(model, rng.uniform(model.lower, model.upper, size=(args.poses, model.dof)))
     n = len(targets)
@@ -80,9 +85,13 @@ def main() -> None:
     I.clear_ik_cache()
     times, res = timed_solves(lambda i, t: I.solve_ik(model, t, seed=i, restarts=args.restarts), targets)
     ok = sum(r.solved for r in res)
-    rows.append((f"mrgc solve_ik ({args.restarts} restarts)",
-                 f"median {statistics.median(times) * 1e3:.2f} ms, mean {statistics.mean(times) * 1e3:.2f} ms",
-                 f"{ok}/{n}"))
+    rows.append(
+        (
+            f"mrgc solve_ik ({args.restarts} restarts)",
+            f"median {statistics.median(times) * 1e3:.2f} ms, mean {statistics.mean(times) * 1e3:.2f} ms",
+            f"{ok}/{n}",
+        )
+    )
 
     I.clear_ik_cache()
     start = time.perf_counter()
@@ -93,26 +102,42 @@ def main() -> None:
     centre = model.shoulder
     dirs = rng.normal(size=(50, 3))
     dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
-    hard = np.array([tf.from_xyz_rpy(centre + d * rng.uniform(0.8, 0.98) * model.reach, rng.uniform(-3, 3, 3))
-                     for d in dirs])
+    hard = np.array(
+        [tf.from_xyz_rpy(centre + d * rng.uniform(0.8, 0.98) * model.reach, rng.uniform(-3, 3, 3)) for d in dirs]
+    )
     I.clear_ik_cache()
     times, res = timed_solves(lambda i, t: I.solve_ik(model, t, seed=i, restarts=args.restarts), hard)
     fails = [t for t, r in zip(times, res) if not r.solved]
     if fails:
-        rows.append(("mrgc solve_ik, failing (hard targets)", f"median {statistics.median(fails) * 1e3:.2f} ms",
-                     f"{len(fails)}/{len(hard)} failed"))
+        rows.append(
+            (
+                "mrgc solve_ik, failing (hard targets)",
+                f"median {statistics.median(fails) * 1e3:.2f} ms",
+                f"{len(fails)}/{len(hard)} failed",
+            )
+        )
 
     times, res = timed_solves(lambda i, t: pybullet_ik(model, t, seed=i, restarts=args.restarts), targets)
     ok = sum(r.solved for r in res)
-    rows.append((f"pybullet IK, DLS ({args.restarts} restarts, 200 it.)",
-                 f"median {statistics.median(times) * 1e3:.2f} ms, mean {statistics.mean(times) * 1e3:.2f} ms",
-                 f"{ok}/{n}"))
+    rows.append(
+        (
+            f"pybullet IK, DLS ({args.restarts} restarts, 200 it.)",
+            f"median {statistics.median(times) * 1e3:.2f} ms, mean {statistics.mean(times) * 1e3:.2f} ms",
+            f"{ok}/{n}",
+        )
+    )
     m = min(args.null_space_poses, n)
     if m:
         times, res = timed_solves(
-            lambda i, t: pybullet_ik(model, t, seed=i, restarts=args.restarts, null_space=True), targets[:m])
-        rows.append((f"pybullet IK, null space + limits ({args.restarts} restarts)",
-                     f"median {statistics.median(times) * 1e3:.2f} ms", f"{sum(r.solved for r in res)}/{m}"))
+            lambda i, t: pybullet_ik(model, t, seed=i, restarts=args.restarts, null_space=True), targets[:m]
+        )
+        rows.append(
+            (
+                f"pybullet IK, null space + limits ({args.restarts} restarts)",
+                f"median {statistics.median(times) * 1e3:.2f} ms",
+                f"{sum(r.solved for r in res)}/{m}",
+            )
+        )
 
     print("command: python " + " ".join(sys.argv))
     print(f"robot: {model!r}, tolerance 1e-4 m / 1e-3 rad, joint limits enforced")

@@ -24,9 +24,16 @@ def generate(n_objects: int, n_robots: int = 4, seed: int = 0) -> str:
     regions = ["start", "bin-a", "bin-b", "bin-c"]
     grasps = ["top", "side-x+", "side-x-", "side-y+", "side-y-"]
     goals = objs[: max(1, n_objects // 10)]
-    lines = [f"(define (domain gen) (:grasps {' '.join(grasps)}))", "", "(define (problem gen-%d)" % n_objects,
-             "  (:domain gen)", f"  (:robots {' '.join(robots)})", f"  (:movable {' '.join(objs)})",
-             f"  (:regions {' '.join(regions)})", "  (:init"]
+    lines = [
+        f"(define (domain gen) (:grasps {' '.join(grasps)}))",
+        "",
+        "(define (problem gen-%d)" % n_objects,
+        "  (:domain gen)",
+        f"  (:robots {' '.join(robots)})",
+        f"  (:movable {' '.join(objs)})",
+        f"  (:regions {' '.join(regions)})",
+        "  (:init",
+    ]
     for o in objs:
         lines.append(f"    (in-region {o} start)")
         for r in rng.sample(robots, 2):

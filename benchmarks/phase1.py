@@ -38,8 +38,12 @@ print(json.dumps({"facts_seconds": t2 - t1, "with_imports": t2 - t0, **result.st
 def phase1(name: str, repeat: int) -> dict[str, float]:
     runs = []
     for _ in range(repeat):
-        out = subprocess.run([sys.executable, "-c", CHILD, str(ROOT / "domains" / "packaging" / f"{name}.mrg")],
-                             capture_output=True, text=True, check=True)
+        out = subprocess.run(
+            [sys.executable, "-c", CHILD, str(ROOT / "domains" / "packaging" / f"{name}.mrg")],
+            capture_output=True,
+            text=True,
+            check=True,
+        )
         runs.append(json.loads(out.stdout.strip().splitlines()[-1]))
     return {
         "median": statistics.median(r["facts_seconds"] for r in runs),
@@ -82,20 +86,26 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--scenes", nargs="+", default=SCENES)
     args = ap.parse_args()
-    print("| scene | robots | objects | facts | IK solves | workers | phase 1 median (s) | min (s) "
-          "| incl. imports (s) |")
+    print(
+        "| scene | robots | objects | facts | IK solves | workers | phase 1 median (s) | min (s) | incl. imports (s) |"
+    )
     print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     for name in args.scenes:
         r = phase1(name, args.repeat)
         from mrgc import parse_file
 
         p = parse_file(ROOT / "domains" / "packaging" / f"{name}.mrg").problem()
-        print(f"| {name} | {len(p.robots)} | {len(p.movable)} | {r['facts']:.0f} | {r['ik_solves']:.0f} | "
-              f"{r['workers']:.0f} | {r['median']:.2f} | {r['min']:.2f} | {r['with_imports']:.2f} |", flush=True)
+        print(
+            f"| {name} | {len(p.robots)} | {len(p.movable)} | {r['facts']:.0f} | {r['ik_solves']:.0f} | "
+            f"{r['workers']:.0f} | {r['median']:.2f} | {r['min']:.2f} | {r['with_imports']:.2f} |",
+            flush=True,
+        )
     check, with_fk = config_check()
     print()
-    print(f"one Panda configuration vs the PA10 scene: {check * 1e6:.1f} µs (FK batched), "
-          f"{with_fk * 1e6:.1f} µs with single-configuration FK")
+    print(
+        f"one Panda configuration vs the PA10 scene: {check * 1e6:.1f} µs (FK batched), "
+        f"{with_fk * 1e6:.1f} µs with single-configuration FK"
+    )
 
 
 if __name__ == "__main__":

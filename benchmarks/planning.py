@@ -23,8 +23,11 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-PROBLEMS = {p.stem: p for p in sorted((ROOT / "domains" / "packaging").glob("pa*.mrg"))
-            + sorted((ROOT / "domains" / "box-moving").glob("bo*.mrg"))}
+PROBLEMS = {
+    p.stem: p
+    for p in sorted((ROOT / "domains" / "packaging").glob("pa*.mrg"))
+    + sorted((ROOT / "domains" / "box-moving").glob("bo*.mrg"))
+}
 
 CHILD = """
 import json, sys
@@ -62,8 +65,11 @@ def main() -> None:
         name = path.stem
         runs = []
         for seed in range(args.seeds):
-            out = subprocess.run([sys.executable, "-c", CHILD, str(path), str(seed), str(args.time_limit)],
-                                 capture_output=True, text=True)
+            out = subprocess.run(
+                [sys.executable, "-c", CHILD, str(path), str(seed), str(args.time_limit)],
+                capture_output=True,
+                text=True,
+            )
             if out.returncode != 0:
                 print(f"{name} seed {seed}: crashed: {out.stderr.strip().splitlines()[-1:]}", file=sys.stderr)
                 continue
@@ -76,10 +82,14 @@ def main() -> None:
             continue
         med = lambda key, ok=ok: statistics.median(r[key] for r in ok)  # noqa: E731
         share = lambda key, ok=ok: statistics.median(  # noqa: E731
-            100 * r.get(key, 0) / max(r["seconds"], 1e-9) for r in ok)
-        print(f"| {name} | {len(ok)}/{args.seeds} | {med('seconds'):.2f} | {max(r['seconds'] for r in ok):.2f} | "
-              f"{med('makespan'):g} | {med('cost'):g} | {share('facts_seconds'):.0f} | "
-              f"{share('skeleton_seconds'):.0f} | {share('grounding_seconds'):.0f} |", flush=True)
+            100 * r.get(key, 0) / max(r["seconds"], 1e-9) for r in ok
+        )
+        print(
+            f"| {name} | {len(ok)}/{args.seeds} | {med('seconds'):.2f} | {max(r['seconds'] for r in ok):.2f} | "
+            f"{med('makespan'):g} | {med('cost'):g} | {share('facts_seconds'):.0f} | "
+            f"{share('skeleton_seconds'):.0f} | {share('grounding_seconds'):.0f} |",
+            flush=True,
+        )
 
 
 if __name__ == "__main__":

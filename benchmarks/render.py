@@ -40,8 +40,10 @@ def main() -> int:
     args = ap.parse_args()
     problem = parse_file(args.problem).problem(None)
     plan = json.loads(Path(args.plan).read_text())
-    print("| size | frames | steps | draw / frame (wall) | draw / frame (CPU) | GIF write "
-          "| `mrgc render` / step (wall) | `mrgc render` / step (CPU) |")
+    print(
+        "| size | frames | steps | draw / frame (wall) | draw / frame (CPU) | GIF write "
+        "| `mrgc render` / step (wall) | `mrgc render` / step (CPU) |"
+    )
     print("| --- | --- | --- | --- | --- | --- | --- | --- |")
     for size in args.size or ["400x300", "640x480"]:
         w, h = (int(v) for v in size.split("x"))
@@ -57,16 +59,32 @@ def main() -> int:
                 write_gif(str(Path(tmp) / "x.gif"), images, opts.fps)
                 gif = time.perf_counter() - t0
                 t0, c0 = time.perf_counter(), _cpu()
-                subprocess.run([sys.executable, "-m", "mrgc.cli", "render", args.problem, args.plan, "-o",
-                                str(Path(tmp) / "y.gif"), "--size", size], check=True, capture_output=True)
+                subprocess.run(
+                    [
+                        sys.executable,
+                        "-m",
+                        "mrgc.cli",
+                        "render",
+                        args.problem,
+                        args.plan,
+                        "-o",
+                        str(Path(tmp) / "y.gif"),
+                        "--size",
+                        size,
+                    ],
+                    check=True,
+                    capture_output=True,
+                )
                 command, command_cpu = time.perf_counter() - t0, _cpu() - c0
             steps = max(1, timeline.steps)
             row = (seconds / len(frames), cpu / len(frames), gif, command / steps, command_cpu / steps)
             best = row if best is None or row[3] < best[3] else best
             n, steps = len(frames), timeline.steps
         assert best is not None
-        print(f"| {size} | {n} | {steps} | {best[0] * 1e3:.1f} ms | {best[1] * 1e3:.1f} ms | {best[2]:.2f} s | "
-              f"{best[3]:.2f} s | {best[4]:.2f} s |")
+        print(
+            f"| {size} | {n} | {steps} | {best[0] * 1e3:.1f} ms | {best[1] * 1e3:.1f} ms | {best[2]:.2f} s | "
+            f"{best[3]:.2f} s | {best[4]:.2f} s |"
+        )
     return 0
 
 

@@ -51,8 +51,17 @@ def instance(n_objects: int, n_robots: int, seed: int) -> tuple[FactBase, list[s
     return base, list(goal)
 
 
-def _object_facts(rng: random.Random, i: int, objs: list[str], robots: list[str], grasps: list[str], n_goals: int,
-                  goal: dict[str, str], reach: dict[str, set[str]], pickers_of: dict[str, list[str]]) -> list[Fact]:
+def _object_facts(
+    rng: random.Random,
+    i: int,
+    objs: list[str],
+    robots: list[str],
+    grasps: list[str],
+    n_goals: int,
+    goal: dict[str, str],
+    reach: dict[str, set[str]],
+    pickers_of: dict[str, list[str]],
+) -> list[Fact]:
     """The facts of the i-th object (see :func:`instance`), drawn from ``rng`` in a fixed order."""
     o = objs[i]
     facts: list[Fact] = []
@@ -68,7 +77,7 @@ def _object_facts(rng: random.Random, i: int, objs: list[str], robots: list[str]
             facts.append(Fact("reachable-place", (o, "start", g, r)))
     if o in goal:
         facts += _goal_facts(rng, o, goal[o], robots, grasps, reach[goal[o]], pickers, pick_grasps)
-    later = objs[max(i + 1, n_goals):]
+    later = objs[max(i + 1, n_goals) :]
     if later and rng.random() < 0.3:
         blocker = rng.choice(later)
         for r in pickers:
@@ -79,8 +88,16 @@ def _object_facts(rng: random.Random, i: int, objs: list[str], robots: list[str]
     return facts
 
 
-def _goal_facts(rng: random.Random, o: str, bin_: str, robots: list[str], grasps: list[str], reach: set[str],
-                pickers: list[str], pick_grasps: dict[str, list[str]]) -> list[Fact]:
+def _goal_facts(
+    rng: random.Random,
+    o: str,
+    bin_: str,
+    robots: list[str],
+    grasps: list[str],
+    reach: set[str],
+    pickers: list[str],
+    pick_grasps: dict[str, list[str]],
+) -> list[Fact]:
     """A goal object's places into its bin and handovers (always one into the bin when no picking robot
     reaches it)."""
     facts = [Fact("reachable-place", (o, bin_, g, r)) for r in robots if r in reach for g in grasps]
@@ -143,8 +160,16 @@ def main() -> None:
             for b in args.backends:
                 for e in args.encodings:
                     res = [run(base, must, b, e, args.time_limit) for base, must in insts]
-                    row = [f"{n}", f"{r}", size, b, e, fmt([x["first"] for x in res]), fmt([x["k10"] for x in res]),
-                           fmt([x["k50"] for x in res])]
+                    row = [
+                        f"{n}",
+                        f"{r}",
+                        size,
+                        b,
+                        e,
+                        fmt([x["first"] for x in res]),
+                        fmt([x["k10"] for x in res]),
+                        fmt([x["k50"] for x in res]),
+                    ]
                     print(" ".join(row), flush=True)
                     rows.append(row)
     print()

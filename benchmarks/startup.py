@@ -36,10 +36,12 @@ COMMANDS = {
     "mrgc compile chain-3.mrg --backend smt": ["compile", CHAIN3, "--backend", "smt"],
     "mrgc plan chain-3.mrg (cpsat)": ["plan", CHAIN3],
 }
-RUNNER = ("import sys; sys.path.insert(0, sys.argv[1]); del sys.argv[1]; "
-          "from mrgc.cli import main; code = main(sys.argv[1:]); "
-          "print(len(sys.modules), file=sys.stderr) if __import__('os').environ.get('COUNT') else None; "
-          "sys.exit(code)")
+RUNNER = (
+    "import sys; sys.path.insert(0, sys.argv[1]); del sys.argv[1]; "
+    "from mrgc.cli import main; code = main(sys.argv[1:]); "
+    "print(len(sys.modules), file=sys.stderr) if __import__('os').environ.get('COUNT') else None; "
+    "sys.exit(code)"
+)
 
 
 def main() -> None:
@@ -63,10 +65,13 @@ def main() -> None:
 
         def run(k: int, argv: list[str], count: bool = False) -> tuple[float, float, str]:
             t0, c0 = time.perf_counter(), resource.getrusage(resource.RUSAGE_CHILDREN)
-            out = subprocess.run([sys.executable, "-c", RUNNER, str(links[k].parent), *argv], cwd=roots[k],
-                                 text=True, capture_output=True,
-                                 env={**env, "PYTHONPYCACHEPREFIX": str(Path(tmp) / f"pyc{k}"),
-                                      **({"COUNT": "1"} if count else {})})
+            out = subprocess.run(
+                [sys.executable, "-c", RUNNER, str(links[k].parent), *argv],
+                cwd=roots[k],
+                text=True,
+                capture_output=True,
+                env={**env, "PYTHONPYCACHEPREFIX": str(Path(tmp) / f"pyc{k}"), **({"COUNT": "1"} if count else {})},
+            )
             seconds, c1 = time.perf_counter() - t0, resource.getrusage(resource.RUSAGE_CHILDREN)
             if out.returncode != 0:
                 raise SystemExit(f"mrgc {' '.join(argv)} failed ({out.returncode}): {out.stderr.strip()[-300:]}")
@@ -75,9 +80,11 @@ def main() -> None:
         for k in range(len(roots)):  # warm the bytecode caches
             for argv in commands.values():
                 run(k, argv)
-        print(f"{args.runs} runs per command and checkout, Python {sys.version.split()[0]}, load average "
-              f"{os.getloadavg()[0]:.1f} at the start; median / least wall time in seconds, median CPU time "
-              f"(user + system) in seconds, modules imported")
+        print(
+            f"{args.runs} runs per command and checkout, Python {sys.version.split()[0]}, load average "
+            f"{os.getloadavg()[0]:.1f} at the start; median / least wall time in seconds, median CPU time "
+            f"(user + system) in seconds, modules imported"
+        )
         print()
         print("| command | " + " | ".join(str(r) for r in roots) + " |")
         print("| --- |" + " --- |" * len(roots))
@@ -92,8 +99,10 @@ def main() -> None:
             cells = []
             for k in range(len(roots)):
                 modules = run(k, argv, count=True)[2].strip().splitlines()[-1]
-                cells.append(f"{statistics.median(times[k]):.3f} / {min(times[k]):.3f}, CPU "
-                             f"{statistics.median(cpu[k]):.3f} ({modules})")
+                cells.append(
+                    f"{statistics.median(times[k]):.3f} / {min(times[k]):.3f}, CPU "
+                    f"{statistics.median(cpu[k]):.3f} ({modules})"
+                )
             print(f"| `{name}` | " + " | ".join(cells) + " |", flush=True)
         print(f"\nload average {os.getloadavg()[0]:.1f} at the end")
 

@@ -28,9 +28,15 @@ def generate(n: int, seed: int = 0) -> tuple[str, list[str]]:
     for o in objs:
         i = rng.randrange(len(o))
         c = rng.choice([ch for ch in "abcdefghijklmnopqrstuvwxyz" if ch != o[i]])
-        wrong.append(o[:i] + c + o[i + 1:])
-    lines = ["(define (domain d) (:grasps top))", "(define (problem p) (:domain d)", "  (:robots r1)",
-             f"  (:movable {' '.join(objs)})", "  (:regions a b)", "  (:init"]
+        wrong.append(o[:i] + c + o[i + 1 :])
+    lines = [
+        "(define (domain d) (:grasps top))",
+        "(define (problem p) (:domain d)",
+        "  (:robots r1)",
+        f"  (:movable {' '.join(objs)})",
+        "  (:regions a b)",
+        "  (:init",
+    ]
     lines += [f"    (in-region {o} a)" for o in objs]
     lines += [f"    (reachable-pick {w} top r1)" for w in wrong]
     lines += ["  )", f"  (:goal (in-region {objs[0]} b)))"]
@@ -51,8 +57,10 @@ def main() -> None:
             seconds = time.perf_counter() - t0
             hints = [re.search(r"did you mean '([^']+)'", d.message) for d in exc.diagnostics]
         good = sum(1 for h, o in zip(hints, objs) if h is not None and h.group(1) == o)
-        print(f"names={n} seconds={seconds:.2f} errors={len(hints)} suggestions={sum(h is not None for h in hints)} "
-              f"intended={good}")
+        print(
+            f"names={n} seconds={seconds:.2f} errors={len(hints)} suggestions={sum(h is not None for h in hints)} "
+            f"intended={good}"
+        )
 
 
 if __name__ == "__main__":

@@ -41,9 +41,12 @@ def main() -> None:
             checks.append(t2 - t1)
         verdict = "valid" if report.ok else f"invalid ({', '.join(sorted({v.code for v in report.violations}))})"
         size = Path(plan_path).stat().st_size / 1e3
-        print(f"| {Path(plan_path).name} | {size:.1f} | {statistics.median(reads):.3f} | "
-              f"{statistics.median(checks):.3f} | {verdict} | {report.stats.get('configurations', '-')} | "
-              f"{report.stats.get('distance_queries', '-')} |", flush=True)
+        print(
+            f"| {Path(plan_path).name} | {size:.1f} | {statistics.median(reads):.3f} | "
+            f"{statistics.median(checks):.3f} | {verdict} | {report.stats.get('configurations', '-')} | "
+            f"{report.stats.get('distance_queries', '-')} |",
+            flush=True,
+        )
 
 
 if __name__ == "__main__":

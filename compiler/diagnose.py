@@ -47,10 +47,12 @@ def explain_infeasible(graph: TaskGraph, facts: FactBase) -> list[str]:
             continue
         own = graph.actions_of(obj)
         if own:
-            culprits = sorted({b for i in own for b in graph.blockers(i) if b in unmovable},
-                              key=graph.objects.index)
-            reasons.append(f"every action moving {obj} is obstructed by an object no robot can move: "
-                           + ", ".join(culprits) + _why_stuck(graph, facts, culprits))
+            culprits = sorted({b for i in own for b in graph.blockers(i) if b in unmovable}, key=graph.objects.index)
+            reasons.append(
+                f"every action moving {obj} is obstructed by an object no robot can move: "
+                + ", ".join(culprits)
+                + _why_stuck(graph, facts, culprits)
+            )
         else:
             reasons.append(_no_action(facts, obj))
     if not reasons:
@@ -117,8 +119,11 @@ def describe_cycle(cycle: list[Forced]) -> str:
 
 
 def _short(a: Action) -> str:
-    return (f"{a.pick_grasp} by {a.pick_robot}" if not a.handover
-            else f"{a.pick_grasp}->{a.place_grasp} by {a.pick_robot}->{a.place_robot}")
+    return (
+        f"{a.pick_grasp} by {a.pick_robot}"
+        if not a.handover
+        else f"{a.pick_grasp}->{a.place_grasp} by {a.pick_robot}->{a.place_robot}"
+    )
 
 
 def _why_stuck(graph: TaskGraph, facts: FactBase, objs: list[str]) -> str:
@@ -138,8 +143,9 @@ def _no_action(facts: FactBase, obj: str) -> str:
         return f"no robot can reach {where} {region}"
     if not any(p[0] == obj and p[1] == region for p in facts.reachable_place):
         return f"no robot can place {obj} in {where} {region}"
-    return (f"no robot that can pick {obj} can also place it in {region}"
-            + (", and no handover of it is enabled" if is_goal else ""))
+    return f"no robot that can pick {obj} can also place it in {region}" + (
+        ", and no handover of it is enabled" if is_goal else ""
+    )
 
 
 def prune(graph: TaskGraph) -> TaskGraph:

@@ -48,8 +48,9 @@ class Batch:
 class SkeletonGenerator:
     """Enumerates the skeletons of ``graph`` with ``encoding``, solving with solvers from ``make_solver``."""
 
-    def __init__(self, graph: TaskGraph, encoding: Encoding, make_solver: Callable[[], Solver],
-                 max_makespan: int | None = None) -> None:
+    def __init__(
+        self, graph: TaskGraph, encoding: Encoding, make_solver: Callable[[], Solver], max_makespan: int | None = None
+    ) -> None:
         self.graph = prune(graph)
         self.encoding = encoding
         self.make_solver = make_solver

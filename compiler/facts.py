@@ -47,14 +47,22 @@ class FactBase:
             goal=problem.goal_regions,
             facts=problem.init if facts is None else facts,
             handover_capacity=None if problem.symbolic else len(problem.handover_points),
-            drivers=[r.name for r in problem.robots
-                     if r.kind is not None and problem.domain.kind(r.kind).base == "planar"],
+            drivers=[
+                r.name for r in problem.robots if r.kind is not None and problem.domain.kind(r.kind).base == "planar"
+            ],
         )
 
     @classmethod
-    def from_facts(cls, robots: Iterable[str], objects: Iterable[str], grasps: dict[str, tuple[str, ...]],
-                   goal: dict[str, str], facts: Iterable[Fact], handover_capacity: int | None = None,
-                   drivers: Iterable[str] = ()) -> "FactBase":
+    def from_facts(
+        cls,
+        robots: Iterable[str],
+        objects: Iterable[str],
+        grasps: dict[str, tuple[str, ...]],
+        goal: dict[str, str],
+        facts: Iterable[Fact],
+        handover_capacity: int | None = None,
+        drivers: Iterable[str] = (),
+    ) -> "FactBase":
         """A fact base from its parts (the symbolic problem's facts, or phase 1's)."""
         region: dict[str, str] = {}
         pick: set[tuple[str, str, str]] = set()

@@ -98,15 +98,23 @@ class SkeletonModel:
         self.vars.append(Var(name, lb, ub, False))
         return len(self.vars) - 1
 
-    def add(self, terms: Sequence[tuple[int, int]], lo: int | None = None, hi: int | None = None,
-            name: str = "") -> Row:
+    def add(
+        self, terms: Sequence[tuple[int, int]], lo: int | None = None, hi: int | None = None, name: str = ""
+    ) -> Row:
         """Add the row ``lo <= sum(terms) <= hi`` (repeated variables merged); the row."""
         row = Row(merge_terms(terms), lo, hi, name)
         self.rows.append(row)
         return row
 
-    def add_if(self, when: Sequence[tuple[int, bool]], terms: Sequence[tuple[int, int]], lo: int | None = None,
-               hi: int | None = None, name: str = "", big_m: int | None = None) -> None:
+    def add_if(
+        self,
+        when: Sequence[tuple[int, bool]],
+        terms: Sequence[tuple[int, int]],
+        lo: int | None = None,
+        hi: int | None = None,
+        name: str = "",
+        big_m: int | None = None,
+    ) -> None:
         """Add a row that holds only when every ``(variable, value)`` of ``when`` does (``big_m``: the bound a
         backend without indicator constraints uses)."""
         self.cond_rows.append(CondRow(tuple(when), Row(merge_terms(terms), lo, hi, name), big_m))

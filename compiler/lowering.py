@@ -19,8 +19,15 @@ from mrgc.compiler.ir import merge_terms as _merge
 
 def lower(model: SkeletonModel, native: frozenset[Feature]) -> SkeletonModel:
     """A copy of ``model`` using only the features in ``native`` (plus linear rows and bounds)."""
-    out = SkeletonModel(list(model.vars), list(model.rows), list(model.cond_rows), list(model.at_most_one),
-                        list(model.no_overlap), list(model.objectives), model.name)
+    out = SkeletonModel(
+        list(model.vars),
+        list(model.rows),
+        list(model.cond_rows),
+        list(model.at_most_one),
+        list(model.no_overlap),
+        list(model.objectives),
+        model.name,
+    )
     if Feature.NO_OVERLAP not in native:
         for no in out.no_overlap:
             _no_overlap(out, no)
@@ -79,4 +86,3 @@ def big_m_rows(model: SkeletonModel, cr: CondRow) -> list[Row]:
         terms = list(row.terms) + [(v, m if val else -m) for v, val in cr.when]
         out.append(Row(_merge(terms), hi=row.hi + m * n_true, name=row.name))
     return out
-

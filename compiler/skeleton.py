@@ -44,8 +44,14 @@ class Skeleton:
             "moved": sorted(self.moved),
             "steps": [
                 [
-                    {"object": a.obj, "region": a.region, "pick_robot": a.pick_robot, "place_robot": a.place_robot,
-                     "pick_grasp": a.pick_grasp, "place_grasp": a.place_grasp}
+                    {
+                        "object": a.obj,
+                        "region": a.region,
+                        "pick_robot": a.pick_robot,
+                        "place_robot": a.place_robot,
+                        "pick_grasp": a.pick_grasp,
+                        "place_grasp": a.place_grasp,
+                    }
                     for a in step
                 ]
                 for step in self.steps

@@ -168,7 +168,11 @@ def _actions_for(facts: FactBase, obj: str) -> list[Action]:
                 if r_place == r_pick:
                     continue
                 for g_place in grasps:
-                    if (obj, g_pick, g_place, r_pick, r_place) in facts.handover and \
-                            (obj, region, g_place, r_place) in facts.reachable_place:
+                    if (obj, g_pick, g_place, r_pick, r_place) in facts.handover and (
+                        obj,
+                        region,
+                        g_place,
+                        r_place,
+                    ) in facts.reachable_place:
                         out.append(Action(obj, region, r_pick, r_place, g_pick, g_place))
     return out

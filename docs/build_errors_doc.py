@@ -61,64 +61,109 @@ One policy for every command (`signals.py`; details in docs/cli.md):
 """
 
 SPECIAL = {
-    "E000": ("mrgc check --frobnicate x.mrg", "usage: mrgc check [-h] [-q] FILE [FILE ...]\n"
-             "mrgc: error[E000]: unrecognized arguments: --frobnicate"),
-    "E005": ("mrgc facts domains/packaging/pa5.mrg -o domains/packaging/domain.mrg",
-             "error[E005]: -o domains/packaging/domain.mrg: is an input of this command; writing it would destroy "
-             "the input: choose another output file"),
-    "E006": ("mrgc compile domains/symbolic/chain-3.mrg --backend mip --emit missing-dir/m.lp",
-             "error[E006]: --emit missing-dir/m.lp: folder missing-dir does not exist"),
-    "E070": ("(any input that trips a bug)", "mrgc: internal error[E070]: KeyError: 'x' "
-             "(please report this with the input that caused it)"),
-    "E300": ("mrgc compile domains/symbolic/chain-3.mrg --backend mip --emit model.smt2",
-             "error[E300]: backend 'mip' cannot write .smt2 files (it writes: .lp, .mps)"),
-    "E301": ("mrgc compile domains/symbolic/chain-3.mrg --backend cplex",
-             "error[E301]: unknown backend 'cplex' (installed: mip, smt, pysmt, cpsat)"),
-    "E302": ("mrgc compile x.mrg --backend my-plugin --encoding paper",
-             "error[E302]: backend 'my-plugin' does not support encoding 'paper'"),
-    "E303": ("mrgc compile domains/symbolic/chain-3.mrg --encoding bigm",
-             "error[E303]: unknown encoding 'bigm' (choose from paper, disaggregated, time-of-move)"),
-    "E400": ("mrgc facts bad-urdf.mrg",
-             "bad-urdf.mrg:5:3: error[E400]: robot URDF 'robots/arm.urdf' not found (looked for "
-             "'/home/me/robots/arm.urdf' or '.../site-packages/pybullet_data/robots/arm.urdf')"),
-    "E401": ("mrgc facts bad-ee.mrg",
-             "bad-ee.mrg:5:3: error[E401]: end-effector link 'hand' is not a link of '.../franka_panda/panda.urdf' "
-             "(links: panda_link0, panda_link1, ..., panda_hand, panda_leftfinger, panda_rightfinger, "
-             "panda_grasptarget)"),
-    "E402": ("mrgc facts domains/symbolic/chain-3.mrg",
-             "domains/symbolic/chain-3.mrg:25:3: error[E402]: problem 'chain-3' is symbolic: it has no geometry"),
-    "E403": ("mrgc facts p.mrg   # o1 is (mesh \"bad.obj\"), whose line 3 reads 'v nan 0 0'",
-             "bad.obj:3:1: error[E403]: mesh file 'bad.obj': coordinate 'nan' is not a finite number within 10000"),
-    "E500": ("mrgc validate domains/packaging/pa5.mrg no-such.json",
-             "error[E500]: cannot read plan 'no-such.json': No such file or directory"),
-    "E501": ("mrgc validate domains/packaging/pa5.mrg truncated.json",
-             "truncated.json:76:21: error[E501]: plan is not JSON: it ends early (truncated?): Expecting ',' "
-             "delimiter\n 76 |         -2.675816509\n    |                     ^"),
-    "E502": ("mrgc validate domains/packaging/pa5.mrg plan.json",
-             "error[E502]: plan.json does not follow the plan schema mrgc-plan/1: plan.steps[0].actions[0] lacks "
-             "'pick_grasp'"),
-    "E503": ("mrgc validate domains/packaging/pa5.mrg old.json",
-             "error[E503]: old.json: schema 'mrgc-plan/0' is not supported (this mrgc reads 'mrgc-plan/1')"),
-    "E510": ("mrgc render domains/packaging/pa3-handover.mrg plan.json -o plan.gif   # a plan for another problem",
-             "error[E510]: plan.json: step 1: object 'o99' is not a movable object of the problem (problem "
-             "'pa3-handover')"),
-    "E504": ("mrgc validate domains/packaging/pa5.mrg deep.json   # a plan nested 100,000 deep",
-             "deep.json:334:47: error[E504]: plan nests arrays and objects more than 32 deep (a plan needs 8)"),
-    "E600": ("mrgc bench run study.yaml",
-             "study.yaml:4:2: error[E600]: study is not YAML: expected <block end>, but found "
-             "'<block mapping start>'\n 4 |  methods: []\n   |  ^"),
-    "E601": ("mrgc bench run study.yaml",
-             "study.yaml:6:18: error[E601]: a method: unknown key 'planer' (did you mean 'planner'?) (known: name, "
-             "planner, compile, backend, encoding, options, limits, only)\n 6 |   - {name: Ours, planer: mcts}\n"
-             "   |                  ^^^^^^"),
-    "E602": ("mrgc bench run study.yaml",
-             "study.yaml:3:5: error[E602]: instance file 'no-such.mrg' not found (looked for /home/me/no-such.mrg)"
-             "\n 3 |   - file: no-such.mrg\n   |     ^^^^^^^^^^^^^^^^^"),
-    "E603": ("mrgc bench report --db notes.txt",
-             "error[E603]: 'notes.txt' is not a results database: file is not a database"),
+    "E000": (
+        "mrgc check --frobnicate x.mrg",
+        "usage: mrgc check [-h] [-q] FILE [FILE ...]\nmrgc: error[E000]: unrecognized arguments: --frobnicate",
+    ),
+    "E005": (
+        "mrgc facts domains/packaging/pa5.mrg -o domains/packaging/domain.mrg",
+        "error[E005]: -o domains/packaging/domain.mrg: is an input of this command; writing it would destroy "
+        "the input: choose another output file",
+    ),
+    "E006": (
+        "mrgc compile domains/symbolic/chain-3.mrg --backend mip --emit missing-dir/m.lp",
+        "error[E006]: --emit missing-dir/m.lp: folder missing-dir does not exist",
+    ),
+    "E070": (
+        "(any input that trips a bug)",
+        "mrgc: internal error[E070]: KeyError: 'x' (please report this with the input that caused it)",
+    ),
+    "E300": (
+        "mrgc compile domains/symbolic/chain-3.mrg --backend mip --emit model.smt2",
+        "error[E300]: backend 'mip' cannot write .smt2 files (it writes: .lp, .mps)",
+    ),
+    "E301": (
+        "mrgc compile domains/symbolic/chain-3.mrg --backend cplex",
+        "error[E301]: unknown backend 'cplex' (installed: mip, smt, pysmt, cpsat)",
+    ),
+    "E302": (
+        "mrgc compile x.mrg --backend my-plugin --encoding paper",
+        "error[E302]: backend 'my-plugin' does not support encoding 'paper'",
+    ),
+    "E303": (
+        "mrgc compile domains/symbolic/chain-3.mrg --encoding bigm",
+        "error[E303]: unknown encoding 'bigm' (choose from paper, disaggregated, time-of-move)",
+    ),
+    "E400": (
+        "mrgc facts bad-urdf.mrg",
+        "bad-urdf.mrg:5:3: error[E400]: robot URDF 'robots/arm.urdf' not found (looked for "
+        "'/home/me/robots/arm.urdf' or '.../site-packages/pybullet_data/robots/arm.urdf')",
+    ),
+    "E401": (
+        "mrgc facts bad-ee.mrg",
+        "bad-ee.mrg:5:3: error[E401]: end-effector link 'hand' is not a link of '.../franka_panda/panda.urdf' "
+        "(links: panda_link0, panda_link1, ..., panda_hand, panda_leftfinger, panda_rightfinger, "
+        "panda_grasptarget)",
+    ),
+    "E402": (
+        "mrgc facts domains/symbolic/chain-3.mrg",
+        "domains/symbolic/chain-3.mrg:25:3: error[E402]: problem 'chain-3' is symbolic: it has no geometry",
+    ),
+    "E403": (
+        "mrgc facts p.mrg   # o1 is (mesh \"bad.obj\"), whose line 3 reads 'v nan 0 0'",
+        "bad.obj:3:1: error[E403]: mesh file 'bad.obj': coordinate 'nan' is not a finite number within 10000",
+    ),
+    "E500": (
+        "mrgc validate domains/packaging/pa5.mrg no-such.json",
+        "error[E500]: cannot read plan 'no-such.json': No such file or directory",
+    ),
+    "E501": (
+        "mrgc validate domains/packaging/pa5.mrg truncated.json",
+        "truncated.json:76:21: error[E501]: plan is not JSON: it ends early (truncated?): Expecting ',' "
+        "delimiter\n 76 |         -2.675816509\n    |                     ^",
+    ),
+    "E502": (
+        "mrgc validate domains/packaging/pa5.mrg plan.json",
+        "error[E502]: plan.json does not follow the plan schema mrgc-plan/1: plan.steps[0].actions[0] lacks "
+        "'pick_grasp'",
+    ),
+    "E503": (
+        "mrgc validate domains/packaging/pa5.mrg old.json",
+        "error[E503]: old.json: schema 'mrgc-plan/0' is not supported (this mrgc reads 'mrgc-plan/1')",
+    ),
+    "E510": (
+        "mrgc render domains/packaging/pa3-handover.mrg plan.json -o plan.gif   # a plan for another problem",
+        "error[E510]: plan.json: step 1: object 'o99' is not a movable object of the problem (problem 'pa3-handover')",
+    ),
+    "E504": (
+        "mrgc validate domains/packaging/pa5.mrg deep.json   # a plan nested 100,000 deep",
+        "deep.json:334:47: error[E504]: plan nests arrays and objects more than 32 deep (a plan needs 8)",
+    ),
+    "E600": (
+        "mrgc bench run study.yaml",
+        "study.yaml:4:2: error[E600]: study is not YAML: expected <block end>, but found "
+        "'<block mapping start>'\n 4 |  methods: []\n   |  ^",
+    ),
+    "E601": (
+        "mrgc bench run study.yaml",
+        "study.yaml:6:18: error[E601]: a method: unknown key 'planer' (did you mean 'planner'?) (known: name, "
+        "planner, compile, backend, encoding, options, limits, only)\n 6 |   - {name: Ours, planer: mcts}\n"
+        "   |                  ^^^^^^",
+    ),
+    "E602": (
+        "mrgc bench run study.yaml",
+        "study.yaml:3:5: error[E602]: instance file 'no-such.mrg' not found (looked for /home/me/no-such.mrg)"
+        "\n 3 |   - file: no-such.mrg\n   |     ^^^^^^^^^^^^^^^^^",
+    ),
+    "E603": (
+        "mrgc bench report --db notes.txt",
+        "error[E603]: 'notes.txt' is not a results database: file is not a database",
+    ),
     "E001": ("mrgc check no-such.mrg", "error[E001]: cannot read 'no-such.mrg': No such file or directory"),
-    "E002": ("mrgc check huge.mrg   # a file over 8 MiB",
-             "huge.mrg:1:1: error[E002]: 'huge.mrg' is 9437184 bytes; the limit is 8388608 bytes"),
+    "E002": (
+        "mrgc check huge.mrg   # a file over 8 MiB",
+        "huge.mrg:1:1: error[E002]: 'huge.mrg' is 9437184 bytes; the limit is 8388608 bytes",
+    ),
 }
 
 

@@ -21,20 +21,55 @@ TUTORIAL = ROOT / "docs" / "tutorial"
 
 #: picture -> the commands that make it ({tmp}: the temporary folder, {img}: docs/img)
 PICTURES: dict[str, list[list[str]]] = {
-    "tutorial-scene.png": [["render", "{tutorial}/two-arms.mrg", "-o", "{img}/tutorial-scene.png",
-                            "--size", "480x360"]],
-    "tutorial-cmtg.svg": [["facts", "{tutorial}/two-arms.mrg", "-o", "{tmp}/two-arms.facts.mrg"],
-                          ["graph", "{tmp}/two-arms.facts.mrg", "-o", "{img}/tutorial-cmtg.svg", "--skeleton", "1"]],
-    "tutorial-replay.gif": [["plan", "{tmp}/two-arms.facts.mrg", "-o", "{tmp}/two-arms.plan.json"],
-                            ["render", "{tmp}/two-arms.facts.mrg", "{tmp}/two-arms.plan.json", "-o",
-                             "{img}/tutorial-replay.gif", "--size", "360x270", "--fps", "8"]],
-    "tutorial-sheet.png": [["render", "{tmp}/two-arms.facts.mrg", "{tmp}/two-arms.plan.json", "-o",
-                            "{img}/tutorial-sheet.png", "--size", "240x180"]],
-    "tutorial-gantt.svg": [["render", "{tmp}/two-arms.facts.mrg", "{tmp}/two-arms.plan.json", "-o",
-                            "{img}/tutorial-gantt.svg"]],
-    "pa5.gif": [["plan", "{domains}/packaging/pa5.mrg", "-o", "{tmp}/pa5.plan.json"],
-                ["render", "{domains}/packaging/pa5.mrg", "{tmp}/pa5.plan.json", "-o", "{img}/pa5.gif",
-                 "--size", "400x300", "--fps", "10"]],
+    "tutorial-scene.png": [
+        ["render", "{tutorial}/two-arms.mrg", "-o", "{img}/tutorial-scene.png", "--size", "480x360"]
+    ],
+    "tutorial-cmtg.svg": [
+        ["facts", "{tutorial}/two-arms.mrg", "-o", "{tmp}/two-arms.facts.mrg"],
+        ["graph", "{tmp}/two-arms.facts.mrg", "-o", "{img}/tutorial-cmtg.svg", "--skeleton", "1"],
+    ],
+    "tutorial-replay.gif": [
+        ["plan", "{tmp}/two-arms.facts.mrg", "-o", "{tmp}/two-arms.plan.json"],
+        [
+            "render",
+            "{tmp}/two-arms.facts.mrg",
+            "{tmp}/two-arms.plan.json",
+            "-o",
+            "{img}/tutorial-replay.gif",
+            "--size",
+            "360x270",
+            "--fps",
+            "8",
+        ],
+    ],
+    "tutorial-sheet.png": [
+        [
+            "render",
+            "{tmp}/two-arms.facts.mrg",
+            "{tmp}/two-arms.plan.json",
+            "-o",
+            "{img}/tutorial-sheet.png",
+            "--size",
+            "240x180",
+        ]
+    ],
+    "tutorial-gantt.svg": [
+        ["render", "{tmp}/two-arms.facts.mrg", "{tmp}/two-arms.plan.json", "-o", "{img}/tutorial-gantt.svg"]
+    ],
+    "pa5.gif": [
+        ["plan", "{domains}/packaging/pa5.mrg", "-o", "{tmp}/pa5.plan.json"],
+        [
+            "render",
+            "{domains}/packaging/pa5.mrg",
+            "{tmp}/pa5.plan.json",
+            "-o",
+            "{img}/pa5.gif",
+            "--size",
+            "400x300",
+            "--fps",
+            "10",
+        ],
+    ],
 }
 #: the README's GIF must stay small
 MAX_README_GIF = 2 * 2**20
@@ -50,8 +85,9 @@ def main(argv: list[str]) -> int:
         for name in only:
             for command in PICTURES[name]:
                 args = [a.format(**where) for a in command]
-                print("mrgc " + " ".join(os.path.relpath(a, ROOT) if a.startswith("/") else a for a in args),
-                      flush=True)
+                print(
+                    "mrgc " + " ".join(os.path.relpath(a, ROOT) if a.startswith("/") else a for a in args), flush=True
+                )
                 code = cli.main(args)
                 if code != 0:
                     print(f"failed with exit code {code}", file=sys.stderr)

@@ -23,8 +23,14 @@ KINDS = {"packaging": packaging, "box-moving": box_moving}
 DEFAULT_COUNTS = {"robots": 2, "goals": 3, "others": 2}
 
 
-def generate(kind: str, seed: int = 0, preset_name: str | None = None, robots: int | None = None,
-             goals: int | None = None, others: int | None = None) -> str:
+def generate(
+    kind: str,
+    seed: int = 0,
+    preset_name: str | None = None,
+    robots: int | None = None,
+    goals: int | None = None,
+    others: int | None = None,
+) -> str:
     """What ``mrgc generate KIND`` writes: a random problem of ``kind`` with the given counts (None: the
     defaults of :data:`DEFAULT_COUNTS`), or instance ``seed`` of suite ``preset_name``, whose counts are
     fixed (only ``robots``, for suites that take several).  InputError E000 for a bad combination."""

@@ -57,9 +57,14 @@ def box_moving(robots: int = 2, goals: int = 2, others: int = 4, seed: int = 0) 
         "Generated within the ranges of docs/generators.md; a plan may not exist.",
     ]
     body = problem_text(
-        name, "box-moving", [f"(r{k + 1} :kind mover :base {pose(c.x, c.y, 0, c.yaw)})" for k, c in enumerate(carts)],
-        [_decl(n, f, WALL_H) for n, f in walls], [_decl(n, f, WALL_H) for n, f in regions],
-        [_decl(n, f, h) for n, f, h in boxes], [f"(in-region g{k + 1} goal)" for k in range(goals)])
+        name,
+        "box-moving",
+        [f"(r{k + 1} :kind mover :base {pose(c.x, c.y, 0, c.yaw)})" for k, c in enumerate(carts)],
+        [_decl(n, f, WALL_H) for n, f in walls],
+        [_decl(n, f, WALL_H) for n, f in regions],
+        [_decl(n, f, h) for n, f, h in boxes],
+        [f"(in-region g{k + 1} goal)" for k in range(goals)],
+    )
     return document("box-moving", command, summary, body)
 
 
@@ -86,8 +91,14 @@ def _layout(rng: np.random.Generator, robots: int, goals: int, others: int) -> L
         w, d = _u(rng, *ALCOVE_WIDTH, 2), _u(rng, *ALCOVE_DEPTH, 2)
         yc = _u(rng, y0 + w / 2 + WALL_T + 0.3, -y0 - w / 2 - WALL_T - 0.3, 2)
         for side, sign in (("n", 1), ("s", -1)):
-            walls.append((f"alcove-{side}", Footprint(round(x0 + d / 2, 3), round(yc + sign * (w + WALL_T) / 2, 3),
-                                                      round(d / 2, 4), WALL_T / 2)))
+            walls.append(
+                (
+                    f"alcove-{side}",
+                    Footprint(
+                        round(x0 + d / 2, 3), round(yc + sign * (w + WALL_T) / 2, 3), round(d / 2, 4), WALL_T / 2
+                    ),
+                )
+            )
     regions = _regions(rng, fx, fy, dividers)
     boxes = _boxes(rng, goals, others, [f for _, f in regions], [f for _, f in walls], dividers, doors)
     if boxes is None:
@@ -100,8 +111,9 @@ def _layout(rng: np.random.Generator, robots: int, goals: int, others: int) -> L
     return walls, regions, found, carts, n_rooms, blocked, alcove
 
 
-def _rooms(rng: np.random.Generator, fx: float, fy: float,
-           n_rooms: int) -> tuple[Named, list[float], list[tuple[float, float, float]]] | None:
+def _rooms(
+    rng: np.random.Generator, fx: float, fy: float, n_rooms: int
+) -> tuple[Named, list[float], list[tuple[float, float, float]]] | None:
     """The outer walls and the dividers with their doorways: (walls, x of each divider's centre line,
     doorways as (x, y centre, width)); None when the doorways do not fit."""
     free = fx - n_rooms * ROOM_MIN - (n_rooms - 1) * WALL_T
@@ -126,8 +138,12 @@ def _rooms(rng: np.random.Generator, fx: float, fy: float,
         ends = [y0] + [v for lo, hi in spans for v in (lo, hi)] + [-y0]
         for j in range(0, len(ends), 2):
             lo, hi = ends[j], ends[j + 1]
-            walls.append((f"divider{k + 1}-{chr(ord('a') + j // 2)}",
-                          Footprint(xd, round((lo + hi) / 2, 3), WALL_T / 2, round((hi - lo) / 2, 4))))
+            walls.append(
+                (
+                    f"divider{k + 1}-{chr(ord('a') + j // 2)}",
+                    Footprint(xd, round((lo + hi) / 2, 3), WALL_T / 2, round((hi - lo) / 2, 4)),
+                )
+            )
         doors += [(xd, (lo + hi) / 2, hi - lo) for lo, hi in spans]
     return walls, dividers, doors
 
@@ -139,8 +155,12 @@ def _regions(rng: np.random.Generator, fx: float, fy: float, dividers: list[floa
     regions: Named = []
     for k in range(len(dividers)):
         lo, hi = bounds[k], bounds[k + 1]
-        regions.append(("start" if k == 0 else f"room{k + 1}",
-                        Footprint(round((lo + hi) / 2, 3), 0.0, round((hi - lo) / 2, 4), round(fy / 2, 3))))
+        regions.append(
+            (
+                "start" if k == 0 else f"room{k + 1}",
+                Footprint(round((lo + hi) / 2, 3), 0.0, round((hi - lo) / 2, 4), round(fy / 2, 3)),
+            )
+        )
     lo, hi = bounds[-2], bounds[-1]
     gx, gy = _u(rng, *GOAL_SHARE) * (hi - lo) / 2, _u(rng, *GOAL_SHARE) * fy / 2
     gx, gy = round(gx, 2), round(gy, 2)
@@ -148,9 +168,15 @@ def _regions(rng: np.random.Generator, fx: float, fy: float, dividers: list[floa
     return regions
 
 
-def _boxes(rng: np.random.Generator, goals: int, others: int, region_of_room: list[Footprint],
-           wall_feet: list[Footprint], dividers: list[float],
-           doors: list[tuple[float, float, float]]) -> tuple[list[tuple[str, Footprint, float]], int] | None:
+def _boxes(
+    rng: np.random.Generator,
+    goals: int,
+    others: int,
+    region_of_room: list[Footprint],
+    wall_feet: list[Footprint],
+    dividers: list[float],
+    doors: list[tuple[float, float, float]],
+) -> tuple[list[tuple[str, Footprint, float]], int] | None:
     """The goal boxes in the start room, boxes blocking doorways (each doorway by chance, up to ``others``)
     and the other boxes in random rooms; with the number of blockers (None when some box found no place)."""
     boxes: list[tuple[str, Footprint, float]] = []
@@ -159,8 +185,13 @@ def _boxes(rng: np.random.Generator, goals: int, others: int, region_of_room: li
     def place(name: str, region: Footprint) -> bool:
         for _ in range(ATTEMPTS):
             hx, hy, h = _u(rng, *BOX) / 2, _u(rng, *BOX) / 2, _u(rng, *BOX_HEIGHT)
-            f = Footprint(_u(rng, region.x - region.hx, region.x + region.hx),
-                          _u(rng, region.y - region.hy, region.y + region.hy), hx, hy, float(rng.integers(-45, 46)))
+            f = Footprint(
+                _u(rng, region.x - region.hx, region.x + region.hx),
+                _u(rng, region.y - region.hy, region.y + region.hy),
+                hx,
+                hy,
+                float(rng.integers(-45, 46)),
+            )
             if f.inside(region) and not any(overlaps(f, o, GAP) for o in (*wall_feet, *taken)):
                 boxes.append((name, f, h))
                 taken.append(f)
@@ -174,8 +205,15 @@ def _boxes(rng: np.random.Generator, goals: int, others: int, region_of_room: li
     for i in rng.permutation(len(doors)):
         if blocked == others or rng.random() >= BLOCKED:
             continue
-        if _block(rng, f"b{blocked + 1}", doors[int(i)], region_of_room[dividers.index(doors[int(i)][0])],
-                  wall_feet, taken, boxes):
+        if _block(
+            rng,
+            f"b{blocked + 1}",
+            doors[int(i)],
+            region_of_room[dividers.index(doors[int(i)][0])],
+            wall_feet,
+            taken,
+            boxes,
+        ):
             blocked += 1
     for k in range(blocked, others):
         if not place(f"b{k + 1}", region_of_room[int(rng.integers(len(dividers) + 1))]):
@@ -183,18 +221,23 @@ def _boxes(rng: np.random.Generator, goals: int, others: int, region_of_room: li
     return boxes, blocked
 
 
-def _carts(rng: np.random.Generator, robots: int, start_room: Footprint, wall_feet: list[Footprint],
-           taken: list[Footprint]) -> list[Footprint] | None:
+def _carts(
+    rng: np.random.Generator, robots: int, start_room: Footprint, wall_feet: list[Footprint], taken: list[Footprint]
+) -> list[Footprint] | None:
     """The carts' footprints in the start room, clear of walls, boxes and each other (None when one found
     no place)."""
     carts: list[Footprint] = []
     for _ in range(robots):
         for _ in range(ATTEMPTS):
-            f = Footprint(_u(rng, start_room.x - start_room.hx, start_room.x + start_room.hx),
-                          _u(rng, start_room.y - start_room.hy, start_room.y + start_room.hy), *CART,
-                          float(rng.integers(-180, 180)))
-            if f.inside(start_room, ROBOT_GAP) and not any(overlaps(f, o, ROBOT_GAP)
-                                                           for o in (*wall_feet, *taken, *carts)):
+            f = Footprint(
+                _u(rng, start_room.x - start_room.hx, start_room.x + start_room.hx),
+                _u(rng, start_room.y - start_room.hy, start_room.y + start_room.hy),
+                *CART,
+                float(rng.integers(-180, 180)),
+            )
+            if f.inside(start_room, ROBOT_GAP) and not any(
+                overlaps(f, o, ROBOT_GAP) for o in (*wall_feet, *taken, *carts)
+            ):
                 carts.append(f)
                 break
         else:
@@ -215,19 +258,29 @@ def _doorways(rng: np.random.Generator, fy: float) -> list[tuple[float, float]] 
     return None
 
 
-def _block(rng: np.random.Generator, name: str, door: tuple[float, float, float], region: Footprint,
-           walls: list[Footprint], taken: list[Footprint], boxes: list[tuple[str, Footprint, float]]) -> bool:
+def _block(
+    rng: np.random.Generator,
+    name: str,
+    door: tuple[float, float, float],
+    region: Footprint,
+    walls: list[Footprint],
+    taken: list[Footprint],
+    boxes: list[tuple[str, Footprint, float]],
+) -> bool:
     """A box standing in a doorway (within the region of the room west of it), if one fits."""
     xd, yc, width = door
     if width - 2 * GAP < BOX[0]:
         return False
     for _ in range(ATTEMPTS // 4):
         sx, sy, h = _u(rng, *BOX), _u(rng, BOX[0], min(BOX[1], width - 2 * GAP)), _u(rng, *BOX_HEIGHT)
-        f = Footprint(_u(rng, xd - 0.15, xd + 0.05), _u(rng, yc - (width - sy) / 2 + GAP, yc + (width - sy) / 2 - GAP),
-                      sx / 2, sy / 2)
+        f = Footprint(
+            _u(rng, xd - 0.15, xd + 0.05),
+            _u(rng, yc - (width - sy) / 2 + GAP, yc + (width - sy) / 2 - GAP),
+            sx / 2,
+            sy / 2,
+        )
         if f.inside(region) and not any(overlaps(f, o, GAP) for o in (*walls, *taken)):
             boxes.append((name, f, h))
             taken.append(f)
             return True
     return False
-

@@ -56,8 +56,10 @@ class Footprint:
     def corners(self) -> list[tuple[float, float]]:
         """A box footprint's four corners in the world."""
         (ax, ay), (bx, by) = self.axes()
-        return [(self.x + sx * self.hx * ax + sy * self.hy * bx, self.y + sx * self.hx * ay + sy * self.hy * by)
-                for sx, sy in ((1, 1), (-1, 1), (-1, -1), (1, -1))]
+        return [
+            (self.x + sx * self.hx * ax + sy * self.hy * bx, self.y + sx * self.hx * ay + sy * self.hy * by)
+            for sx, sy in ((1, 1), (-1, 1), (-1, -1), (1, -1))
+        ]
 
     def inside(self, outer: "Footprint", margin: float = 0.0) -> bool:
         """Whether this footprint lies inside the rectangle ``outer``, at least ``margin`` from its edges."""

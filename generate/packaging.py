@@ -109,11 +109,15 @@ def packaging(robots: int = 2, goals: int = 3, others: int = 2, seed: int = 0) -
         "Generated within the ranges of docs/generators.md; a plan may not exist.",
     ]
     body = problem_text(
-        name, "packaging", [f"({a.name} :kind panda :base {pose(a.x, a.y, 0, a.yaw)})" for a in arms],
+        name,
+        "packaging",
+        [f"({a.name} :kind panda :base {pose(a.x, a.y, 0, a.yaw)})" for a in arms],
         [f"(table :shape (box {num(2 * table.hx)} {num(2 * table.hy)} 0.05) :pose (0 0 -0.025 0))"],
-        [r.decl() for r in (start, *bins)], [o.decl() for o in objects],
+        [r.decl() for r in (start, *bins)],
+        [o.decl() for o in objects],
         [f"(in-region {objects[i].name} {goal_bin[i]})" for i in goal_idx],
-        [f"({h} :position ({num(x)} {num(y)} {num(z)}))" for h, (x, y, z) in handovers])
+        [f"({h} :position ({num(x)} {num(y)} {num(z)}))" for h, (x, y, z) in handovers],
+    )
     return document("packaging", command, summary, body)
 
 
@@ -128,9 +132,12 @@ def _layout(rng: np.random.Generator, robots: int, goals: int, others: int):  # 
     margin = _u(rng, 0.005, 0.04)
     start_hx = round(cols * pitch[0] / 2 + margin, 3)
     start_hy = round(rows * pitch[1] / 2 + margin, 3)
-    table = Footprint(0.0, 0.0,
-                      _u(rng, max(TABLE_MIN[0], 2 * start_hx + 0.4), max(TABLE_MAX[0], 2 * start_hx + 0.7), 2) / 2,
-                      _u(rng, max(TABLE_MIN[1], 2 * start_hy + 0.4), max(TABLE_MAX[1], 2 * start_hy + 0.7), 2) / 2)
+    table = Footprint(
+        0.0,
+        0.0,
+        _u(rng, max(TABLE_MIN[0], 2 * start_hx + 0.4), max(TABLE_MAX[0], 2 * start_hx + 0.7), 2) / 2,
+        _u(rng, max(TABLE_MIN[1], 2 * start_hy + 0.4), max(TABLE_MAX[1], 2 * start_hy + 0.7), 2) / 2,
+    )
     arms = _arms(rng, robots, table)
     if arms is None:
         return None
@@ -184,8 +191,9 @@ def _arms(rng: np.random.Generator, n: int, table: Footprint) -> list[Arm] | Non
     return arms
 
 
-def _region_spot(rng: np.random.Generator, table: Footprint, arms: list[Arm], hx: float, hy: float,
-                 taken: list[Footprint]) -> Footprint | None:
+def _region_spot(
+    rng: np.random.Generator, table: Footprint, arms: list[Arm], hx: float, hy: float, taken: list[Footprint]
+) -> Footprint | None:
     """An axis-aligned region of half sizes hx, hy on the table, clear of the arm bases and of ``taken``,
     whose centre (10 cm above the table) is within REACH of some arm's shoulder."""
     if hx > table.hx or hy > table.hy:
@@ -203,8 +211,9 @@ def _region_spot(rng: np.random.Generator, table: Footprint, arms: list[Arm], hx
     return None
 
 
-def _object(rng: np.random.Generator, name: str, start: Footprint, rows: int, cols: int,
-            pitch: tuple[float, float], cell: int) -> Item:
+def _object(
+    rng: np.random.Generator, name: str, start: Footprint, rows: int, cols: int, pitch: tuple[float, float], cell: int
+) -> Item:
     """A box or cylinder in grid cell ``cell`` of the start region, jittered within its cell."""
     r, c = divmod(cell, cols)
     cx = start.x + (c - (cols - 1) / 2) * pitch[0]
@@ -230,15 +239,15 @@ def _object(rng: np.random.Generator, name: str, start: Footprint, rows: int, co
     bx, by = foot.half_box()
     x = cx + float(rng.uniform(-1, 1)) * max(room_x - bx - 0.001, 0.0)
     y = cy + float(rng.uniform(-1, 1)) * max(room_y - by - 0.001, 0.0)
-    return Item(name, Footprint(round(x, 3) + 0.0, round(y, 3) + 0.0, foot.hx, foot.hy, foot.yaw, foot.radius),
-                height)
+    return Item(name, Footprint(round(x, 3) + 0.0, round(y, 3) + 0.0, foot.hx, foot.hy, foot.yaw, foot.radius), height)
 
 
-def _handovers(rng: np.random.Generator, arms: list[Arm],
-               table: Footprint) -> list[tuple[str, tuple[float, float, float]]] | None:
+def _handovers(
+    rng: np.random.Generator, arms: list[Arm], table: Footprint
+) -> list[tuple[str, tuple[float, float, float]]] | None:
     """Handover points above the table between two arms, within REACH of both shoulders when any pair of
     arms is close enough for that (else between the closest pair, without the guarantee)."""
-    pairs = [(a, b) for i, a in enumerate(arms) for b in arms[i + 1:]]
+    pairs = [(a, b) for i, a in enumerate(arms) for b in arms[i + 1 :]]
     close = [p for p in pairs if math.hypot(p[0].x - p[1].x, p[0].y - p[1].y) <= 2 * math.sqrt(REACH**2 - 0.01)]
     pool = close or [min(pairs, key=lambda p: math.hypot(p[0].x - p[1].x, p[0].y - p[1].y))]
     points: list[tuple[str, tuple[float, float, float]]] = []
@@ -270,21 +279,32 @@ def reaches(arm: Arm, item: Item) -> bool:
     return arm.shoulder_distance(item.foot.x, item.foot.y, z) <= REACH
 
 
-def connected(arms: list[Arm], obj: Item, region: Item,
-              handovers: list[tuple[str, tuple[float, float, float]]]) -> bool:
+def connected(
+    arms: list[Arm], obj: Item, region: Item, handovers: list[tuple[str, tuple[float, float, float]]]
+) -> bool:
     """Whether some arm reaches both ``obj`` and ``region``, or a handover point lies within REACH of an arm
     that reaches ``obj`` and of another arm that reaches ``region``."""
     pickers = [a for a in arms if reaches(a, obj)]
     placers = [a for a in arms if reaches(a, region)]
     if any(a in placers for a in pickers):
         return True
-    return any(a.shoulder_distance(*p) <= REACH and b.shoulder_distance(*p) <= REACH
-               for _, p in handovers for a in pickers for b in placers)
+    return any(
+        a.shoulder_distance(*p) <= REACH and b.shoulder_distance(*p) <= REACH
+        for _, p in handovers
+        for a in pickers
+        for b in placers
+    )
 
 
-def _connect(rng: np.random.Generator, arms: list[Arm], table: Footprint, objects: list[Item], bins: list[Item],
-             goal_bin: dict[int, str], handovers: list[tuple[str, tuple[float, float, float]]]
-             ) -> list[tuple[str, tuple[float, float, float]]]:
+def _connect(
+    rng: np.random.Generator,
+    arms: list[Arm],
+    table: Footprint,
+    objects: list[Item],
+    bins: list[Item],
+    goal_bin: dict[int, str],
+    handovers: list[tuple[str, tuple[float, float, float]]],
+) -> list[tuple[str, tuple[float, float, float]]]:
     """Handover points added where a goal object is not :func:`connected` to its bin: between the closest
     pair of an arm that reaches the object and one that reaches the bin, within REACH of both shoulders (as
     drawn points are), when such a pair is close enough.  The layout is otherwise left as drawn."""
@@ -294,8 +314,10 @@ def _connect(rng: np.random.Generator, arms: list[Arm], table: Footprint, object
         obj, reg = objects[i], region[name]
         if connected(arms, obj, reg, points):
             continue
-        pairs = sorted(((a, b) for a in arms if reaches(a, obj) for b in arms if b is not a and reaches(b, reg)),
-                       key=lambda p: (math.hypot(p[0].x - p[1].x, p[0].y - p[1].y), p[0].name, p[1].name))
+        pairs = sorted(
+            ((a, b) for a in arms if reaches(a, obj) for b in arms if b is not a and reaches(b, reg)),
+            key=lambda p: (math.hypot(p[0].x - p[1].x, p[0].y - p[1].y), p[0].name, p[1].name),
+        )
         for a, b in pairs:
             spot = _between(rng, a, b, table, points)
             if spot is not None:
@@ -304,8 +326,9 @@ def _connect(rng: np.random.Generator, arms: list[Arm], table: Footprint, object
     return points
 
 
-def _between(rng: np.random.Generator, a: Arm, b: Arm, table: Footprint,
-             points: list[tuple[str, tuple[float, float, float]]]) -> tuple[float, float, float] | None:
+def _between(
+    rng: np.random.Generator, a: Arm, b: Arm, table: Footprint, points: list[tuple[str, tuple[float, float, float]]]
+) -> tuple[float, float, float] | None:
     """A handover point above the table between arms ``a`` and ``b`` as :func:`_handovers` draws them, within
     REACH of both shoulders and 10 cm from the other points; None when ATTEMPTS draws find none."""
     for _ in range(ATTEMPTS):
@@ -326,8 +349,12 @@ def _between(rng: np.random.Generator, a: Arm, b: Arm, table: Footprint,
 # ---------------------------------------------------------------- the shipped PA-n benchmark problems
 _GRID_ARMS = {
     2: ["(r1 :kind panda :base (0 -0.7 0 90))", "(r2 :kind panda :base (0 0.7 0 -90))"],
-    4: ["(r1 :kind panda :base (0 -0.7 0 90))", "(r2 :kind panda :base (0 0.7 0 -90))",
-        "(r3 :kind panda :base (0.65 0 0 180))", "(r4 :kind panda :base (-0.65 0 0 0))"],
+    4: [
+        "(r1 :kind panda :base (0 -0.7 0 90))",
+        "(r2 :kind panda :base (0 0.7 0 -90))",
+        "(r3 :kind panda :base (0.65 0 0 180))",
+        "(r4 :kind panda :base (-0.65 0 0 0))",
+    ],
 }
 
 

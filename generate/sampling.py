@@ -40,8 +40,13 @@ def uniform(rng: np.random.Generator, lo: float, hi: float, digits: int = 3) -> 
     return round(float(rng.uniform(lo, hi)), digits) + 0.0
 
 
-def draw_layout(kind: str, ranges: dict[str, tuple[int, int]], counts: dict[str, int], seed: int,
-                attempt: Callable[[np.random.Generator], T | None]) -> tuple[np.random.Generator, T]:
+def draw_layout(
+    kind: str,
+    ranges: dict[str, tuple[int, int]],
+    counts: dict[str, int],
+    seed: int,
+    attempt: Callable[[np.random.Generator], T | None],
+) -> tuple[np.random.Generator, T]:
     """Check ``counts`` (``--robots`` etc.) against ``ranges`` and the seed, then draw layouts until one fits.
 
     Returns the random stream (to draw the rest from) and the layout.

@@ -29,8 +29,11 @@ class Arm:
         self.tcp = from_pose(spec.kind.tcp) if spec.kind.tcp is not None else np.eye(4)
         self.tcp_inv = inverse(self.tcp)
         home = np.array(spec.kind.home, dtype=float) if spec.kind.home else None
-        self.home = self.model.clamp(home[: self.model.dof]) if home is not None and len(home) >= self.model.dof \
+        self.home = (
+            self.model.clamp(home[: self.model.dof])
+            if home is not None and len(home) >= self.model.dof
             else self.model.clamp((self.model.lower + self.model.upper) / 2)
+        )
 
     @cached_property
     def probes(self) -> tuple[list[CollisionShape], list[int]]:
@@ -63,5 +66,6 @@ class Arm:
     def in_reach(self, point: np.ndarray, margin: float = 0.0) -> bool:
         """Whether a world point can be within reach of the tool (cheap pre-filter)."""
         local = self.base_inv[:3, :3] @ point + self.base_inv[:3, 3]
-        return bool(np.linalg.norm(local - self.model.shoulder) <= self.model.reach + np.linalg.norm(self.tcp[:3, 3])
-                    + margin)
+        return bool(
+            np.linalg.norm(local - self.model.shoulder) <= self.model.reach + np.linalg.norm(self.tcp[:3, 3]) + margin
+        )

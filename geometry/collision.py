@@ -201,10 +201,15 @@ def _thicken(pts: np.ndarray) -> np.ndarray:
 class _Entry:
     __slots__ = ("name", "group", "shape", "obj", "gid", "transform")
 
-    def __init__(self, name: str, group: str, shape: CollisionShape, obj: Any, gid: int,
-                 transform: np.ndarray) -> None:
-        self.name, self.group, self.shape, self.obj, self.gid, self.transform = (name, group, shape, obj, gid,
-                                                                                   transform)
+    def __init__(self, name: str, group: str, shape: CollisionShape, obj: Any, gid: int, transform: np.ndarray) -> None:
+        self.name, self.group, self.shape, self.obj, self.gid, self.transform = (
+            name,
+            group,
+            shape,
+            obj,
+            gid,
+            transform,
+        )
 
 
 class _Selection:
@@ -325,8 +330,7 @@ class CollisionWorld:
                 return True
         return False
 
-    def colliding_with(self, names: str | Iterable[str], against: Against = None,
-                       ignore: Against = ()) -> set[str]:
+    def colliding_with(self, names: str | Iterable[str], against: Against = None, ignore: Against = ()) -> set[str]:
         """The selected objects that any of the named world objects collides with."""
         entries = self._query_entries(names)
         manager = self._manager(against, ignore, tuple(e.name for e in entries))
@@ -361,21 +365,24 @@ class CollisionWorld:
         """The union of the objects the probes hit (a swept volume given as configurations along a path)."""
         return self._probe_hits([pair for probe in probes for pair in probe], against, ignore)
 
-    def batch_collides(self, shapes: Sequence[ShapeLike], transforms: np.ndarray, against: Against = None,
-                       ignore: Against = ()) -> bool:
+    def batch_collides(
+        self, shapes: Sequence[ShapeLike], transforms: np.ndarray, against: Against = None, ignore: Against = ()
+    ) -> bool:
         """:meth:`probe_collides` for shapes ``L`` at ``transforms`` of shape (L, 4, 4) or (C, L, 4, 4)
         (C configurations of the same L links, as batched forward kinematics returns them)."""
         return self._probe_collides(_batch(shapes, transforms), against, ignore)
 
-    def batch_hits(self, shapes: Sequence[ShapeLike], transforms: np.ndarray, against: Against = None,
-                   ignore: Against = ()) -> set[str]:
+    def batch_hits(
+        self, shapes: Sequence[ShapeLike], transforms: np.ndarray, against: Against = None, ignore: Against = ()
+    ) -> set[str]:
         """:meth:`probe_hits` (or :meth:`sweep_hits` for C configurations) in the batched form."""
         return self._probe_hits(_batch(shapes, transforms), against, ignore)
 
     # -------------------------------------------------------------------------------------- internals
 
-    def _probe_collides(self, shapes: Iterable[tuple[ShapeLike, np.ndarray]], against: Against,
-                        ignore: Against) -> bool:
+    def _probe_collides(
+        self, shapes: Iterable[tuple[ShapeLike, np.ndarray]], against: Against, ignore: Against
+    ) -> bool:
         manager = self._manager(against, ignore, ())
         if manager is None:
             return False
@@ -387,8 +394,9 @@ class CollisionWorld:
                 return True
         return False
 
-    def _probe_hits(self, shapes: Iterable[tuple[ShapeLike, np.ndarray]], against: Against,
-                    ignore: Against) -> set[str]:
+    def _probe_hits(
+        self, shapes: Iterable[tuple[ShapeLike, np.ndarray]], against: Against, ignore: Against
+    ) -> set[str]:
         manager = self._manager(against, ignore, ())
         hits: set[str] = set()
         if manager is None:
@@ -430,8 +438,11 @@ class CollisionWorld:
 
     def _manager(self, against: Against, ignore: Against, exclude: tuple[str, ...]) -> Any:
         """The broadphase manager of the selected objects (None when nothing is selected), refit if stale."""
-        key = (against if against is None or isinstance(against, str) else frozenset(against),
-               ignore if isinstance(ignore, str) else frozenset(ignore or ()), exclude)
+        key = (
+            against if against is None or isinstance(against, str) else frozenset(against),
+            ignore if isinstance(ignore, str) else frozenset(ignore or ()),
+            exclude,
+        )
         sel = self._selections.get(key)
         if sel is None:
             chosen = self._tokens(against) - self._tokens(ignore) - set(exclude)

@@ -44,6 +44,7 @@ APPROACH_SAMPLES = 5
 
 # ----------------------------------------------------------------------------------------- angles, frames
 
+
 @overload
 def wrap_angle(angle: float) -> float: ...
 @overload
@@ -114,6 +115,7 @@ def pose_error(pose: Array, target: Array) -> tuple[Array, Array]:
 
 # ------------------------------------------------------------------------------ placements, resolution
 
+
 def lattice_offsets(grid: int) -> list[tuple[float, float]]:
     """The ``grid × grid`` placement lattice as offsets ``(a, b)`` in [-1, 1]² (a fraction of the room an
     object has in a region along its x and y), centre first, then by distance from it (ties by value)."""
@@ -127,8 +129,7 @@ def refine(configs: Array, sub: int = 4) -> Array:
     if len(configs) < 2:
         return configs
     s = np.linspace(0.0, 1.0, sub + 1)[:-1, None]
-    return np.concatenate([a[None] * (1 - s) + b[None] * s for a, b in zip(configs[:-1], configs[1:])]
-                          + [configs[-1:]])
+    return np.concatenate([a[None] * (1 - s) + b[None] * s for a, b in zip(configs[:-1], configs[1:])] + [configs[-1:]])
 
 
 def seed_for(*parts: str, seed: int = 0) -> int:

@@ -87,20 +87,28 @@ def plan(model: RobotModel) -> _Plan:
             if link.chain_index >= 0:
                 steps.append((link.index, link.parent, link.chain_index, None))
             elif link.joint_kind in ("revolute", "prismatic"):
-                steps.append((link.index, link.parent, -1,
-                              _local(link.joint_kind, link.origin, link.axis, link.frozen_value)))
+                steps.append(
+                    (link.index, link.parent, -1, _local(link.joint_kind, link.origin, link.axis, link.frozen_value))
+                )
             else:
                 steps.append((link.index, link.parent, -1, np.array(link.origin)))
         o, pre = stack([j.origin for j in js]), stack([j.pre for j in js])
         b, pre_b = stack([t[1] for t in ta]), stack([t[1] for t in tp])
         p = _Plan(
             rev=np.array([j.kind == "revolute" for j in js], dtype=bool),
-            o=o, a=stack([t[0] for t in ta]), b=b, ob=o + b,
-            pre_o=pre, pre_a=stack([t[0] for t in tp]), pre_b=pre_b, pre_ob=pre + pre_b,
+            o=o,
+            a=stack([t[0] for t in ta]),
+            b=b,
+            ob=o + b,
+            pre_o=pre,
+            pre_a=stack([t[0] for t in tp]),
+            pre_b=pre_b,
+            pre_ob=pre + pre_b,
             axes=np.array([j.axis for j in js]).reshape(-1, 3),
             all_rev=all(j.kind == "revolute" for j in js),
             z_axes=all(np.array_equal(j.axis, [0.0, 0.0, 1.0]) for j in js),
-            steps=tuple(steps))
+            steps=tuple(steps),
+        )
         _PLANS[model.key] = p
     return p
 
@@ -142,10 +150,21 @@ def _steps(model: RobotModel, p: _Plan, fingers: float | None) -> tuple[tuple[in
             _FINGER_STEPS.clear()
         links = model.links
         steps = tuple(
-            (k, parent, ci, _local("prismatic", links[k].origin, links[k].axis,
-                                   min(max(float(fingers), links[k].lower), links[k].upper))
-             if links[k].finger else const)
-            for k, parent, ci, const in p.steps)
+            (
+                k,
+                parent,
+                ci,
+                _local(
+                    "prismatic",
+                    links[k].origin,
+                    links[k].axis,
+                    min(max(float(fingers), links[k].lower), links[k].upper),
+                )
+                if links[k].finger
+                else const,
+            )
+            for k, parent, ci, const in p.steps
+        )
         _FINGER_STEPS[key] = steps
     return steps
 

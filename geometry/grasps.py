@@ -87,8 +87,13 @@ def grasp_warnings(problem: Problem) -> list[Diagnostic]:
                 continue
             w = width(spec, m.shape)
             names = ", ".join(f"'{k.name}' opens {k.gripper_opening:g} m" for k in narrow)
-            out.append(Diagnostic(
-                "W270", f"grasp '{g}' of '{m.name}' needs the fingers {w + FINGER_CLEARANCE:g} m apart ({w:g} m "
-                f"wide + {FINGER_CLEARANCE:g} m clearance), but robot kind {names}: no facts for it", m.span,
-                severity="warning"))
+            out.append(
+                Diagnostic(
+                    "W270",
+                    f"grasp '{g}' of '{m.name}' needs the fingers {w + FINGER_CLEARANCE:g} m apart ({w:g} m "
+                    f"wide + {FINGER_CLEARANCE:g} m clearance), but robot kind {names}: no facts for it",
+                    m.span,
+                    severity="warning",
+                )
+            )
     return out

@@ -164,8 +164,9 @@ class Grounder:
         arms but ``robot``, ``partner`` (which moves with ``robot``: the other arm of a handover, at the
         exchange or in transit) and the step's arms away from home then."""
         away = self._away.get(phase, self._away.get("*", frozenset()))
-        return tuple(h for h in self._arm_homes()
-                     if h not in (f"home:{robot}", f"home:{partner}") and h[5:] not in away)
+        return tuple(
+            h for h in self._arm_homes() if h not in (f"home:{robot}", f"home:{partner}") and h[5:] not in away
+        )
 
     # ------------------------------------------------------------ state
     def arm(self, robot: str) -> Arm:
@@ -194,8 +195,13 @@ class Grounder:
         return collision_shape(self.scene.body(obj).shape)
 
     # ------------------------------------------------------------ volumes
-    def arm_volume(self, robot: str, configs: np.ndarray, holding: tuple[str, str] | None = None,
-                   grasp: tuple[str, str] | None = None) -> Volume:
+    def arm_volume(
+        self,
+        robot: str,
+        configs: np.ndarray,
+        holding: tuple[str, str] | None = None,
+        grasp: tuple[str, str] | None = None,
+    ) -> Volume:
         """Link hulls (and the held object) at each of ``configs`` (C, dof); the fingers stand at the opening
         of the (object, grasp) held, or of ``grasp`` (approaching it), else fully open."""
         arm = self.arm(robot)
@@ -240,8 +246,17 @@ class Grounder:
         return self.world.probe_hits(volume, against=_against(among), ignore=tuple(ignore))
 
     # ------------------------------------------------------------ placements
-    def placement(self, obj: str, region: str, avoid: Iterable[str] = (), volume: Volume | None = None,
-                  samples: int = 200, key: str = "", skip: int = 0, packed: bool = False) -> Answer:
+    def placement(
+        self,
+        obj: str,
+        region: str,
+        avoid: Iterable[str] = (),
+        volume: Volume | None = None,
+        samples: int = 200,
+        key: str = "",
+        skip: int = 0,
+        packed: bool = False,
+    ) -> Answer:
         """A pose of ``obj`` entirely inside ``region`` that hits no fixed object, none of ``avoid`` (at their
         current poses) and nothing of ``volume``: phase 1's lattice first, then random positions and the four
         yaws; ``skip`` passes over that many valid candidates (to get another one on a retry).
@@ -256,9 +271,17 @@ class Grounder:
             skip -= 1  # the caller wants a different placement than the ones it already tried
         return Answer(GroundStatus.NO_PLACEMENT)
 
-    def placements(self, obj: str, region: str, avoid: Iterable[str] = (), volume: Volume | None = None,
-                   samples: int = 200, key: str = "", packed: bool = False,
-                   prefer: Callable[[np.ndarray], float] | None = None) -> Iterator[np.ndarray]:
+    def placements(
+        self,
+        obj: str,
+        region: str,
+        avoid: Iterable[str] = (),
+        volume: Volume | None = None,
+        samples: int = 200,
+        key: str = "",
+        packed: bool = False,
+        prefer: Callable[[np.ndarray], float] | None = None,
+    ) -> Iterator[np.ndarray]:
         """The poses :meth:`placement` would return with ``skip`` 0, 1, 2 ..., in that order, each checked
         once (asking :meth:`placement` for the k-th checks the first k again).  ``prefer`` (a rank of a pose,
         e.g. :meth:`comfortable`'s) orders the grid and lattice candidates by rank, keeping their order
@@ -278,8 +301,10 @@ class Grounder:
         if packed:
             fixed = _packing_grid(h_r[:2] - min(h_o[0], h_o[1])) + fixed
         if prefer is not None:  # accepted ones first in their order, then the others by the preference's rank
-            rank = {c: prefer(reg.pose @ translation(c[1], c[2], -h_r[2] + h_o[2] + ARM_PLACE_LIFT) @ rot_z(c[0]))
-                    for c in fixed}
+            rank = {
+                c: prefer(reg.pose @ translation(c[1], c[2], -h_r[2] + h_o[2] + ARM_PLACE_LIFT) @ rot_z(c[0]))
+                for c in fixed
+            }
             fixed = sorted(fixed, key=lambda c: rank[c])  # stable
         for k in range(len(fixed) + samples):
             if k < len(fixed):
@@ -318,6 +343,7 @@ class Grounder:
         def rank(pose: np.ndarray) -> float:
             far = float(np.linalg.norm(arm.ee_target(pose @ g_t)[:3, 3] - arm.model.shoulder))
             return 0.0 if far <= share * arm.model.reach else far
+
         return rank
 
     def _volume_world(self, volume: Volume) -> CollisionWorld:
@@ -330,9 +356,21 @@ class Grounder:
         return self._moving_world.holding(volume)
 
     # ------------------------------------------------------------ arm configurations
-    def _approach(self, robot: str, obj: str, grasp: str, pose: np.ndarray, key: str,
-                  avoid: Iterable[str], attempts: int = 8, approach: bool = True, held: bool = False,
-                  busy: Pieces = (), partner: str | None = None, from_home: bool = True) -> Answer:
+    def _approach(
+        self,
+        robot: str,
+        obj: str,
+        grasp: str,
+        pose: np.ndarray,
+        key: str,
+        avoid: Iterable[str],
+        attempts: int = 8,
+        approach: bool = True,
+        held: bool = False,
+        busy: Pieces = (),
+        partner: str | None = None,
+        from_home: bool = True,
+    ) -> Answer:
         spec = self.scene.grasp_specs.get(grasp)
         arm = self.arm(robot)
         if spec is None or not fits(spec, self.scene.body(obj).shape, arm.spec.kind):
@@ -348,8 +386,11 @@ class Grounder:
             seed = seed_for(robot, obj, grasp, key, str(attempt), seed=self.seed)
             # the first attempt starts from home (the solution nearest it); the others from a start drawn from
             # their seed, or every attempt would converge to that same solution again
-            start = arm.home if attempt == 0 and from_home else np.random.default_rng(seed).uniform(
-                arm.model.lower, arm.model.upper)
+            start = (
+                arm.home
+                if attempt == 0 and from_home
+                else np.random.default_rng(seed).uniform(arm.model.lower, arm.model.upper)
+            )
             q = solve_ik_many(arm.model, arm.ee_target(pose @ g_t)[None], seed, q_init=start)[0]
             if not q.solved or q.q is None:  # (q is None exactly when the solve failed)
                 if q.status.value == "unreachable":
@@ -362,9 +403,9 @@ class Grounder:
                 continue
             # checked at every APPROACH_CHECK of joint motion (finer than the validator samples), with the
             # object in hand when placing
-            volume = self.arm_volume(robot, joint_line(configs, APPROACH_CHECK),
-                                     holding=(obj, grasp) if held else None,
-                                     grasp=(obj, grasp))
+            volume = self.arm_volume(
+                robot, joint_line(configs, APPROACH_CHECK), holding=(obj, grasp) if held else None, grasp=(obj, grasp)
+            )
             self.queries += 1
             if self._fixed_clash(robot, obj, grasp, configs, volume, held, self._others_home(robot, partner, phase)):
                 status, clash = GroundStatus.COLLISION, ("fixed", volume)
@@ -384,8 +425,9 @@ class Grounder:
             detail = self._clash_detail(robot, partner, phase, clash, ignore=() if held else (obj,))
         return Answer(status, blockers=blockers, detail=detail)
 
-    def _fixed_clash(self, robot: str, obj: str, grasp: str, configs: np.ndarray, volume: Volume, held: bool,
-                     homes: tuple[str, ...]) -> bool:
+    def _fixed_clash(
+        self, robot: str, obj: str, grasp: str, configs: np.ndarray, volume: Volume, held: bool, homes: tuple[str, ...]
+    ) -> bool:
         """Whether an approach (``configs``, swept as ``volume``) hits a fixed object or an arm at home
         (``homes``), or, picking, the object it picks before its contact segment (the last one: the validator
         exempts the picked object there only)."""
@@ -402,8 +444,9 @@ class Grounder:
         :data:`APPROACH_SAMPLES` configurations to ``q``; None when the pre-grasp has no solution, or when
         pre-grasp and grasp come from different IK branches and swing the tool off the approach line (the
         contact segment must start near the grasp: the validator's rule, with a margin)."""
-        pre = solve_ik_many(arm.model, arm.ee_target(tool @ pregrasp_transform(np.eye(4)))[None], seed,
-                            q_init=q[None], restarts=2)[0]
+        pre = solve_ik_many(
+            arm.model, arm.ee_target(tool @ pregrasp_transform(np.eye(4)))[None], seed, q_init=q[None], restarts=2
+        )[0]
         if not pre.solved or pre.q is None:
             return None
         s = np.linspace(0.0, 1.0, APPROACH_SAMPLES)[:, None]
@@ -413,15 +456,15 @@ class Grounder:
             return None
         return configs
 
-    def _clash_detail(self, robot: str, partner: str | None, phase: str, clash: tuple[str, Volume],
-                      ignore: tuple[str, ...]) -> str:
+    def _clash_detail(
+        self, robot: str, partner: str | None, phase: str, clash: tuple[str, Volume], ignore: tuple[str, ...]
+    ) -> str:
         """Name what a volume collided with besides the avoided objects: fixed bodies, other arms at home
         (their links are named ``@<arm>:<i>``), or the other robots of the step."""
         kind, volume = clash
         if kind == "moving":
             return BUSY
-        hit = self.world.probe_hits(volume, against=("fixed", *self._others_home(robot, partner, phase)),
-                                    ignore=ignore)
+        hit = self.world.probe_hits(volume, against=("fixed", *self._others_home(robot, partner, phase)), ignore=ignore)
         named = sorted({f"{h[1:].split(':')[0]} at home" if h.startswith("@") else h for h in hit})
         return "hits " + ", ".join(named) if named else ""
 
@@ -431,13 +474,23 @@ class Grounder:
         names the avoided objects that were in the way."""
         return self._approach(robot, obj, grasp, self.poses[obj], "pick", avoid, busy=busy)
 
-    def place(self, robot: str, obj: str, grasp: str, pose: np.ndarray, avoid: Iterable[str] = (),
-              busy: Pieces = ()) -> Answer:
+    def place(
+        self, robot: str, obj: str, grasp: str, pose: np.ndarray, avoid: Iterable[str] = (), busy: Pieces = ()
+    ) -> Answer:
         """Approach configurations for ``robot`` holding ``obj`` with ``grasp`` to put it at ``pose``."""
         return self._approach(robot, obj, grasp, pose, "place", avoid, held=True, busy=busy)
 
-    def handover(self, obj: str, point: str, giver: str, g1: str, taker: str, g2: str,
-                 avoid: Iterable[str] = (), busy: Pieces = ()) -> Answer:
+    def handover(
+        self,
+        obj: str,
+        point: str,
+        giver: str,
+        g1: str,
+        taker: str,
+        g2: str,
+        avoid: Iterable[str] = (),
+        busy: Pieces = (),
+    ) -> Answer:
         """Both arms' configurations holding ``obj`` at handover point ``point`` (configs: giver, taker)."""
         pose = translation(*self.scene.handover_points[point])
         # as in phase 1, a handover is checked at the exchange configurations (no approach).  Each round draws
@@ -449,10 +502,12 @@ class Grounder:
         worlds: list[CollisionWorld] = []  # the taker's configurations, one world each
         for attempt in range(HANDOVER_PAIRS):
             key = f"handover:{point}" + (f":{attempt}" if attempt else "")
-            a = self._approach(giver, obj, g1, pose, key, avoid, approach=False, busy=busy, partner=taker,
-                               from_home=attempt == 0)
-            b = self._approach(taker, obj, g2, pose, key, avoid, approach=False, busy=busy, partner=giver,
-                               from_home=attempt == 0)
+            a = self._approach(
+                giver, obj, g1, pose, key, avoid, approach=False, busy=busy, partner=taker, from_home=attempt == 0
+            )
+            b = self._approach(
+                taker, obj, g2, pose, key, avoid, approach=False, busy=busy, partner=giver, from_home=attempt == 0
+            )
             if not b.ok:
                 failed = b
             else:
@@ -479,14 +534,27 @@ class Grounder:
         return Answer(GroundStatus.COLLISION, detail="the two arms collide at every exchange drawn")
 
     # ------------------------------------------------------------ paths
-    def arm_path(self, robot: str, start: np.ndarray, goal: np.ndarray, holding: tuple[str, str] | None = None,
-                 avoid: Iterable[str] = (), max_checks: int = MAX_CHECKS, resolution: float = 0.05,
-                 busy: Pieces = (), partner: str | None = None, phase: str = "*") -> Answer:
+    def arm_path(
+        self,
+        robot: str,
+        start: np.ndarray,
+        goal: np.ndarray,
+        holding: tuple[str, str] | None = None,
+        avoid: Iterable[str] = (),
+        max_checks: int = MAX_CHECKS,
+        resolution: float = 0.05,
+        busy: Pieces = (),
+        partner: str | None = None,
+        phase: str = "*",
+    ) -> Answer:
         """A joint-space path (RRTConnect, at most ``max_checks`` validity checks: no clock decides) free of
         fixed objects, ``avoid`` and ``busy`` (and of the held object's collisions with them)."""
         arm = self.arm(robot)
-        against = ("fixed", *self._others_home(robot, partner, phase),
-                   *[a for a in avoid if not holding or a != holding[0]])
+        against = (
+            "fixed",
+            *self._others_home(robot, partner, phase),
+            *[a for a in avoid if not holding or a != holding[0]],
+        )
         ignore = (holding[0],) if holding else ()
         moving = self._busy_world(busy) if busy else None
 
@@ -497,23 +565,56 @@ class Grounder:
                 return False
             return not self.world.probe_collides(volume, against=against, ignore=ignore)
 
-        res = plan_joint_path(arm.model.lower, arm.model.upper, start, goal, valid, max_checks=max_checks,
-                              seed=seed_for(robot, "arm-path", seed=self.seed), resolution=resolution)
+        res = plan_joint_path(
+            arm.model.lower,
+            arm.model.upper,
+            start,
+            goal,
+            valid,
+            max_checks=max_checks,
+            seed=seed_for(robot, "arm-path", seed=self.seed),
+            resolution=resolution,
+        )
         return Answer(GroundStatus.OK if res.solved else GroundStatus.NO_PATH, path=list(res.path))
 
-    def transfer(self, robot: str, obj: str, grasp: str, start: np.ndarray, goal: np.ndarray,
-                 avoid: Iterable[str] = (), lift: bool = False, busy: Pieces = (), partner: str | None = None,
-                 lower: bool = False) -> Answer:
+    def transfer(
+        self,
+        robot: str,
+        obj: str,
+        grasp: str,
+        start: np.ndarray,
+        goal: np.ndarray,
+        avoid: Iterable[str] = (),
+        lift: bool = False,
+        busy: Pieces = (),
+        partner: str | None = None,
+        lower: bool = False,
+    ) -> Answer:
         """:meth:`_transfer`, remembered: the same question (same configurations, objects at the same poses,
         the same moving robots and arms at home) gets the same answer without a second search (the reverse
         search asks again when it splits a step or grounds a skeleton that shares a suffix)."""
         avoid = tuple(sorted(set(avoid)))
         digest = hashlib.sha1()
-        for part in (np.asarray(start, dtype=float), np.asarray(goal, dtype=float),
-                     *(self.poses[o] for o in sorted(self.poses)), *(t for _, t in busy)):
+        for part in (
+            np.asarray(start, dtype=float),
+            np.asarray(goal, dtype=float),
+            *(self.poses[o] for o in sorted(self.poses)),
+            *(t for _, t in busy),
+        ):
             digest.update(np.ascontiguousarray(part).tobytes())
-        key = ("transfer", robot, obj, grasp, avoid, lift, lower, partner, tuple(id(shape) for shape, _ in busy),
-               tuple(sorted(self._away.items())), digest.digest())
+        key = (
+            "transfer",
+            robot,
+            obj,
+            grasp,
+            avoid,
+            lift,
+            lower,
+            partner,
+            tuple(id(shape) for shape, _ in busy),
+            tuple(sorted(self._away.items())),
+            digest.digest(),
+        )
         if key not in self._paths:
             self._remember(key, self._transfer(robot, obj, grasp, start, goal, avoid, lift, busy, partner, lower))
         return self._paths[key]
@@ -525,9 +626,19 @@ class Grounder:
             del self._paths[next(iter(self._paths))]
         self._paths[key] = answer
 
-    def _transfer(self, robot: str, obj: str, grasp: str, start: np.ndarray, goal: np.ndarray,
-                  avoid: Iterable[str] = (), lift: bool = False, busy: Pieces = (), partner: str | None = None,
-                  lower: bool = False) -> Answer:
+    def _transfer(
+        self,
+        robot: str,
+        obj: str,
+        grasp: str,
+        start: np.ndarray,
+        goal: np.ndarray,
+        avoid: Iterable[str] = (),
+        lift: bool = False,
+        busy: Pieces = (),
+        partner: str | None = None,
+        lower: bool = False,
+    ) -> Answer:
         """How ``robot`` carries ``obj`` (held with ``grasp``) from configuration ``start`` to ``goal``: when
         ``lift`` (``start`` grasps the object where it rests), first straight up by :meth:`lift_height`
         (tool poses every centimetre, each by IK from the one before; as far as the way up is free); then the
@@ -570,24 +681,37 @@ class Grounder:
             # then centimetre by centimetre as far as the way up is free (an arm waiting at home above the
             # table may stop it early; the carry goes on from there)
             top = 1
-            while top + 1 < len(up) and hits(joint_line(up[top:top + 2], PATH_RESOLUTION)) is None:
+            while top + 1 < len(up) and hits(joint_line(up[top : top + 2], PATH_RESOLUTION)) is None:
                 top += 1
-            back = joint_line(up[:top + 1], PATH_RESOLUTION)
+            back = joint_line(up[: top + 1], PATH_RESOLUTION)
         # with ``lower``, the carry ends above the goal and comes straight down onto it (the mirror of the lift)
-        tail = self._descent(robot, np.asarray(goal, dtype=float), self.lift_height(obj), hits) if lower \
+        tail = (
+            self._descent(robot, np.asarray(goal, dtype=float), self.lift_height(obj), hits)
+            if lower
             else np.asarray(goal, dtype=float)[None]
+        )
         line = joint_line(np.stack([back[-1], tail[0]]), PATH_RESOLUTION)
         blocked = hits(line)
         if blocked is None:
             return Answer(GroundStatus.OK, path=[*back, *line[1:], *tail[1:]])
-        planned = self.arm_path(robot, back[-1], tail[0], holding=held, avoid=others,
-                                resolution=PATH_RESOLUTION, busy=busy, partner=partner, max_checks=TRANSFER_CHECKS)
+        planned = self.arm_path(
+            robot,
+            back[-1],
+            tail[0],
+            holding=held,
+            avoid=others,
+            resolution=PATH_RESOLUTION,
+            busy=busy,
+            partner=partner,
+            max_checks=TRANSFER_CHECKS,
+        )
         if not planned.ok:
             return Answer(GroundStatus.NO_PATH, blockers=blocked, detail=BUSY if crossed[0] else "")
         return Answer(GroundStatus.OK, path=[*back, *planned.path[1:], *tail[1:]])
 
-    def _descent(self, robot: str, goal: np.ndarray, height: float,
-                 hits: Callable[[np.ndarray], set[str] | None]) -> np.ndarray:
+    def _descent(
+        self, robot: str, goal: np.ndarray, height: float, hits: Callable[[np.ndarray], set[str] | None]
+    ) -> np.ndarray:
         """Configurations coming straight down onto ``goal`` from up to ``height`` above it (the tool's pose
         at ``goal`` raised centimetre by centimetre, as far as IK follows and ``hits`` finds the way free),
         ``goal`` last, at :data:`PATH_RESOLUTION`; ``goal`` alone when not even one centimetre is free."""
@@ -595,13 +719,21 @@ class Grounder:
         if up is None:
             return goal[None]
         top = 0
-        while top + 1 < len(up) and hits(joint_line(up[top:top + 2], PATH_RESOLUTION)) is None:
+        while top + 1 < len(up) and hits(joint_line(up[top : top + 2], PATH_RESOLUTION)) is None:
             top += 1
-        return joint_line(up[:top + 1][::-1], PATH_RESOLUTION)
+        return joint_line(up[: top + 1][::-1], PATH_RESOLUTION)
 
-    def transit(self, robot: str, start: np.ndarray, goal: np.ndarray, avoid: Iterable[str] = (),
-                busy: Pieces = (), via: np.ndarray | None = None, partner: str | None = None,
-                phase: str = "*") -> Answer:
+    def transit(
+        self,
+        robot: str,
+        start: np.ndarray,
+        goal: np.ndarray,
+        avoid: Iterable[str] = (),
+        busy: Pieces = (),
+        via: np.ndarray | None = None,
+        partner: str | None = None,
+        phase: str = "*",
+    ) -> Answer:
         """An empty-handed motion of ``robot`` (fingers fully open, as the validator replays it) from
         ``start`` to ``goal``: along ``via`` first when given (configurations, ``start`` first, joined by
         straight joint-space lines: a release backing off along its approach), then the straight line or, when
@@ -624,9 +756,17 @@ class Grounder:
         line = joint_line(np.stack([back[-1], np.asarray(goal, dtype=float)]), PATH_RESOLUTION)
         if free(line):
             return Answer(GroundStatus.OK, path=[*back, *line[1:]])
-        planned = self.arm_path(robot, back[-1], np.asarray(goal, dtype=float), avoid=tuple(avoid),
-                                resolution=PATH_RESOLUTION, busy=busy, partner=partner, max_checks=TRANSFER_CHECKS,
-                                phase=phase)
+        planned = self.arm_path(
+            robot,
+            back[-1],
+            np.asarray(goal, dtype=float),
+            avoid=tuple(avoid),
+            resolution=PATH_RESOLUTION,
+            busy=busy,
+            partner=partner,
+            max_checks=TRANSFER_CHECKS,
+            phase=phase,
+        )
         if not planned.ok:
             return Answer(GroundStatus.NO_PATH)
         return Answer(GroundStatus.OK, path=[*back, *planned.path[1:]])
@@ -663,8 +803,15 @@ class Grounder:
             out.append(ik.q)
         return np.array(out) if len(out) > 1 else None
 
-    def base_path(self, robot: str, start: np.ndarray, goal: np.ndarray, holding: tuple[str, str] | None = None,
-                  avoid: Iterable[str] = (), busy: Sequence[tuple[CollisionShape, np.ndarray]] = ()) -> Answer:
+    def base_path(
+        self,
+        robot: str,
+        start: np.ndarray,
+        goal: np.ndarray,
+        holding: tuple[str, str] | None = None,
+        avoid: Iterable[str] = (),
+        busy: Sequence[tuple[CollisionShape, np.ndarray]] = (),
+    ) -> Answer:
         """An SE(2) path for a planar robot, free of fixed objects, of the other robots parked at their
         starts, of ``avoid`` (objects at their current poses) and of the volume ``busy`` (what robots moving
         at the same time sweep), searched on the robot's lattice
@@ -674,16 +821,27 @@ class Grounder:
         gets the same answer, and the search never asks twice."""
         movers = sorted({a for a in avoid if not holding or a != holding[0]})
         digest = hashlib.sha1()
-        for part in (np.asarray(start, dtype=float), np.asarray(goal, dtype=float),
-                     *(self.poses[a] for a in movers), *(t for _, t in busy)):
+        for part in (
+            np.asarray(start, dtype=float),
+            np.asarray(goal, dtype=float),
+            *(self.poses[a] for a in movers),
+            *(t for _, t in busy),
+        ):
             digest.update(np.ascontiguousarray(part).tobytes())
         key = (robot, holding, tuple(movers), tuple(id(shape) for shape, _ in busy), digest.digest())
         if key not in self._paths:
             self._remember(key, self._base_path(robot, start, goal, holding, movers, busy))
         return self._paths[key]
 
-    def _base_path(self, robot: str, start: np.ndarray, goal: np.ndarray, holding: tuple[str, str] | None,
-                   movers: list[str], busy: Sequence[tuple[CollisionShape, np.ndarray]]) -> Answer:
+    def _base_path(
+        self,
+        robot: str,
+        start: np.ndarray,
+        goal: np.ndarray,
+        holding: tuple[str, str] | None,
+        movers: list[str],
+        busy: Sequence[tuple[CollisionShape, np.ndarray]],
+    ) -> Answer:
         others = [name for r, name in self.parked.items() if r != robot]
         against = ("fixed", *others, *movers)
         ignore = (holding[0],) if holding else ()
@@ -691,8 +849,10 @@ class Grounder:
             self._grids[robot] = DiscGrid(self.planar(robot), self.scene, scene_bounds(self.scene, 0.5))
             self._lattices[robot] = LatticePlanner(scene_bounds(self.scene, 0.5))
         # the disc grid knows objects at their initial poses only: objects moved since are left to the lattice
-        obstacles = frozenset([b.name for b in self.scene.fixed]
-                              + [a for a in movers if np.array_equal(self.poses[a], self.scene.body(a).pose)])
+        obstacles = frozenset(
+            [b.name for b in self.scene.fixed]
+            + [a for a in movers if np.array_equal(self.poses[a], self.scene.body(a).pose)]
+        )
         if not self._grids[robot].connected(np.asarray(start), np.asarray(goal), obstacles):
             return Answer(GroundStatus.NO_PATH)  # not even the footprint's inscribed disc gets through
 
@@ -722,8 +882,14 @@ class Grounder:
         bodies += [(("busy", pts.tobytes()), pts, np.eye(4)) for pts in _swept_hulls(busy)]
         lattice = self._lattices[robot]
         occupied = lattice.occupancy(parts, bodies)
-        res = lattice.plan(occupied, np.asarray(start, dtype=float), np.asarray(goal, dtype=float), valid,
-                           PATH_RESOLUTION, PATH_RESOLUTION)
+        res = lattice.plan(
+            occupied,
+            np.asarray(start, dtype=float),
+            np.asarray(goal, dtype=float),
+            valid,
+            PATH_RESOLUTION,
+            PATH_RESOLUTION,
+        )
         return Answer(GroundStatus.OK if res.solved else GroundStatus.NO_PATH, path=list(res.path))
 
 
@@ -759,6 +925,7 @@ def _packing_grid(room: np.ndarray, cells: int = 15) -> list[tuple[float, float,
     room = np.maximum(room, 0.0)
     axes = [np.linspace(-r, r, max(1, min(cells, int(2 * r / 0.01) + 1))) for r in room]
     scale = np.maximum(room, 1e-9)
+
     def level(x: float, y: float) -> float:
         return float(-round(abs(x) / scale[0] + abs(y) / scale[1], 9))  # numpy's round, as before
 

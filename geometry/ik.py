@@ -84,8 +84,9 @@ def clear_ik_cache() -> None:
     _CACHE.clear()
 
 
-def _key(model: RobotModel, target: np.ndarray, seed: int, q_init: np.ndarray | None,
-         params: tuple[object, ...]) -> tuple[object, ...]:
+def _key(
+    model: RobotModel, target: np.ndarray, seed: int, q_init: np.ndarray | None, params: tuple[object, ...]
+) -> tuple[object, ...]:
     init = None if q_init is None else np.round(np.asarray(q_init, dtype=float), 9).tobytes()
     return (model.key, np.round(target[:3], 9).tobytes(), seed, init, params)
 
@@ -98,8 +99,17 @@ def _remember(key: tuple[object, ...], result: IKResult) -> None:
 
 # ---------------------------------------------------------------------------------------- public API
 
-def solve_ik(model: RobotModel, target: np.ndarray, seed: int, q_init: np.ndarray | None = None,
-             restarts: int = 8, tol_pos: float = 1e-4, tol_rot: float = 1e-3, max_iters: int = 100) -> IKResult:
+
+def solve_ik(
+    model: RobotModel,
+    target: np.ndarray,
+    seed: int,
+    q_init: np.ndarray | None = None,
+    restarts: int = 8,
+    tol_pos: float = 1e-4,
+    tol_rot: float = 1e-3,
+    max_iters: int = 100,
+) -> IKResult:
     """A configuration putting the end-effector link at ``target`` (4×4 in the robot's base frame).
 
     ``restarts`` start configurations (see :func:`restart_configurations`) run as one batch for at most
@@ -107,13 +117,21 @@ def solve_ik(model: RobotModel, target: np.ndarray, seed: int, q_init: np.ndarra
     farther from the shoulder than the arm's reach are UNREACHABLE without iterating.  Cached per (model,
     target rounded to 1e-9, seed, q_init, parameters).
     """
-    return solve_ik_many(model, np.asarray(target, dtype=float)[None], seed, q_init, restarts, tol_pos, tol_rot,
-                         max_iters)[0]
+    return solve_ik_many(
+        model, np.asarray(target, dtype=float)[None], seed, q_init, restarts, tol_pos, tol_rot, max_iters
+    )[0]
 
 
-def solve_ik_many(model: RobotModel, targets: np.ndarray, seed: int, q_init: np.ndarray | None = None,
-                  restarts: int = 8, tol_pos: float = 1e-4, tol_rot: float = 1e-3,
-                  max_iters: int = 100) -> list[IKResult]:
+def solve_ik_many(
+    model: RobotModel,
+    targets: np.ndarray,
+    seed: int,
+    q_init: np.ndarray | None = None,
+    restarts: int = 8,
+    tol_pos: float = 1e-4,
+    tol_rot: float = 1e-3,
+    max_iters: int = 100,
+) -> list[IKResult]:
     """:func:`solve_ik` for each of ``targets`` (M, 4, 4), solved together in one batch: the same results
     as M separate calls, at a fraction of the cost when M is large.  ``q_init`` may be one configuration for
     all targets or an (M, dof) array giving each target its own first start."""
@@ -137,7 +155,7 @@ def solve_ik_many(model: RobotModel, targets: np.ndarray, seed: int, q_init: np.
     if todo:
         starts = restart_configurations(model, seed, restarts, None if per_target else q_init)
         for lo in range(0, len(todo), CHUNK):
-            part = todo[lo:lo + CHUNK]
+            part = todo[lo : lo + CHUNK]
             if inits is not None:
                 batch = np.repeat(starts[None], len(part), axis=0)
                 batch[:, 0] = model.clamp(inits[part])
@@ -151,8 +169,16 @@ def solve_ik_many(model: RobotModel, targets: np.ndarray, seed: int, q_init: np.
 
 # ------------------------------------------------------------------------------------------- the solver
 
-def _lm(model: RobotModel, targets: np.ndarray, starts: np.ndarray, seed: int, tol_pos: float, tol_rot: float,
-        max_iters: int) -> list[IKResult]:
+
+def _lm(
+    model: RobotModel,
+    targets: np.ndarray,
+    starts: np.ndarray,
+    seed: int,
+    tol_pos: float,
+    tol_rot: float,
+    max_iters: int,
+) -> list[IKResult]:
     # Written for few numpy calls per iteration: a single solve is bound by call overhead, not arithmetic.
     m, r, n = len(targets), starts.shape[-2], model.dof
     w = np.array([1.0, 1.0, 1.0, ROT_WEIGHT, ROT_WEIGHT, ROT_WEIGHT])
@@ -190,17 +216,27 @@ def _lm(model: RobotModel, targets: np.ndarray, starts: np.ndarray, seed: int, t
                     qs.setflags(write=False)
                     out[ids[k]] = IKResult(IKStatus.SOLVED, qs, float(np.sqrt(pe2[row])), float(np.sqrt(re2[row])), it)
                 else:
-                    row = k * r + (low[k] if not dead[k * r + low[k]] else int(np.argmin(energy[k * r:(k + 1) * r])))
-                    out[ids[k]] = IKResult(IKStatus.NO_CONVERGENCE, None, float(np.sqrt(pe2[row])),
-                                           float(np.sqrt(re2[row])), it)
+                    row = k * r + (low[k] if not dead[k * r + low[k]] else int(np.argmin(energy[k * r : (k + 1) * r])))
+                    out[ids[k]] = IKResult(
+                        IKStatus.NO_CONVERGENCE, None, float(np.sqrt(pe2[row])), float(np.sqrt(re2[row])), it
+                    )
             if finished.all():
                 break
             if finished.any():
                 ids, redraws = ids[~finished], redraws[~finished]
                 keep = np.repeat(~finished, r)
                 q, t_pos, t_rot, frames, ee, e_pos, e_rot, energy, dead, checked = (
-                    q[keep], t_pos[keep], t_rot[keep], frames[keep], ee[keep], e_pos[keep], e_rot[keep],
-                    energy[keep], dead[keep], checked[keep])
+                    q[keep],
+                    t_pos[keep],
+                    t_rot[keep],
+                    frames[keep],
+                    ee[keep],
+                    e_pos[keep],
+                    e_rot[keep],
+                    energy[keep],
+                    dead[keep],
+                    checked[keep],
+                )
         # one Levenberg-Marquardt step: (Jᵀ W J + (E + w̄) I) dq = Jᵀ W e
         jt = jacobian_t(model, frames, ee)  # (B, n, 6)
         jtw = jt * w
@@ -225,4 +261,3 @@ def _lm(model: RobotModel, targets: np.ndarray, starts: np.ndarray, seed: int, t
                     q[row] = rngs[tid].uniform(lower, upper)
                     checked[row] = np.inf
     return out  # type: ignore[return-value]
-

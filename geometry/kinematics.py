@@ -38,8 +38,18 @@ from mrgc.geometry.urdf import MAX_LENGTH, Urdf, UrdfError, mesh_path, parse_urd
 from mrgc.geometry.urdf import origin as urdf_origin
 from mrgc.language.model import RobotKind
 
-__all__ = ["E_LINK", "E_URDF", "Collision", "Joint", "Link", "RobotModel", "load_robot_model", "model_for_kind",
-           "read_mesh", "resolve_urdf"]
+__all__ = [
+    "E_LINK",
+    "E_URDF",
+    "Collision",
+    "Joint",
+    "Link",
+    "RobotModel",
+    "load_robot_model",
+    "model_for_kind",
+    "read_mesh",
+    "resolve_urdf",
+]
 
 #: code of "robot URDF not found or unreadable" and of "end-effector link not in the URDF"
 E_URDF = "E400"
@@ -47,6 +57,7 @@ E_LINK = "E401"
 
 
 # ----------------------------------------------------------------------------------------------- data
+
 
 @dataclass(frozen=True, eq=False)
 class Collision:
@@ -185,6 +196,7 @@ class RobotModel:
 
 # ----------------------------------------------------------------------------------------- loading
 
+
 def resolve_urdf(urdf: str, base_dir: str, span: Span | None = None, roots: tuple[str, ...] = ()) -> str:
     """The real path of ``urdf``: relative to ``base_dir`` (the declaring .mrg file's folder) if it exists
     there, else relative to pybullet_data (never the current folder); InputError E400 when neither exists,
@@ -196,16 +208,24 @@ def resolve_urdf(urdf: str, base_dir: str, span: Span | None = None, roots: tupl
         if os.path.isfile(c):
             real = os.path.realpath(c)
             if roots and not inside(real, roots + (os.path.realpath(data_path()),)):
-                raise InputError([Diagnostic("E236", f"robot URDF {urdf!r} is outside the folder tree of the "
-                                             f"problem and pybullet_data; pass --allow-outside FOLDER to allow it",
-                                             span)])
+                raise InputError(
+                    [
+                        Diagnostic(
+                            "E236",
+                            f"robot URDF {urdf!r} is outside the folder tree of the "
+                            f"problem and pybullet_data; pass --allow-outside FOLDER to allow it",
+                            span,
+                        )
+                    ]
+                )
             return real
     looked = " or ".join(repr(c) for c in candidates)
     raise InputError([Diagnostic(E_URDF, f"robot URDF {urdf!r} not found (looked for {looked})", span)])
 
 
-def load_robot_model(urdf: str, base_dir: str, end_effector: str, *, span: Span | None = None,
-                     roots: tuple[str, ...] = ()) -> RobotModel:
+def load_robot_model(
+    urdf: str, base_dir: str, end_effector: str, *, span: Span | None = None, roots: tuple[str, ...] = ()
+) -> RobotModel:
     """Read the robot of ``urdf`` (resolved by :func:`resolve_urdf`) with ``end_effector`` as its tool link.
 
     Raises :class:`~mrgc.errors.InputError` with E400 when the URDF is missing, malformed (located at its
@@ -226,9 +246,15 @@ def load_robot_model(urdf: str, base_dir: str, end_effector: str, *, span: Span 
     if refused is not None:
         raise InputError([Diagnostic(E_URDF, f"pybullet cannot load robot URDF {path!r}: {refused}", span)])
     if model is None:
-        raise InputError([Diagnostic(
-            E_LINK, f"end-effector link {end_effector!r} is not a link of {path!r} (links: {', '.join(names)})",
-            span)])
+        raise InputError(
+            [
+                Diagnostic(
+                    E_LINK,
+                    f"end-effector link {end_effector!r} is not a link of {path!r} (links: {', '.join(names)})",
+                    span,
+                )
+            ]
+        )
     return model
 
 
@@ -246,6 +272,7 @@ def model_for_kind(kind: RobotKind, base_dir: str) -> RobotModel:
 # the rotation inverted (bullet3 issues #3253, #4231); pybullet still loads every file, as the reference and
 # as a validity check.
 
+
 @functools.lru_cache(maxsize=None)
 def _build_model(path: str, end_effector: str, roots: tuple[str, ...] = ()) -> RobotModel:
     urdf = parse_urdf(path)
@@ -258,8 +285,12 @@ def _build_model(path: str, end_effector: str, roots: tuple[str, ...] = ()) -> R
         if j.kind in ("revolute", "continuous", "prismatic"):
             chain_names.append(k_name)
         elif j.kind != "fixed":
-            raise urdf_error(path, f"joint {j.name!r} between the base and {end_effector!r} is {j.kind}, "
-                                   f"not revolute, continuous, prismatic or fixed", j.line)
+            raise urdf_error(
+                path,
+                f"joint {j.name!r} between the base and {end_effector!r} is {j.kind}, "
+                f"not revolute, continuous, prismatic or fixed",
+                j.line,
+            )
         k_name = j.parent
     chain_names.reverse()
 
@@ -281,10 +312,23 @@ def _build_model(path: str, end_effector: str, roots: tuple[str, ...] = ()) -> R
             frozen = float(min(max(0.0, lo), hi))
         collisions = tuple(_collisions(urdf, urdf.links[name], roots))
         pts = [(c.origin[:3, :3] @ c.vertices.T).T + c.origin[:3, 3] for c in collisions if len(c.vertices)]
-        links.append(Link(
-            name=name, index=k, parent=parent, joint=jname, joint_kind=kind, origin=_ro(origin), axis=_ro(axis),
-            chain_index=chain_index, frozen_value=frozen, collisions=collisions,
-            points=_ro(np.concatenate(pts) if pts else np.zeros((0, 3))), lower=float(lo), upper=float(hi)))
+        links.append(
+            Link(
+                name=name,
+                index=k,
+                parent=parent,
+                joint=jname,
+                joint_kind=kind,
+                origin=_ro(origin),
+                axis=_ro(axis),
+                chain_index=chain_index,
+                frozen_value=frozen,
+                collisions=collisions,
+                points=_ro(np.concatenate(pts) if pts else np.zeros((0, 3))),
+                lower=float(lo),
+                upper=float(hi),
+            )
+        )
 
     joints: list[Joint] = []
     prev = 0  # frame of the previous chain joint (its child link) or the base link
@@ -292,17 +336,38 @@ def _build_model(path: str, end_effector: str, roots: tuple[str, ...] = ()) -> R
         k = index[name]
         j = urdf.joint_of[name]
         pre = _fixed_between(links, prev, links[k].parent) @ links[k].origin
-        joints.append(Joint(name=j.name, kind=links[k].joint_kind, axis=links[k].axis, origin=links[k].origin,
-                            pre=_ro(pre), lower=j.lower, upper=j.upper, max_velocity=j.velocity, link=k,
-                            continuous=j.kind == "continuous"))
+        joints.append(
+            Joint(
+                name=j.name,
+                kind=links[k].joint_kind,
+                axis=links[k].axis,
+                origin=links[k].origin,
+                pre=_ro(pre),
+                lower=j.lower,
+                upper=j.upper,
+                max_velocity=j.velocity,
+                link=k,
+                continuous=j.kind == "continuous",
+            )
+        )
         prev = k
     ee_offset = _fixed_between(links, prev, ee)
     shoulder, reach = _reach_bound(joints, ee_offset)
     return RobotModel(
-        key=f"{path}#{end_effector}", urdf=path, name=urdf.name, end_effector=end_effector, links=tuple(links),
-        joints=tuple(joints), ee_link=ee, ee_offset=_ro(ee_offset),
-        lower=_ro(np.array([j.lower for j in joints])), upper=_ro(np.array([j.upper for j in joints])),
-        max_velocity=_ro(np.array([j.max_velocity for j in joints])), shoulder=_ro(shoulder), reach=reach)
+        key=f"{path}#{end_effector}",
+        urdf=path,
+        name=urdf.name,
+        end_effector=end_effector,
+        links=tuple(links),
+        joints=tuple(joints),
+        ee_link=ee,
+        ee_offset=_ro(ee_offset),
+        lower=_ro(np.array([j.lower for j in joints])),
+        upper=_ro(np.array([j.upper for j in joints])),
+        max_velocity=_ro(np.array([j.max_velocity for j in joints])),
+        shoulder=_ro(shoulder),
+        reach=reach,
+    )
 
 
 def _fixed_between(links: list[Link], ancestor: int, k: int) -> np.ndarray:
@@ -337,6 +402,7 @@ def _ro(a: np.ndarray) -> np.ndarray:
 
 # ------------------------------------------------------------------------------ collision geometry
 
+
 def _collisions(urdf: Urdf, link: ET.Element, roots: tuple[str, ...]) -> Iterator[Collision]:
     data = os.path.realpath(data_path()) if roots else None
     for col in link.findall("collision"):
@@ -357,20 +423,23 @@ def _collisions(urdf: Urdf, link: ET.Element, roots: tuple[str, ...]) -> Iterato
                 verts = checked_vertices(mesh_file, size)
             elif shape.tag == "box":
                 size = vec(shape.get("size"), (0.0, 0.0, 0.0), line, MAX_LENGTH, "box size")
-                verts = np.array([[x, y, z] for x in (-.5, .5) for y in (-.5, .5) for z in (-.5, .5)]) * size
+                verts = np.array([[x, y, z] for x in (-0.5, 0.5) for y in (-0.5, 0.5) for z in (-0.5, 0.5)]) * size
             elif shape.tag == "sphere":
                 size = (scalar(shape.get("radius"), 0.0, line, "radius", MAX_LENGTH),)
                 verts = _sphere_points(size[0])
             elif shape.tag in ("cylinder", "capsule"):
-                size = (scalar(shape.get("radius"), 0.0, line, "radius", MAX_LENGTH),
-                        scalar(shape.get("length"), 0.0, line, "length", MAX_LENGTH))
+                size = (
+                    scalar(shape.get("radius"), 0.0, line, "radius", MAX_LENGTH),
+                    scalar(shape.get("length"), 0.0, line, "length", MAX_LENGTH),
+                )
                 verts = _ring_points(size[0], size[1], capsule=shape.tag == "capsule")
             else:  # planes and unknown shapes carry no points
                 size, verts = (), np.zeros((0, 3))
         except UrdfError as exc:
             raise urdf_error(urdf.path, str(exc), exc.line) from None
-        yield Collision(kind=shape.tag, origin=origin, size=tuple(size), mesh_path=mesh_file, vertices=_ro(verts),
-                        faces=faces)
+        yield Collision(
+            kind=shape.tag, origin=origin, size=tuple(size), mesh_path=mesh_file, vertices=_ro(verts), faces=faces
+        )
 
 
 def _ring_points(radius: float, length: float, capsule: bool, segments: int = 16) -> np.ndarray:
@@ -383,7 +452,8 @@ def _ring_points(radius: float, length: float, capsule: bool, segments: int = 16
 
 
 def _sphere_points(radius: float) -> np.ndarray:
-    d = np.array([[x, y, z] for x in (-1, 0, 1) for y in (-1, 0, 1) for z in (-1, 0, 1) if (x, y, z) != (0, 0, 0)],
-                 dtype=float)
+    d = np.array(
+        [[x, y, z] for x in (-1, 0, 1) for y in (-1, 0, 1) for z in (-1, 0, 1) if (x, y, z) != (0, 0, 0)], dtype=float
+    )
     points: np.ndarray = radius * d / np.linalg.norm(d, axis=1, keepdims=True)
     return points

@@ -137,8 +137,9 @@ class LatticePlanner:
     # ------------------------------------------------------------------------------------ lattice states
     def state(self, k: int, i: int, j: int) -> np.ndarray:
         """The base pose ``(x, y, yaw)`` of lattice state ``(k, i, j)``: heading ``k``, cell ``(i, j)``."""
-        return np.array([self.xmin + (i + 0.5) * self.cell, self.ymin + (j + 0.5) * self.cell,
-                         wrap_angle(self.headings[k])])
+        return np.array(
+            [self.xmin + (i + 0.5) * self.cell, self.ymin + (j + 0.5) * self.cell, wrap_angle(self.headings[k])]
+        )
 
     def _near(self, q: np.ndarray) -> list[tuple[int, int, int]]:
         """Lattice states near ``q``, nearest first (position, then heading)."""
@@ -155,8 +156,9 @@ class LatticePlanner:
         return [(k, i, j) for _, k, i, j in sorted(out)]
 
     # ------------------------------------------------------------------------------------ occupancy
-    def _c_obstacle(self, parts: Sequence[tuple[np.ndarray, float, float]], obstacle: Placed
-                    ) -> list[tuple[int, int, np.ndarray]]:
+    def _c_obstacle(
+        self, parts: Sequence[tuple[np.ndarray, float, float]], obstacle: Placed
+    ) -> list[tuple[int, int, np.ndarray]]:
         """(i0, j0, mask over headings × cells) blocks of the states where a part (floor hull and height
         range) overlaps ``obstacle``."""
         o_hull, o_lo, o_hi = _footprint(obstacle)
@@ -191,8 +193,13 @@ class LatticePlanner:
         c, s = np.cos(self.headings), np.sin(self.headings)
         rot = np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2)  # (H, 2, 2)
         turned = np.einsum("hab,kb->hka", rot, part)  # (H, K, 2): the part's vertices at each heading
-        axes = np.concatenate([np.broadcast_to(_normals(obstacle), (self.yaws, *_normals(obstacle).shape)),
-                               np.einsum("hab,kb->hka", rot, _normals(part))], axis=1)  # (H, A, 2)
+        axes = np.concatenate(
+            [
+                np.broadcast_to(_normals(obstacle), (self.yaws, *_normals(obstacle).shape)),
+                np.einsum("hab,kb->hka", rot, _normals(part)),
+            ],
+            axis=1,
+        )  # (H, A, 2)
         p_proj = np.einsum("hka,hna->hnk", turned, axes)
         o_proj = np.einsum("ka,hna->hnk", obstacle, axes)
         eps = 1e-9
@@ -209,8 +216,7 @@ class LatticePlanner:
         mask = (ys >= y_lo[..., None]) & (ys <= y_hi[..., None])  # (H, columns, rows)
         return (i0, j0, mask) if mask.any() else None
 
-    def occupancy(self, parts: Sequence[Placed], obstacles: Sequence[tuple[Hashable, Body, np.ndarray]]
-                  ) -> np.ndarray:
+    def occupancy(self, parts: Sequence[Placed], obstacles: Sequence[tuple[Hashable, Body, np.ndarray]]) -> np.ndarray:
         """(headings, nx, ny) booleans: states where the robot's parts overlap an obstacle (see the module
         docstring); ``obstacles`` are (key, shape, world transform), the key naming the obstacle at its pose
         (the occupancy of each is cached per key and the parts' floor hulls)."""
@@ -222,12 +228,19 @@ class LatticePlanner:
             if blocks is None:
                 blocks = self._blocks[(parts_key, key)] = self._c_obstacle(footprints, (shape, t))
             for i0, j0, m in blocks:
-                occ[:, i0:i0 + m.shape[1], j0:j0 + m.shape[2]] |= m
+                occ[:, i0 : i0 + m.shape[1], j0 : j0 + m.shape[2]] |= m
         return occ
 
     # ------------------------------------------------------------------------------------ search
-    def plan(self, occupied: np.ndarray, start: Sequence[float] | np.ndarray, goal: Sequence[float] | np.ndarray,
-             valid: Validity, resolution: float, yaw_resolution: float) -> MotionResult:
+    def plan(
+        self,
+        occupied: np.ndarray,
+        start: Sequence[float] | np.ndarray,
+        goal: Sequence[float] | np.ndarray,
+        valid: Validity,
+        resolution: float,
+        yaw_resolution: float,
+    ) -> MotionResult:
         """A path from ``start`` to ``goal`` through free lattice states, every state of it (at the
         resolutions) accepted by ``valid``; the first state is ``start``, the last ``goal``."""
         t0 = time.perf_counter()
@@ -272,8 +285,9 @@ class LatticePlanner:
                 return result(MotionStatus.NO_PATH)
         return result(MotionStatus.NO_PATH)
 
-    def _joins(self, q: np.ndarray, free: np.ndarray, check: Callable[[tuple[int, int, int]], bool]
-               ) -> list[tuple[int, int, int]]:
+    def _joins(
+        self, q: np.ndarray, free: np.ndarray, check: Callable[[tuple[int, int, int]], bool]
+    ) -> list[tuple[int, int, int]]:
         """Free lattice states near ``q`` whose join to ``q`` passes ``check``; stops at the first few."""
         out = []
         for s in self._near(q)[:JOINS]:
@@ -283,8 +297,9 @@ class LatticePlanner:
                     break
         return out
 
-    def _wavefront(self, free: np.ndarray, goals: list[tuple[int, int, int]],
-                   starts: list[tuple[int, int, int]]) -> list[tuple[int, int, int]] | None:
+    def _wavefront(
+        self, free: np.ndarray, goals: list[tuple[int, int, int]], starts: list[tuple[int, int, int]]
+    ) -> list[tuple[int, int, int]] | None:
         """Lattice states from a start to a goal (inclusive), fewest moves, or None when none connect."""
         dist = np.full(free.shape, -1, dtype=np.int32)
         front = np.zeros(free.shape, dtype=bool)
@@ -332,8 +347,12 @@ class LatticePlanner:
         return path
 
     @staticmethod
-    def _shortcut(waypoints: list[np.ndarray], motion_ok: Callable[[np.ndarray, np.ndarray], bool],
-                  resolution: float, yaw_resolution: float) -> list[np.ndarray]:
+    def _shortcut(
+        waypoints: list[np.ndarray],
+        motion_ok: Callable[[np.ndarray, np.ndarray], bool],
+        resolution: float,
+        yaw_resolution: float,
+    ) -> list[np.ndarray]:
         """Greedy straight shortcuts over ``waypoints`` (each checked), then the dense path."""
         kept = [0]
         i, n = 0, len(waypoints)

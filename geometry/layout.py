@@ -100,10 +100,15 @@ def home_diagnostics(problem: Problem) -> list[Diagnostic]:
         if joints is None or len(joints) == len(kind.home):
             continue
         shown = ", ".join(joints) if len(joints) <= 4 else f"{joints[0]}, ..., {joints[-1]}"
-        out.append(Diagnostic(
-            "E263", f"robot kind '{kind.name}': :home has {len(kind.home)} value{'s' * (len(kind.home) != 1)}, but "
-            f"the arm of '{kind.urdf}' has {len(joints)} joint{'s' * (len(joints) != 1)} from its base to "
-            f"'{kind.end_effector}' ({shown}): give one value per joint", kind.home_span))
+        out.append(
+            Diagnostic(
+                "E263",
+                f"robot kind '{kind.name}': :home has {len(kind.home)} value{'s' * (len(kind.home) != 1)}, but "
+                f"the arm of '{kind.urdf}' has {len(joints)} joint{'s' * (len(joints) != 1)} from its base to "
+                f"'{kind.end_effector}' ({shown}): give one value per joint",
+                kind.home_span,
+            )
+        )
     return out
 
 
@@ -127,8 +132,13 @@ def overlap_diagnostics(problem: Problem) -> list[Diagnostic]:
     footprints = []
     for r in problem.robots:
         kind = kinds.get(r.kind or "")
-        if kind is None or kind.base != "planar" or kind.footprint is None or isinstance(kind.footprint, Mesh) \
-                or r.base is None:
+        if (
+            kind is None
+            or kind.base != "planar"
+            or kind.footprint is None
+            or isinstance(kind.footprint, Mesh)
+            or r.base is None
+        ):
             continue
         robot = PlanarRobot(RobotSpec(r.name, kind, from_pose(r.base)))
         world.add(r.name, robot.footprint, robot.body_transform(robot.start), "robot")
@@ -136,16 +146,23 @@ def overlap_diagnostics(problem: Problem) -> list[Diagnostic]:
     out: list[Diagnostic] = []
     for i, name in enumerate(movable):
         for other, depth in _overlaps(world, name, movable[:i]):
-            out.append(_overlap("E264", f"movable object '{name}' overlaps movable object '{other}'", depth,
-                                spans, name, other))
+            out.append(
+                _overlap(
+                    "E264", f"movable object '{name}' overlaps movable object '{other}'", depth, spans, name, other
+                )
+            )
         for other, depth in _overlaps(world, name, fixed):
-            out.append(_overlap("E265", f"movable object '{name}' overlaps fixed object '{other}'", depth,
-                                spans, name, other))
+            out.append(
+                _overlap("E265", f"movable object '{name}' overlaps fixed object '{other}'", depth, spans, name, other)
+            )
     for i, name in enumerate(footprints):
         for other, depth in _overlaps(world, name, [*movable, *fixed, *footprints[:i]]):
             what = "robot" if other in footprints else "fixed object" if other in fixed else "movable object"
-            out.append(_overlap("E266", f"the footprint of robot '{name}' overlaps {what} '{other}'", depth, spans,
-                                name, other))
+            out.append(
+                _overlap(
+                    "E266", f"the footprint of robot '{name}' overlaps {what} '{other}'", depth, spans, name, other
+                )
+            )
     return out
 
 
@@ -179,8 +196,9 @@ def _overlaps(world: CollisionWorld, name: str, against: Iterable[str]) -> list[
 
 def _overlap(code: str, what: str, depth: float, spans: dict[str, Span], name: str, other: str) -> Diagnostic:
     note = (f"'{other}' is declared at {spans[other]}",) if other in spans and spans[other].line else ()
-    return Diagnostic(code, f"{what} by {depth * 1000:.1f} mm at the start: no plan can start from here",
-                      spans.get(name), notes=note)
+    return Diagnostic(
+        code, f"{what} by {depth * 1000:.1f} mm at the start: no plan can start from here", spans.get(name), notes=note
+    )
 
 
 # ---------------------------------------------------------------------------------------------- regions
@@ -200,10 +218,20 @@ def region_diagnostics(problem: Problem) -> list[Diagnostic]:
                 continue
         except InputError:
             continue
-        use = ("it is a goal object, so it can still be moved into its goal region" if m.name in goal
-               else "it can never move, so if it is in the way its goals cannot be reached")
-        out.append(Diagnostic("W271", f"movable object '{m.name}' lies in no region at its start pose (a region "
-                                      f"must hold it entirely): {use}", m.span, severity="warning"))
+        use = (
+            "it is a goal object, so it can still be moved into its goal region"
+            if m.name in goal
+            else "it can never move, so if it is in the way its goals cannot be reached"
+        )
+        out.append(
+            Diagnostic(
+                "W271",
+                f"movable object '{m.name}' lies in no region at its start pose (a region "
+                f"must hold it entirely): {use}",
+                m.span,
+                severity="warning",
+            )
+        )
     return out
 
 
@@ -247,8 +275,16 @@ def _arms_at_home(problem: Problem, scene: SceneSpec, arms: list[Arm]) -> list[D
                     found[other] = (depth, key.split("/")[1])
         for target, (depth, link) in found.items():
             what = "movable object" if target in world.names("movable") else "fixed object"
-            out.append(_overlap("E266", f"robot '{arm.name}' ({link}) at its home configuration overlaps {what} "
-                                        f"'{target}'", depth, spans, arm.name, target))
+            out.append(
+                _overlap(
+                    "E266",
+                    f"robot '{arm.name}' ({link}) at its home configuration overlaps {what} '{target}'",
+                    depth,
+                    spans,
+                    arm.name,
+                    target,
+                )
+            )
     return out
 
 
@@ -264,11 +300,18 @@ def _regions_out_of_reach(problem: Problem, scene: SceneSpec, arms: list[Arm]) -
     for region in scene.regions:
         inv = np.linalg.inv(region.pose)
         half = half_extents(region.shape)
-        gaps = [float(np.linalg.norm(np.maximum(np.abs(inv[:3, :3] @ shoulder + inv[:3, 3]) - half, 0.0)))
-                for shoulder in shoulders]
+        gaps = [
+            float(np.linalg.norm(np.maximum(np.abs(inv[:3, :3] @ shoulder + inv[:3, 3]) - half, 0.0)))
+            for shoulder in shoulders
+        ]
         if all(gap > arm.model.reach for arm, gap in zip(arms, gaps)):
-            out.append(Diagnostic(
-                "W272", f"region '{region.name}' lies outside the workspace of every robot (farther from each "
-                        f"arm's shoulder than its reach): nothing can be placed in it or picked from it",
-                region_spans.get(region.name), severity="warning"))
+            out.append(
+                Diagnostic(
+                    "W272",
+                    f"region '{region.name}' lies outside the workspace of every robot (farther from each "
+                    f"arm's shoulder than its reach): nothing can be placed in it or picked from it",
+                    region_spans.get(region.name),
+                    severity="warning",
+                )
+            )
     return out

@@ -85,8 +85,12 @@ def _read_obj(path: str, data: bytes) -> tuple[np.ndarray, np.ndarray]:
                 raise mesh_error(path, "a face lists vertex numbers", n) from None
             idx = [i - 1 if i > 0 else len(verts) + i for i in idx]
             if len(idx) < 3 or any(not 0 <= i < len(verts) for i in idx):
-                raise mesh_error(path, f"face {raw.split(None, 1)[-1][:40]!r} needs 3 or more vertices among "
-                                       f"the {len(verts)} defined before it", n)
+                raise mesh_error(
+                    path,
+                    f"face {raw.split(None, 1)[-1][:40]!r} needs 3 or more vertices among "
+                    f"the {len(verts)} defined before it",
+                    n,
+                )
             faces.extend((idx[0], idx[i], idx[i + 1]) for i in range(1, len(idx) - 1))
     return np.array(verts, dtype=float).reshape(-1, 3), np.array(faces, dtype=np.int64).reshape(-1, 3)
 
@@ -95,13 +99,17 @@ def _read_stl(path: str, data: bytes) -> tuple[np.ndarray, np.ndarray]:
     if len(data) >= 84:
         (count,) = struct.unpack_from("<I", data, 80)
         if 84 + 50 * count == len(data):
-            rec = np.frombuffer(data, dtype=np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")]),
-                                count=count, offset=84)
+            rec = np.frombuffer(
+                data, dtype=np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")]), count=count, offset=84
+            )
             tri = rec["v"].astype(float).reshape(-1, 3)
             bad = ~np.isfinite(tri).all(axis=1) | (np.abs(tri) > MAX_COORD).any(axis=1)
             if bad.any():
-                raise mesh_error(path, f"triangle {int(np.argmax(bad)) // 3 + 1} of the binary STL has a "
-                                       f"coordinate that is not a finite number within {MAX_COORD:g}")
+                raise mesh_error(
+                    path,
+                    f"triangle {int(np.argmax(bad)) // 3 + 1} of the binary STL has a "
+                    f"coordinate that is not a finite number within {MAX_COORD:g}",
+                )
             return tri, np.arange(len(tri)).reshape(-1, 3)
     pts = []
     for n, raw in enumerate(data.decode("utf-8", errors="replace").splitlines(), 1):

@@ -39,9 +39,9 @@ class MotionStatus(str, enum.Enum):
     """How a motion-planning query ended."""
 
     SOLVED = "solved"
-    NO_PATH = "no-path"              # no exact solution within the budget of validity checks
+    NO_PATH = "no-path"  # no exact solution within the budget of validity checks
     INVALID_START = "invalid-start"  # the start is out of bounds or fails is_valid
-    INVALID_GOAL = "invalid-goal"    # the goal is out of bounds or fails is_valid
+    INVALID_GOAL = "invalid-goal"  # the goal is out of bounds or fails is_valid
 
 
 @dataclass(frozen=True)
@@ -80,9 +80,17 @@ def _seed(ou: Any, seed: int) -> None:
     ou.RNG.setSeed(int(seed) % (2**31 - 2) + 1)
 
 
-def plan_joint_path(lower: Vector, upper: Vector, start: Vector, goal: Vector, is_valid: Validity,
-                    max_checks: int = MAX_CHECKS, seed: int = 0, resolution: float = 0.05,
-                    simplify: bool = False) -> MotionResult:
+def plan_joint_path(
+    lower: Vector,
+    upper: Vector,
+    start: Vector,
+    goal: Vector,
+    is_valid: Validity,
+    max_checks: int = MAX_CHECKS,
+    seed: int = 0,
+    resolution: float = 0.05,
+    simplify: bool = False,
+) -> MotionResult:
     """A collision-free path in the box ``lower <= q <= upper`` from ``start`` to ``goal`` (RRTConnect).
 
     ``is_valid(q)`` gets a fresh float array of the joint values; ``resolution`` is the largest step
@@ -92,8 +100,9 @@ def plan_joint_path(lower: Vector, upper: Vector, start: Vector, goal: Vector, i
     q0, q1 = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
     n = len(lo)
     if n == 0 or lo.shape != (n,) or hi.shape != (n,) or q0.shape != (n,) or q1.shape != (n,):
-        raise ValueError(f"bounds, start and goal must be 1-D of one length (got {lo.shape}, {hi.shape}, "
-                         f"{q0.shape}, {q1.shape})")
+        raise ValueError(
+            f"bounds, start and goal must be 1-D of one length (got {lo.shape}, {hi.shape}, {q0.shape}, {q1.shape})"
+        )
     if np.any(hi < lo) or resolution <= 0 or max_checks < 1:
         raise ValueError("need lower <= upper, resolution > 0 and max_checks >= 1")
     if np.any(q0 < lo) or np.any(q0 > hi) or not is_valid(q0.copy()):
@@ -119,8 +128,7 @@ def plan_joint_path(lower: Vector, upper: Vector, start: Vector, goal: Vector, i
     setup = og.SimpleSetup(space)
     setup.setStateValidityChecker(check)
     extent = space.getMaximumExtent()
-    setup.getSpaceInformation().setStateValidityCheckingResolution(min(1.0, resolution / extent)
-                                                                   if extent > 0 else 1.0)
+    setup.getSpaceInformation().setStateValidityCheckingResolution(min(1.0, resolution / extent) if extent > 0 else 1.0)
     s, g = space.allocState(), space.allocState()
     for i in index:
         s[i], g[i] = float(q0[i]), float(q1[i])
@@ -144,8 +152,9 @@ class _Budget:
         return self.used >= self.limit
 
 
-def _solve(ob: Any, og: Any, setup: Any, budget: _Budget, simplify: bool,
-           read: Callable[[Any], np.ndarray]) -> MotionResult:
+def _solve(
+    ob: Any, og: Any, setup: Any, budget: _Budget, simplify: bool, read: Callable[[Any], np.ndarray]
+) -> MotionResult:
     setup.setPlanner(og.RRTConnect(setup.getSpaceInformation()))
     t0 = time.perf_counter()  # statistics only: the budget is counted in validity checks
     # evaluated by the planner itself, between iterations (no watcher thread: no period argument)

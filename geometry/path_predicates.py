@@ -84,8 +84,13 @@ class PlanarEvaluator:
         self.out = RobotFacts()
         self.paths: dict[tuple[object, ...], Path | None] = {}
         #: counters: path queries planned, their validity checks and seconds, cache hits
-        self.stats: dict[str, float] = {"path_queries": 0, "path_checks": 0, "path_seconds": 0.0,
-                                         "path_cache_hits": 0, "grid_rejections": 0}
+        self.stats: dict[str, float] = {
+            "path_queries": 0,
+            "path_checks": 0,
+            "path_seconds": 0.0,
+            "path_cache_hits": 0,
+            "grid_rejections": 0,
+        }
 
     # ------------------------------------------------------------------------------------ primitives
     def _collides(self, probe: list[tuple[CollisionShape, np.ndarray]], obstacles: Iterable[str]) -> bool:
@@ -96,8 +101,14 @@ class PlanarEvaluator:
         xmin, xmax, ymin, ymax = self.bounds
         return bool(xmin <= q[0] <= xmax and ymin <= q[1] <= ymax)
 
-    def _path(self, start: np.ndarray, goal: np.ndarray, carried: Carried, carry_key: tuple[str, ...],
-              obstacles: frozenset[str]) -> Path | None:
+    def _path(
+        self,
+        start: np.ndarray,
+        goal: np.ndarray,
+        carried: Carried,
+        carry_key: tuple[str, ...],
+        obstacles: frozenset[str],
+    ) -> Path | None:
         """A base path avoiding the fixed objects and ``obstacles`` (movable names), or None; cached."""
         key = (tuple(np.round(start, 6)), tuple(np.round(goal, 6)), carry_key, obstacles)
         if key in self.paths:
@@ -120,8 +131,9 @@ class PlanarEvaluator:
         bodies = [(b.name, b.shape, b.pose) for b in self.scene.fixed]
         bodies += [(name, self.scene.body(name).shape, self.scene.body(name).pose) for name in sorted(obstacles)]
         occupied = self.lattice.occupancy(parts, bodies)  # type: ignore[arg-type]
-        res = self.lattice.plan(occupied, tuple(map(float, start)), tuple(map(float, goal)), valid, RESOLUTION,
-                                YAW_RESOLUTION)
+        res = self.lattice.plan(
+            occupied, tuple(map(float, start)), tuple(map(float, goal)), valid, RESOLUTION, YAW_RESOLUTION
+        )
         self.stats["path_queries"] += 1
         self.stats["path_checks"] += res.checks
         self.stats["path_seconds"] += res.planning_time
@@ -136,8 +148,15 @@ class PlanarEvaluator:
         self.out.collision_checks += len(path)
         return self.world.sweep_hits((self.robot.probe(q, carried) for q in path), against=candidates)
 
-    def _least_blocked(self, start: np.ndarray, goal: np.ndarray, carried: Carried, carry_key: tuple[str, ...],
-                       avoid: frozenset[str], candidates: frozenset[str]) -> tuple[Path, set[str]] | None:
+    def _least_blocked(
+        self,
+        start: np.ndarray,
+        goal: np.ndarray,
+        carried: Carried,
+        carry_key: tuple[str, ...],
+        avoid: frozenset[str],
+        candidates: frozenset[str],
+    ) -> tuple[Path, set[str]] | None:
         """A path avoiding fixed objects and ``avoid``, crossing as few of ``candidates`` as found.
 
         Tries a path free of every candidate first, then one crossing only objects that earlier facts of
@@ -160,9 +179,17 @@ class PlanarEvaluator:
         self.occluders |= hits
         return path, hits
 
-    def _reduce(self, start: np.ndarray, goal: np.ndarray, carried: Carried, carry_key: tuple[str, ...],
-                avoid: frozenset[str], candidates: frozenset[str], path: Path,
-                hits: set[str]) -> tuple[Path, set[str]]:
+    def _reduce(
+        self,
+        start: np.ndarray,
+        goal: np.ndarray,
+        carried: Carried,
+        carry_key: tuple[str, ...],
+        avoid: frozenset[str],
+        candidates: frozenset[str],
+        path: Path,
+        hits: set[str],
+    ) -> tuple[Path, set[str]]:
         tries = 0
         for h in sorted(hits):
             if tries >= MAX_REDUCE:
@@ -197,8 +224,9 @@ class PlanarEvaluator:
                         continue
                     self.out.facts.append(Fact("reachable-place", (m.name, region, g, r)))
                     if region == goal:
-                        self.out.facts.extend(Fact("occludes-goal-place", (o, m.name, region, g, r))
-                                              for o in sorted(place))
+                        self.out.facts.extend(
+                            Fact("occludes-goal-place", (o, m.name, region, g, r)) for o in sorted(place)
+                        )
         return self.out
 
     def _pick(self, m: Body, g: str) -> tuple[np.ndarray, set[str]] | None:
@@ -209,9 +237,9 @@ class PlanarEvaluator:
         found = self._least_blocked(self.robot.start, q, None, (), frozenset({m.name}), self.movable - {m.name})
         return None if found is None else (q, found[1])
 
-    def _place_candidates(self, m: Body, g: str, region: str, carried: tuple[CollisionShape, np.ndarray],
-                          others: frozenset[str]) -> tuple[list[tuple[np.ndarray, np.ndarray]],
-                                                            list[tuple[np.ndarray, np.ndarray]]]:
+    def _place_candidates(
+        self, m: Body, g: str, region: str, carried: tuple[CollisionShape, np.ndarray], others: frozenset[str]
+    ) -> tuple[list[tuple[np.ndarray, np.ndarray]], list[tuple[np.ndarray, np.ndarray]]]:
         """(object pose, place base pose) pairs of m in region (grasp g) whose object pose and base pose
         (carrying m) are free of fixed objects: the first ones free of ``others`` too, and a few that are
         not."""
@@ -265,9 +293,14 @@ class PlanarEvaluator:
             return None
         return self._place_hits(q_pick, best, carried, key, others)
 
-    def _place_hits(self, q_pick: np.ndarray, best: tuple[Path, set[str], np.ndarray, np.ndarray],
-                    carried: tuple[CollisionShape, np.ndarray], key: tuple[str, str],
-                    others: frozenset[str]) -> set[str]:
+    def _place_hits(
+        self,
+        q_pick: np.ndarray,
+        best: tuple[Path, set[str], np.ndarray, np.ndarray],
+        carried: tuple[CollisionShape, np.ndarray],
+        key: tuple[str, str],
+        others: frozenset[str],
+    ) -> set[str]:
         """What the chosen place path (and the object at its placement) hits, the path's hits reduced: as
         :meth:`_least_blocked`, first a path around the known occluders, then greedily."""
         path, hits, pose, q = best
@@ -276,7 +309,6 @@ class PlanarEvaluator:
             known = self._path(q_pick, q, carried, key, others - self.occluders - at_place)
             if known is not None:
                 path, hits = known, self._sweep(known, carried, others) | at_place
-        path, path_hits = self._reduce(q_pick, q, carried, key, frozenset(), others - at_place, path,
-                                       hits - at_place)
+        path, path_hits = self._reduce(q_pick, q, carried, key, frozenset(), others - at_place, path, hits - at_place)
         self.occluders |= path_hits
         return path_hits | at_place

@@ -104,8 +104,9 @@ class PlanarRobot:
         """Pose of a carried object (of ``shape``, held with ``grasp``) relative to the base frame."""
         return carry_transform(self.spec.kind, shape, grasp)
 
-    def probe(self, q: np.ndarray, carried: tuple[CollisionShape, np.ndarray] | None = None
-              ) -> list[tuple[CollisionShape, np.ndarray]]:
+    def probe(
+        self, q: np.ndarray, carried: tuple[CollisionShape, np.ndarray] | None = None
+    ) -> list[tuple[CollisionShape, np.ndarray]]:
         """Collision probe of the robot at ``q`` (and of the object it carries, given its carry transform)."""
         base = se2(q[0], q[1], q[2])
         out = [(self.shape, base @ self.lift)]
@@ -127,8 +128,13 @@ def carry_transform(kind: RobotKind, shape: Shape, grasp: str) -> np.ndarray:
     relative to its base frame: the kind's ``:carry`` pose, or on top of the footprint; the grasped face
     towards the robot."""
     face = rot_z(math.radians(PLANAR_GRASPS[grasp][1]))
-    on: np.ndarray = from_pose(kind.carry) if kind.carry is not None else translation(
-        0.0, 0.0, 2 * float(_footprint_half(kind)[2]) + 2 * PLANAR_LIFT + float(half_extents(shape)[2]))
+    on: np.ndarray = (
+        from_pose(kind.carry)
+        if kind.carry is not None
+        else translation(
+            0.0, 0.0, 2 * float(_footprint_half(kind)[2]) + 2 * PLANAR_LIFT + float(half_extents(shape)[2])
+        )
+    )
     carried: np.ndarray = on @ face
     return carried
 
@@ -197,8 +203,14 @@ class DiscGrid:
     keeps the test conservative.  Without a box or vertical-cylinder footprint the grid says "maybe" always.
     """
 
-    def __init__(self, robot: PlanarRobot, scene: SceneSpec, bounds: tuple[float, float, float, float],
-                 cell: float = 0.05, slack: float = 0.025) -> None:
+    def __init__(
+        self,
+        robot: PlanarRobot,
+        scene: SceneSpec,
+        bounds: tuple[float, float, float, float],
+        cell: float = 0.05,
+        slack: float = 0.025,
+    ) -> None:
         self.bounds = bounds
         self.cell = cell
         xmin, xmax, ymin, ymax = bounds

@@ -61,16 +61,28 @@ class RobotEvaluator:
         self.current = {m.name: r.name for m in scene.movable for r in scene.regions if inside(r, m.shape, m.pose)}
 
     # ------------------------------------------------------------ primitives
-    def _ik(self, tool_poses: list[np.ndarray], key: str, q_init: np.ndarray | None = None,
-            attempt: int = 0, restarts: int = 8) -> list[np.ndarray | None]:
+    def _ik(
+        self,
+        tool_poses: list[np.ndarray],
+        key: str,
+        q_init: np.ndarray | None = None,
+        attempt: int = 0,
+        restarts: int = 8,
+    ) -> list[np.ndarray | None]:
         """IK for many tool poses in one batch (``q_init``: one start for all, or one per pose)."""
         if not tool_poses:
             return []
         targets = np.stack([self.arm.ee_target(t) for t in tool_poses])
         self.out.ik_solves += len(targets)
         start = self.arm.home if q_init is None else q_init
-        res = solve_ik_many(self.arm.model, targets, seed_for(self.arm.name, key, str(attempt), seed=self.seed),
-                            q_init=start, restarts=restarts, max_iters=IK_ITERS)
+        res = solve_ik_many(
+            self.arm.model,
+            targets,
+            seed_for(self.arm.name, key, str(attempt), seed=self.seed),
+            q_init=start,
+            restarts=restarts,
+            max_iters=IK_ITERS,
+        )
         return [r.q if r.solved else None for r in res]
 
     def usable(self, obj: str, grasp: str) -> bool:
@@ -86,8 +98,9 @@ class RobotEvaluator:
     def _free(self, qs: np.ndarray, ignore: tuple[str, ...], opening: float | None, against: str = "fixed") -> bool:
         shapes, _ = self.arm.probes
         self.out.collision_checks += 1
-        return not self.world.batch_collides(shapes, self.arm.link_transforms(qs, opening), against=against,
-                                             ignore=ignore)
+        return not self.world.batch_collides(
+            shapes, self.arm.link_transforms(qs, opening), against=against, ignore=ignore
+        )
 
     def _swept_hits(self, qs: np.ndarray, ignore: tuple[str, ...], opening: float | None) -> set[str]:
         shapes, _ = self.arm.probes
@@ -105,8 +118,9 @@ class RobotEvaluator:
         probes = [(shape, p) for p in obj_poses] + [(shape, pose)]
         return self.world.probe_hits(probes, against="movable", ignore=(obj,))
 
-    def _solve(self, queries: list[tuple[str, str, np.ndarray, bool, str]],
-               want_free: bool) -> dict[int, tuple[np.ndarray, set[str]]]:
+    def _solve(
+        self, queries: list[tuple[str, str, np.ndarray, bool, str]], want_free: bool
+    ) -> dict[int, tuple[np.ndarray, set[str]]]:
         """Batched grasp + pre-grasp IK and collision checks for (object, grasp, object pose, held, key)
         queries; the approach path and the movable objects it hits for each query that is reachable.
 
@@ -120,15 +134,29 @@ class RobotEvaluator:
         for attempt in range(IK_SEEDS):
             if not todo:
                 break
-            g_ts = [grasp_transform(self.scene.grasp(queries[i][1]), self.scene.body(queries[i][0]).shape)
-                    for i in todo]
+            g_ts = [
+                grasp_transform(self.scene.grasp(queries[i][1]), self.scene.body(queries[i][0]).shape) for i in todo
+            ]
             qs = self._ik([queries[i][2] @ g for i, g in zip(todo, g_ts)], "grasp", attempt=attempt)
             unsolvable = {i for i, q in zip(todo, qs) if q is None}  # IK with restarts failed: no retry
-            ok = [(i, g, q) for i, g, q in zip(todo, g_ts, qs) if q is not None and not (
-                queries[i][3] and self.world.probe_collides([(self.scene.body(queries[i][0]).shape, queries[i][2])],
-                                                            against="fixed"))]
-            pres = self._ik([queries[i][2] @ pregrasp_transform(g) for i, g, _ in ok], "pre", attempt=attempt,
-                            q_init=np.stack([q for _, _, q in ok]) if ok else None, restarts=2)
+            ok = [
+                (i, g, q)
+                for i, g, q in zip(todo, g_ts, qs)
+                if q is not None
+                and not (
+                    queries[i][3]
+                    and self.world.probe_collides(
+                        [(self.scene.body(queries[i][0]).shape, queries[i][2])], against="fixed"
+                    )
+                )
+            ]
+            pres = self._ik(
+                [queries[i][2] @ pregrasp_transform(g) for i, g, _ in ok],
+                "pre",
+                attempt=attempt,
+                q_init=np.stack([q for _, _, q in ok]) if ok else None,
+                restarts=2,
+            )
             for (i, g, q), q_pre in zip(ok, pres):
                 if q_pre is None:
                     continue
@@ -172,8 +200,13 @@ class RobotEvaluator:
         """This robot's facts (see the module docstring), its handover configurations and counters."""
         r, scene = self.arm.name, self.scene
         near = {m.name: self.arm.in_reach(m.pose[:3, 3], margin=0.3) for m in scene.movable}
-        picks = [(m.name, g, m.pose, False, "pick") for m in scene.movable if near[m.name]
-                 for g in scene.grasps[m.name] if self.usable(m.name, g)]
+        picks = [
+            (m.name, g, m.pose, False, "pick")
+            for m in scene.movable
+            if near[m.name]
+            for g in scene.grasps[m.name]
+            if self.usable(m.name, g)
+        ]
         for i, (_, hits) in sorted(self._solve(picks, want_free=True).items()):
             obj, g = picks[i][0], picks[i][1]
             self.out.facts.append(Fact("reachable-pick", (obj, g, r)))
@@ -183,12 +216,18 @@ class RobotEvaluator:
         for m in scene.movable:
             for region in sorted({r for r in (scene.goal.get(m.name), self.current.get(m.name)) if r is not None}):
                 poses = [p for p in self.placements(m.name, region) if self.arm.in_reach(p[:3, 3], margin=0.3)]
-                triples.extend((m.name, region, g, poses) for g in scene.grasps[m.name]
-                               if self.usable(m.name, g) and poses)
+                triples.extend(
+                    (m.name, region, g, poses) for g in scene.grasps[m.name] if self.usable(m.name, g) and poses
+                )
         placed: dict[int, set[str]] = {}
         for k in range(PLACEMENT_GRID * PLACEMENT_GRID):
-            open_ = [i for i, t in enumerate(triples) if k < len(t[3]) and (i not in placed or placed[i])
-                     and (i not in placed or scene.goal.get(t[0]) == t[1])]
+            open_ = [
+                i
+                for i, t in enumerate(triples)
+                if k < len(t[3])
+                and (i not in placed or placed[i])
+                and (i not in placed or scene.goal.get(t[0]) == t[1])
+            ]
             if not open_:
                 break
             queries = [(triples[i][0], triples[i][2], triples[i][3][k], True, "place") for i in open_]
@@ -223,8 +262,12 @@ class RobotEvaluator:
             if q is None:
                 continue
             self.out.collision_checks += 1
-            hits = self.world.batch_hits(shapes, self.arm.link_transforms(q[None], self.opening(key[0], key[2])),
-                                         against="fixed", ignore=(key[0],))
+            hits = self.world.batch_hits(
+                shapes,
+                self.arm.link_transforms(q[None], self.opening(key[0], key[2])),
+                against="fixed",
+                ignore=(key[0],),
+            )
             if all(h.startswith("@") for h in hits):  # only arms at home: fine if the partner is the one hit
                 self.out.handover[key] = q
                 self.out.handover_homes[key] = frozenset(h[1:].split(":")[0] for h in hits)
@@ -260,8 +303,14 @@ def compute_facts(scene: SceneSpec, seed: int = 0, workers: int | None = None) -
         for reg in scene.regions:
             if inside(reg, m.shape, m.pose):
                 facts.add(Fact("in-region", (m.name, reg.name)))
-    order = {"in-region": 0, "reachable-pick": 1, "reachable-place": 2, "occludes-pick": 3,
-             "occludes-goal-place": 4, "enable-goal-handover": 5}
+    order = {
+        "in-region": 0,
+        "reachable-pick": 1,
+        "reachable-place": 2,
+        "occludes-pick": 3,
+        "occludes-goal-place": 4,
+        "enable-goal-handover": 5,
+    }
     stats = {
         "seconds": time.perf_counter() - t0,
         "robot_seconds": t_robots,
@@ -292,8 +341,10 @@ def _handovers(scene: SceneSpec, per_robot: dict[str, RobotFacts]) -> set[Fact]:
                         if fact in out:
                             continue
                         # an arm may reach into the other one's home only: that one is at the exchange
-                        if not (per_robot[r1].handover_homes[(o1, point, g1)] <= {r2}
-                                and per_robot[r2].handover_homes[(o2, point2, g2)] <= {r1}):
+                        if not (
+                            per_robot[r1].handover_homes[(o1, point, g1)] <= {r2}
+                            and per_robot[r2].handover_homes[(o2, point2, g2)] <= {r1}
+                        ):
                             continue
                         a1 = arms.setdefault(r1, Arm(scene.robot(r1)))
                         a2 = arms.setdefault(r2, Arm(scene.robot(r2)))

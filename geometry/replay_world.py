@@ -132,21 +132,26 @@ class ReplayScene:
             corners = [[x * h[0], y * h[1], z * h[2]] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]
             return int(pb.createCollisionShape(pb.GEOM_MESH, vertices=corners, physicsClientId=cid))
         if isinstance(shape, Cylinder):
-            return int(pb.createCollisionShape(pb.GEOM_CYLINDER, radius=shape.radius, height=shape.height,
-                                               physicsClientId=cid))
+            return int(
+                pb.createCollisionShape(pb.GEOM_CYLINDER, radius=shape.radius, height=shape.height, physicsClientId=cid)
+            )
         if isinstance(shape, Sphere):
             return int(pb.createCollisionShape(pb.GEOM_SPHERE, radius=shape.radius, physicsClientId=cid))
         if isinstance(shape, Mesh):
             with quiet_output():
-                return int(pb.createCollisionShape(pb.GEOM_MESH, fileName=shape.path, meshScale=[shape.scale] * 3,
-                                                   physicsClientId=cid))
+                return int(
+                    pb.createCollisionShape(
+                        pb.GEOM_MESH, fileName=shape.path, meshScale=[shape.scale] * 3, physicsClientId=cid
+                    )
+                )
         raise TypeError(f"no pybullet shape for {shape!r}")
 
     def add_object(self, name: str, shape: Shape, pose: np.ndarray | None, fixed: bool = False) -> None:
         """A rigid static body called ``name`` at ``pose`` (parked when None); ``fixed`` objects are what
         robots' base links may touch."""
-        body = int(self.pb.createMultiBody(baseMass=0, baseCollisionShapeIndex=self._shape(shape),
-                                           physicsClientId=self.cid))
+        body = int(
+            self.pb.createMultiBody(baseMass=0, baseCollisionShapeIndex=self._shape(shape), physicsClientId=self.cid)
+        )
         self.bodies[name] = body
         self._owner[body] = name
         if isinstance(shape, (Mesh, Box)):
@@ -159,8 +164,9 @@ class ReplayScene:
         pb, cid = self.pb, self.cid
         pos, orn = tf.to_quaternion(np.asarray(base, dtype=float))
         with quiet_output():
-            body = int(pb.loadURDF(model.urdf, basePosition=pos, baseOrientation=orn, useFixedBase=True,
-                                   physicsClientId=cid))
+            body = int(
+                pb.loadURDF(model.urdf, basePosition=pos, baseOrientation=orn, useFixedBase=True, physicsClientId=cid)
+            )
         by_link: dict[str, int] = {pb.getBodyInfo(body, physicsClientId=cid)[0].decode(): -1}
         info = {}
         for j in range(pb.getNumJoints(body, physicsClientId=cid)):
@@ -185,23 +191,45 @@ class ReplayScene:
                 if link.finger:
                     fingers.append((j, link.lower, link.upper, float(link.frozen_value)))
         self.robots[name] = ReplayRobot(
-            name=name, body=body, planar=False, joints=tuple(joints), lower=np.array(lower), upper=np.array(upper),
-            ee=by_link[model.end_effector], links={i: n for n, i in by_link.items()},
-            base=np.asarray(base, dtype=float), lift=np.eye(4), joint_names=tuple(jt.name for jt in model.joints),
-            fingers=tuple(fingers), finger_value=model.finger_value)
+            name=name,
+            body=body,
+            planar=False,
+            joints=tuple(joints),
+            lower=np.array(lower),
+            upper=np.array(upper),
+            ee=by_link[model.end_effector],
+            links={i: n for n, i in by_link.items()},
+            base=np.asarray(base, dtype=float),
+            lift=np.eye(4),
+            joint_names=tuple(jt.name for jt in model.joints),
+            fingers=tuple(fingers),
+            finger_value=model.finger_value,
+        )
         self._owner[body] = name
 
     def _add_planar(self, name: str, footprint: Shape | None, base: np.ndarray) -> None:
         if footprint is None:
             raise ValueError(f"planar robot {name!r} has no footprint")
-        body = int(self.pb.createMultiBody(baseMass=0, baseCollisionShapeIndex=self._shape(footprint),
-                                           physicsClientId=self.cid))
+        body = int(
+            self.pb.createMultiBody(
+                baseMass=0, baseCollisionShapeIndex=self._shape(footprint), physicsClientId=self.cid
+            )
+        )
         if isinstance(footprint, (Mesh, Box)):
             self._margin[(body, -1)] = MESH_MARGIN
         lift = tf.translation(0.0, 0.0, float(half_extents(footprint)[2]) + PLANAR_LIFT)
         self.robots[name] = ReplayRobot(
-            name=name, body=body, planar=True, joints=(), lower=np.full(3, -math.inf), upper=np.full(3, math.inf),
-            ee=-1, links={-1: "footprint"}, base=np.asarray(base, dtype=float), lift=lift)
+            name=name,
+            body=body,
+            planar=True,
+            joints=(),
+            lower=np.full(3, -math.inf),
+            upper=np.full(3, math.inf),
+            ee=-1,
+            links={-1: "footprint"},
+            base=np.asarray(base, dtype=float),
+            lift=lift,
+        )
         self.bodies[name] = body
         self._owner[body] = name
         yaw = yaw_of(base)
@@ -226,8 +254,9 @@ class ReplayScene:
             pos, orn = tf.to_quaternion(base @ r.lift)
             self.pb.resetBasePositionAndOrientation(r.body, pos, orn, physicsClientId=self.cid)
             return
-        self.pb.resetJointStatesMultiDof(r.body, r.joints, [[float(v)] for v in q[: len(r.joints)]],
-                                         physicsClientId=self.cid)
+        self.pb.resetJointStatesMultiDof(
+            r.body, r.joints, [[float(v)] for v in q[: len(r.joints)]], physicsClientId=self.cid
+        )
 
     def set_fingers(self, robot: str, opening: float | None) -> None:
         """Open an arm's fingers ``opening`` metres apart (None: back to their frozen, fully open values)."""
@@ -256,8 +285,10 @@ class ReplayScene:
         links = self._shaped.get(body)
         if links is None:  # the links that have collision shapes (a link without one has no box)
             links = self._shaped[body] = tuple(
-                link for link in (tuple(r.links) if r is not None else (-1,))
-                if self.pb.getCollisionShapeData(body, link, physicsClientId=self.cid)) or (-1,)
+                link
+                for link in (tuple(r.links) if r is not None else (-1,))
+                if self.pb.getCollisionShapeData(body, link, physicsClientId=self.cid)
+            ) or (-1,)
         boxes = [self.pb.getAABB(body, link, physicsClientId=self.cid) for link in links]
         lo = [min(b[0][k] for b in boxes) for k in range(3)]
         hi = [max(b[1][k] for b in boxes) for k in range(3)]

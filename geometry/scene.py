@@ -70,8 +70,9 @@ class SceneSpec:
 def scene_from_problem(problem: Problem) -> SceneSpec:
     """The scene of a geometric problem (InputError E401 for a symbolic one)."""
     if problem.symbolic:
-        raise InputError([Diagnostic("E402", f"problem '{problem.name}' is symbolic: it has no geometry",
-                                     problem.span)])
+        raise InputError(
+            [Diagnostic("E402", f"problem '{problem.name}' is symbolic: it has no geometry", problem.span)]
+        )
     for shape in _mesh_shapes(problem):  # bad mesh files fail here, located, before any worker starts
         mesh_vertices(shape)
     kinds = {k.name: k for k in problem.domain.robot_kinds}

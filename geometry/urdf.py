@@ -84,9 +84,16 @@ class Urdf:
 
 def urdf_error(path: str, message: str, line: int = 1, note: str | None = None) -> InputError:
     """E400 located at ``path:line``."""
-    return InputError([Diagnostic(E_URDF, f"robot URDF '{os.path.basename(path)}': {message}",
-                                  Span(path, line, 1, line, 2),
-                                  notes=(note,) if note else ())])
+    return InputError(
+        [
+            Diagnostic(
+                E_URDF,
+                f"robot URDF '{os.path.basename(path)}': {message}",
+                Span(path, line, 1, line, 2),
+                notes=(note,) if note else (),
+            )
+        ]
+    )
 
 
 @functools.lru_cache(maxsize=None)
@@ -101,8 +108,7 @@ def parse_urdf(path: str) -> Urdf:
     try:
         root, lines = _xml(data)
     except xml.parsers.expat.ExpatError as exc:
-        raise urdf_error(path, f"not well-formed XML: {xml.parsers.expat.ErrorString(exc.code)}",
-                         exc.lineno) from None
+        raise urdf_error(path, f"not well-formed XML: {xml.parsers.expat.ErrorString(exc.code)}", exc.lineno) from None
     except UrdfError as exc:
         raise urdf_error(path, str(exc), exc.line) from None
     try:
@@ -120,8 +126,7 @@ def _xml(data: bytes) -> tuple[ET.Element, dict[ET.Element, int]]:
         lines[builder.start(tag, attrs)] = parser.CurrentLineNumber
 
     def entity(*args: object) -> None:
-        raise UrdfError("declares an XML entity (refused: entities can expand without bound)",
-                        parser.CurrentLineNumber)
+        raise UrdfError("declares an XML entity (refused: entities can expand without bound)", parser.CurrentLineNumber)
 
     parser.StartElementHandler = start
     parser.EndElementHandler = builder.end
@@ -145,9 +150,11 @@ def _structure(path: str, root: ET.Element, lines: dict[ET.Element, int]) -> Urd
             if end not in links:
                 raise UrdfError(f"joint {j.name!r} names link {end!r}, which is not declared", j.line)
         if j.child in joint_of:
-            raise UrdfError(f"link {j.child!r} is the child of joint {j.name!r} and of joint "
-                            f"{joint_of[j.child].name!r} (line {joint_of[j.child].line}): a link has one parent",
-                            j.line)
+            raise UrdfError(
+                f"link {j.child!r} is the child of joint {j.name!r} and of joint "
+                f"{joint_of[j.child].name!r} (line {joint_of[j.child].line}): a link has one parent",
+                j.line,
+            )
         joint_of[j.child] = j
         children.setdefault(j.parent, []).append(j.child)
     roots = [name for name in links if name not in joint_of]
@@ -170,8 +177,9 @@ def _links(root: ET.Element, lines: dict[ET.Element, int]) -> dict[str, ET.Eleme
         if not name:
             raise UrdfError("a <link> without a name", lines.get(el, 1))
         if name in links:
-            raise UrdfError(f"link {name!r} is declared twice (first at line {lines.get(links[name], 1)})",
-                            lines.get(el, 1))
+            raise UrdfError(
+                f"link {name!r} is declared twice (first at line {lines.get(links[name], 1)})", lines.get(el, 1)
+            )
         links[name] = el
     return links
 
@@ -197,7 +205,7 @@ def _cycle(joint_of: dict[str, UrdfJoint], start: str) -> str:
     while at in joint_of:
         at = joint_of[at].parent
         if at in path:
-            loop = path[path.index(at):] + [at]
+            loop = path[path.index(at) :] + [at]
             return "joint cycle: " + " -> ".join(reversed(loop)) + " (each link must hang below the root link)"
         path.append(at)
     return f"link {start!r} does not hang below the root link"  # pragma: no cover
@@ -208,14 +216,22 @@ def _joint(el: ET.Element, lines: dict[ET.Element, int]) -> UrdfJoint:
     name = el.get("name") or "?"
     kind = el.get("type")
     if kind not in ("revolute", "continuous", "prismatic", "fixed", "floating", "planar"):
-        raise UrdfError(f"joint {name!r} has type {kind!r} (revolute, continuous, prismatic, fixed, floating "
-                        f"or planar)", line)
+        raise UrdfError(
+            f"joint {name!r} has type {kind!r} (revolute, continuous, prismatic, fixed, floating or planar)", line
+        )
     parent, child = el.find("parent"), el.find("child")
     if parent is None or child is None or not parent.get("link") or not child.get("link"):
         raise UrdfError(f"joint {name!r} lacks its <parent link=...> or <child link=...>", line)
     axis_el = el.find("axis")
-    axis = np.array(vec(axis_el.get("xyz") if axis_el is not None else None, (1.0, 0.0, 0.0),
-                        lines.get(axis_el, line) if axis_el is not None else line, MAX_LENGTH, "axis"))
+    axis = np.array(
+        vec(
+            axis_el.get("xyz") if axis_el is not None else None,
+            (1.0, 0.0, 0.0),
+            lines.get(axis_el, line) if axis_el is not None else line,
+            MAX_LENGTH,
+            "axis",
+        )
+    )
     norm = float(np.linalg.norm(axis))
     if norm == 0 and kind in ("revolute", "continuous", "prismatic"):
         raise UrdfError(f"joint {name!r} has a zero axis", line)
@@ -230,9 +246,18 @@ def _joint(el: ET.Element, lines: dict[ET.Element, int]) -> UrdfJoint:
     elif kind == "prismatic" and max(abs(lo), abs(hi)) > bound:
         raise UrdfError(f"joint {name!r}: limits {lo:g} .. {hi:g} exceed {bound:g}", lim_line)
     org = el.find("origin")
-    return UrdfJoint(name, kind, parent.get("link", ""), child.get("link", ""),
-                     origin(org, lines.get(org, line) if org is not None else line),
-                     axis / norm if norm > 0 else axis, lo, hi, vel, line)
+    return UrdfJoint(
+        name,
+        kind,
+        parent.get("link", ""),
+        child.get("link", ""),
+        origin(org, lines.get(org, line) if org is not None else line),
+        axis / norm if norm > 0 else axis,
+        lo,
+        hi,
+        vel,
+        line,
+    )
 
 
 def scalar(text: str | None, default: float, line: int, what: str, bound: float | None) -> float:
@@ -244,13 +269,15 @@ def scalar(text: str | None, default: float, line: int, what: str, bound: float 
     except ValueError:
         raise UrdfError(f"{what} {text[:40]!r} is not a number", line) from None
     if not math.isfinite(x) or (bound is not None and abs(x) > bound):
-        raise UrdfError(f"{what} {text[:40]!r} is not a finite number"
-                        + (f" within {bound:g}" if bound is not None else ""), line)
+        raise UrdfError(
+            f"{what} {text[:40]!r} is not a finite number" + (f" within {bound:g}" if bound is not None else ""), line
+        )
     return x
 
 
-def vec(text: str | None, default: tuple[float, ...], line: int = 1, bound: float = MAX_LENGTH,
-        what: str = "value") -> tuple[float, ...]:
+def vec(
+    text: str | None, default: tuple[float, ...], line: int = 1, bound: float = MAX_LENGTH, what: str = "value"
+) -> tuple[float, ...]:
     """A space-separated vector attribute of ``len(default)`` finite numbers within ``bound``."""
     if text is None:
         return default
@@ -264,8 +291,10 @@ def origin(el: ET.Element | None, line: int = 1) -> np.ndarray:
     """The 4×4 transform of an ``<origin xyz=... rpy=...>`` element (identity when absent)."""
     if el is None:
         return np.eye(4)
-    return tf.from_xyz_rpy(vec(el.get("xyz"), (0.0, 0.0, 0.0), line, MAX_LENGTH, "origin xyz"),
-                           vec(el.get("rpy"), (0.0, 0.0, 0.0), line, MAX_ANGLE, "origin rpy"))
+    return tf.from_xyz_rpy(
+        vec(el.get("xyz"), (0.0, 0.0, 0.0), line, MAX_LENGTH, "origin xyz"),
+        vec(el.get("rpy"), (0.0, 0.0, 0.0), line, MAX_ANGLE, "origin rpy"),
+    )
 
 
 def mesh_path(filename: str, urdf: str, line: int, roots: tuple[str, ...] = (), data: str | None = None) -> str:
@@ -276,7 +305,7 @@ def mesh_path(filename: str, urdf: str, line: int, roots: tuple[str, ...] = (), 
     rel = filename
     for prefix in ("package://", "file://"):
         if rel.startswith(prefix):
-            rel = rel[len(prefix):]
+            rel = rel[len(prefix) :]
     if not rel:
         raise urdf_error(urdf, "a <mesh> without a filename", line)
     if os.path.isabs(rel):
@@ -285,14 +314,26 @@ def mesh_path(filename: str, urdf: str, line: int, roots: tuple[str, ...] = (), 
         cands = [os.path.join(here, rel), os.path.join(here, rel.split("/", 1)[-1]), os.path.join(here, os.pardir, rel)]
     found = next((c for c in cands if os.path.isfile(c)), None)
     if found is None:
-        raise urdf_error(urdf, f"mesh file {filename!r} not found (looked for "
-                               f"{' or '.join(repr(os.path.normpath(c)) for c in dict.fromkeys(cands))})", line)
+        raise urdf_error(
+            urdf,
+            f"mesh file {filename!r} not found (looked for "
+            f"{' or '.join(repr(os.path.normpath(c)) for c in dict.fromkeys(cands))})",
+            line,
+        )
     real = os.path.realpath(found)
     allowed = roots + ((data,) if data else ())
     if roots and not inside(real, allowed):
-        raise InputError([Diagnostic("E236", f"mesh file {filename!r} of robot URDF '{urdf}' is outside the "
-                                     f"folder tree of the problem and pybullet_data; pass --allow-outside FOLDER "
-                                     f"to allow it", Span(urdf, line, 1, line, 2))])
+        raise InputError(
+            [
+                Diagnostic(
+                    "E236",
+                    f"mesh file {filename!r} of robot URDF '{urdf}' is outside the "
+                    f"folder tree of the problem and pybullet_data; pass --allow-outside FOLDER "
+                    f"to allow it",
+                    Span(urdf, line, 1, line, 2),
+                )
+            ]
+        )
     return real
 
 

@@ -93,8 +93,9 @@ class Checker:
             if isinstance(sec, ast.RobotKindDecl):
                 kind = self.robot_kind(sec)
                 if sec.name in kinds:
-                    self.err("E200", f"robot kind '{sec.name}' declared twice (first at {kinds[sec.name].span})",
-                             sec.span)
+                    self.err(
+                        "E200", f"robot kind '{sec.name}' declared twice (first at {kinds[sec.name].span})", sec.span
+                    )
                 else:
                     kinds[sec.name] = kind
         grasps, specs = self._grasps(secs["grasps"], bool(kinds)) if "grasps" in secs else ((), [])
@@ -124,8 +125,12 @@ class Checker:
                     specs.append(spec)
             elif has_kinds and decl.name not in BUILTIN_GRASPS:
                 hint = did_you_mean(decl.name, BUILTIN_GRASPS) or f" (built in: {' '.join(BUILTIN_GRASPS)})"
-                self.err("E243", f"grasp '{decl.name}' has no geometry: it is not built in and not declared "
-                         f"as ({decl.name} :approach AXIS :fingers AXIS){hint}", decl.span)
+                self.err(
+                    "E243",
+                    f"grasp '{decl.name}' has no geometry: it is not built in and not declared "
+                    f"as ({decl.name} :approach AXIS :fingers AXIS){hint}",
+                    decl.span,
+                )
         return tuple(seen), specs
 
     def grasp(self, d: ast.Decl) -> GraspSpec | None:
@@ -138,16 +143,30 @@ class Checker:
                 self.err("E255", f"{what} needs ':{key}'", d.span)
         approach = cast("tuple[float, float, float] | None", vals.get("approach"))
         fingers = cast("tuple[float, float, float] | None", vals.get("fingers"))
-        if approach is None or fingers is None or ("depth" in table and vals["depth"] is None) or (
-                "offset" in table and vals["offset"] is None):
+        if (
+            approach is None
+            or fingers is None
+            or ("depth" in table and vals["depth"] is None)
+            or ("offset" in table and vals["offset"] is None)
+        ):
             return None
         if sum(a * b for a, b in zip(approach, fingers)) != 0:
             span = table["fingers"].span
-            self.err("E241", f"{what}: the finger axis ({_word(table['fingers'])}) must be perpendicular to the "
-                     f"approach axis ({_word(table['approach'])})", span)
+            self.err(
+                "E241",
+                f"{what}: the finger axis ({_word(table['fingers'])}) must be perpendicular to the "
+                f"approach axis ({_word(table['approach'])})",
+                span,
+            )
             return None
-        return GraspSpec(d.name, approach, fingers, vals.get("depth", DEFAULT_GRASP_DEPTH),  # type: ignore[arg-type]
-                         vals.get("offset", (0.0, 0.0, 0.0)), span=d.span)  # type: ignore[arg-type]
+        return GraspSpec(
+            d.name,
+            approach,
+            fingers,
+            vals.get("depth", DEFAULT_GRASP_DEPTH),  # type: ignore[arg-type]
+            vals.get("offset", (0.0, 0.0, 0.0)),  # type: ignore[arg-type]
+            span=d.span,
+        )
 
     def robot_kind(self, k: ast.RobotKindDecl) -> RobotKind:
         """A checked robot kind: URDF and end effector (fixed base) or footprint (planar base), home, TCP, carry
@@ -195,8 +214,9 @@ class Checker:
             kind = v.get("kind")
             if kind is not None and kind not in kinds:
                 span = _prop_span(d, "kind")
-                self.err("E214", f"undeclared robot kind '{kind}' in domain '{domain.name}'"
-                                 f"{did_you_mean(kind, kinds)}", span)
+                self.err(
+                    "E214", f"undeclared robot kind '{kind}' in domain '{domain.name}'{did_you_mean(kind, kinds)}", span
+                )
             if geometric and "kind" not in v and not _has(d, "kind"):
                 self.err("E260", f"robot '{d.name}' of a geometric problem needs ':kind'", d.span)
             robots.append(Robot(d.name, kind, v.get("base"), d.span))
@@ -211,8 +231,16 @@ class Checker:
             v = self._decl_values("movable", "movable object", d)
             own = self._name_list(v.get("grasps"), grasps, "grasp", f"domain '{domain.name}'")
             via = self._name_list(v.get("handover"), set(point_names), "handover-point", "this problem")
-            movable.append(MovableObject(d.name, v.get("shape"), v.get("pose"), own or domain.grasps,
-                                         via or tuple(dict.fromkeys(point_names)), d.span))
+            movable.append(
+                MovableObject(
+                    d.name,
+                    v.get("shape"),
+                    v.get("pose"),
+                    own or domain.grasps,
+                    via or tuple(dict.fromkeys(point_names)),
+                    d.span,
+                )
+            )
         for d in decls["handover-points"]:
             v = self._decl_values("handover-points", "handover point", d)
             points.append(HandoverPoint(d.name, v.get("position"), d.span))
@@ -258,8 +286,13 @@ class Checker:
     def _classify(self, decls: dict[str, tuple[ast.Decl, ...]]) -> bool:
         """Geometric iff some movable object has a shape; then report missing geometry, else mixed-in geometry."""
         geometric = any(_has(d, "shape") for d in decls["movable"])
-        required = {"fixed": ("shape", "pose"), "regions": ("shape", "pose"), "movable": ("shape", "pose"),
-                    "robots": ("base",), "handover-points": ("position",)}
+        required = {
+            "fixed": ("shape", "pose"),
+            "regions": ("shape", "pose"),
+            "movable": ("shape", "pose"),
+            "robots": ("base",),
+            "handover-points": ("position",),
+        }
         for kind, items in decls.items():
             noun = SORTS[SECTION_SORT[kind]][1]
             for d in items:
@@ -315,8 +348,9 @@ class Checker:
             ok = self._arg(name, want, span, sort_of, grasps, atom.predicate) and ok
         return Fact(atom.predicate, atom.args) if ok else None
 
-    def _arg(self, name: str, want: str, span: Span, sort_of: dict[str, tuple[str, Span]],
-             grasps: set[str], predicate: str) -> bool:
+    def _arg(
+        self, name: str, want: str, span: Span, sort_of: dict[str, tuple[str, Span]], grasps: set[str], predicate: str
+    ) -> bool:
         code, noun = SORTS[want]
         if want == "grasp":
             if name not in grasps:
@@ -332,13 +366,19 @@ class Checker:
             return False
         have = sort_of[name][0]
         if have != want:
-            self.err("E216", f"'{name}' is {_article(SORTS[have][1])}, but '{predicate}' expects {_article(noun)} "
-                             f"here", span)
+            self.err(
+                "E216", f"'{name}' is {_article(SORTS[have][1])}, but '{predicate}' expects {_article(noun)} here", span
+            )
             return False
         return True
 
-    def _facts(self, init: ast.Init | None, sort_of: dict[str, tuple[str, Span]], grasps: set[str],
-               obj_grasps: dict[str, set[str]]) -> list[Fact]:
+    def _facts(
+        self,
+        init: ast.Init | None,
+        sort_of: dict[str, tuple[str, Span]],
+        grasps: set[str],
+        obj_grasps: dict[str, set[str]],
+    ) -> list[Fact]:
         if init is None:
             return []
         facts: dict[Fact, None] = {}
@@ -351,8 +391,11 @@ class Checker:
                 continue
             for obj, grasp in _grasp_uses(fact):
                 if grasp not in obj_grasps.get(obj, {grasp}):
-                    self.err("E227", f"grasp '{grasp}' is not among the grasps of '{obj}' "
-                             f"({' '.join(sorted(obj_grasps[obj]))})", atom.span)
+                    self.err(
+                        "E227",
+                        f"grasp '{grasp}' is not among the grasps of '{obj}' ({' '.join(sorted(obj_grasps[obj]))})",
+                        atom.span,
+                    )
             facts[fact] = None
         return list(facts)
 
@@ -377,14 +420,18 @@ class Checker:
                 continue
             obj, region = fact.args
             if obj in out and out[obj][0] != fact:
-                self.err("E224", f"'{obj}' cannot be in both '{out[obj][0].args[1]}' and '{region}' "
-                         f"(first goal at {out[obj][1]})", atom.span)
+                self.err(
+                    "E224",
+                    f"'{obj}' cannot be in both '{out[obj][0].args[1]}' and '{region}' (first goal at {out[obj][1]})",
+                    atom.span,
+                )
                 continue
             out.setdefault(obj, (fact, atom.span))
         return [f for f, _ in out.values()]
 
-    def _initial_regions(self, init: list[Fact], init_sec: ast.Init | None, movable: list[MovableObject],
-                         geometric: bool) -> None:
+    def _initial_regions(
+        self, init: list[Fact], init_sec: ast.Init | None, movable: list[MovableObject], geometric: bool
+    ) -> None:
         where: dict[str, list[str]] = {}
         attempted = {a.args[0] for a in (init_sec.atoms if init_sec else ()) if a.predicate == "in-region" and a.args}
         for f in init:

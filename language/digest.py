@@ -55,8 +55,10 @@ def _value(node: Any, source: str) -> Any:
         out["urdf"] = _urdf_hash(node)
         return out
     if is_dataclass(node) and not isinstance(node, type):
-        return {"type": type(node).__name__,
-                **{f.name: _value(getattr(node, f.name), source) for f in fields(node) if f.compare}}
+        return {
+            "type": type(node).__name__,
+            **{f.name: _value(getattr(node, f.name), source) for f in fields(node) if f.compare},
+        }
     if isinstance(node, (tuple, list)):
         return [_value(v, source) for v in node]
     if isinstance(node, float):

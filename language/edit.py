@@ -70,20 +70,36 @@ def relocate_paths(node: object, relocate: Relocate, declaring_file: str) -> obj
         return replace(node, path=relocate(node.path, "include", declaring_file))
     if isinstance(node, ast.Property) and node.key == "urdf" and isinstance(node.value, ast.String):
         return replace(node, value=replace(node.value, value=relocate(node.value.value, "urdf", declaring_file)))
-    if (isinstance(node, ast.ListValue) and len(node.items) >= 2 and isinstance(node.items[0], ast.Symbol)
-            and node.items[0].name == "mesh" and isinstance(node.items[1], ast.String)):
+    if (
+        isinstance(node, ast.ListValue)
+        and len(node.items) >= 2
+        and isinstance(node.items[0], ast.Symbol)
+        and node.items[0].name == "mesh"
+        and isinstance(node.items[1], ast.String)
+    ):
         path = replace(node.items[1], value=relocate(node.items[1].value, "mesh", declaring_file))
         return replace(node, items=(node.items[0], path, *node.items[2:]))
     if not is_dataclass(node) or isinstance(node, type):
         return node
-    changes = {f.name: relocate_paths(getattr(node, f.name), relocate, declaring_file) for f in fields(node)
-               if isinstance(getattr(node, f.name), tuple) or is_dataclass(getattr(node, f.name))}
+    changes = {
+        f.name: relocate_paths(getattr(node, f.name), relocate, declaring_file)
+        for f in fields(node)
+        if isinstance(getattr(node, f.name), tuple) or is_dataclass(getattr(node, f.name))
+    }
     return replace(node, **changes)
 
 
-def facts_document(source: ast.SourceFile, problem_name: str, domain_name: str, domain_file: str,
-                   facts: Iterable[Fact], source_path: str, out_path: str | None, header: str,
-                   relocate: Relocate | None = None) -> str:
+def facts_document(
+    source: ast.SourceFile,
+    problem_name: str,
+    domain_name: str,
+    domain_file: str,
+    facts: Iterable[Fact],
+    source_path: str,
+    out_path: str | None,
+    header: str,
+    relocate: Relocate | None = None,
+) -> str:
     """The text ``mrgc facts`` writes: ``problem_name`` with its ``:init`` completed by ``facts``.
 
     The domain comes along when the source file defines it, or when the output is written to another
@@ -95,8 +111,9 @@ def facts_document(source: ast.SourceFile, problem_name: str, domain_name: str, 
     from mrgc.language.parser import parse_text
     from mrgc.language.printer import format_source
 
-    same_folder = out_path is None or os.path.dirname(os.path.abspath(out_path)) == \
-        os.path.dirname(os.path.abspath(source_path))
+    same_folder = out_path is None or os.path.dirname(os.path.abspath(out_path)) == os.path.dirname(
+        os.path.abspath(source_path)
+    )
     defs: list[ast.DomainDef | ast.ProblemDef] = []
     own = [d for d in source.definitions if isinstance(d, ast.DomainDef) and d.name == domain_name]
     if own:

@@ -50,8 +50,9 @@ class MrgFile:
         if name is None:
             if len(self.problems) != 1:
                 found = ", ".join(p.name for p in self.problems) or "none"
-                raise InputError([Diagnostic("E230", f"{self.path} holds {len(self.problems)} problems ({found}); "
-                                                     f"name one")])
+                raise InputError(
+                    [Diagnostic("E230", f"{self.path} holds {len(self.problems)} problems ({found}); name one")]
+                )
             return self.problems[0]
         for p in self.problems:
             if p.name == name:
@@ -65,8 +66,9 @@ def read_source(path: str) -> tuple[str | None, Diagnostic | None]:
     try:
         data = read_regular(path, MAX_BYTES)
     except FileTooLarge as exc:
-        return None, Diagnostic("E002", f"'{path}' is {exc.size} bytes; the limit is {MAX_BYTES} bytes",
-                                Span(path, 1, 1, 1, 2))
+        return None, Diagnostic(
+            "E002", f"'{path}' is {exc.size} bytes; the limit is {MAX_BYTES} bytes", Span(path, 1, 1, 1, 2)
+        )
     except OSError as exc:
         return None, Diagnostic("E001", f"cannot read '{path}': {exc.strerror or exc}")
     return decode(data, path)
@@ -150,8 +152,13 @@ class _Loader:
         for d in tree.definitions:
             what = "domain" if isinstance(d, ast.DomainDef) else "problem"
             if (what, d.name) in seen:
-                self.diags.append(Diagnostic("E200", f"{what} '{d.name}' defined twice in this file "
-                                             f"(first at {seen[(what, d.name)]})", d.span))
+                self.diags.append(
+                    Diagnostic(
+                        "E200",
+                        f"{what} '{d.name}' defined twice in this file (first at {seen[(what, d.name)]})",
+                        d.span,
+                    )
+                )
             seen.setdefault((what, d.name), d.span)
 
     def follow_includes(self, path: str, tree: ast.SourceFile, stack: tuple[str, ...]) -> list[str]:
@@ -170,8 +177,11 @@ class _Loader:
                 self.diags.append(Diagnostic("E234", f"include path {inc.path!r} is not usable: {exc}", inc.span))
                 continue
             if os.path.commonpath([self.root_dir, real]) != self.root_dir:
-                self.diags.append(Diagnostic("E233", f"include '{inc.path}' leaves the folder tree of "
-                                             f"{shown(self.root_dir)}", inc.span))
+                self.diags.append(
+                    Diagnostic(
+                        "E233", f"include '{inc.path}' leaves the folder tree of {shown(self.root_dir)}", inc.span
+                    )
+                )
                 continue
             if real in stack or real == key:
                 chain = " -> ".join(os.path.basename(s) for s in (*stack, real))
@@ -179,8 +189,9 @@ class _Loader:
                 continue
             if not os.path.isfile(real):
                 what = "is not a regular file" if os.path.exists(real) else "not found"
-                self.diags.append(Diagnostic("E234", f"included file '{inc.path}' {what} (looked for {shown(target)})",
-                                             inc.span))
+                self.diags.append(
+                    Diagnostic("E234", f"included file '{inc.path}' {what} (looked for {shown(target)})", inc.span)
+                )
                 continue
             sub = self.parse(shown(target))
             if real not in out:
@@ -210,14 +221,21 @@ class _Loader:
         for found in levels:
             if len(found) > 1:
                 where = ", ".join(str(d.span) for d in found)
-                self.diags.append(Diagnostic("E231", f"domain '{ref.name}' is defined in several places ({where})",
-                                             ref.span))
+                self.diags.append(
+                    Diagnostic("E231", f"domain '{ref.name}' is defined in several places ({where})", ref.span)
+                )
                 return None
             if found:
                 return found[0]
         known = sorted({d.name for ds in self.domains.values() for d in ds})
-        self.diags.append(Diagnostic("E230", f"domain '{ref.name}' not found in this file, {DOMAIN_FILE} beside "
-                                     f"it, or its includes{did_you_mean(ref.name, known)}", ref.span))
+        self.diags.append(
+            Diagnostic(
+                "E230",
+                f"domain '{ref.name}' not found in this file, {DOMAIN_FILE} beside "
+                f"it, or its includes{did_you_mean(ref.name, known)}",
+                ref.span,
+            )
+        )
         return None
 
     def _in_files(self, files: list[str], name: str) -> list[Domain]:
@@ -228,8 +246,9 @@ def _includes(tree: ast.SourceFile) -> list[ast.Include]:
     return [s for d in tree.definitions for s in d.sections if isinstance(s, ast.Include)]
 
 
-def load(path: str, text: str | None = None, root_dir: str | None = None,
-         allow_outside: tuple[str, ...] = ()) -> MrgFile:
+def load(
+    path: str, text: str | None = None, root_dir: str | None = None, allow_outside: tuple[str, ...] = ()
+) -> MrgFile:
     """Parse and check ``path`` (or ``text`` under that name); raise InputError with every diagnostic.
 
     ``allow_outside``: folders whose files (meshes, URDFs) may be used besides the file's own tree."""
@@ -250,8 +269,9 @@ def load(path: str, text: str | None = None, root_dir: str | None = None,
             continue
         refs = [s for s in pdef.sections if isinstance(s, ast.DomainRef)]
         if not refs:
-            loader.diags.append(Diagnostic("E230", f"problem '{pdef.name}' names no domain: add (:domain NAME)",
-                                           pdef.span))
+            loader.diags.append(
+                Diagnostic("E230", f"problem '{pdef.name}' names no domain: add (:domain NAME)", pdef.span)
+            )
             continue
         domain = loader.find_domain(path, key, tree, refs[0])
         if domain is None:
@@ -307,22 +327,38 @@ def confinement(problem: Problem, roots: tuple[str, ...]) -> list[Diagnostic]:
     shown_roots = " or ".join(shown(r) for r in roots[:1])
     for obj in problem.bodies:
         if isinstance(obj.shape, Mesh) and not inside(obj.shape.path, roots):
-            out.append(Diagnostic("E236", f"mesh file '{obj.shape.path}' of '{obj.name}' is outside the folder "
-                                  f"tree of {shown_roots}{hint}", obj.span))
+            out.append(
+                Diagnostic(
+                    "E236",
+                    f"mesh file '{obj.shape.path}' of '{obj.name}' is outside the folder tree of {shown_roots}{hint}",
+                    obj.span,
+                )
+            )
     data = pybullet_data_dir()
     for kind in problem.domain.robot_kinds:
         if isinstance(kind.footprint, Mesh) and not inside(kind.footprint.path, roots):
-            out.append(Diagnostic("E236", f"mesh file '{kind.footprint.path}' of robot kind '{kind.name}' is "
-                                  f"outside the folder tree of {shown_roots}{hint}", kind.span))
+            out.append(
+                Diagnostic(
+                    "E236",
+                    f"mesh file '{kind.footprint.path}' of robot kind '{kind.name}' is "
+                    f"outside the folder tree of {shown_roots}{hint}",
+                    kind.span,
+                )
+            )
         if kind.urdf is None:
             continue
         base = os.path.dirname(os.path.abspath(kind.source)) if kind.source else roots[0]
         for cand, in_data in urdf_candidates(kind.urdf, base):
             if os.path.exists(cand):
                 if not in_data and not inside(cand, roots + ((data,) if data else ())):
-                    out.append(Diagnostic("E236", f"robot URDF '{kind.urdf}' of robot kind '{kind.name}' is "
-                                          f"outside the folder tree of {shown_roots} and pybullet_data{hint}",
-                                          kind.span))
+                    out.append(
+                        Diagnostic(
+                            "E236",
+                            f"robot URDF '{kind.urdf}' of robot kind '{kind.name}' is "
+                            f"outside the folder tree of {shown_roots} and pybullet_data{hint}",
+                            kind.span,
+                        )
+                    )
                 break
     return out
 

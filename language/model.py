@@ -28,13 +28,24 @@ PREDICATES: dict[str, tuple[str, ...]] = {
 #: words users write for a predicate -> the predicates they mean (E220's "did you mean"; a word that is a
 #: part of predicate names, like ``reachable``, needs no entry: every predicate holding it is suggested)
 PREDICATE_WORDS: dict[str, tuple[str, ...]] = {
-    "handover": ("enable-goal-handover",), "hand-over": ("enable-goal-handover",),
-    "handoff": ("enable-goal-handover",), "can-handover": ("enable-goal-handover",),
-    "in": ("in-region",), "at": ("in-region",), "on": ("in-region",), "inside": ("in-region",),
-    "pick": ("reachable-pick",), "can-pick": ("reachable-pick",), "graspable": ("reachable-pick",),
-    "place": ("reachable-place",), "can-place": ("reachable-place",), "placeable": ("reachable-place",),
-    "blocks": ("occludes-pick", "occludes-goal-place"), "obstructs": ("occludes-pick", "occludes-goal-place"),
-    "blocks-pick": ("occludes-pick",), "blocks-place": ("occludes-goal-place",),
+    "handover": ("enable-goal-handover",),
+    "hand-over": ("enable-goal-handover",),
+    "handoff": ("enable-goal-handover",),
+    "can-handover": ("enable-goal-handover",),
+    "in": ("in-region",),
+    "at": ("in-region",),
+    "on": ("in-region",),
+    "inside": ("in-region",),
+    "pick": ("reachable-pick",),
+    "can-pick": ("reachable-pick",),
+    "graspable": ("reachable-pick",),
+    "place": ("reachable-place",),
+    "can-place": ("reachable-place",),
+    "placeable": ("reachable-place",),
+    "blocks": ("occludes-pick", "occludes-goal-place"),
+    "obstructs": ("occludes-pick", "occludes-goal-place"),
+    "blocks-pick": ("occludes-pick",),
+    "blocks-place": ("occludes-goal-place",),
     "occludes-place": ("occludes-goal-place",),
 }
 
@@ -48,7 +59,8 @@ Axis = tuple[float, float, float]
 #: axis word -> unit vector in the object frame (``x`` is ``+x``)
 AXES: dict[str, Axis] = {
     f"{sign}{name}": tuple(float(s * (i == k)) for i in range(3))  # type: ignore[misc]
-    for k, name in enumerate("xyz") for sign, s in (("+", 1), ("-", -1), ("", 1))
+    for k, name in enumerate("xyz")
+    for sign, s in (("+", 1), ("-", -1), ("", 1))
 }
 
 DEFAULT_GRASP_DEPTH = 0.02  # m the tool centre point sits inside the face it approaches
@@ -144,14 +156,17 @@ def _builtin(name: str, approach: str, fingers: str) -> GraspSpec:
 
 
 #: the built-in grasps: what a bare name in ``(:grasps ...)`` means
-BUILTIN_GRASPS: dict[str, GraspSpec] = {g.name: g for g in (
-    _builtin("top", "-z", "+y"),  # from above, fingers closing along y
-    _builtin("top-x", "-z", "+x"),  # from above, the wrist turned 90 degrees: fingers closing along x
-    _builtin("side-x+", "-x", "+y"),  # from the +x side
-    _builtin("side-x-", "+x", "+y"),
-    _builtin("side-y+", "-y", "+x"),
-    _builtin("side-y-", "+y", "+x"),
-)}
+BUILTIN_GRASPS: dict[str, GraspSpec] = {
+    g.name: g
+    for g in (
+        _builtin("top", "-z", "+y"),  # from above, fingers closing along y
+        _builtin("top-x", "-z", "+x"),  # from above, the wrist turned 90 degrees: fingers closing along x
+        _builtin("side-x+", "-x", "+y"),  # from the +x side
+        _builtin("side-x-", "+x", "+y"),
+        _builtin("side-y+", "-y", "+x"),
+        _builtin("side-y-", "+y", "+x"),
+    )
+}
 
 
 @dataclass(frozen=True)

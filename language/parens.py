@@ -100,6 +100,6 @@ def paren_at(text: str, offset: int) -> OpenParen:
     while j < len(text) and text[j] in " \t":
         j += 1
     k = j
-    while k < len(text) and not text[k].isspace() and text[k] not in "()\";" and k - j < 40:
+    while k < len(text) and not text[k].isspace() and text[k] not in '()";' and k - j < 40:
         k += 1
     return OpenParen(offset, line, column, text[j:k])

@@ -32,8 +32,6 @@ _READABLE = {
 }
 
 
-
-
 @lru_cache(maxsize=1)
 def _lark() -> Lark:
     return Lark(
@@ -168,8 +166,9 @@ class _ToAst(Transformer[Token, Any]):
 
     def prop(self, children: list[Any]) -> ast.Property:
         key, value = children
-        return ast.Property(str(key)[1:], value, Span(self.path, key.line, key.column,
-                                                      value.span.end_line, value.span.end_column))
+        return ast.Property(
+            str(key)[1:], value, Span(self.path, key.line, key.column, value.span.end_line, value.span.end_column)
+        )
 
     def number(self, children: list[Token]) -> ast.Number:
         tok = children[0]
@@ -256,19 +255,28 @@ def _syntax_diagnostic(exc: UnexpectedInput, text: str, file: str) -> Diagnostic
     """The diagnostic of a syntax error; one a missing ``)`` explains is reported at the ``(`` left open
     (E102 at the end of the file, E104 before the next form: :mod:`mrgc.language.parens`)."""
     found = _first_syntax_diagnostic(exc, text, file)
-    if isinstance(exc, UnexpectedToken) and (found.code == "E102" or (
-            found.code == "E101" and exc.token.type not in _VALUES and str(exc.token) != ")")):
+    if isinstance(exc, UnexpectedToken) and (
+        found.code == "E102" or (found.code == "E101" and exc.token.type not in _VALUES and str(exc.token) != ")")
+    ):
         end = len(text) if exc.token.type == "$END" else (exc.token.start_pos or 0)
         paren = unclosed_paren(text, end)
         if paren is not None:
             span = Span(file, paren.line, paren.column, paren.line, paren.column + 1 + len(paren.word))
             what = f"'({paren.word}'" if paren.word else "'('"
             if found.code == "E102":
-                return Diagnostic("E102", f"{what} is never closed: the file ends inside it", span,
-                                  notes=(f"the file ends at {found.span}",))
+                return Diagnostic(
+                    "E102",
+                    f"{what} is never closed: the file ends inside it",
+                    span,
+                    notes=(f"the file ends at {found.span}",),
+                )
             assert found.span is not None
-            return Diagnostic("E104", f"{what} is not closed before {_form_at(text, end)} on line "
-                                      f"{found.span.line}", span, notes=(f"at {found.span}: {found.message}",))
+            return Diagnostic(
+                "E104",
+                f"{what} is not closed before {_form_at(text, end)} on line {found.span.line}",
+                span,
+                notes=(f"at {found.span}: {found.message}",),
+            )
     return found
 
 
@@ -289,9 +297,7 @@ def _first_syntax_diagnostic(exc: UnexpectedInput, text: str, file: str) -> Diag
         expected = set(exc.expected)
         if tok.type == "$END":
             span = _end_span(text, file)
-            return Diagnostic(
-                "E102", f"unexpected end of file; expected {_phrase(_expected(expected))}", span
-            )
+            return Diagnostic("E102", f"unexpected end of file; expected {_phrase(_expected(expected))}", span)
         span = _tok_span(file, tok)
         sections = _section_literals(expected)
         if tok.type == "KEYWORD" and sections:
@@ -308,9 +314,7 @@ def _first_syntax_diagnostic(exc: UnexpectedInput, text: str, file: str) -> Diag
         if exc.char == '"':
             return Diagnostic("E100", "unterminated string", span)
         shown = word if len(word) > 1 else exc.char
-        return Diagnostic(
-            "E100", f"unexpected {shown!r}; expected {_phrase(_expected(allowed))}", span
-        )
+        return Diagnostic("E100", f"unexpected {shown!r}; expected {_phrase(_expected(allowed))}", span)
     if isinstance(exc, UnexpectedEOF):  # pragma: no cover - LALR reports end of input as UnexpectedToken
         return Diagnostic("E102", "unexpected end of file", _end_span(text, file))
     return Diagnostic("E101", str(exc).splitlines()[0], Span(file, line, col, line, col + 1))  # pragma: no cover
@@ -347,4 +351,3 @@ def _end_span(text: str, file: str) -> Span:
         idx -= 1
     col = len(lines[idx].rstrip()) + 1
     return Span(file, idx + 1, col, idx + 1, col + 1)
-

@@ -261,8 +261,11 @@ def _fill(out: _Out, head: str, names: list[tuple[str, Span]], span: Span) -> No
     ind, cont = "  ", "    "
     out.emit("(" + head, ind, span, header=True)
     for name, nspan in names:
-        has_comment = bool(out.pending) and nspan.file != "<generated>" and \
-            (out.pending[0].line, out.pending[0].column) < (nspan.line, nspan.column)
+        has_comment = (
+            bool(out.pending)
+            and nspan.file != "<generated>"
+            and (out.pending[0].line, out.pending[0].column) < (nspan.line, nspan.column)
+        )
         if has_comment or out.lines[-1][1] or len(out.lines[-1][0]) + 1 + len(name) > WIDTH:
             out.emit(name, cont, nspan)
         else:

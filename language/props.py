@@ -94,8 +94,11 @@ class PropReader:
             self.err("E251", f"{what} is not a finite number", value.span)
             return None
         if abs(value.value) > MAX_MAGNITUDE:
-            self.err("E259", f"{what} is {_fmt(value.value)}, beyond the bound of {MAX_MAGNITUDE:g} "
-                             "(metres, radians)", value.span)
+            self.err(
+                "E259",
+                f"{what} is {_fmt(value.value)}, beyond the bound of {MAX_MAGNITUDE:g} (metres, radians)",
+                value.span,
+            )
             return None
         return value.value
 
@@ -124,8 +127,9 @@ class PropReader:
         if value.name not in AXES:
             word = value.name.lower()
             word = word if word in AXES else word[::-1] if word[::-1] in AXES else ""  # -Z, z-
-            hint = (f" (did you mean '{word}'?)" if word
-                    else did_you_mean(value.name, AXES) or f" (use {' '.join(words)})")
+            hint = (
+                f" (did you mean '{word}'?)" if word else did_you_mean(value.name, AXES) or f" (use {' '.join(words)})"
+            )
             self.err("E240", f"unknown axis '{value.name}' for {what}{hint}", value.span)
             return None
         return AXES[value.name]
@@ -209,8 +213,9 @@ class PropReader:
         if head.name == "mesh":
             return self._mesh(value, args)
         if len(args) != len(names):
-            self.err("E252", f"a {head.name} needs {len(names)} numbers ({', '.join(names)}), got {len(args)}",
-                     value.span)
+            self.err(
+                "E252", f"a {head.name} needs {len(names)} numbers ({', '.join(names)}), got {len(args)}", value.span
+            )
             return None
         dims = [self._length(a, f"{head.name} {n}") for a, n in zip(args, names)]
         given = [d for d in dims if d is not None]

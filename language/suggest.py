@@ -1,4 +1,4 @@
-""""Did you mean" suggestions for misspelt names, near-linear in the number of names.
+"""The "Did you mean" suggestions for misspelt names, near-linear in the number of names.
 
 A file with thousands of misspelt names asks for thousands of suggestions from thousands of candidates;
 comparing every pair was quadratic (1,000 misspelt names took 92 s).  Now each distinct candidate pool is
@@ -41,7 +41,7 @@ def edit_distance(a: str, b: str, bound: int | None = None) -> int:
 
 
 def _deletions(word: str) -> set[str]:
-    return {word[:i] + word[i + 1:] for i in range(len(word))}
+    return {word[:i] + word[i + 1 :] for i in range(len(word))}
 
 
 class _Pool:

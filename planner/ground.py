@@ -80,8 +80,9 @@ def _configs(c: np.ndarray | None) -> list[list[float]]:
 class ReverseGrounder:
     """Grounds skeletons on a scene (see the module docstring)."""
 
-    def __init__(self, grounder: Grounder, goal: dict[str, str], full: bool = False,
-                 deadline: float | None = None) -> None:
+    def __init__(
+        self, grounder: Grounder, goal: dict[str, str], full: bool = False, deadline: float | None = None
+    ) -> None:
         self.g = grounder
         self.goal = goal
         #: arms' empty-handed motions planned too (``mrgc plan --motions full``): home -> pre-grasp, release
@@ -115,19 +116,26 @@ class ReverseGrounder:
                 # M* as the paper defines it: every movable object not moved in S' that obstructs the whole
                 # grounded sequence S' (this call's steps *and* the older suffix: an object the suffix hits
                 # was to be moved by a step of this skeleton that is now discarded)
-                blockers = self.g.hits([p for s in steps for p in s.volume],
-                                       among=sorted(o for o in self.movable if o not in moved))
+                blockers = self.g.hits(
+                    [p for s in steps for p in s.volume], among=sorted(o for o in self.movable if o not in moved)
+                )
                 must = {o for o in self.goal if o not in moved} | blockers
-                return Grounding(Outcome.PARTIAL, steps, must, reason=f"step {t + 1} needs {sorted(blockers)} moved",
-                                 failures=[strict])
+                return Grounding(
+                    Outcome.PARTIAL,
+                    steps,
+                    must,
+                    reason=f"step {t + 1} needs {sorted(blockers)} moved",
+                    failures=[strict],
+                )
             grounded[:0] = strict
             volume = volume + [p for s in strict for p in s.volume]
             fut_objs |= same
         return Grounding(Outcome.SUCCESS, grounded + suffix)
 
     # ------------------------------------------------------------ one joint action
-    def _steps(self, step: tuple[Action, ...], avoid: set[str], v_fut: Volume, key: str,
-               index: int) -> list[GroundedStep] | Failure:
+    def _steps(
+        self, step: tuple[Action, ...], avoid: set[str], v_fut: Volume, key: str, index: int
+    ) -> list[GroundedStep] | Failure:
         """Ground one skeleton step; when its robots get in each other's way (an action collides with what
         another robot of the step sweeps in the same phase), split it: the failing action alone one step
         later, or else one step earlier, than the others (each part split again as needed).  The skeleton's
@@ -147,14 +155,20 @@ class ReverseGrounder:
             tail = self._steps(later, avoid, v_fut, f"{key}:late", index)
             if isinstance(tail, Failure):
                 continue
-            head = self._steps(earlier, avoid | {a.obj for a in later}, v_fut + [p for s in tail for p in s.volume],
-                               f"{key}:early", index)
+            head = self._steps(
+                earlier,
+                avoid | {a.obj for a in later},
+                v_fut + [p for s in tail for p in s.volume],
+                f"{key}:early",
+                index,
+            )
             if not isinstance(head, Failure):
                 return head + tail
         return done
 
-    def _step(self, step: tuple[Action, ...], avoid: set[str], same: set[str], v_fut: Volume,
-              key: str, index: int = 0) -> GroundedStep | Failure:
+    def _step(
+        self, step: tuple[Action, ...], avoid: set[str], same: set[str], v_fut: Volume, key: str, index: int = 0
+    ) -> GroundedStep | Failure:
         # the step's arms are not at home while they pick, place or are in transit (the validator's model)
         self.g.step([a.pick_robot for a in step], [a.place_robot for a in step])
         try:
@@ -162,8 +176,9 @@ class ReverseGrounder:
         finally:
             self.g.step((), ())
 
-    def _actions(self, step: tuple[Action, ...], avoid: set[str], same: set[str], v_fut: Volume,
-                 key: str, index: int) -> GroundedStep | Failure:
+    def _actions(
+        self, step: tuple[Action, ...], avoid: set[str], same: set[str], v_fut: Volume, key: str, index: int
+    ) -> GroundedStep | Failure:
         actions: list[PlannedAction] = []
         step_volume: Volume = []
         motions: Motions = {}  # robot -> phase -> volume at each sample
@@ -200,32 +215,42 @@ class ReverseGrounder:
         out: Motions = {}
         if g.is_planar(action.pick_robot):
             carried = {"to-pick": None, "to-place": (obj, action.pick_grasp), "home": None}
-            out[action.pick_robot] = {ph: [g.base_volume(action.pick_robot, [q], carried[ph]) for q in np.array(path)]
-                                      for ph, path in action.paths.items()}
+            out[action.pick_robot] = {
+                ph: [g.base_volume(action.pick_robot, [q], carried[ph]) for q in np.array(path)]
+                for ph, path in action.paths.items()
+            }
             return out
         out.setdefault(action.pick_robot, {})["pick"] = [
             g.arm_volume(action.pick_robot, q[None], grasp=(obj, action.pick_grasp))
-            for q in refine(np.array(action.configs["pick"]))]
+            for q in refine(np.array(action.configs["pick"]))
+        ]
         if "handover" in action.configs:
             giver, taker = np.array(action.configs["handover"])
             out[action.pick_robot]["handover"] = [
-                g.arm_volume(action.pick_robot, giver[None], (obj, action.pick_grasp))]
+                g.arm_volume(action.pick_robot, giver[None], (obj, action.pick_grasp))
+            ]
             out.setdefault(action.place_robot, {})["handover"] = [
-                g.arm_volume(action.place_robot, taker[None], (obj, action.place_grasp))]
+                g.arm_volume(action.place_robot, taker[None], (obj, action.place_grasp))
+            ]
         # the paths (every configuration: they are already at the validator's resolution); holding the
         # object on the transfers, empty-handed (fingers fully open) otherwise
-        for phase, robot, grasp in (("to-handover", action.pick_robot, action.pick_grasp),
-                                    ("to-place", action.place_robot, action.place_grasp),
-                                    ("to-pick", action.pick_robot, None),
-                                    ("taker-to-handover", action.place_robot, None),
-                                    ("home", action.place_robot, None), ("giver-home", action.pick_robot, None)):
+        for phase, robot, grasp in (
+            ("to-handover", action.pick_robot, action.pick_grasp),
+            ("to-place", action.place_robot, action.place_grasp),
+            ("to-pick", action.pick_robot, None),
+            ("taker-to-handover", action.place_robot, None),
+            ("home", action.place_robot, None),
+            ("giver-home", action.pick_robot, None),
+        ):
             if phase in action.paths:
                 held = (obj, grasp) if grasp is not None else None
                 out.setdefault(robot, {})[PATH_PHASE.get(phase, phase)] = [
-                    g.arm_volume(robot, np.array(q)[None], holding=held) for q in action.paths[phase]]
+                    g.arm_volume(robot, np.array(q)[None], holding=held) for q in action.paths[phase]
+                ]
         out.setdefault(action.place_robot, {})["place"] = [
             g.arm_volume(action.place_robot, q[None], (obj, action.place_grasp))
-            for q in refine(np.array(action.configs["place"]))]
+            for q in refine(np.array(action.configs["place"]))
+        ]
         return out
 
     def _on_time(self) -> None:
@@ -233,9 +258,15 @@ class ReverseGrounder:
         if self.deadline is not None and time.perf_counter() > self.deadline:
             raise DeadlineReached()
 
-    def _action(self, a: Action, avoid: list[str], v_fut: Volume, key: str,
-                placed: dict[str, np.ndarray] | None = None,
-                busy: dict[str, Volume] | None = None) -> PlannedAction | Failure:
+    def _action(
+        self,
+        a: Action,
+        avoid: list[str],
+        v_fut: Volume,
+        key: str,
+        placed: dict[str, np.ndarray] | None = None,
+        busy: dict[str, Volume] | None = None,
+    ) -> PlannedAction | Failure:
         if self.g.is_planar(a.pick_robot):
             return self._drive(a, avoid, v_fut, key, placed or {}, busy or {})
         g, busy = self.g, busy or {}
@@ -255,9 +286,15 @@ class ReverseGrounder:
         tried = 0  # placements that failed for another reason than being out of the arm's reach
         # goal bins are shared by several objects: packed from the corners; elsewhere (moving an obstacle
         # aside) the middle of the region first, nearest the arms that reach it
-        spots = g.placements(a.obj, a.region, avoid=avoid, volume=v_fut, key=key,
-                             packed=self.goal.get(a.obj) == a.region,
-                             prefer=g.comfortable(a.place_robot, a.obj, a.place_grasp))
+        spots = g.placements(
+            a.obj,
+            a.region,
+            avoid=avoid,
+            volume=v_fut,
+            key=key,
+            packed=self.goal.get(a.obj) == a.region,
+            prefer=g.comfortable(a.place_robot, a.obj, a.place_grasp),
+        )
         for _ in range(PLACEMENT_TRIES + OUT_OF_REACH_TRIES):
             if tried >= PLACEMENT_TRIES:
                 break
@@ -271,9 +308,18 @@ class ReverseGrounder:
                 continue
             tried += 1
             assert place.configs is not None
-            carry = g.transfer(a.place_robot, a.obj, a.place_grasp, start, place.configs[0], avoid, lift=lift,
-                               busy=busy.get("to-place", []),
-                               partner=a.pick_robot if a.pick_robot != a.place_robot else None, lower=True)
+            carry = g.transfer(
+                a.place_robot,
+                a.obj,
+                a.place_grasp,
+                start,
+                place.configs[0],
+                avoid,
+                lift=lift,
+                busy=busy.get("to-place", []),
+                partner=a.pick_robot if a.pick_robot != a.place_robot else None,
+                lower=True,
+            )
             if not carry.ok:
                 last = _failed(f"carry to the placement by {a.place_robot}", carry)
                 continue
@@ -289,8 +335,9 @@ class ReverseGrounder:
         assert last is not None
         return last
 
-    def _hand_over(self, a: Action, planned: PlannedAction, grasped: np.ndarray, avoid: list[str],
-                   busy: dict[str, Volume]) -> np.ndarray | Failure:
+    def _hand_over(
+        self, a: Action, planned: PlannedAction, grasped: np.ndarray, avoid: list[str], busy: dict[str, Volume]
+    ) -> np.ndarray | Failure:
         """A handover action's exchange (both arms at a handover point) and the giver's carry there from
         ``grasped`` (its pick configuration), into ``planned``; the taker's configuration at the exchange."""
         g = self.g
@@ -301,16 +348,26 @@ class ReverseGrounder:
         assert answer.configs is not None
         planned.handover_point = point
         planned.configs["handover"] = _configs(answer.configs)
-        giver = g.transfer(a.pick_robot, a.obj, a.pick_grasp, grasped, answer.configs[0], avoid,
-                           lift=True, busy=busy.get("to-handover", []), partner=a.place_robot)
+        giver = g.transfer(
+            a.pick_robot,
+            a.obj,
+            a.pick_grasp,
+            grasped,
+            answer.configs[0],
+            avoid,
+            lift=True,
+            busy=busy.get("to-handover", []),
+            partner=a.place_robot,
+        )
         if not giver.ok:
             return _failed(f"carry to the handover by {a.pick_robot}", giver)
         planned.paths["to-handover"] = _configs(np.array(giver.path))
         taker: np.ndarray = answer.configs[1]
         return taker
 
-    def _transits(self, a: Action, planned: PlannedAction, avoid: list[str], busy: dict[str, Volume],
-                  new: dict[str, np.ndarray]) -> None | Failure:
+    def _transits(
+        self, a: Action, planned: PlannedAction, avoid: list[str], busy: dict[str, Volume], new: dict[str, np.ndarray]
+    ) -> None | Failure:
         """An arm action's empty-handed motions (``full``), into ``planned.paths``: home to the pre-grasp
         (the object to pick in the way too), the taker home to the exchange; then, with every object of the
         step at its new pose (``new``, the validator's home phase), back off along the place approach and go
@@ -318,7 +375,8 @@ class ReverseGrounder:
         g = self.g
         pick, place = np.array(planned.configs["pick"]), np.array(planned.configs["place"])
         asks: list[tuple[str, str, np.ndarray, np.ndarray, list[str], np.ndarray | None]] = [
-            ("to-pick", a.pick_robot, g.arm(a.pick_robot).home, pick[0], [*avoid, a.obj], None)]
+            ("to-pick", a.pick_robot, g.arm(a.pick_robot).home, pick[0], [*avoid, a.obj], None)
+        ]
         after = sorted({*avoid, *new})
         if a.handover:
             giver, taker = np.array(planned.configs["handover"])
@@ -328,8 +386,9 @@ class ReverseGrounder:
         # the giver's motions share the validator's phases with the taker's: each keeps clear of the other's
         mine: dict[str, Volume] = {}
         if "to-handover" in planned.paths:
-            mine["to-handover"] = g.arm_volume(a.pick_robot, np.array(planned.paths["to-handover"]),
-                                               holding=(a.obj, a.pick_grasp))
+            mine["to-handover"] = g.arm_volume(
+                a.pick_robot, np.array(planned.paths["to-handover"]), holding=(a.obj, a.pick_grasp)
+            )
         initial = {o: g.poses[o] for o in new}
         try:
             for name, robot, start, goal, obstacles, via in asks:
@@ -338,8 +397,16 @@ class ReverseGrounder:
                     for o, pose in new.items():
                         g.move(o, pose)
                 other = ({a.pick_robot, a.place_robot} - {robot}) if phase != "to-pick" else set()
-                ans = g.transit(robot, start, goal, avoid=obstacles, busy=busy.get(phase, []) + mine.get(phase, []),
-                                via=via, partner=next(iter(other), None), phase=phase)
+                ans = g.transit(
+                    robot,
+                    start,
+                    goal,
+                    avoid=obstacles,
+                    busy=busy.get(phase, []) + mine.get(phase, []),
+                    via=via,
+                    partner=next(iter(other), None),
+                    phase=phase,
+                )
                 if not ans.ok:
                     return _failed(f"{name} of {robot}", ans)
                 planned.paths[name] = _configs(np.array(ans.path))
@@ -349,8 +416,15 @@ class ReverseGrounder:
                 g.move(o, pose)
         return None
 
-    def _drive(self, a: Action, avoid: list[str], v_fut: Volume, key: str,
-               placed: dict[str, np.ndarray], busy: dict[str, Volume]) -> PlannedAction | Failure:
+    def _drive(
+        self,
+        a: Action,
+        avoid: list[str],
+        v_fut: Volume,
+        key: str,
+        placed: dict[str, np.ndarray],
+        busy: dict[str, Volume],
+    ) -> PlannedAction | Failure:
         """A planar robot's action (path mode): drive from its start pose to the pick pose, carry the object
         to the place pose, drive back; every path free of fixed objects and of ``avoid``.  The drive home
         sees every object of the step at its new pose (the validator's home phase): the one just placed and
@@ -376,8 +450,9 @@ class ReverseGrounder:
                 return last or Failure(0, "", f"placement: no free pose of {a.obj} in {a.region}")
             assert spot.pose is not None
             q_place = pr.grasp_base(spot.pose, shape, a.place_grasp)
-            carry = g.base_path(robot, q_pick, q_place, holding=(a.obj, a.pick_grasp), avoid=avoid,
-                                busy=busy.get("to-place", []))
+            carry = g.base_path(
+                robot, q_pick, q_place, holding=(a.obj, a.pick_grasp), avoid=avoid, busy=busy.get("to-place", [])
+            )
             if not carry.ok:
                 last = _failed("carry to the placement", carry)
                 continue
@@ -393,11 +468,15 @@ class ReverseGrounder:
             if not back.ok:
                 last = _failed("drive home", back)
                 continue
-            planned = PlannedAction(a.obj, a.region, robot, robot, a.pick_grasp, a.place_grasp,
-                                    place_pose=_matrix(spot.pose))
+            planned = PlannedAction(
+                a.obj, a.region, robot, robot, a.pick_grasp, a.place_grasp, place_pose=_matrix(spot.pose)
+            )
             planned.configs = {"pick": _configs(q_pick), "place": _configs(q_place)}
-            planned.paths = {"to-pick": _configs(np.array(to_pick.path)), "to-place": _configs(np.array(carry.path)),
-                             "home": _configs(np.array(back.path))}
+            planned.paths = {
+                "to-pick": _configs(np.array(to_pick.path)),
+                "to-place": _configs(np.array(carry.path)),
+                "home": _configs(np.array(back.path)),
+            }
             return planned
         assert last is not None
         return last
@@ -407,14 +486,18 @@ class ReverseGrounder:
         for point in self.g.scene.handover_of.get(a.obj, ()):
             if point not in self.g.scene.handover_points:
                 continue
-            ans = self.g.handover(a.obj, point, a.pick_robot, a.pick_grasp, a.place_robot, a.place_grasp, avoid=avoid,
-                                  busy=busy)
+            ans = self.g.handover(
+                a.obj, point, a.pick_robot, a.pick_grasp, a.place_robot, a.place_grasp, avoid=avoid, busy=busy
+            )
             if ans.ok:
                 return point, ans
             failure = _failed(f"handover at {point}", ans)
             if ans.status is GroundStatus.COLLISION and not ans.blockers and not ans.detail.startswith(("hits", BUSY)):
-                failure = replace(failure, check=f"handover at {point}: the two arms collide",
-                                  bodies=tuple(sorted((a.pick_robot, a.place_robot))))
+                failure = replace(
+                    failure,
+                    check=f"handover at {point}: the two arms collide",
+                    bodies=tuple(sorted((a.pick_robot, a.place_robot))),
+                )
         return failure
 
 

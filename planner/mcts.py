@@ -82,8 +82,15 @@ class SearchResult:
 class MCTS:
     """The search; ``ground(skeleton, suffix)`` evaluates, ``sources(M*, moved)`` makes skeleton sources."""
 
-    def __init__(self, ground: Callable[[Skeleton, list[GroundedStep]], Grounding], sources: SourceFactory,
-                 must_move: set[str], c: float = 1.0, alpha: float = 1.0, k: int = 5) -> None:
+    def __init__(
+        self,
+        ground: Callable[[Skeleton, list[GroundedStep]], Grounding],
+        sources: SourceFactory,
+        must_move: set[str],
+        c: float = 1.0,
+        alpha: float = 1.0,
+        k: int = 5,
+    ) -> None:
         self.ground = ground
         self.sources = sources
         self.c, self.alpha, self.k = c, alpha, k
@@ -94,8 +101,14 @@ class MCTS:
         self.memo: set[tuple[frozenset[tuple[str, ...]], frozenset[object]]] = set()
         #: the best full plan found so far (by makespan, then objects moved)
         self.best: list[GroundedStep] | None = None
-        self.stats: dict[str, float] = {"groundings": 0, "grounding_seconds": 0.0, "skeleton_seconds": first_skeletons,
-                                        "skeletons": len(self.root.edges), "nodes": 1, "memo_hits": 0}
+        self.stats: dict[str, float] = {
+            "groundings": 0,
+            "grounding_seconds": 0.0,
+            "skeleton_seconds": first_skeletons,
+            "skeletons": len(self.root.edges),
+            "nodes": 1,
+            "memo_hits": 0,
+        }
 
     def q(self, node: Node, e: Edge) -> float:
         """The edge's upper confidence bound (PUCT with the skeleton prior)."""
@@ -110,8 +123,7 @@ class MCTS:
                 if time.perf_counter() >= deadline:
                     return SearchResult(self.best, it - 1, self.stats, "time limit")
                 if not self._iterate(anytime):
-                    return SearchResult(self.best, it, self.stats,
-                                        "solved" if self.best is not None else "exhausted")
+                    return SearchResult(self.best, it, self.stats, "solved" if self.best is not None else "exhausted")
                 if self.best is not None and not anytime:
                     return SearchResult(self.best, it, self.stats, "solved")
         except KeyboardInterrupt:
@@ -154,8 +166,10 @@ class MCTS:
         return True
 
     def _expand(self, node: Node, edge: Edge) -> tuple[list[GroundedStep] | None, float]:
-        memo_key = (frozenset((a.object, a.region, a.pick_robot, a.place_robot) for s in node.suffix
-                              for a in s.actions), edge.skeleton.actions)
+        memo_key = (
+            frozenset((a.object, a.region, a.pick_robot, a.place_robot) for s in node.suffix for a in s.actions),
+            edge.skeleton.actions,
+        )
         if memo_key in self.memo:
             self.stats["memo_hits"] += 1
             edge.dead = True

@@ -92,8 +92,9 @@ class BlockingCycle:
     def line(self) -> str:
         """The cycle in one line."""
         ring = " -> ".join(self.objects + self.objects[:1])
-        return f"blocking cycle {ring}: " + "; ".join(f"every pick of {o} is obstructed by {b} ({how})"
-                                                       for o, b, how in self.edges)
+        return f"blocking cycle {ring}: " + "; ".join(
+            f"every pick of {o} is obstructed by {b} ({how})" for o, b, how in self.edges
+        )
 
 
 @dataclass
@@ -132,9 +133,23 @@ class Why:
         return {
             "summary": self.summary,
             "facts": list(self.facts),
-            "cycles": [{"objects": list(c.objects), "edges": [{"object": o, "blocker": b, "how": how}
-                                                              for o, b, how in c.edges]} for c in self.cycles],
+            "cycles": [
+                {
+                    "objects": list(c.objects),
+                    "edges": [{"object": o, "blocker": b, "how": how} for o, b, how in c.edges],
+                }
+                for c in self.cycles
+            ],
             "rejected_plans": self.rejected_plans,
-            "grounding_failures": [{"step": f.step, "action": f.action, "check": f.check, "bodies": list(f.bodies),
-                                    "detail": f.detail, "count": count} for f, count in self.top_failures(n)],
+            "grounding_failures": [
+                {
+                    "step": f.step,
+                    "action": f.action,
+                    "check": f.check,
+                    "bodies": list(f.bodies),
+                    "detail": f.detail,
+                    "count": count,
+                }
+                for f, count in self.top_failures(n)
+            ],
         }

@@ -37,17 +37,29 @@ class FactsFile:
     assets: dict[str, bytes] = field(default_factory=dict)
 
 
-def facts_file(mf: MrgFile, problem: Problem, facts: list[Fact], seed: int, version: str,
-               out_path: str | None) -> FactsFile:
+def facts_file(
+    mf: MrgFile, problem: Problem, facts: list[Fact], seed: int, version: str, out_path: str | None
+) -> FactsFile:
     """The facts file of ``problem`` (from ``mf``) with ``facts``, to be written at ``out_path`` (None:
     standard output, read as if beside the problem file)."""
     from mrgc.language.edit import facts_document
 
-    header = (f"facts of problem {problem.name} computed by mrgc {version} (seed {seed}) from "
-              f"{os.path.basename(mf.path)}: {len(facts)} facts")
+    header = (
+        f"facts of problem {problem.name} computed by mrgc {version} (seed {seed}) from "
+        f"{os.path.basename(mf.path)}: {len(facts)} facts"
+    )
     relocation = _Relocation(mf.path, out_path) if out_path is not None else None
-    text = facts_document(mf.syntax, problem.name, problem.domain.name, problem.domain.source, facts, mf.path,
-                          out_path, header, relocation.path if relocation is not None else None)
+    text = facts_document(
+        mf.syntax,
+        problem.name,
+        problem.domain.name,
+        problem.domain.source,
+        facts,
+        mf.path,
+        out_path,
+        header,
+        relocation.path if relocation is not None else None,
+    )
     return FactsFile(text, relocation.assets if relocation is not None else {})
 
 
@@ -80,9 +92,16 @@ class _Relocation:
 
             for mesh in referenced_files(parse_urdf(target)):
                 if not inside(mesh, (self.root,)):
-                    raise InputError([Diagnostic("E236", f"robot URDF '{written}' names mesh file '{mesh}' outside "
-                                                 f"the folder tree of {self.root}: it cannot be copied beside the "
-                                                 f"output; write the facts beside the problem file instead")])
+                    raise InputError(
+                        [
+                            Diagnostic(
+                                "E236",
+                                f"robot URDF '{written}' names mesh file '{mesh}' outside "
+                                f"the folder tree of {self.root}: it cannot be copied beside the "
+                                f"output; write the facts beside the problem file instead",
+                            )
+                        ]
+                    )
                 self._copy(mesh)
         return os.path.relpath(self._copy_path(target), self.out_dir).replace(os.sep, "/")
 

@@ -25,10 +25,10 @@ SCHEMA = "mrgc-plan/1"
 #: ``motion_model.arms`` -> what an arm's motions in the plan are
 ARM_MODELS: dict[str, str] = {
     "configurations": "the paper's packaging model: pick and place approaches (pre-grasp to grasp) and the "
-                      "handover configurations; a transfer holding the object is a straight joint-space move "
-                      "unless the plan gives its path; empty-handed transit is not modelled",
+    "handover configurations; a transfer holding the object is a straight joint-space move "
+    "unless the plan gives its path; empty-handed transit is not modelled",
     "full": "every motion is a path: to-pick, to-handover, taker-to-handover, to-place, home, giver-home, "
-            "besides the approaches and handover configurations",
+    "besides the approaches and handover configurations",
 }
 #: ``motion_model.planar`` -> what a planar robot's motions in the plan are
 PLANAR_MODELS: dict[str, str] = {
@@ -55,16 +55,24 @@ class MotionModel:
 
     def to_json(self) -> dict[str, Any]:
         """The motion model as the plan's ``motion_model``."""
-        return {"arms": self.arms, "planar": self.planar,
-                "approach": {"configurations": self.approach_configurations, "back_off": self.approach_back_off},
-                "resolution": self.resolution}
+        return {
+            "arms": self.arms,
+            "planar": self.planar,
+            "approach": {"configurations": self.approach_configurations, "back_off": self.approach_back_off},
+            "resolution": self.resolution,
+        }
 
     @classmethod
     def from_json(cls, data: dict[str, Any]) -> "MotionModel":
         """The model of a schema-checked ``motion_model`` object."""
         approach = data["approach"]
-        return cls(data["arms"], data["planar"], approach["configurations"], float(approach["back_off"]),
-                   float(data["resolution"]))
+        return cls(
+            data["arms"],
+            data["planar"],
+            approach["configurations"],
+            float(approach["back_off"]),
+            float(data["resolution"]),
+        )
 
 
 def planner_motion_model(arms: str = "configurations") -> MotionModel:
@@ -105,9 +113,13 @@ class PlannedAction:
     def to_json(self) -> dict[str, Any]:
         """The action as the plan's JSON holds it."""
         out: dict[str, Any] = {
-            "kind": self.kind, "object": self.object, "region": self.region,
-            "pick_robot": self.pick_robot, "place_robot": self.place_robot,
-            "pick_grasp": self.pick_grasp, "place_grasp": self.place_grasp,
+            "kind": self.kind,
+            "object": self.object,
+            "region": self.region,
+            "pick_robot": self.pick_robot,
+            "place_robot": self.place_robot,
+            "pick_grasp": self.pick_grasp,
+            "place_grasp": self.place_grasp,
         }
         if self.place_pose is not None:
             out["place_pose"] = self.place_pose
@@ -176,8 +188,10 @@ class Plan:
             **({} if self.symbolic else {"motion_model": (self.motion_model or planner_motion_model()).to_json()}),
             "makespan": self.makespan if self.steps else None,
             "motion_cost": self.motion_cost if self.steps else None,
-            "steps": [{"index": i, "actions": [a.to_json() for a in step],
-                       "waiting": self._waiting(step)} for i, step in enumerate(self.steps, 1)],
+            "steps": [
+                {"index": i, "actions": [a.to_json() for a in step], "waiting": self._waiting(step)}
+                for i, step in enumerate(self.steps, 1)
+            ],
             **({"validation": self.validation} if self.validation is not None else {}),
             **({"why": self.why.to_json()} if self.why is not None else {}),
             "stats": self.stats,
@@ -193,8 +207,10 @@ class Plan:
 
     def summary(self) -> list[str]:
         """The plan in a few lines, as ``mrgc plan`` prints it."""
-        lines = [f"plan for {self.problem}: {self.status}"
-                 + (f", makespan {self.makespan}, {self.motion_cost} objects moved" if self.steps else "")]
+        lines = [
+            f"plan for {self.problem}: {self.status}"
+            + (f", makespan {self.makespan}, {self.motion_cost} objects moved" if self.steps else "")
+        ]
         for i, step in enumerate(self.steps, 1):
             parts = []
             for a in step:

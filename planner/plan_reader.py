@@ -76,8 +76,10 @@ class Action:
         """``r1 moves o1 to bin (top)`` / ``r1->r2 moves o1 to bin (top->side-x+)``."""
         if not self.handover:
             return f"{self.pick_robot} moves {self.object} to {self.region} ({self.pick_grasp})"
-        return (f"{self.pick_robot}->{self.place_robot} moves {self.object} to {self.region} "
-                f"({self.pick_grasp}->{self.place_grasp})")
+        return (
+            f"{self.pick_robot}->{self.place_robot} moves {self.object} to {self.region} "
+            f"({self.pick_grasp}->{self.place_grasp})"
+        )
 
 
 @dataclass(frozen=True)
@@ -138,8 +140,15 @@ def _read_text(path: str) -> str:
         if not stat.S_ISREG(st.st_mode):
             raise OSError("it is not a regular file")
         if st.st_size > MAX_BYTES:
-            raise InputError([Diagnostic(E_LIMIT, f"plan {path!r} is {st.st_size} bytes; a plan file may hold at "
-                                                  f"most {MAX_BYTES} ({MAX_BYTES // 2**20} MiB)")])
+            raise InputError(
+                [
+                    Diagnostic(
+                        E_LIMIT,
+                        f"plan {path!r} is {st.st_size} bytes; a plan file may hold at "
+                        f"most {MAX_BYTES} ({MAX_BYTES // 2**20} MiB)",
+                    )
+                ]
+            )
         with open(path, "rb") as fh:
             raw = fh.read(MAX_BYTES + 1)
         if len(raw) > MAX_BYTES:
@@ -166,8 +175,15 @@ def check_limits(text: str, where: str = "plan") -> None:
             if depth > MAX_DEPTH:
                 line = text.count("\n", 0, m.start()) + 1
                 col = m.start() - (text.rfind("\n", 0, m.start()) + 1) + 1
-                raise InputError([Diagnostic(E_LIMIT, f"plan nests arrays and objects more than {MAX_DEPTH} deep "
-                                                      f"(a plan needs 8)", Span(where, line, col, line, col + 1))])
+                raise InputError(
+                    [
+                        Diagnostic(
+                            E_LIMIT,
+                            f"plan nests arrays and objects more than {MAX_DEPTH} deep (a plan needs 8)",
+                            Span(where, line, col, line, col + 1),
+                        )
+                    ]
+                )
         elif ch in "]}":
             depth -= 1
 
@@ -209,12 +225,22 @@ def _no_duplicates(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
 def parse_json(text: str, where: str = "plan") -> Any:
     """The JSON value of ``text`` (InputError E501 when it is not JSON, E504 for a refused number)."""
     try:
-        return json.loads(text, parse_constant=_no_constant, parse_int=_parse_int, parse_float=_parse_float,
-                          object_pairs_hook=_no_duplicates)
+        return json.loads(
+            text,
+            parse_constant=_no_constant,
+            parse_int=_parse_int,
+            parse_float=_parse_float,
+            object_pairs_hook=_no_duplicates,
+        )
     except json.JSONDecodeError as exc:
         span = Span(where, exc.lineno, exc.colno, exc.lineno, exc.colno + 1)
-        what = ("it is empty" if not text.strip() else
-                f"it ends early (truncated?): {exc.msg}" if _ends_early(text) else exc.msg)
+        what = (
+            "it is empty"
+            if not text.strip()
+            else f"it ends early (truncated?): {exc.msg}"
+            if _ends_early(text)
+            else exc.msg
+        )
         raise InputError([Diagnostic(E_JSON, f"plan is not JSON: {what}", span)], {where: text}) from None
     except _Refused as exc:
         at = text.find(exc.literal)
@@ -255,13 +281,13 @@ def check_schema(plan: Any, where: str = "plan") -> None:
     """Raise InputError E503 (another schema version) or E502 (not following docs/plan.schema.json)."""
     if isinstance(plan, dict) and "schema" in plan and plan["schema"] != SCHEMA:
         shown = plan["schema"] if isinstance(plan["schema"], str) else json.dumps(plan["schema"])[:40]
-        raise InputError([Diagnostic(E_VERSION, f"{where}: schema {shown!r} is not supported "
-                                                f"(this mrgc reads {SCHEMA!r})")])
+        raise InputError(
+            [Diagnostic(E_VERSION, f"{where}: schema {shown!r} is not supported (this mrgc reads {SCHEMA!r})")]
+        )
     errors = schema_errors(plan)
     if errors:
         more = f" (and {len(errors) - 1} more)" if len(errors) > 1 else ""
-        raise InputError([Diagnostic(E_SCHEMA, f"{where} does not follow the plan schema {SCHEMA}: "
-                                               f"{errors[0]}{more}")])
+        raise InputError([Diagnostic(E_SCHEMA, f"{where} does not follow the plan schema {SCHEMA}: {errors[0]}{more}")])
 
 
 def schema_errors(plan: Any, limit: int = 20) -> list[str]:
@@ -272,8 +298,15 @@ def schema_errors(plan: Any, limit: int = 20) -> list[str]:
     return [_describe(e) for e in errors]
 
 
-_ARTICLE = {"object": "an object", "array": "an array", "string": "a string", "integer": "an integer",
-            "number": "a finite number", "boolean": "true or false", "null": "null"}
+_ARTICLE = {
+    "object": "an object",
+    "array": "an array",
+    "string": "a string",
+    "integer": "an integer",
+    "number": "a finite number",
+    "boolean": "true or false",
+    "null": "null",
+}
 
 
 def _where(path: Any) -> str:
@@ -309,8 +342,12 @@ def _describe(e: Any) -> str:
         want = f"{lo}" if lo == hi else f"{lo} to {hi}" if hi is not None else f"at least {lo}"
         return f"{at} should hold {want} items, not {len(value)}"
     if kw in ("minimum", "exclusiveMinimum", "maximum", "exclusiveMaximum"):
-        words = {"minimum": "at least", "exclusiveMinimum": "more than", "maximum": "at most",
-                 "exclusiveMaximum": "less than"}
+        words = {
+            "minimum": "at least",
+            "exclusiveMinimum": "more than",
+            "maximum": "at most",
+            "exclusiveMaximum": "less than",
+        }
         return f"{at} should be {words[kw]} {arg}, not {_show(value)}"
     if kw in ("minLength", "maxLength"):
         return f"{at} should be {'at least' if kw == 'minLength' else 'at most'} {arg} characters long"
@@ -331,15 +368,24 @@ def read_plan(data: Any, where: str = "plan") -> PlanFile:
         check_schema(data, where)
     model = data.get("motion_model")
     return PlanFile(
-        schema=data["schema"], mrgc_version=data["mrgc_version"], problem=data["problem"],
-        problem_file=data["problem_file"], problem_sha256=data["problem_sha256"], backend=data["backend"],
-        encoding=data["encoding"], seed=int(data["seed"]), status=data["status"], symbolic=data["symbolic"],
+        schema=data["schema"],
+        mrgc_version=data["mrgc_version"],
+        problem=data["problem"],
+        problem_file=data["problem_file"],
+        problem_sha256=data["problem_sha256"],
+        backend=data["backend"],
+        encoding=data["encoding"],
+        seed=int(data["seed"]),
+        status=data["status"],
+        symbolic=data["symbolic"],
         makespan=None if data["makespan"] is None else int(data["makespan"]),
         motion_cost=None if data["motion_cost"] is None else int(data["motion_cost"]),
-        steps=tuple(Step(int(s["index"]), tuple(_action(a) for a in s["actions"]), tuple(s["waiting"]))
-                    for s in data["steps"]),
+        steps=tuple(
+            Step(int(s["index"]), tuple(_action(a) for a in s["actions"]), tuple(s["waiting"])) for s in data["steps"]
+        ),
         motion_model=MotionModel.from_json(model) if model is not None else None,
-        problem_digest=data.get("problem_digest"))
+        problem_digest=data.get("problem_digest"),
+    )
 
 
 def _motion(qs: list[list[float]]) -> Motion:
@@ -348,7 +394,16 @@ def _motion(qs: list[list[float]]) -> Motion:
 
 def _action(a: dict[str, Any]) -> Action:
     pose = a.get("place_pose")
-    return Action(a["kind"], a["object"], a["region"], a["pick_robot"], a["place_robot"], a["pick_grasp"],
-                  a["place_grasp"], None if pose is None else _motion(pose), a.get("handover_point"),
-                  {k: _motion(v) for k, v in a.get("configs", {}).items()},
-                  {k: _motion(v) for k, v in a.get("paths", {}).items()})
+    return Action(
+        a["kind"],
+        a["object"],
+        a["region"],
+        a["pick_robot"],
+        a["place_robot"],
+        a["pick_grasp"],
+        a["place_grasp"],
+        None if pose is None else _motion(pose),
+        a.get("handover_point"),
+        {k: _motion(v) for k, v in a.get("configs", {}).items()},
+        {k: _motion(v) for k, v in a.get("paths", {}).items()},
+    )

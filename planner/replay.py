@@ -101,8 +101,14 @@ class _Stop(Exception):
     """The first violation is known and no more are wanted."""
 
 
-def replay(problem: Problem, model: MotionModel, steps: Sequence[Sequence[Action]], usable: set[int],
-           stats: dict[str, Any], first_only: bool = False) -> list[Violation]:
+def replay(
+    problem: Problem,
+    model: MotionModel,
+    steps: Sequence[Sequence[Action]],
+    usable: set[int],
+    stats: dict[str, Any],
+    first_only: bool = False,
+) -> list[Violation]:
     """The geometric violations of a plan whose actions (``usable``: ids of the name-checked ones) are
     ``steps``, under motion model ``model``; fills ``stats`` with the configurations and distance queries
     checked.  ``first_only``: stop at the end of the first phase or check that finds a violation (a
@@ -179,8 +185,16 @@ class _Replayer(ActionReader):
                         role, grasp_role = PATH_PHASES[name][:2]
                         robot, grasp = a.robot(role), a.grasp(grasp_role)
                         label = f"straight {name} transfer" if name in a.straight else f"{name} path"
-                        out.append(_Track(robot, a.paths[name], label, a.obj if grasp else None, grasp,
-                                          self.fingers(robot, a.obj, grasp)))
+                        out.append(
+                            _Track(
+                                robot,
+                                a.paths[name],
+                                label,
+                                a.obj if grasp else None,
+                                grasp,
+                                self.fingers(robot, a.obj, grasp),
+                            )
+                        )
             return out
 
         def others(tracks: list[_Track]) -> list[str]:
@@ -192,22 +206,43 @@ class _Replayer(ActionReader):
         for a in geo:
             qs, robot = a.configs["pick"], a.action.pick_robot
             contact = max(0.0, (len(qs) - 2) / (len(qs) - 1)) if len(qs) > 1 else 0.0
-            tracks.append(_Track(robot, qs, "pick", fingers=self.fingers(robot, a.obj, a.action.pick_grasp),
-                                 exempt=None if self.planar[robot] else a.obj, exempt_from=contact))
+            tracks.append(
+                _Track(
+                    robot,
+                    qs,
+                    "pick",
+                    fingers=self.fingers(robot, a.obj, a.action.pick_grasp),
+                    exempt=None if self.planar[robot] else a.obj,
+                    exempt_from=contact,
+                )
+            )
         self._sweep(t, "pick", tracks, others(tracks), everything)
         self._sweep(t, "to-handover", paths("to-handover", "taker-to-handover"), waiting, present)
         tracks = []
         for a in geo:
             if a.handover:
-                h, (giver, taker), (g1, g2) = a.configs["handover"], a.action.robots(), (a.action.pick_grasp,
-                                                                                         a.action.place_grasp)
+                h, (giver, taker), (g1, g2) = (
+                    a.configs["handover"],
+                    a.action.robots(),
+                    (a.action.pick_grasp, a.action.place_grasp),
+                )
                 tracks.append(_Track(giver, h[:1], "handover (giver)", a.obj, g1, self.fingers(giver, a.obj, g1)))
-                tracks.append(_Track(taker, h[1:], "handover (taker)", a.obj, g2, self.fingers(taker, a.obj, g2),
-                                     carries=False))
+                tracks.append(
+                    _Track(taker, h[1:], "handover (taker)", a.obj, g2, self.fingers(taker, a.obj, g2), carries=False)
+                )
         self._sweep(t, "handover", tracks, waiting, present)
         self._sweep(t, "to-place", paths("to-place"), waiting, present)
-        tracks = [_Track(a.action.place_robot, a.configs["place"], "place", a.obj, a.action.place_grasp,
-                         self.fingers(a.action.place_robot, a.obj, a.action.place_grasp)) for a in geo]
+        tracks = [
+            _Track(
+                a.action.place_robot,
+                a.configs["place"],
+                "place",
+                a.obj,
+                a.action.place_grasp,
+                self.fingers(a.action.place_robot, a.obj, a.action.place_grasp),
+            )
+            for a in geo
+        ]
         self._sweep(t, "place", tracks, others(tracks), present)
         for a in acts:
             if a.place_pose is None:
@@ -215,8 +250,13 @@ class _Replayer(ActionReader):
             self.poses[a.obj] = a.place_pose
             if not inside(self.scene.body(a.action.region), self.shapes[a.obj], a.place_pose):
                 p = a.place_pose[:3, 3]
-                self._v(t, a.obj, "outside-region", f"the placement of {a.obj} at ({p[0]:.3f}, {p[1]:.3f}, {p[2]:.3f}) "
-                                                    f"is not entirely inside region {a.action.region}")
+                self._v(
+                    t,
+                    a.obj,
+                    "outside-region",
+                    f"the placement of {a.obj} at ({p[0]:.3f}, {p[1]:.3f}, {p[2]:.3f}) "
+                    f"is not entirely inside region {a.action.region}",
+                )
         self._sweep(t, "home", paths("home", "giver-home"), waiting, everything)
         placed = [a for a in acts if a.place_pose is not None]
         self._placements(t, placed)
@@ -228,8 +268,9 @@ class _Replayer(ActionReader):
         if not tracks or self.budget_spent or not self._within_budget(t, phase, tracks):
             return
         others = self._stage(tracks, static, present)
-        times = np.unique(np.concatenate([sample_times(tr.configs, self.planar[tr.robot], self.resolution)
-                                          for tr in tracks]))
+        times = np.unique(
+            np.concatenate([sample_times(tr.configs, self.planar[tr.robot], self.resolution) for tr in tracks])
+        )
         for s in times:
             self._sample(t, phase, tracks, static, others, float(s))
             if self.first_only and self._worst:
@@ -244,13 +285,22 @@ class _Replayer(ActionReader):
         n = max(counts)
         if n > MAX_SAMPLES:
             tr = tracks[counts.index(n)]
-            self._v(t, tr.robot, "too-long",
-                    f"{phase}: the {tr.label} motion of {tr.robot} is too long to check "
-                    f"({n} samples at {self.resolution:g} rad or m each; at most {MAX_SAMPLES})")
+            self._v(
+                t,
+                tr.robot,
+                "too-long",
+                f"{phase}: the {tr.label} motion of {tr.robot} is too long to check "
+                f"({n} samples at {self.resolution:g} rad or m each; at most {MAX_SAMPLES})",
+            )
             return False
         if self.samples + sum(counts) * len(tracks) > MAX_PLAN_SAMPLES:
-            self._v(t, None, "too-long", f"{phase}: the plan's motions need more than {MAX_PLAN_SAMPLES} robot "
-                                         f"samples in all; the rest of the plan's motions are not checked")
+            self._v(
+                t,
+                None,
+                "too-long",
+                f"{phase}: the plan's motions need more than {MAX_PLAN_SAMPLES} robot "
+                f"samples in all; the rest of the plan's motions are not checked",
+            )
             self.budget_spent = True
             return False
         return True
@@ -276,8 +326,7 @@ class _Replayer(ActionReader):
         self._boxes = {b: self.rs.aabb(b) for b in (*self.fixed, *others, *static)}
         return others
 
-    def _sample(self, t: int, phase: str, tracks: list[_Track], static: list[str], others: list[str],
-                s: float) -> None:
+    def _sample(self, t: int, phase: str, tracks: list[_Track], static: list[str], others: list[str], s: float) -> None:
         """Every moving robot (and what it holds) at time ``s`` of the phase, checked against the scene, the
         other moving robots and the robots at home."""
         rs = self.rs
@@ -309,8 +358,14 @@ class _Replayer(ActionReader):
         bounding boxes, grown by 1 mm, are apart)."""
         a0, a1, a2, a3, a4, a5 = self._boxes[a]
         b0, b1, b2, b3, b4, b5 = self._boxes[b]
-        if (a0 > b3 + BOX_PAD or a1 > b4 + BOX_PAD or a2 > b5 + BOX_PAD or b0 > a3 + BOX_PAD or b1 > a4 + BOX_PAD
-                or b2 > a5 + BOX_PAD):
+        if (
+            a0 > b3 + BOX_PAD
+            or a1 > b4 + BOX_PAD
+            or a2 > b5 + BOX_PAD
+            or b0 > a3 + BOX_PAD
+            or b1 > a4 + BOX_PAD
+            or b2 > a5 + BOX_PAD
+        ):
             return None
         return self.rs.closest(a, b)
 
@@ -337,17 +392,28 @@ class _Replayer(ActionReader):
         ha = a.holding if a.holding and a.carries else None
         hb = b.holding if b.holding and b.carries else None
         if hb and hb != a.holding:
-            self._hit(t, phase, a.robot, hb, self._closest(a.robot, hb), da, (f"{hb} held by {b.robot}", wb),
-                      "robot-object")
+            self._hit(
+                t, phase, a.robot, hb, self._closest(a.robot, hb), da, (f"{hb} held by {b.robot}", wb), "robot-object"
+            )
         if ha and ha != b.holding:
-            self._hit(t, phase, b.robot, ha, self._closest(b.robot, ha), db, (f"{ha} held by {a.robot}", wa),
-                      "robot-object")
+            self._hit(
+                t, phase, b.robot, ha, self._closest(b.robot, ha), db, (f"{ha} held by {a.robot}", wa), "robot-object"
+            )
         if ha and hb and ha != hb:
-            self._hit(t, phase, ha, hb, self._closest(ha, hb), (f"{ha} held by {a.robot}", wa),
-                      (f"{hb} held by {b.robot}", wb), "object-object")
+            self._hit(
+                t,
+                phase,
+                ha,
+                hb,
+                self._closest(ha, hb),
+                (f"{ha} held by {a.robot}", wa),
+                (f"{hb} held by {b.robot}", wb),
+                "object-object",
+            )
 
-    def _hit(self, t: int, phase: str, a: str, b: str, c: Any, da: tuple[str, str], db: tuple[str, str],
-             kind: str) -> None:
+    def _hit(
+        self, t: int, phase: str, a: str, b: str, c: Any, da: tuple[str, str], db: tuple[str, str], kind: str
+    ) -> None:
         """Record a penetration deeper than CONTACT_TOL between ``a`` and ``b`` (described by (label, when)),
         keeping the deepest per (step, phase, pair)."""
         if c is None or c.distance >= -CONTACT_TOL:
@@ -387,8 +453,16 @@ class _Replayer(ActionReader):
             for other in self.movable:
                 if other != o and frozenset((o, other)) not in done:
                     done.add(frozenset((o, other)))
-                    self._hit(t, "placement", o, other, rs.closest(o, other), (f"{o} placed", ""), (other, ""),
-                              "object-object")
+                    self._hit(
+                        t,
+                        "placement",
+                        o,
+                        other,
+                        rs.closest(o, other),
+                        (f"{o} placed", ""),
+                        (other, ""),
+                        "object-object",
+                    )
             for r in self.planar:
                 self._hit(t, "placement", o, r, rs.closest(o, r), (f"{o} placed", ""), (r, "at home"), "robot-object")
 
@@ -445,22 +519,39 @@ class _Replayer(ActionReader):
             if not self.support[o]:
                 floor = self._floor_gap(o)
                 p = self.poses[o][:3, 3]
-                above = (f"its lowest point is {floor[0] * 1e3:.1f} mm above the floor of {floor[1]}" if floor
-                         else "no region lies under it")
-                self._v(t, o, "floating", f"{o} is released at ({p[0]:.3f}, {p[1]:.3f}, {p[2]:.3f}) resting on "
-                                          f"nothing: {above}, and nothing is within {SUPPORT_TOL * 1e3:g} mm under it")
+                above = (
+                    f"its lowest point is {floor[0] * 1e3:.1f} mm above the floor of {floor[1]}"
+                    if floor
+                    else "no region lies under it"
+                )
+                self._v(
+                    t,
+                    o,
+                    "floating",
+                    f"{o} is released at ({p[0]:.3f}, {p[1]:.3f}, {p[2]:.3f}) resting on "
+                    f"nothing: {above}, and nothing is within {SUPPORT_TOL * 1e3:g} mm under it",
+                )
         for o in self.movable:
             lost = self.support[o] & moved
             if o in moved or not lost:
                 continue
             self.support[o] = self._supports(o)
             if not self.support[o]:
-                self._v(t, o, "floating", f"{o} rested on {', '.join(sorted(lost))}, which the step moves away: "
-                                          f"nothing holds it up now")
+                self._v(
+                    t,
+                    o,
+                    "floating",
+                    f"{o} rested on {', '.join(sorted(lost))}, which the step moves away: nothing holds it up now",
+                )
 
     def goals(self) -> None:
         for obj, region in sorted(self.scene.goal.items()):
             if not inside(self.scene.body(region), self.shapes[obj], self.poses[obj]):
                 p = self.poses[obj][:3, 3]
-                self._v(None, obj, "goal", f"goal (in-region {obj} {region}) does not hold at the end: {obj} is at "
-                                           f"({p[0]:.3f}, {p[1]:.3f}, {p[2]:.3f}), not entirely inside {region}")
+                self._v(
+                    None,
+                    obj,
+                    "goal",
+                    f"goal (in-region {obj} {region}) does not hold at the end: {obj} is at "
+                    f"({p[0]:.3f}, {p[1]:.3f}, {p[2]:.3f}), not entirely inside {region}",
+                )

@@ -49,8 +49,10 @@ HANDOVER_PATHS = ("to-handover", "taker-to-handover", "giver-home")
 REQUIRED_PATHS: dict[tuple[bool, str], tuple[tuple[str, ...], tuple[str, ...]]] = {
     (True, "paths"): (("to-pick", "to-place", "home"), ()),
     (False, "configurations"): ((), ()),
-    (False, "full"): (("to-pick", "to-place", "home"), ("to-pick", "to-handover", "taker-to-handover", "to-place",
-                                                        "home", "giver-home")),
+    (False, "full"): (
+        ("to-pick", "to-place", "home"),
+        ("to-pick", "to-handover", "taker-to-handover", "to-place", "home", "giver-home"),
+    ),
 }
 #: holding transfers an arm makes in a straight joint-space line when the plan gives no path (configurations
 #: model): path name -> (from, to) as in PATH_PHASES
@@ -162,12 +164,22 @@ class ActionReader:
         """The plan's motion model is one this validator knows how to check ``[motion-model]``."""
         m = self.model
         if abs(m.approach_back_off - APPROACH) > 1e-9:
-            self._v(None, None, "motion-model", f"the motion model's approach back-off is {m.approach_back_off:g} m; "
-                                                f"the grasp specification's pre-grasp stands {APPROACH:g} m back")
+            self._v(
+                None,
+                None,
+                "motion-model",
+                f"the motion model's approach back-off is {m.approach_back_off:g} m; "
+                f"the grasp specification's pre-grasp stands {APPROACH:g} m back",
+            )
         if m.approach_configurations < MIN_APPROACH_CONFIGURATIONS:
-            self._v(None, None, "motion-model", f"the motion model's approaches hold {m.approach_configurations} "
-                                                f"configurations; at least {MIN_APPROACH_CONFIGURATIONS} are needed "
-                                                f"(the object is exempt only in the last segment)")
+            self._v(
+                None,
+                None,
+                "motion-model",
+                f"the motion model's approaches hold {m.approach_configurations} "
+                f"configurations; at least {MIN_APPROACH_CONFIGURATIONS} are needed "
+                f"(the object is exempt only in the last segment)",
+            )
 
     # ------------------------------------------------------------------ reading one action
     def parse(self, t: int, a: Action) -> ActionGeometry:
@@ -177,17 +189,31 @@ class ActionReader:
         obj = a.object
         for robot, grasp in ((a.pick_robot, a.pick_grasp), (a.place_robot, a.place_grasp)):
             if self.planar[robot] and grasp not in PLANAR_GRASPS:
-                self._v(t, obj, "grasp", f"planar robot {robot} cannot use grasp {grasp!r} "
-                                         f"(side grasps only: {', '.join(PLANAR_GRASPS)})")
+                self._v(
+                    t,
+                    obj,
+                    "grasp",
+                    f"planar robot {robot} cannot use grasp {grasp!r} (side grasps only: {', '.join(PLANAR_GRASPS)})",
+                )
                 act.geometry = False
             elif not self.planar[robot] and grasp not in self.scene.grasp_specs:
-                self._v(t, obj, "grasp", f"grasp {grasp!r} has no geometric meaning (known: "
-                                         f"{', '.join(sorted(self.scene.grasp_specs))})")
+                self._v(
+                    t,
+                    obj,
+                    "grasp",
+                    f"grasp {grasp!r} has no geometric meaning (known: {', '.join(sorted(self.scene.grasp_specs))})",
+                )
                 act.geometry = False
-            elif not self.planar[robot] and not fits(self.scene.grasp(grasp), self.shapes[obj],
-                                                     self.scene.robot(robot).kind):
-                self._v(t, obj, "grasp", f"grasp {grasp!r} needs the fingers {self.opening(obj, grasp):.3f} m apart; "
-                                         f"{robot} opens {self.scene.robot(robot).kind.gripper_opening:g} m")
+            elif not self.planar[robot] and not fits(
+                self.scene.grasp(grasp), self.shapes[obj], self.scene.robot(robot).kind
+            ):
+                self._v(
+                    t,
+                    obj,
+                    "grasp",
+                    f"grasp {grasp!r} needs the fingers {self.opening(obj, grasp):.3f} m apart; "
+                    f"{robot} opens {self.scene.robot(robot).kind.gripper_opening:g} m",
+                )
                 act.geometry = False
         if a.handover and (self.planar[a.pick_robot] or self.planar[a.place_robot]):
             self._v(t, obj, "handover", "planar robots cannot hand objects over")
@@ -212,8 +238,7 @@ class ActionReader:
             return
         m = np.array(pose, dtype=float)
         r = m[:3, :3]
-        if (np.abs(r.T @ r - np.eye(3)).max() > 1e-6 or np.linalg.det(r) < 0
-                or np.abs(m[3] - [0, 0, 0, 1]).max() > 1e-9):
+        if np.abs(r.T @ r - np.eye(3)).max() > 1e-6 or np.linalg.det(r) < 0 or np.abs(m[3] - [0, 0, 0, 1]).max() > 1e-9:
             self._v(t, obj, "pose", "place_pose is not a rigid transform (orthonormal rotation, last row 0 0 0 1)")
             act.geometry = False
         elif np.abs(m[:3, 3]).max() > WORLD:
@@ -233,12 +258,12 @@ class ActionReader:
                 continue
             if phase == "handover":
                 if len(qs) != 2:
-                    self._v(t, obj, "missing", f"configs.handover holds {len(qs)} configurations, not 2 "
-                                               f"(giver, taker)")
+                    self._v(t, obj, "missing", f"configs.handover holds {len(qs)} configurations, not 2 (giver, taker)")
                     act.geometry = False
                     continue
-                ok = self.check_configs(t, a.pick_robot, "handover", qs[:1], obj) & \
-                    self.check_configs(t, a.place_robot, "handover", qs[1:], obj)
+                ok = self.check_configs(t, a.pick_robot, "handover", qs[:1], obj) & self.check_configs(
+                    t, a.place_robot, "handover", qs[1:], obj
+                )
             else:
                 ok = self.check_configs(t, robot, phase, qs, obj)
             if ok:
@@ -253,8 +278,12 @@ class ActionReader:
                 self._v(t, obj, "missing", "the handover names no handover_point")
                 act.geometry = False
             elif a.handover_point not in allowed:
-                self._v(t, obj, "handover", f"{obj} may not be handed over at {a.handover_point} "
-                                            f"(allowed: {', '.join(allowed)})")
+                self._v(
+                    t,
+                    obj,
+                    "handover",
+                    f"{obj} may not be handed over at {a.handover_point} (allowed: {', '.join(allowed)})",
+                )
         elif a.handover_point is not None:
             self._v(t, obj, "action", f"a pick-and-place names a handover point ({a.handover_point})")
 
@@ -278,8 +307,12 @@ class ActionReader:
             if name not in a.paths:
                 who = act.robot(PATH_PHASES[name][0])
                 model = f"planar {self.model.planar!r}" if planar else f"arms {self.model.arms!r}"
-                self._v(t, who, "missing", f"the action moving {obj} has no {name!r} path, which the motion "
-                                           f"model ({model}) requires")
+                self._v(
+                    t,
+                    who,
+                    "missing",
+                    f"the action moving {obj} has no {name!r} path, which the motion model ({model}) requires",
+                )
 
     def check_configs(self, t: int, robot: str, what: str, qs: Any, obj: str) -> bool:
         """Each configuration has one value per joint, lies in the world and within the joint limits."""
@@ -288,21 +321,36 @@ class ActionReader:
         for i, q in enumerate(qs, 1):
             if len(q) != rr.dof:
                 unit = "joints" if not rr.planar else "(x, y, yaw)"
-                self._v(t, robot, "config", f"{what} configuration {i} of {len(qs)} (moving {obj}) has {len(q)} "
-                                            f"values; {robot} has {rr.dof} {unit}")
+                self._v(
+                    t,
+                    robot,
+                    "config",
+                    f"{what} configuration {i} of {len(qs)} (moving {obj}) has {len(q)} "
+                    f"values; {robot} has {rr.dof} {unit}",
+                )
                 ok = False
                 continue
             v = np.asarray(q, dtype=float)
             if rr.planar and max(abs(v[0]), abs(v[1])) > WORLD:
-                self._v(t, robot, "config", f"{what} configuration {i} of {len(qs)} (moving {obj}) puts the base "
-                                            f"outside the world (|x|, |y| <= {WORLD:g} m)")
+                self._v(
+                    t,
+                    robot,
+                    "config",
+                    f"{what} configuration {i} of {len(qs)} (moving {obj}) puts the base "
+                    f"outside the world (|x|, |y| <= {WORLD:g} m)",
+                )
                 ok = False
                 continue
             bad = np.nonzero((v < rr.lower - LIMIT_TOL) | (v > rr.upper + LIMIT_TOL) | (np.abs(v) > WORLD))[0]
             for j in bad:
-                self._v(t, robot, "joint-limits", f"{what} configuration {i} of {len(qs)} (moving {obj}): "
-                                                  f"{rr.joint_names[j]} = {v[j]:.4f} is outside "
-                                                  f"[{rr.lower[j]:.4f}, {rr.upper[j]:.4f}]")
+                self._v(
+                    t,
+                    robot,
+                    "joint-limits",
+                    f"{what} configuration {i} of {len(qs)} (moving {obj}): "
+                    f"{rr.joint_names[j]} = {v[j]:.4f} is outside "
+                    f"[{rr.lower[j]:.4f}, {rr.upper[j]:.4f}]",
+                )
                 ok = False
         return ok
 
@@ -310,27 +358,44 @@ class ActionReader:
     def _check_grasps(self, act: ActionGeometry) -> None:
         a, t, obj = act.action, act.step, act.obj
         assert act.place_pose is not None
-        checks = [("pick", a.pick_robot, a.pick_grasp, self.poses[obj], "the object"),
-                  ("place", a.place_robot, a.place_grasp, act.place_pose, "place_pose")]
+        checks = [
+            ("pick", a.pick_robot, a.pick_grasp, self.poses[obj], "the object"),
+            ("place", a.place_robot, a.place_grasp, act.place_pose, "place_pose"),
+        ]
         for phase, robot, grasp, pose, what in checks:
             q = act.configs[phase][-1]
             if self.planar[robot]:
                 if len(act.configs[phase]) != 1:
-                    self._v(t, robot, "config", f"configs.{phase} of planar robot {robot} holds "
-                                                f"{len(act.configs[phase])} base poses, not 1 (its motions are paths)")
+                    self._v(
+                        t,
+                        robot,
+                        "config",
+                        f"configs.{phase} of planar robot {robot} holds "
+                        f"{len(act.configs[phase])} base poses, not 1 (its motions are paths)",
+                    )
                 want = self._grasp_base(robot, obj, grasp, pose)
                 dp = float(np.hypot(q[0] - want[0], q[1] - want[1]))
                 dr = abs(wrap_angle(float(q[2] - want[2])))
                 if dp > POS_TOL or dr > ROT_TOL:
-                    self._v(t, robot, "grasp", f"the last {phase} base pose of {robot} is {dp * 1e3:.1f} mm, "
-                                               f"{dr:.3f} rad from where grasp {grasp!r} of {obj} puts it (at "
-                                               f"{what}; tolerance {POS_TOL * 1e3:g} mm, {ROT_TOL} rad)")
+                    self._v(
+                        t,
+                        robot,
+                        "grasp",
+                        f"the last {phase} base pose of {robot} is {dp * 1e3:.1f} mm, "
+                        f"{dr:.3f} rad from where grasp {grasp!r} of {obj} puts it (at "
+                        f"{what}; tolerance {POS_TOL * 1e3:g} mm, {ROT_TOL} rad)",
+                    )
                 continue
             dp, dr = _pose_error(self.tool(robot, q), pose @ grasp_transform(self.scene.grasp(grasp), self.shapes[obj]))
             if dp > POS_TOL or dr > ROT_TOL:
-                self._v(t, robot, "grasp", f"the last {phase} configuration of {robot} puts the tool "
-                                           f"{dp * 1e3:.1f} mm, {dr:.3f} rad from grasp {grasp!r} of {obj} at {what} "
-                                           f"(tolerance {POS_TOL * 1e3:g} mm, {ROT_TOL} rad)")
+                self._v(
+                    t,
+                    robot,
+                    "grasp",
+                    f"the last {phase} configuration of {robot} puts the tool "
+                    f"{dp * 1e3:.1f} mm, {dr:.3f} rad from grasp {grasp!r} of {obj} at {what} "
+                    f"(tolerance {POS_TOL * 1e3:g} mm, {ROT_TOL} rad)",
+                )
         if a.handover:
             point = self.scene.handover_points.get(a.handover_point or "")
             h = act.configs["handover"]
@@ -340,14 +405,24 @@ class ActionReader:
                 for robot, x, grasp in ((a.pick_robot, x1, a.pick_grasp), (a.place_robot, x2, a.place_grasp)):
                     d = float(np.linalg.norm(x[:3, 3] - point))
                     if d > POS_TOL:
-                        self._v(t, robot, "handover", f"{robot} holds {obj} (grasp {grasp!r}) {d * 1e3:.1f} mm from "
-                                                      f"handover point {a.handover_point} (tolerance "
-                                                      f"{POS_TOL * 1e3:g} mm)")
+                        self._v(
+                            t,
+                            robot,
+                            "handover",
+                            f"{robot} holds {obj} (grasp {grasp!r}) {d * 1e3:.1f} mm from "
+                            f"handover point {a.handover_point} (tolerance "
+                            f"{POS_TOL * 1e3:g} mm)",
+                        )
             dp, dr = _pose_error(x1, x2)
             if dp > POS_TOL or dr > ROT_TOL:
-                self._v(t, obj, "handover", f"giver {a.pick_robot} and taker {a.place_robot} hold {obj} at poses "
-                                            f"{dp * 1e3:.1f} mm, {dr:.3f} rad apart (tolerance {POS_TOL * 1e3:g} mm, "
-                                            f"{ROT_TOL} rad)")
+                self._v(
+                    t,
+                    obj,
+                    "handover",
+                    f"giver {a.pick_robot} and taker {a.place_robot} hold {obj} at poses "
+                    f"{dp * 1e3:.1f} mm, {dr:.3f} rad apart (tolerance {POS_TOL * 1e3:g} mm, "
+                    f"{ROT_TOL} rad)",
+                )
 
     def _check_approaches(self, act: ActionGeometry) -> None:
         """An arm's pick and place approaches hold the model's number of configurations, start at the
@@ -357,29 +432,47 @@ class ActionReader:
         assert act.place_pose is not None
         n = self.model.approach_configurations
         share = APPROACH / max(n - 1, 1) * CONTACT_SLACK
-        for phase, robot, grasp, pose in (("pick", a.pick_robot, a.pick_grasp, self.poses[obj]),
-                                          ("place", a.place_robot, a.place_grasp, act.place_pose)):
+        for phase, robot, grasp, pose in (
+            ("pick", a.pick_robot, a.pick_grasp, self.poses[obj]),
+            ("place", a.place_robot, a.place_grasp, act.place_pose),
+        ):
             if self.planar[robot]:
                 continue
             qs = act.configs[phase]
             word = "pre-grasp" if phase == "pick" else "pre-place"
             if len(qs) != n:
-                self._v(t, robot, "approach", f"the {phase} approach of {robot} (moving {obj}) holds {len(qs)} "
-                                              f"configuration{'s' * (len(qs) != 1)}; the motion model's approaches "
-                                              f"hold {n}, {word} first")
+                self._v(
+                    t,
+                    robot,
+                    "approach",
+                    f"the {phase} approach of {robot} (moving {obj}) holds {len(qs)} "
+                    f"configuration{'s' * (len(qs) != 1)}; the motion model's approaches "
+                    f"hold {n}, {word} first",
+                )
             g = pose @ grasp_transform(self.scene.grasp(grasp), self.shapes[obj])
-            dp, dr = _pose_error(self.tool(robot, qs[0]), pose @ pregrasp_transform(
-                grasp_transform(self.scene.grasp(grasp), self.shapes[obj])))
+            dp, dr = _pose_error(
+                self.tool(robot, qs[0]),
+                pose @ pregrasp_transform(grasp_transform(self.scene.grasp(grasp), self.shapes[obj])),
+            )
             if dp > POS_TOL or dr > ROT_TOL:
-                self._v(t, robot, "approach",
-                        f"the first {phase} configuration of {robot} puts the tool "
-                        f"{dp * 1e3:.1f} mm, {dr:.3f} rad from the {word} of {obj} ({APPROACH:g} m "
-                        f"back from grasp {grasp!r}; tolerance {POS_TOL * 1e3:g} mm, {ROT_TOL} rad)")
+                self._v(
+                    t,
+                    robot,
+                    "approach",
+                    f"the first {phase} configuration of {robot} puts the tool "
+                    f"{dp * 1e3:.1f} mm, {dr:.3f} rad from the {word} of {obj} ({APPROACH:g} m "
+                    f"back from grasp {grasp!r}; tolerance {POS_TOL * 1e3:g} mm, {ROT_TOL} rad)",
+                )
             d = float(np.linalg.norm(self.tool(robot, qs[-2])[:3, 3] - g[:3, 3])) if len(qs) > 1 else 0.0
             if d > share + POS_TOL:
-                self._v(t, robot, "approach", f"the contact segment of {robot}'s {phase} approach (moving {obj}) "
-                                              f"starts with the tool {d * 1e3:.1f} mm from the grasp; at most "
-                                              f"{share * 1e3:.1f} mm ({CONTACT_SLACK:g} x the back-off / {n - 1})")
+                self._v(
+                    t,
+                    robot,
+                    "approach",
+                    f"the contact segment of {robot}'s {phase} approach (moving {obj}) "
+                    f"starts with the tool {d * 1e3:.1f} mm from the grasp; at most "
+                    f"{share * 1e3:.1f} mm ({CONTACT_SLACK:g} x the back-off / {n - 1})",
+                )
 
     def _straight_transfers(self, act: ActionGeometry) -> None:
         """Arms under the configurations model: a holding transfer the plan gives no path for is the
@@ -426,9 +519,14 @@ class ActionReader:
                 d = float(np.abs(q - want).max())
                 bad, gap = d > JOINT_TOL, f"{d:.4f} rad"
             if bad:
-                self._v(act.step, robot, "path", f"path {name!r} (moving {act.obj}) {which} {gap} away from the "
-                                                 f"{what} (tolerance {JOINT_TOL} rad; planar {POS_TOL * 1e3:g} mm, "
-                                                 f"{ROT_TOL} rad)")
+                self._v(
+                    act.step,
+                    robot,
+                    "path",
+                    f"path {name!r} (moving {act.obj}) {which} {gap} away from the "
+                    f"{what} (tolerance {JOINT_TOL} rad; planar {POS_TOL * 1e3:g} mm, "
+                    f"{ROT_TOL} rad)",
+                )
 
 
 def _pose_error(a: np.ndarray, b: np.ndarray) -> tuple[float, float]:

@@ -84,4 +84,3 @@ def where(label: str, m: int, s: float) -> str:
     if abs(x - k) < 1e-9:
         return f"at {label} configuration {k + 1} of {m}"
     return f"between {label} configurations {math.floor(x) + 1} and {math.floor(x) + 2} of {m}"
-

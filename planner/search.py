@@ -37,10 +37,24 @@ Log = Callable[[str], None]
 MOTIONS = ("configurations", "full")
 
 
-def plan_problem(problem: Problem, problem_file: str, sha256: str, version: str, backend: str = DEFAULT_BACKEND,
-                 encoding: str = DEFAULT_ENCODING, seed: int = 0, time_limit: float = 60.0, c: float = 1.0,
-                 alpha: float = 1.0, skeletons: int = 5, max_makespan: int | None = None, anytime: bool = False,
-                 log: Log | None = None, max_iterations: int = 10_000, motions: str = "configurations") -> Plan:
+def plan_problem(
+    problem: Problem,
+    problem_file: str,
+    sha256: str,
+    version: str,
+    backend: str = DEFAULT_BACKEND,
+    encoding: str = DEFAULT_ENCODING,
+    seed: int = 0,
+    time_limit: float = 60.0,
+    c: float = 1.0,
+    alpha: float = 1.0,
+    skeletons: int = 5,
+    max_makespan: int | None = None,
+    anytime: bool = False,
+    log: Log | None = None,
+    max_iterations: int = 10_000,
+    motions: str = "configurations",
+) -> Plan:
     """Plan ``problem`` (see the module docstring).  ``anytime`` keeps searching after the first plan until
     the time limit (or the end of the tree) and returns the best by (makespan, objects moved); ``log`` gets
     one line per grounded skeleton.  ``motions``: ``configurations`` (the paper's packaging model: arms'
@@ -53,13 +67,25 @@ def plan_problem(problem: Problem, problem_file: str, sha256: str, version: str,
     say: Log = log or (lambda line: None)
     facts, facts_seconds = problem_facts(problem, seed=seed)
     base = FactBase.from_problem(problem, facts)
-    plan = Plan(problem.name, problem_file, sha256, version, backend, encoding, seed, PlanStatus.EXHAUSTED,
-                symbolic=problem.symbolic)
+    plan = Plan(
+        problem.name,
+        problem_file,
+        sha256,
+        version,
+        backend,
+        encoding,
+        seed,
+        PlanStatus.EXHAUSTED,
+        symbolic=problem.symbolic,
+    )
     plan.motion_model = None if problem.symbolic else planner_motion_model(motions)
     why = Why()
     plan.why = why
-    stats: dict[str, Any] = {"robots": [r.name for r in problem.robots], "facts": len(facts),
-                             "facts_seconds": round(facts_seconds, 4)}
+    stats: dict[str, Any] = {
+        "robots": [r.name for r in problem.robots],
+        "facts": len(facts),
+        "facts_seconds": round(facts_seconds, 4),
+    }
     sources = _Sources(base, _order(problem), backend, encoding, max_makespan, seed, deadline)
     start = must_move(problem, facts)
     if problem.symbolic:
@@ -125,24 +151,40 @@ class _Skeletons:
 
     def reasons(self) -> list[str]:
         """Why no skeleton exists: the facts' explanation, or the model's infeasibility."""
-        return list(self.source.reasons) or ["no task skeleton exists under the facts (the skeleton model is "
-                                             "infeasible at every horizon)"]
+        return list(self.source.reasons) or [
+            "no task skeleton exists under the facts (the skeleton model is infeasible at every horizon)"
+        ]
 
 
 class _Sources:
     """The search's skeleton sources (``sources(M*, moved)``), one per request; the first one made (the
     root's, for M* = the objects that must move) is kept as :attr:`root`."""
 
-    def __init__(self, base: FactBase, order: Callable[[str], int], backend: str, encoding: str,
-                 max_makespan: int | None, seed: int, deadline: float) -> None:
+    def __init__(
+        self,
+        base: FactBase,
+        order: Callable[[str], int],
+        backend: str,
+        encoding: str,
+        max_makespan: int | None,
+        seed: int,
+        deadline: float,
+    ) -> None:
         self.base, self.order = base, order
         self.backend, self.encoding, self.max_makespan, self.seed = backend, encoding, max_makespan, seed
         self.deadline = deadline
         self.roots: list[_Skeletons] = []
 
     def __call__(self, need: set[str], moved: set[str]) -> _Skeletons:
-        src = SkeletonSource(self.base, sorted(need, key=self.order), sorted(moved), self.backend, self.encoding,
-                             self.max_makespan, self.seed)
+        src = SkeletonSource(
+            self.base,
+            sorted(need, key=self.order),
+            sorted(moved),
+            self.backend,
+            self.encoding,
+            self.max_makespan,
+            self.seed,
+        )
         more = _Skeletons(src, self.deadline)
         if not self.roots:
             self.roots.append(more)
@@ -169,8 +211,15 @@ def _conclude_symbolic(plan: Plan, why: Why, more: _Skeletons, time_limit: float
         why.summary = f"skeleton generation did not finish within {time_limit:g} s"
 
 
-def _conclude_search(plan: Plan, why: Why, result: SearchResult, root: _Skeletons, grounder: Grounder,
-                     validation: dict[str, Any], deadline: float) -> None:
+def _conclude_search(
+    plan: Plan,
+    why: Why,
+    result: SearchResult,
+    root: _Skeletons,
+    grounder: Grounder,
+    validation: dict[str, Any],
+    deadline: float,
+) -> None:
     """The plan's status (and steps, verdict, reasons) from how the search ended."""
     if result.steps is not None:
         plan.steps = [s.actions for s in result.steps]
@@ -210,17 +259,28 @@ def _cycles_with_evidence(source: SkeletonSource, grounder: Grounder, per_edge: 
     return out
 
 
-def _referee(problem: Problem, problem_file: str, plan: Plan, result: Grounding, why: Why,
-             verdicts: dict[str, Any]) -> Grounding:
+def _referee(
+    problem: Problem, problem_file: str, plan: Plan, result: Grounding, why: Why, verdicts: dict[str, Any]
+) -> Grounding:
     """The validator's verdict on a complete grounded plan: SUCCESS stays SUCCESS only when it accepts it;
     otherwise the grounding is a failure (named by the validator's first violation)."""
     from mrgc.planner.ground import Grounding, Outcome
     from mrgc.planner.validate import validate
 
-    candidate = Plan(plan.problem, plan.problem_file, plan.problem_sha256, plan.mrgc_version, plan.backend,
-                     plan.encoding, plan.seed, PlanStatus.SOLVED, [s.actions for s in result.steps],
-                     symbolic=False, stats={"robots": [r.name for r in problem.robots]},
-                     motion_model=plan.motion_model)  # judged under the model the plan will state
+    candidate = Plan(
+        plan.problem,
+        plan.problem_file,
+        plan.problem_sha256,
+        plan.mrgc_version,
+        plan.backend,
+        plan.encoding,
+        plan.seed,
+        PlanStatus.SOLVED,
+        [s.actions for s in result.steps],
+        symbolic=False,
+        stats={"robots": [r.name for r in problem.robots]},
+        motion_model=plan.motion_model,
+    )  # judged under the model the plan will state
     t0 = time.perf_counter()
     report = validate(problem, candidate.to_json(), problem_file, first_only=True)  # the verdict, fast
     seconds = time.perf_counter() - t0
@@ -230,16 +290,23 @@ def _referee(problem: Problem, problem_file: str, plan: Plan, result: Grounding,
         return result
     why.rejected_plans += 1
     first = report.violations[0]
-    failure = Failure(first.step or 0, f"validator ({len(report.violations)} violation"
-                                       f"{'s' * (len(report.violations) != 1)})", first.code,
-                      (first.subject,) if first.subject else (), first.message)
+    failure = Failure(
+        first.step or 0,
+        f"validator ({len(report.violations)} violation{'s' * (len(report.violations) != 1)})",
+        first.code,
+        (first.subject,) if first.subject else (),
+        first.message,
+    )
     return Grounding(Outcome.FAIL, reason=failure.line(), failures=[failure])
 
 
 def _verdict_of(plan: Plan, verdicts: dict[str, Any]) -> dict[str, Any]:
     """What the plan JSON records of the validator's verdict on the returned plan."""
-    return {"valid": True, "validator": "mrgc validate (independent pybullet replay)",
-            "plans_checked": verdicts.get("checked", 0)}
+    return {
+        "valid": True,
+        "validator": "mrgc validate (independent pybullet replay)",
+        "plans_checked": verdicts.get("checked", 0),
+    }
 
 
 def _summary(status: PlanStatus, ended: str, time_limit: float, max_iterations: int, why: Why) -> str:

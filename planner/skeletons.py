@@ -100,9 +100,16 @@ def problem_facts(problem: Problem, facts: Iterable[Fact] | None = None, seed: i
 class SkeletonSource:
     """Skeletons for one (M*, already moved) request, from a chosen backend and encoding; resumable."""
 
-    def __init__(self, facts: FactBase, must: Iterable[str], moved: Iterable[str] = (),
-                 backend: str | type[Backend] = DEFAULT_BACKEND, encoding: str = DEFAULT_ENCODING,
-                 max_makespan: int | None = None, seed: int = 0) -> None:
+    def __init__(
+        self,
+        facts: FactBase,
+        must: Iterable[str],
+        moved: Iterable[str] = (),
+        backend: str | type[Backend] = DEFAULT_BACKEND,
+        encoding: str = DEFAULT_ENCODING,
+        max_makespan: int | None = None,
+        seed: int = 0,
+    ) -> None:
         cls = backend if isinstance(backend, type) else backend_class(backend)
         backend = cls.info.name
         self.backend, self.encoding = backend, encoding
@@ -125,10 +132,16 @@ class SkeletonSource:
         return self.generator.next(k, time_limit)
 
 
-def compile_problem(problem: Problem, backend: str | type[Backend] = DEFAULT_BACKEND,
-                    encoding: str = DEFAULT_ENCODING, skeletons: int = 1, max_makespan: int | None = None,
-                    time_limit: float | None = None, facts: Iterable[Fact] | None = None,
-                    seed: int = 0) -> CompileResult:
+def compile_problem(
+    problem: Problem,
+    backend: str | type[Backend] = DEFAULT_BACKEND,
+    encoding: str = DEFAULT_ENCODING,
+    skeletons: int = 1,
+    max_makespan: int | None = None,
+    time_limit: float | None = None,
+    facts: Iterable[Fact] | None = None,
+    seed: int = 0,
+) -> CompileResult:
     """The first ``skeletons`` skeletons of ``problem`` (facts default to its ``:init``); ``backend`` is a
     registered name or a :class:`~mrgc.backends.base.Backend` subclass."""
     fact_list, facts_seconds = problem_facts(problem, facts, seed)
@@ -158,9 +171,15 @@ def compile_problem(problem: Problem, backend: str | type[Backend] = DEFAULT_BAC
     return CompileResult(problem.name, source.backend, encoding, status, batch.skeletons, reasons, stats)
 
 
-def export_model(problem: Problem, path: str, backend: str | type[Backend] = DEFAULT_BACKEND,
-                 encoding: str = DEFAULT_ENCODING, horizon: int | None = None, facts: Iterable[Fact] | None = None,
-                 max_makespan: int | None = None) -> int:
+def export_model(
+    problem: Problem,
+    path: str,
+    backend: str | type[Backend] = DEFAULT_BACKEND,
+    encoding: str = DEFAULT_ENCODING,
+    horizon: int | None = None,
+    facts: Iterable[Fact] | None = None,
+    max_makespan: int | None = None,
+) -> int:
     """Write the skeleton model of horizon ``horizon`` to ``path`` and return the horizon written (default:
     the horizon limit, ``max_makespan`` capped at the number of objects of the task graph).  The model holds
     no cuts: its optimum is the first skeleton of that horizon."""

@@ -59,8 +59,19 @@ from mrgc.planner.plan_reader import (
 from mrgc.planner.violation import Violation
 
 #: the reader's entry points and :class:`Violation` are re-exported here, where the CLI and the tests import them
-__all__ = ["E_JSON", "E_LIMIT", "E_READ", "E_SCHEMA", "E_VERSION", "ValidationReport", "Violation", "check_schema",
-           "load_plan", "schema_errors", "validate"]
+__all__ = [
+    "E_JSON",
+    "E_LIMIT",
+    "E_READ",
+    "E_SCHEMA",
+    "E_VERSION",
+    "ValidationReport",
+    "Violation",
+    "check_schema",
+    "load_plan",
+    "schema_errors",
+    "validate",
+]
 
 
 @dataclass
@@ -75,10 +86,15 @@ class ValidationReport:
         """The report as ``mrgc validate`` prints it: ``valid: ...``, or each violation and a count."""
         if self.ok:
             s = self.stats
-            geo = (f"; replayed {s['configurations']} configurations, {s['distance_queries']} pybullet distance "
-                   f"queries" if "configurations" in s else "")
-            return [f"valid: plan for {s.get('problem')}: {s.get('steps', 0)} steps, {s.get('moved', 0)} objects "
-                    f"moved ({s.get('mode')} checks{geo})"]
+            geo = (
+                f"; replayed {s['configurations']} configurations, {s['distance_queries']} pybullet distance queries"
+                if "configurations" in s
+                else ""
+            )
+            return [
+                f"valid: plan for {s.get('problem')}: {s.get('steps', 0)} steps, {s.get('moved', 0)} objects "
+                f"moved ({s.get('mode')} checks{geo})"
+            ]
         n = len(self.violations)
         return [str(v) for v in self.violations] + [f"invalid: {n} violation{'s' * (n != 1)}"]
 
@@ -88,8 +104,9 @@ class ValidationReport:
 
 
 # ------------------------------------------------------------------------------------------ validating
-def validate(problem: Problem, plan: Any, problem_path: str | None = None, first_only: bool = False
-             ) -> ValidationReport:
+def validate(
+    problem: Problem, plan: Any, problem_path: str | None = None, first_only: bool = False
+) -> ValidationReport:
     """Check ``plan`` against ``problem``, read from ``problem_path`` (whose sha256 must match the plan's;
     None skips that comparison).  ``plan`` is a :class:`~mrgc.planner.plan_reader.PlanFile`, parsed plan
     JSON (as :func:`load_plan` returns it) or a :class:`~mrgc.planner.plan.Plan`; InputError when it breaks
@@ -98,8 +115,12 @@ def validate(problem: Problem, plan: Any, problem_path: str | None = None, first
     doc = read_plan(plan)
     out: list[Violation] = []
     steps = [s.actions for s in doc.steps]
-    stats: dict[str, Any] = {"problem": problem.name, "steps": len(steps), "moved": sum(map(len, steps)),
-                             "mode": "symbolic" if problem.symbolic else "geometric"}
+    stats: dict[str, Any] = {
+        "problem": problem.name,
+        "steps": len(steps),
+        "moved": sum(map(len, steps)),
+        "mode": "symbolic" if problem.symbolic else "geometric",
+    }
     _header(problem, doc, problem_path, out)
     if doc.status != "solved":
         out.append(Violation(None, None, "status", f"the plan's status is {doc.status!r}: it holds no plan"))
@@ -116,8 +137,11 @@ def validate(problem: Problem, plan: Any, problem_path: str | None = None, first
         for obj, region in sorted(problem.goal_regions.items()):
             if final.get(obj) != region:
                 where = f"in {final[obj]!r}" if obj in final else "nowhere known"
-                out.append(Violation(None, obj, "goal", f"goal (in-region {obj} {region}) does not hold at the "
-                                                        f"end: {obj} is {where}"))
+                out.append(
+                    Violation(
+                        None, obj, "goal", f"goal (in-region {obj} {region}) does not hold at the end: {obj} is {where}"
+                    )
+                )
     elif not doc.symbolic and not (first_only and out):  # a symbolic plan carries no geometry to replay
         from mrgc.planner.replay import replay
 
@@ -128,14 +152,16 @@ def validate(problem: Problem, plan: Any, problem_path: str | None = None, first
 
 def _header(problem: Problem, plan: PlanFile, problem_path: str | None, out: list[Violation]) -> None:
     if plan.problem != problem.name:
-        out.append(Violation(None, None, "problem", f"the plan is for problem {plan.problem!r}, "
-                                                    f"not {problem.name!r}"))
+        out.append(Violation(None, None, "problem", f"the plan is for problem {plan.problem!r}, not {problem.name!r}"))
     changed = _changed(problem, plan, problem_path)
     if changed:
         out.append(Violation(None, None, "problem-changed", changed))
     if plan.symbolic != problem.symbolic:
-        what = ("a symbolic plan for a geometric problem (it carries no geometry to check)" if plan.symbolic
-                else "a geometric plan for a symbolic problem")
+        what = (
+            "a symbolic plan for a geometric problem (it carries no geometry to check)"
+            if plan.symbolic
+            else "a geometric plan for a symbolic problem"
+        )
         out.append(Violation(None, None, "plan-kind", f"this is {what}"))
     if plan.status != "solved":
         return
@@ -144,9 +170,15 @@ def _header(problem: Problem, plan: PlanFile, problem_path: str | None, out: lis
             out.append(Violation(i, None, "summary", f"step {i} is numbered {s.index}"))
     moved = sum(len(s.actions) for s in plan.steps)
     if plan.makespan != len(plan.steps) or plan.motion_cost != moved:
-        out.append(Violation(None, None, "summary",
-                             f"the plan says makespan {plan.makespan}, motion cost {plan.motion_cost}; its steps "
-                             f"give {len(plan.steps)} and {moved}"))
+        out.append(
+            Violation(
+                None,
+                None,
+                "summary",
+                f"the plan says makespan {plan.makespan}, motion cost {plan.motion_cost}; its steps "
+                f"give {len(plan.steps)} and {moved}",
+            )
+        )
     for i, s in enumerate(plan.steps, 1):
         if not s.actions:
             out.append(Violation(i, None, "summary", "the step is empty"))
@@ -173,10 +205,14 @@ def _changed(problem: Problem, plan: PlanFile, problem_path: str | None) -> str:
     if content in recorded:
         return ""
     if plan.problem_digest is not None:
-        return (f"the plan was made for other problem contents: problem digest {plan.problem_digest[:12]}... in "
-                f"the plan, {content[:12]}... now")
-    return (f"the problem file changed since the plan was made: sha256 {plan.problem_sha256[:12]}... in the plan, "
-            f"{file_digest[:12]}... now")
+        return (
+            f"the plan was made for other problem contents: problem digest {plan.problem_digest[:12]}... in "
+            f"the plan, {content[:12]}... now"
+        )
+    return (
+        f"the problem file changed since the plan was made: sha256 {plan.problem_sha256[:12]}... in the plan, "
+        f"{file_digest[:12]}... now"
+    )
 
 
 @dataclass(frozen=True)
@@ -191,9 +227,13 @@ class _Names:
 
     @classmethod
     def of(cls, problem: Problem) -> _Names:
-        return cls(frozenset(r.name for r in problem.robots), frozenset(r.name for r in problem.regions),
-                   frozenset(m.name for m in problem.movable), frozenset(h.name for h in problem.handover_points),
-                   frozenset(f.name for f in problem.fixed))
+        return cls(
+            frozenset(r.name for r in problem.robots),
+            frozenset(r.name for r in problem.regions),
+            frozenset(m.name for m in problem.movable),
+            frozenset(h.name for h in problem.handover_points),
+            frozenset(f.name for f in problem.fixed),
+        )
 
 
 def _names(problem: Problem, plan: PlanFile, out: list[Violation]) -> set[int]:
@@ -202,8 +242,9 @@ def _names(problem: Problem, plan: PlanFile, out: list[Violation]) -> set[int]:
     names = _Names.of(problem)
     usable: set[int] = set()
     for t, s in enumerate(plan.steps, 1):
-        out.extend(Violation(t, r, "unknown-name", f"no robot {r!r} (waiting)")
-                   for r in s.waiting if r not in names.robots)
+        out.extend(
+            Violation(t, r, "unknown-name", f"no robot {r!r} (waiting)") for r in s.waiting if r not in names.robots
+        )
         for a in s.actions:
             bad = _unknown_names(problem, names, a)
             out.extend(Violation(t, a.object, "unknown-name", b) for b in bad)
@@ -218,8 +259,9 @@ def _unknown_names(problem: Problem, names: _Names, a: Action) -> list[str]:
     bad = []
     obj = a.object
     if obj not in names.objects:
-        bad.append(f"{obj!r} is a fixed object, which never moves" if obj in names.fixed
-                   else f"no movable object {obj!r}")
+        bad.append(
+            f"{obj!r} is a fixed object, which never moves" if obj in names.fixed else f"no movable object {obj!r}"
+        )
     if a.region not in names.regions:
         bad.append(f"no region {a.region!r}")
     for role, robot in (("pick robot", a.pick_robot), ("place robot", a.place_robot)):
@@ -239,11 +281,21 @@ def _kind(t: int, a: Action, out: list[Violation]) -> None:
     """The action's ``kind`` matches its robots, and a pick-and-place keeps its grasp ``[action]``."""
     kind = "handover" if a.handover else "pick-place"
     if a.kind != kind:
-        out.append(Violation(t, a.object, "action", f"kind {a.kind!r} but robots {a.pick_robot} and "
-                                                    f"{a.place_robot} make it a {kind}"))
+        out.append(
+            Violation(
+                t, a.object, "action", f"kind {a.kind!r} but robots {a.pick_robot} and {a.place_robot} make it a {kind}"
+            )
+        )
     if kind == "pick-place" and a.pick_grasp != a.place_grasp:
-        out.append(Violation(t, a.object, "action", f"{a.pick_robot} picks with {a.pick_grasp} but places "
-                                                    f"with {a.place_grasp}: a robot cannot regrasp in hand"))
+        out.append(
+            Violation(
+                t,
+                a.object,
+                "action",
+                f"{a.pick_robot} picks with {a.pick_grasp} but places "
+                f"with {a.place_grasp}: a robot cannot regrasp in hand",
+            )
+        )
 
 
 def _structure(problem: Problem, plan: PlanFile, usable: set[int], out: list[Violation]) -> None:
@@ -255,14 +307,21 @@ def _structure(problem: Problem, plan: PlanFile, usable: set[int], out: list[Vio
             obj = a.object
             if id(a) in usable:
                 if obj in moved_at:
-                    out.append(Violation(t, obj, "moved-twice", f"{obj} is moved again (first at step "
-                                                                f"{moved_at[obj]}); each object moves at most once"))
+                    out.append(
+                        Violation(
+                            t,
+                            obj,
+                            "moved-twice",
+                            f"{obj} is moved again (first at step {moved_at[obj]}); each object moves at most once",
+                        )
+                    )
                 else:
                     moved_at[obj] = t
             for r in dict.fromkeys(a.robots()):
                 if r in busy:
-                    out.append(Violation(t, r, "robot-busy", f"{r} is in two actions of the step "
-                                                             f"(moving {busy[r]} and {obj})"))
+                    out.append(
+                        Violation(t, r, "robot-busy", f"{r} is in two actions of the step (moving {busy[r]} and {obj})")
+                    )
                 else:
                     busy[r] = obj
         seen: set[str] = set()
@@ -292,8 +351,9 @@ def _symbolic(problem: Problem, steps: list[tuple[Action, ...]], usable: set[int
                 _obstacles_moved(facts, moved_at, t, a, out)
 
 
-def _supported(problem: Problem, facts: set[tuple[str, tuple[str, ...]]], t: int, a: Action,
-               out: list[Violation]) -> None:
+def _supported(
+    problem: Problem, facts: set[tuple[str, tuple[str, ...]]], t: int, a: Action, out: list[Violation]
+) -> None:
     """Facts support action ``a`` ``[unsupported]``; only goal objects are handed over, and an object goes
     only to its goal region or, outside the goal, within its own region ``[region]``."""
     goal = problem.goal_regions
@@ -302,21 +362,28 @@ def _supported(problem: Problem, facts: set[tuple[str, tuple[str, ...]]], t: int
     if r1 != r2:
         need.insert(1, ("enable-goal-handover", (o, g1, g2, r1, r2)))
         if o not in goal:
-            out.append(Violation(t, o, "region", f"{o} is not a goal object: only goal objects are handed "
-                                                 f"over (enable-goal-handover)"))
+            out.append(
+                Violation(
+                    t,
+                    o,
+                    "region",
+                    f"{o} is not a goal object: only goal objects are handed over (enable-goal-handover)",
+                )
+            )
     for pred, args in need:
         if (pred, args) not in facts:
-            out.append(Violation(t, o, "unsupported", f"no fact ({pred} {' '.join(args)}) supports "
-                                                      f"'{a.describe()}'"))
+            out.append(Violation(t, o, "unsupported", f"no fact ({pred} {' '.join(args)}) supports '{a.describe()}'"))
     target = goal.get(o, problem.initial_regions.get(o))
     if target is not None and re_ != target:
         why = "its goal region" if o in goal else "its own region (it is only moved out of the way)"
-        out.append(Violation(t, o, "region", f"{o} goes to {re_!r}, but the model moves it only into "
-                                             f"{target!r}, {why}"))
+        out.append(
+            Violation(t, o, "region", f"{o} goes to {re_!r}, but the model moves it only into {target!r}, {why}")
+        )
 
 
-def _obstacles_moved(facts: set[tuple[str, tuple[str, ...]]], moved_at: dict[str, int], t: int, a: Action,
-                     out: list[Violation]) -> None:
+def _obstacles_moved(
+    facts: set[tuple[str, tuple[str, ...]]], moved_at: dict[str, int], t: int, a: Action, out: list[Violation]
+) -> None:
     """Every ``occludes-pick`` obstacle of action ``a`` moves at a strictly earlier step, every
     ``occludes-goal-place`` obstacle no later ``[pick-obstacle]``, ``[place-obstacle]``."""
     o, re_, r1, r2, g1, g2 = a.object, a.region, a.pick_robot, a.place_robot, a.pick_grasp, a.place_grasp
@@ -325,12 +392,23 @@ def _obstacles_moved(facts: set[tuple[str, tuple[str, ...]]], moved_at: dict[str
             when = moved_at.get(args[0])
             if when is None or when >= t:
                 state = "never moves" if when is None else f"moves at step {when}"
-                out.append(Violation(t, o, "pick-obstacle", f"{args[0]} blocks {r1} picking {o} with {g1} "
-                                                            f"and {state}; it must move at an earlier step"))
+                out.append(
+                    Violation(
+                        t,
+                        o,
+                        "pick-obstacle",
+                        f"{args[0]} blocks {r1} picking {o} with {g1} and {state}; it must move at an earlier step",
+                    )
+                )
         elif pred == "occludes-goal-place" and args[1:] == (o, re_, g2, r2):
             when = moved_at.get(args[0])
             if when is None or when > t:
                 state = "never moves" if when is None else f"moves at step {when}"
-                out.append(Violation(t, o, "place-obstacle",
-                                     f"{args[0]} blocks {r2} placing {o} in {re_} with {g2} and {state}; "
-                                     f"it must move by step {t}"))
+                out.append(
+                    Violation(
+                        t,
+                        o,
+                        "place-obstacle",
+                        f"{args[0]} blocks {r2} placing {o} in {re_} with {g2} and {state}; it must move by step {t}",
+                    )
+                )

@@ -18,8 +18,9 @@ class Violation:
     message: str
 
     def __str__(self) -> str:
-        where = "".join([f"step {self.step}: " if self.step is not None else "",
-                         f"{self.subject}: " if self.subject else ""])
+        where = "".join(
+            [f"step {self.step}: " if self.step is not None else "", f"{self.subject}: " if self.subject else ""]
+        )
         return f"{where}{self.message} [{self.code}]"
 
     def to_json(self) -> dict[str, Any]:

@@ -25,14 +25,22 @@ CAMERA_HELP = "iso, front, back, side or top"
 
 def add_commands(sub: Any) -> None:
     """Add ``render`` and ``graph`` to the CLI's sub-parsers."""
-    p = sub.add_parser("render", help="draw a plan or a scene: .gif/.mp4 replay, .png sheet or scene, .html 3D "
-                                      "replay, .svg/.png Gantt chart")
+    p = sub.add_parser(
+        "render",
+        help="draw a plan or a scene: .gif/.mp4 replay, .png sheet or scene, .html 3D replay, .svg/.png Gantt chart",
+    )
     p.add_argument("file", metavar="FILE", help="the problem file")
-    p.add_argument("plan", metavar="PLAN", nargs="?", help="the plan JSON (mrgc plan -o PLAN); leave out to "
-                                                           "draw the scene alone")
-    p.add_argument("-o", "--output", metavar="OUT", required=True,
-                   help=".gif or .mp4 (replay), .png (key frames; the scene without PLAN), .html (3D replay), "
-                        ".svg or *gantt.png (Gantt chart)")
+    p.add_argument(
+        "plan", metavar="PLAN", nargs="?", help="the plan JSON (mrgc plan -o PLAN); leave out to draw the scene alone"
+    )
+    p.add_argument(
+        "-o",
+        "--output",
+        metavar="OUT",
+        required=True,
+        help=".gif or .mp4 (replay), .png (key frames; the scene without PLAN), .html (3D replay), "
+        ".svg or *gantt.png (Gantt chart)",
+    )
     p.add_argument("--problem", help="which problem of the file (default: the one the plan names, else its only one)")
     p.add_argument("--size", default="400x300", metavar="WxH", help="picture size in pixels (default 400x300)")
     p.add_argument("--fps", type=float, default=10.0, help="frames per second of the replay (default 10)")
@@ -76,8 +84,14 @@ def _progress(label: str) -> Iterator[Any]:
     from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
-    with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
-                  console=Console(stderr=True), transient=True) as bar:
+    with Progress(
+        TextColumn("{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeRemainingColumn(),
+        console=Console(stderr=True),
+        transient=True,
+    ) as bar:
         task = bar.add_task(label, total=None)
 
         def update(done: int, total: int) -> None:
@@ -137,8 +151,11 @@ def _written(kind: str, path: str, stats: dict[str, Any]) -> str:
         "animation": f"replay of {stats['steps']} steps, {stats['frames']} frames",
         "sheet": f"contact sheet of {stats['frames']} key frames",
         "scene": "the scene",
-        "html": (f"3D replay of {stats['steps']} steps, {stats['frames']} frames; open it in a web browser"
-                 if stats["steps"] else "the scene in 3D; open it in a web browser"),
+        "html": (
+            f"3D replay of {stats['steps']} steps, {stats['frames']} frames; open it in a web browser"
+            if stats["steps"]
+            else "the scene in 3D; open it in a web browser"
+        ),
         "gantt": f"Gantt chart of {stats['steps']} steps",
     }[kind]
     timing = f", {stats['draw_seconds']:.1f} s" if "draw_seconds" in stats else ""

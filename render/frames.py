@@ -123,13 +123,24 @@ class Timeline:
                         poses[obj] = pose
                 for obj, (robot, grasp) in holder.items():
                     poses[obj] = w.robots[robot].held_pose(configs[robot], w.shapes[obj], grasp)
-                out.append(Frame(t0 + s * ph.duration, ph.step, ph.name, ph.caption, dict(configs), dict(fingers),
-                                 dict(poses), key=i == n and ph.name in KEY_PHASES))
+                out.append(
+                    Frame(
+                        t0 + s * ph.duration,
+                        ph.step,
+                        ph.name,
+                        ph.caption,
+                        dict(configs),
+                        dict(fingers),
+                        dict(poses),
+                        key=i == n and ph.name in KEY_PHASES,
+                    )
+                )
             t0 += ph.duration
         if len(out) > 1:
             last = out[-1]
-            out[-1] = Frame(last.time, last.step, last.phase, last.caption, last.configs, last.fingers, last.poses,
-                            key=True)
+            out[-1] = Frame(
+                last.time, last.step, last.phase, last.caption, last.configs, last.fingers, last.poses, key=True
+            )
         return out
 
 
@@ -175,16 +186,21 @@ class _Act:
 def build_timeline(world: World, plan: Mapping[str, Any], source: str = "plan") -> Timeline:
     """The timeline of a geometric plan (JSON) in ``world``; InputError E510 when the plan does not fit the
     problem (``source`` names the plan file in messages)."""
-    steps = [[_parse(world, a, t, source) for a in step.get("actions", [])]
-             for t, step in enumerate(plan.get("steps", []), 1)]
+    steps = [
+        [_parse(world, a, t, source) for a in step.get("actions", [])]
+        for t, step in enumerate(plan.get("steps", []), 1)
+    ]
     home = {r: v.home for r, v in world.robots.items()}
     phases: list[Phase] = []
     n = len(steps)
     for t, acts in enumerate(steps, 1):
         phases += _step_phases(world, t, n, acts, home)
     moved = sum(len(a) for a in steps)
-    title = (f"{world.problem.name}: {n} step{'s' * (n != 1)}, {moved} object{'s' * (moved != 1)} moved"
-             if n else f"{world.problem.name}: the plan has no steps")
+    title = (
+        f"{world.problem.name}: {n} step{'s' * (n != 1)}, {moved} object{'s' * (moved != 1)} moved"
+        if n
+        else f"{world.problem.name}: the plan has no steps"
+    )
     return Timeline(world, title, phases, n)
 
 
@@ -199,8 +215,13 @@ def _step_phases(world: World, t: int, n: int, acts: list[_Act], home: Mapping[s
     def path(a: _Act, name: str, start: np.ndarray, end: np.ndarray) -> np.ndarray:
         return a.paths[name] if name in a.paths else np.stack([start, end])
 
-    def add(name: str, motions: Iterable[Motion], take: dict[str, tuple[str, str]] | None = None,
-            release: dict[str, np.ndarray] | None = None, pause: float = 0.0) -> None:
+    def add(
+        name: str,
+        motions: Iterable[Motion],
+        take: dict[str, tuple[str, str]] | None = None,
+        release: dict[str, np.ndarray] | None = None,
+        pause: float = 0.0,
+    ) -> None:
         ms = tuple(motions)
         if not ms:
             return
@@ -210,40 +231,101 @@ def _step_phases(world: World, t: int, n: int, acts: list[_Act], home: Mapping[s
             speed = BASE_SPEED if view.planar else ARM_SPEED
             length = sum(view.distance(m.configs[i], m.configs[i + 1]) for i in range(len(m.configs) - 1))
             move = max(move, length / speed)
-        out.append(Phase(t, name, ms, MIN_PHASE + move + pause, f"{head} | {name} | {what}", take or {},
-                         release or {}))
+        out.append(Phase(t, name, ms, MIN_PHASE + move + pause, f"{head} | {name} | {what}", take or {}, release or {}))
 
     hands = [a for a in acts if a.handover]
-    add("to-pick", (Motion(a.giver, path(a, "to-pick", home[a.giver], a.configs["pick"][0]),
-                           fingers=opening(a.giver, a, a.g1)) for a in acts))
-    add("pick", (Motion(a.giver, a.configs["pick"], fingers=opening(a.giver, a, a.g1)) for a in acts),
-        take={a.obj: (a.giver, a.g1) for a in acts})
-    add("to-handover", [m for a in hands for m in (
-        Motion(a.giver, path(a, "to-handover", a.configs["pick"][-1], a.configs["handover"][0]), a.obj, a.g1,
-               opening(a.giver, a, a.g1)),
-        Motion(a.taker, path(a, "taker-to-handover", home[a.taker], a.configs["handover"][1]),
-               fingers=opening(a.taker, a, a.g2)))])
-    add("handover", [m for a in hands for m in (
-        Motion(a.giver, a.configs["handover"][:1], a.obj, a.g1, opening(a.giver, a, a.g1)),
-        Motion(a.taker, a.configs["handover"][1:], a.obj, a.g2, opening(a.taker, a, a.g2)))],
-        take={a.obj: (a.taker, a.g2) for a in hands}, pause=HANDOVER_PAUSE)
-    add("to-place", (Motion(a.taker, path(a, "to-place", a.configs["handover"][1] if a.handover
-                                          else a.configs["pick"][-1], a.configs["place"][0]), a.obj, a.g2,
-                            opening(a.taker, a, a.g2)) for a in acts))
-    add("place", (Motion(a.taker, a.configs["place"], a.obj, a.g2, opening(a.taker, a, a.g2)) for a in acts),
-        release={a.obj: a.pose for a in acts})
-    add("home", [m for a in acts for m in (
-        [Motion(a.taker, path(a, "home", a.configs["place"][-1], home[a.taker]))]
-        + ([Motion(a.giver, path(a, "giver-home", a.configs["handover"][0], home[a.giver]))] if a.handover
-           else []))])
+    add(
+        "to-pick",
+        (
+            Motion(a.giver, path(a, "to-pick", home[a.giver], a.configs["pick"][0]), fingers=opening(a.giver, a, a.g1))
+            for a in acts
+        ),
+    )
+    add(
+        "pick",
+        (Motion(a.giver, a.configs["pick"], fingers=opening(a.giver, a, a.g1)) for a in acts),
+        take={a.obj: (a.giver, a.g1) for a in acts},
+    )
+    add(
+        "to-handover",
+        [
+            m
+            for a in hands
+            for m in (
+                Motion(
+                    a.giver,
+                    path(a, "to-handover", a.configs["pick"][-1], a.configs["handover"][0]),
+                    a.obj,
+                    a.g1,
+                    opening(a.giver, a, a.g1),
+                ),
+                Motion(
+                    a.taker,
+                    path(a, "taker-to-handover", home[a.taker], a.configs["handover"][1]),
+                    fingers=opening(a.taker, a, a.g2),
+                ),
+            )
+        ],
+    )
+    add(
+        "handover",
+        [
+            m
+            for a in hands
+            for m in (
+                Motion(a.giver, a.configs["handover"][:1], a.obj, a.g1, opening(a.giver, a, a.g1)),
+                Motion(a.taker, a.configs["handover"][1:], a.obj, a.g2, opening(a.taker, a, a.g2)),
+            )
+        ],
+        take={a.obj: (a.taker, a.g2) for a in hands},
+        pause=HANDOVER_PAUSE,
+    )
+    add(
+        "to-place",
+        (
+            Motion(
+                a.taker,
+                path(
+                    a,
+                    "to-place",
+                    a.configs["handover"][1] if a.handover else a.configs["pick"][-1],
+                    a.configs["place"][0],
+                ),
+                a.obj,
+                a.g2,
+                opening(a.taker, a, a.g2),
+            )
+            for a in acts
+        ),
+    )
+    add(
+        "place",
+        (Motion(a.taker, a.configs["place"], a.obj, a.g2, opening(a.taker, a, a.g2)) for a in acts),
+        release={a.obj: a.pose for a in acts},
+    )
+    add(
+        "home",
+        [
+            m
+            for a in acts
+            for m in (
+                [Motion(a.taker, path(a, "home", a.configs["place"][-1], home[a.taker]))]
+                + (
+                    [Motion(a.giver, path(a, "giver-home", a.configs["handover"][0], home[a.giver]))]
+                    if a.handover
+                    else []
+                )
+            )
+        ],
+    )
     return out
 
 
 def _parse(world: World, a: Mapping[str, Any], t: int, source: str) -> _Act:
     """One action of the plan, checked against the world (E510 when it does not fit)."""
+
     def fail(message: str) -> InputError:
-        return InputError([Diagnostic(E_PLAN_FIT, f"{source}: step {t}: {message} (problem "
-                                                  f"'{world.problem.name}')")])
+        return InputError([Diagnostic(E_PLAN_FIT, f"{source}: step {t}: {message} (problem '{world.problem.name}')")])
 
     obj, region, giver, taker = a["object"], a["region"], a["pick_robot"], a["place_robot"]
     problem = _names_misfit(world, a)
@@ -259,8 +341,10 @@ def _parse(world: World, a: Mapping[str, Any], t: int, source: str) -> _Act:
     for name, (robot, count) in need.items():
         arr = _configs(a.get("configs", {}).get(name), world.robots[robot].home.size)
         if arr is None or len(arr) < count:
-            raise fail(f"moving {obj}: configs.{name} must hold at least {count} configuration(s) of "
-                       f"{world.robots[robot].home.size} values ({robot})")
+            raise fail(
+                f"moving {obj}: configs.{name} must hold at least {count} configuration(s) of "
+                f"{world.robots[robot].home.size} values ({robot})"
+            )
         configs[name] = arr
     from mrgc.planner.replay_actions import PATH_PHASES
 
@@ -271,11 +355,23 @@ def _parse(world: World, a: Mapping[str, Any], t: int, source: str) -> _Act:
         robot = a[PATH_PHASES[name][0]]
         arr = _configs(qs, world.robots[robot].home.size)
         if arr is None or len(arr) < 1:
-            raise fail(f"moving {obj}: path {name!r} must be configurations of {world.robots[robot].home.size} "
-                       f"values ({robot})")
+            raise fail(
+                f"moving {obj}: path {name!r} must be configurations of {world.robots[robot].home.size} "
+                f"values ({robot})"
+            )
         paths[name] = arr
-    return _Act(obj, region, giver, taker, a["pick_grasp"], a["place_grasp"], np.asarray(pose, dtype=float),
-                configs, paths, a.get("handover_point"))
+    return _Act(
+        obj,
+        region,
+        giver,
+        taker,
+        a["pick_grasp"],
+        a["place_grasp"],
+        np.asarray(pose, dtype=float),
+        configs,
+        paths,
+        a.get("handover_point"),
+    )
 
 
 def _names_misfit(world: World, a: Mapping[str, Any]) -> str | None:

@@ -43,14 +43,23 @@ def write(problem: Problem, plan: Mapping[str, Any], path: str) -> None:
                     bars.insert(0, (giver, f"{a['object']} \u2192 {taker}\n{a['pick_grasp']}"))
                 for robot, label in bars:
                     y = row.get(robot, 0)
-                    ax.add_patch(Rectangle((t - BAR / 2, y - BAR / 2), BAR, BAR, facecolor=face,
-                                           edgecolor=colours.get(robot, (0, 0, 0)), linewidth=2.0))
+                    ax.add_patch(
+                        Rectangle(
+                            (t - BAR / 2, y - BAR / 2),
+                            BAR,
+                            BAR,
+                            facecolor=face,
+                            edgecolor=colours.get(robot, (0, 0, 0)),
+                            linewidth=2.0,
+                        )
+                    )
                     ax.text(t, y, label, ha="center", va="center", fontsize=8, color="white", fontweight="bold")
                 if giver != taker:
                     y0, y1 = row.get(giver, 0), row.get(taker, 0)
                     x = t + BAR / 2 + 0.05
-                    ax.annotate("", xy=(x, y1), xytext=(x, y0),
-                                arrowprops={"arrowstyle": "-|>", "color": "black", "lw": 1.8})
+                    ax.annotate(
+                        "", xy=(x, y1), xytext=(x, y0), arrowprops={"arrowstyle": "-|>", "color": "black", "lw": 1.8}
+                    )
                     if a.get("handover_point"):
                         ax.text(x + 0.02, (y0 + y1) / 2, a["handover_point"], ha="left", va="center", fontsize=8)
         ax.set_xlim(0.5, n + 0.5)
@@ -63,12 +72,19 @@ def write(problem: Problem, plan: Mapping[str, Any], path: str) -> None:
         ax.set_xticks([t + 0.5 for t in range(n)], minor=True)
         ax.grid(which="minor", axis="x", color="0.85")
         ax.tick_params(which="minor", length=0)
-        ax.set_title(f"{problem.name}: {len(steps)} steps, {sum(len(s.get('actions', [])) for s in steps)} "
-                     "objects moved")
-        ax.legend(handles=[Patch(facecolor=ROLE_COLOURS[Role.GOAL], label="goal object"),
-                           Patch(facecolor=ROLE_COLOURS[Role.MOVED], label="moved obstacle")],
-                  loc="upper center", bbox_to_anchor=(0.5, -0.12 - 0.05 / max(1, len(robots))), ncol=2,
-                  frameon=False)
+        ax.set_title(
+            f"{problem.name}: {len(steps)} steps, {sum(len(s.get('actions', [])) for s in steps)} objects moved"
+        )
+        ax.legend(
+            handles=[
+                Patch(facecolor=ROLE_COLOURS[Role.GOAL], label="goal object"),
+                Patch(facecolor=ROLE_COLOURS[Role.MOVED], label="moved obstacle"),
+            ],
+            loc="upper center",
+            bbox_to_anchor=(0.5, -0.12 - 0.05 / max(1, len(robots))),
+            ncol=2,
+            frameon=False,
+        )
         fig.tight_layout()
         fig.savefig(path, format=path.rsplit(".", 1)[-1].lower(), dpi=110, metadata=_metadata(path))
         plt.close(fig)

@@ -30,8 +30,14 @@ from mrgc.render.palette import REGION_ALPHA, byte_colour
 from mrgc.render.world import Drawable, World, shape_drawable
 
 
-def write(world: World, frames: list[Frame], camera: Camera, fps: float, path: str,
-          progress: Callable[[int, int], None] | None = None) -> int:
+def write(
+    world: World,
+    frames: list[Frame],
+    camera: Camera,
+    fps: float,
+    path: str,
+    progress: Callable[[int, int], None] | None = None,
+) -> int:
     """Write the replay of ``frames`` (one frame: a still scene) to ``path``; returns its size in bytes."""
     page = build(world, frames, camera, fps, progress)
     data = page.encode("utf-8")
@@ -40,8 +46,9 @@ def write(world: World, frames: list[Frame], camera: Camera, fps: float, path: s
     return len(data)
 
 
-def build(world: World, frames: list[Frame], camera: Camera, fps: float,
-          progress: Callable[[int, int], None] | None = None) -> str:
+def build(
+    world: World, frames: list[Frame], camera: Camera, fps: float, progress: Callable[[int, int], None] | None = None
+) -> str:
     """The HTML page of the replay."""
     with contextlib.redirect_stdout(io.StringIO()):  # viser reports its server's start and stop
         import viser
@@ -53,8 +60,14 @@ def build(world: World, frames: list[Frame], camera: Camera, fps: float,
             server.stop()
 
 
-def _record(server: Any, world: World, frames: list[Frame], camera: Camera, fps: float,
-            progress: Callable[[int, int], None] | None) -> str:
+def _record(
+    server: Any,
+    world: World,
+    frames: list[Frame],
+    camera: Camera,
+    fps: float,
+    progress: Callable[[int, int], None] | None,
+) -> str:
     """The replay as one HTML file: the scene at the first frame, then each frame's moves recorded one
     ``1 / fps`` apart."""
     handles, label = _first_frame(server, world, frames[0], camera)
@@ -99,8 +112,9 @@ def _first_frame(server: Any, world: World, first: Frame, camera: Camera) -> tup
             handles[part.name] = _add(scene, f"/robots/{part.name}", part, pose)
     # the caption floats above the middle of the scene, a fifth of the viewing distance up
     top = camera.target + np.array([0.0, 0.0, 0.2 * float(np.linalg.norm(camera.eye - camera.target))])
-    label = scene.add_label("/caption", first.caption, position=tuple(float(v) for v in top),
-                            anchor="bottom-center", font_screen_scale=1.2)
+    label = scene.add_label(
+        "/caption", first.caption, position=tuple(float(v) for v in top), anchor="bottom-center", font_screen_scale=1.2
+    )
     return handles, label
 
 
@@ -134,5 +148,12 @@ def _add(scene: Any, name: str, d: Drawable, pose: np.ndarray) -> Any:
 
         v, faces = read_mesh(d.mesh_path)
         vertices = v * np.asarray(d.size)
-    return scene.add_mesh_simple(name, np.asarray(vertices, dtype=np.float32), np.asarray(faces, dtype=np.uint32),
-                                 color=colour, opacity=opacity, side="double" if opacity else "front", **where)
+    return scene.add_mesh_simple(
+        name,
+        np.asarray(vertices, dtype=np.float32),
+        np.asarray(faces, dtype=np.uint32),
+        color=colour,
+        opacity=opacity,
+        side="double" if opacity else "front",
+        **where,
+    )

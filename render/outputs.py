@@ -64,9 +64,11 @@ def kind_of(path: str, gantt: bool, has_plan: bool) -> str:
     else:
         raise _usage(f"cannot write {path!r}: mrgc render writes .gif, .mp4, .png, .html or .svg")
     if not has_plan and kind in ("animation", "gantt"):
-        raise _usage(f"{'an animation' if kind == 'animation' else 'a Gantt chart'} needs a plan: "
-                     f"mrgc render FILE PLAN -o {os.path.basename(path)} (without a plan, write the scene as .png "
-                     "or .html)")
+        raise _usage(
+            f"{'an animation' if kind == 'animation' else 'a Gantt chart'} needs a plan: "
+            f"mrgc render FILE PLAN -o {os.path.basename(path)} (without a plan, write the scene as .png "
+            "or .html)"
+        )
     return kind
 
 
@@ -74,8 +76,9 @@ def _usage(message: str) -> InputError:
     return InputError([Diagnostic("E000", message)])
 
 
-def replay_frames(problem: Problem, plan: Mapping[str, Any], opts: Options, source: str
-                  ) -> tuple[World, Timeline, list[Frame], Camera]:
+def replay_frames(
+    problem: Problem, plan: Mapping[str, Any], opts: Options, source: str
+) -> tuple[World, Timeline, list[Frame], Camera]:
     """The world, timeline, frames at ``opts.fps`` and one camera framing all of them."""
     world = World(problem, plan)
     timeline = build_timeline(world, plan, source)
@@ -92,8 +95,14 @@ def frame_camera(world: World, frames: list[Frame], opts: Options) -> Camera:
     return fit(np.concatenate(pts), opts.camera, opts.width / opts.height)
 
 
-def draw(world: World, frames: list[Frame], camera: Camera, opts: Options, progress: Progress | None = None,
-         captions: bool = True) -> tuple[list[np.ndarray], float]:
+def draw(
+    world: World,
+    frames: list[Frame],
+    camera: Camera,
+    opts: Options,
+    progress: Progress | None = None,
+    captions: bool = True,
+) -> tuple[list[np.ndarray], float]:
     """Every frame as an image (captioned), and the seconds the drawing took.  Long replays are drawn by
     one forked process per usable core (:func:`mrgc.workers.map_in_workers`), each its own renderer over a
     contiguous share of the frames; the images are the same either way."""
@@ -105,7 +114,7 @@ def draw(world: World, frames: list[Frame], camera: Camera, opts: Options, progr
         images = _draw_share((world, frames, camera, opts, captions), progress)
     else:
         size = -(-len(frames) // workers)
-        shares = [(world, frames[i:i + size], camera, opts, captions) for i in range(0, len(frames), size)]
+        shares = [(world, frames[i : i + size], camera, opts, captions) for i in range(0, len(frames), size)]
         _SHARES[:] = shares  # forked workers find their share here (nothing large is pickled to them)
         try:
             images = [img for part in map_in_workers(_draw_job, list(range(len(shares))), workers) for img in part]
@@ -125,8 +134,7 @@ def _draw_job(index: int) -> list[np.ndarray]:
     return _draw_share(_SHARES[index], None)
 
 
-def _draw_share(share: tuple[World, list[Frame], Camera, Options, bool], progress: Progress | None
-                ) -> list[np.ndarray]:
+def _draw_share(share: tuple[World, list[Frame], Camera, Options, bool], progress: Progress | None) -> list[np.ndarray]:
     from mrgc.render.picture import caption
     from mrgc.render.raster import Rasterizer
 
@@ -141,8 +149,9 @@ def _draw_share(share: tuple[World, list[Frame], Camera, Options, bool], progres
     return images
 
 
-def write_animation(problem: Problem, plan: Mapping[str, Any], path: str, opts: Options, source: str,
-                    progress: Progress | None = None) -> dict[str, Any]:
+def write_animation(
+    problem: Problem, plan: Mapping[str, Any], path: str, opts: Options, source: str, progress: Progress | None = None
+) -> dict[str, Any]:
     """The replay as ``.gif`` or ``.mp4``; returns what was written (frames, steps, seconds)."""
     from mrgc.render.picture import HOLD_LAST, write_gif
 
@@ -158,12 +167,18 @@ def write_animation(problem: Problem, plan: Mapping[str, Any], path: str, opts: 
         write_mp4(path, images, opts.fps, HOLD_LAST)
     else:
         write_gif(path, images, opts.fps)
-    return {"frames": len(images), "steps": timeline.steps, "draw_seconds": seconds,
-            "write_seconds": time.perf_counter() - t0, "duration": timeline.duration}
+    return {
+        "frames": len(images),
+        "steps": timeline.steps,
+        "draw_seconds": seconds,
+        "write_seconds": time.perf_counter() - t0,
+        "duration": timeline.duration,
+    }
 
 
-def write_sheet(problem: Problem, plan: Mapping[str, Any], path: str, opts: Options, source: str,
-                progress: Progress | None = None) -> dict[str, Any]:
+def write_sheet(
+    problem: Problem, plan: Mapping[str, Any], path: str, opts: Options, source: str, progress: Progress | None = None
+) -> dict[str, Any]:
     """A contact sheet of the key frames (the start, the end of every pick, handover and place, the end)."""
     from mrgc.render.picture import sheet, write_png
 
@@ -189,14 +204,30 @@ def write_scene(problem: Problem, path: str, opts: Options) -> dict[str, Any]:
 def scene_frame(world: World) -> Frame:
     """The scene at the start: robots at home, objects where the problem puts them."""
     goal = ", ".join(f"{o} in {r}" for o, r in sorted(world.scene.goal.items()))
-    text = (f"{world.problem.name}: {len(world.robots)} robots, {len(world.objects)} objects, "
-            f"{len(world.regions)} regions; goal: {goal or 'none'}")
-    return Frame(0.0, 0, "start", text, {r: v.home for r, v in world.robots.items()},
-                 dict.fromkeys(world.robots), dict(world.start), key=True)
+    text = (
+        f"{world.problem.name}: {len(world.robots)} robots, {len(world.objects)} objects, "
+        f"{len(world.regions)} regions; goal: {goal or 'none'}"
+    )
+    return Frame(
+        0.0,
+        0,
+        "start",
+        text,
+        {r: v.home for r, v in world.robots.items()},
+        dict.fromkeys(world.robots),
+        dict(world.start),
+        key=True,
+    )
 
 
-def write_html(problem: Problem, plan: Mapping[str, Any] | None, path: str, opts: Options, source: str,
-               progress: Progress | None = None) -> dict[str, Any]:
+def write_html(
+    problem: Problem,
+    plan: Mapping[str, Any] | None,
+    path: str,
+    opts: Options,
+    source: str,
+    progress: Progress | None = None,
+) -> dict[str, Any]:
     """The interactive 3D replay (or the scene) as one self-contained HTML file."""
     from mrgc.render.html import write
 
@@ -211,8 +242,14 @@ def write_html(problem: Problem, plan: Mapping[str, Any] | None, path: str, opts
         steps = timeline.steps
     fitted = frame_camera(world, frames, opts)
     # a browser window has any shape and a control bar: start further back than the fitted picture
-    camera = Camera(fitted.target + HTML_BACK_OFF * (fitted.eye - fitted.target), fitted.target, fitted.up,
-                    fitted.fov, fitted.near, fitted.far * HTML_BACK_OFF)
+    camera = Camera(
+        fitted.target + HTML_BACK_OFF * (fitted.eye - fitted.target),
+        fitted.target,
+        fitted.up,
+        fitted.fov,
+        fitted.near,
+        fitted.far * HTML_BACK_OFF,
+    )
     t0 = time.perf_counter()
     size = write(world, frames, camera, opts.fps, path, progress)
     return {"frames": len(frames), "steps": steps, "draw_seconds": time.perf_counter() - t0, "bytes": size}

@@ -62,7 +62,7 @@ def sheet(images: Sequence[np.ndarray], columns: int | None = None, gap: int = 4
     out = np.full((rows * h + (rows - 1) * gap, cols * w + (cols - 1) * gap, 3), SHEET_BACKGROUND, dtype=np.uint8)
     for i, img in enumerate(images):
         r, c = divmod(i, cols)
-        out[r * (h + gap): r * (h + gap) + h, c * (w + gap): c * (w + gap) + w] = img
+        out[r * (h + gap) : r * (h + gap) + h, c * (w + gap) : c * (w + gap) + w] = img
     return out
 
 
@@ -79,11 +79,10 @@ def write_gif(path: str, images: Sequence[np.ndarray], fps: float) -> None:
 
     stride = max(1, len(images) // PALETTE_SAMPLES)
     sample = np.concatenate([images[i] for i in range(0, len(images), stride)], axis=0)
-    palette = Image.fromarray(sample).quantize(colors=255, method=Image.Quantize.FASTOCTREE,
-                                               dither=Image.Dither.NONE)
-    frames = [Image.fromarray(np.ascontiguousarray(img)).quantize(palette=palette, dither=Image.Dither.NONE)
-              for img in images]
+    palette = Image.fromarray(sample).quantize(colors=255, method=Image.Quantize.FASTOCTREE, dither=Image.Dither.NONE)
+    frames = [
+        Image.fromarray(np.ascontiguousarray(img)).quantize(palette=palette, dither=Image.Dither.NONE) for img in images
+    ]
     ms = round(1000.0 / fps)
     durations = [ms] * (len(frames) - 1) + [max(ms, round(HOLD_LAST * 1000))]
-    frames[0].save(path, format="GIF", save_all=True, append_images=frames[1:], duration=durations, loop=0,
-                   disposal=1)
+    frames[0].save(path, format="GIF", save_all=True, append_images=frames[1:], duration=durations, loop=0, disposal=1)

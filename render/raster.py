@@ -66,24 +66,30 @@ class Rasterizer:
         if key not in self._shapes:
             rgba = [*d.colour, 1.0]
             if d.kind == "box":
-                vs = pb.createVisualShape(pb.GEOM_BOX, halfExtents=[s / 2 for s in d.size], rgbaColor=rgba,
-                                          physicsClientId=cid)
+                vs = pb.createVisualShape(
+                    pb.GEOM_BOX, halfExtents=[s / 2 for s in d.size], rgbaColor=rgba, physicsClientId=cid
+                )
             elif d.kind == "sphere":
                 vs = pb.createVisualShape(pb.GEOM_SPHERE, radius=d.size[0], rgbaColor=rgba, physicsClientId=cid)
             elif d.kind in ("cylinder", "capsule"):
                 geom = pb.GEOM_CYLINDER if d.kind == "cylinder" else pb.GEOM_CAPSULE
-                vs = pb.createVisualShape(geom, radius=d.size[0], length=d.size[1], rgbaColor=rgba,
-                                          physicsClientId=cid)
+                vs = pb.createVisualShape(geom, radius=d.size[0], length=d.size[1], rgbaColor=rgba, physicsClientId=cid)
             elif d.mesh_path is not None:
                 from mrgc.geometry.bullet import quiet_output
 
                 with quiet_output():
-                    vs = pb.createVisualShape(pb.GEOM_MESH, fileName=d.mesh_path, meshScale=list(d.size),
-                                              rgbaColor=rgba, physicsClientId=cid)
+                    vs = pb.createVisualShape(
+                        pb.GEOM_MESH, fileName=d.mesh_path, meshScale=list(d.size), rgbaColor=rgba, physicsClientId=cid
+                    )
             else:
                 assert d.vertices is not None and d.faces is not None
-                vs = pb.createVisualShape(pb.GEOM_MESH, vertices=d.vertices.tolist(),
-                                          indices=d.faces.reshape(-1).tolist(), rgbaColor=rgba, physicsClientId=cid)
+                vs = pb.createVisualShape(
+                    pb.GEOM_MESH,
+                    vertices=d.vertices.tolist(),
+                    indices=d.faces.reshape(-1).tolist(),
+                    rgbaColor=rgba,
+                    physicsClientId=cid,
+                )
             self._shapes[key] = int(vs)
         body = int(pb.createMultiBody(baseMass=0, baseVisualShapeIndex=self._shapes[key], physicsClientId=cid))
         self.bodies[d.name] = body
@@ -106,10 +112,20 @@ class Rasterizer:
         """The RGB image (height, width, 3; uint8) of ``frame`` seen by ``camera``, regions translucent."""
         self.pose(frame)
         pb = self.pb
-        out = pb.getCameraImage(width, height, camera.view_matrix(), camera.projection_matrix(width / height),
-                                renderer=pb.ER_TINY_RENDERER, flags=pb.ER_NO_SEGMENTATION_MASK, shadow=0,
-                                lightDirection=list(LIGHT), lightAmbientCoeff=AMBIENT, lightDiffuseCoeff=DIFFUSE,
-                                lightSpecularCoeff=SPECULAR, physicsClientId=self.cid)
+        out = pb.getCameraImage(
+            width,
+            height,
+            camera.view_matrix(),
+            camera.projection_matrix(width / height),
+            renderer=pb.ER_TINY_RENDERER,
+            flags=pb.ER_NO_SEGMENTATION_MASK,
+            shadow=0,
+            lightDirection=list(LIGHT),
+            lightAmbientCoeff=AMBIENT,
+            lightDiffuseCoeff=DIFFUSE,
+            lightSpecularCoeff=SPECULAR,
+            physicsClientId=self.cid,
+        )
         rgb = np.asarray(out[2], dtype=np.uint8).reshape(height, width, 4)[..., :3]
         depth = camera.linear_depth(np.asarray(out[3], dtype=float).reshape(height, width))
         key = (camera, width, height)
@@ -144,8 +160,13 @@ class RegionPatch:
     tint: np.ndarray
 
 
-def region_patches(camera: Camera, regions: list[tuple[np.ndarray, np.ndarray, RGB]], width: int, height: int,
-                   alpha: float = REGION_ALPHA) -> list[RegionPatch]:
+def region_patches(
+    camera: Camera,
+    regions: list[tuple[np.ndarray, np.ndarray, RGB]],
+    width: int,
+    height: int,
+    alpha: float = REGION_ALPHA,
+) -> list[RegionPatch]:
     """Cast the view rays of the pixels each region box (pose, half extents, colour) covers: faces shaded by
     their direction, edges darker and more opaque.  Depends on the camera only, so it is done once."""
     rays = camera.rays(width, height)
@@ -171,9 +192,15 @@ def region_patches(camera: Camera, regions: list[tuple[np.ndarray, np.ndarray, R
         local = o + near[..., None] * d
         eps = 1.5 * pixel * np.maximum(near, 1e-6)
         edge = (np.abs(np.abs(local) - half) <= eps[..., None]).sum(axis=2) >= 2
-        out.append(RegionPatch(slice(r0, r1), slice(c0, c1), np.where(miss, np.inf, near),
-                               np.where(edge, min(1.0, 2.5 * alpha), alpha)[..., None],
-                               np.array(colour) * 255 * np.where(edge, 0.55, shade)[..., None]))
+        out.append(
+            RegionPatch(
+                slice(r0, r1),
+                slice(c0, c1),
+                np.where(miss, np.inf, near),
+                np.where(edge, min(1.0, 2.5 * alpha), alpha)[..., None],
+                np.array(colour) * 255 * np.where(edge, 0.55, shade)[..., None],
+            )
+        )
     return out
 
 
@@ -190,8 +217,7 @@ def tint_regions(rgb: np.ndarray, depth: np.ndarray, patches: list[RegionPatch])
     return out
 
 
-def _pixel_box(camera: Camera, pose: np.ndarray, half: np.ndarray, w: int, h: int
-               ) -> tuple[int, int, int, int] | None:
+def _pixel_box(camera: Camera, pose: np.ndarray, half: np.ndarray, w: int, h: int) -> tuple[int, int, int, int] | None:
     """Rows and columns [r0, r1) × [c0, c1) covering the box's projection (the whole picture when a corner
     lies behind the eye); None when it is off the picture."""
     signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=float)

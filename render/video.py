@@ -23,8 +23,10 @@ def mp4_available() -> bool:
 def require_mp4(path: str) -> None:
     """MissingBackendError unless ``.mp4`` can be written."""
     if not mp4_available():
-        raise MissingBackendError(f"cannot write {path}: .mp4 needs imageio's ffmpeg plugin "
-                                  "(pip install imageio-ffmpeg); .gif works without it")
+        raise MissingBackendError(
+            f"cannot write {path}: .mp4 needs imageio's ffmpeg plugin "
+            "(pip install imageio-ffmpeg); .gif works without it"
+        )
 
 
 def write_mp4(path: str, images: Sequence[np.ndarray], fps: float, hold_last: float) -> None:
@@ -34,8 +36,16 @@ def write_mp4(path: str, images: Sequence[np.ndarray], fps: float, hold_last: fl
 
     h, w = images[0].shape[:2]
     hold = max(1, round(hold_last * fps))
-    writer: Any = iio2.get_writer(path, format="FFMPEG", mode="I", fps=fps, codec="libx264", macro_block_size=1,
-                                  ffmpeg_log_level="error", output_params=["-pix_fmt", "yuv420p"])
+    writer: Any = iio2.get_writer(
+        path,
+        format="FFMPEG",
+        mode="I",
+        fps=fps,
+        codec="libx264",
+        macro_block_size=1,
+        ffmpeg_log_level="error",
+        output_params=["-pix_fmt", "yuv420p"],
+    )
     with writer as out:
         for i, img in enumerate(images):
             even = np.pad(img, ((0, h % 2), (0, w % 2), (0, 0)), mode="edge")

@@ -75,7 +75,8 @@ class RobotView:
             self.mobile = PlanarRobot(self.spec)
             self.home: np.ndarray = to_se2(self.spec.base)
             self.parts: list[tuple[int, Drawable, np.ndarray]] = [
-                (-1, shape_drawable(f"{name}/footprint", self.mobile.footprint, colour), np.eye(4))]
+                (-1, shape_drawable(f"{name}/footprint", self.mobile.footprint, colour), np.eye(4))
+            ]
             return
         from mrgc.geometry.kinematics import model_for_kind
 
@@ -87,8 +88,15 @@ class RobotView:
         self.parts = []
         for link in m.links:
             for k, c in enumerate(link.collisions):
-                part = Drawable(f"{name}/{link.name}/{k}", c.kind, tuple(c.size), colour, c.mesh_path,
-                                c.vertices if c.kind == "mesh" else None, c.faces if c.kind == "mesh" else None)
+                part = Drawable(
+                    f"{name}/{link.name}/{k}",
+                    c.kind,
+                    tuple(c.size),
+                    colour,
+                    c.mesh_path,
+                    c.vertices if c.kind == "mesh" else None,
+                    c.faces if c.kind == "mesh" else None,
+                )
                 self.parts.append((link.index, part, c.origin))
 
     def part_poses(self, q: np.ndarray, fingers: float | None = None) -> Iterator[tuple[Drawable, np.ndarray]]:
@@ -146,9 +154,11 @@ class World:
         goal_regions = set(scene.goal.values())
         self.fixed = [(shape_drawable(b.name, b.shape, FIXED), b.pose) for b in scene.fixed]
         self.regions: list[tuple[Body, RGB]] = [
-            (b, GOAL_REGION if b.name in goal_regions else OTHER_REGION) for b in scene.regions]
-        self.objects = {b.name: shape_drawable(b.name, b.shape, ROLE_COLOURS[self.roles[b.name]])
-                        for b in scene.movable}
+            (b, GOAL_REGION if b.name in goal_regions else OTHER_REGION) for b in scene.regions
+        ]
+        self.objects = {
+            b.name: shape_drawable(b.name, b.shape, ROLE_COLOURS[self.roles[b.name]]) for b in scene.movable
+        }
         self.start = {b.name: np.array(b.pose, dtype=float) for b in scene.movable}
         self.shapes = {b.name: b.shape for b in scene.movable}
         self.colours = robot_colours(r.name for r in scene.robots)

@@ -308,23 +308,26 @@ def check_known_optima(backend: BackendClass) -> None:
     for name, case in MODELS.items():
         model = case.build()
         sol = solve(backend, model)
-        _require(sol.status == case.status, f"{name}: status {sol.status.value}, expected {case.status.value} "
-                                            f"({sol.message})")
+        _require(
+            sol.status == case.status,
+            f"{name}: status {sol.status.value}, expected {case.status.value} ({sol.message})",
+        )
         if case.status == SolveStatus.OPTIMAL:
             require_valid(model, sol)
             got = objectives(model, sol.values)
             _require(got == case.optimum, f"{name}: objective {got}, the optimum is {case.optimum}")
             if len(model.objectives) == 1:
-                _require(sol.objective == case.optimum, f"{name}: reports objective {sol.objective}, its values "
-                                                        f"give {case.optimum}")
+                _require(
+                    sol.objective == case.optimum,
+                    f"{name}: reports objective {sol.objective}, its values give {case.optimum}",
+                )
         else:
             _require(sol.values == (), f"{name}: values returned with status {sol.status.value}")
 
 
 def check_unique_optima(backend: BackendClass) -> None:
     """Models with a single optimal assignment get exactly that assignment."""
-    for build, want in ((at_most_one, (0, 1, 0, 1)), (conditional_rows, (1, 1, 0, 3, -2)),
-                        (no_overlap_makespan, None)):
+    for build, want in ((at_most_one, (0, 1, 0, 1)), (conditional_rows, (1, 1, 0, 3, -2)), (no_overlap_makespan, None)):
         model = build()
         _, _, arg = brute_force(model)
         values = tuple(solve(backend, model).values[: len(model.vars)])
@@ -335,14 +338,15 @@ def check_unique_optima(backend: BackendClass) -> None:
 def check_load_keeps_model(backend: BackendClass) -> None:
     """Loading, adding rows and solving leave the caller's model unchanged."""
     model = no_overlap()
-    before = (list(model.vars), list(model.rows), list(model.cond_rows), list(model.no_overlap),
-              list(model.objectives))
+    before = (list(model.vars), list(model.rows), list(model.cond_rows), list(model.no_overlap), list(model.objectives))
     solver = backend()
     solver.load(model)
     solver.add_rows([Row(((0, 1),), hi=0)])
     solver.solve()
-    _require((model.vars, model.rows, model.cond_rows, model.no_overlap, model.objectives) == before,
-             "loading or solving changed the model it was given")
+    _require(
+        (model.vars, model.rows, model.cond_rows, model.no_overlap, model.objectives) == before,
+        "loading or solving changed the model it was given",
+    )
 
 
 def check_incremental_cuts(backend: BackendClass) -> None:
@@ -383,13 +387,16 @@ def check_rows_after_solving(backend: BackendClass) -> None:
     makespan = len(model.vars) - 1
     solver.add_rows([Row(((makespan, 1),), lo=5, name="C>=5")])
     sol = solver.solve()
-    _require(sol.status == SolveStatus.OPTIMAL and sol.objective == (5,),
-             f"after C >= 5: {sol.status.value} {sol.objective}, expected optimal (5,)")
+    _require(
+        sol.status == SolveStatus.OPTIMAL and sol.objective == (5,),
+        f"after C >= 5: {sol.status.value} {sol.objective}, expected optimal (5,)",
+    )
     require_valid(model, sol, " after C >= 5")
     solver.add_rows([Row(((0, 1),), hi=0, name="p0 absent")])  # contradicts p0 >= 1
     sol = solver.solve()
-    _require(sol.status == SolveStatus.INFEASIBLE, f"after p0 <= 0 (p0 >= 1 holds): {sol.status.value}, expected "
-                                              f"infeasible")
+    _require(
+        sol.status == SolveStatus.INFEASIBLE, f"after p0 <= 0 (p0 >= 1 holds): {sol.status.value}, expected infeasible"
+    )
 
 
 def check_zero_variables(backend: BackendClass) -> None:
@@ -409,12 +416,15 @@ def check_determinism(backend: BackendClass) -> None:
     """The same model and seed give the same values (the model has many optima)."""
     first = solve(backend, symmetric(), seed=7)
     second = solve(backend, symmetric(), seed=7)
-    _require(first.status == second.status == SolveStatus.OPTIMAL, f"symmetric: {first.status.value}, "
-                                                               f"{second.status.value}")
+    _require(
+        first.status == second.status == SolveStatus.OPTIMAL, f"symmetric: {first.status.value}, {second.status.value}"
+    )
     _require(first.values == second.values, f"symmetric, seed 7: {first.values} then {second.values}")
     require_valid(symmetric(), first)
-    _require(objectives(symmetric(), first.values) == (3,), f"symmetric: objective "
-                                                            f"{objectives(symmetric(), first.values)}, optimum (3,)")
+    _require(
+        objectives(symmetric(), first.values) == (3,),
+        f"symmetric: objective {objectives(symmetric(), first.values)}, optimum (3,)",
+    )
 
 
 def check_time_limit(backend: BackendClass) -> None:
@@ -423,8 +433,10 @@ def check_time_limit(backend: BackendClass) -> None:
     mean "no limit"."""
     hard = hard_ish(1000)
     sol = solve(backend, hard, time_limit=0.001)
-    _require(sol.status in (SolveStatus.TIME_LIMIT, SolveStatus.FEASIBLE, SolveStatus.OPTIMAL),
-             f"1 ms limit: status {sol.status.value} ({sol.message})")
+    _require(
+        sol.status in (SolveStatus.TIME_LIMIT, SolveStatus.FEASIBLE, SolveStatus.OPTIMAL),
+        f"1 ms limit: status {sol.status.value} ({sol.message})",
+    )
     if sol.status in (SolveStatus.FEASIBLE, SolveStatus.OPTIMAL):
         require_valid(hard, sol, " (1 ms limit)")
     if sol.status == SolveStatus.OPTIMAL:
@@ -435,8 +447,10 @@ def check_time_limit(backend: BackendClass) -> None:
     t0 = time.perf_counter()
     sol = solver.solve(time_limit=0.0004)
     elapsed = time.perf_counter() - t0
-    _require(sol.status in (SolveStatus.TIME_LIMIT, SolveStatus.FEASIBLE, SolveStatus.OPTIMAL),
-             f"0.4 ms limit: status {sol.status.value} ({sol.message})")
+    _require(
+        sol.status in (SolveStatus.TIME_LIMIT, SolveStatus.FEASIBLE, SolveStatus.OPTIMAL),
+        f"0.4 ms limit: status {sol.status.value} ({sol.message})",
+    )
     _require(elapsed < 0.3, f"0.4 ms limit: ran {elapsed:.2f} s ({sol.status.value})")
 
 
@@ -451,7 +465,7 @@ def fixtures() -> dict[str, tuple[str, tuple[int, int] | None]]:
         first = path.read_text(encoding="utf-8").splitlines()[0]
         if not first.startswith("; expect: "):
             continue
-        spec = first[len("; expect: "):].strip()
+        spec = first[len("; expect: ") :].strip()
         if spec == "infeasible":
             out[path.name] = (str(path), None)
         else:
@@ -472,8 +486,10 @@ def check_fixture(backend: BackendClass, fixture: str, encoding: str) -> None:
     res = compile_problem(problem, backend=backend, encoding=encoding, skeletons=1)
     where = f"{fixture} ({encoding})"
     if expected is None:
-        _require(res.status == "infeasible" and res.skeletons == [], f"{where}: {res.status}, expected infeasible "
-                                                                      f"({res.reasons})")
+        _require(
+            res.status == "infeasible" and res.skeletons == [],
+            f"{where}: {res.status}, expected infeasible ({res.reasons})",
+        )
         return
     _require(res.status == "optimal", f"{where}: {res.status}, expected optimal ({res.reasons})")
     keys = [s.key for s in res.skeletons]

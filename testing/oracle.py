@@ -70,8 +70,9 @@ def check_skeleton(graph: TaskGraph, skeleton: Any) -> list[str]:
     return bad
 
 
-def _step_faults(obstacles: dict[Action, tuple[frozenset[str], frozenset[str]]], steps: list[tuple[Action, ...]]
-                 ) -> tuple[list[str], dict[str, int], list[tuple[int, Action]]]:
+def _step_faults(
+    obstacles: dict[Action, tuple[frozenset[str], frozenset[str]]], steps: list[tuple[Action, ...]]
+) -> tuple[list[str], dict[str, int], list[tuple[int, Action]]]:
     """Faults of the steps themselves (empty steps, unknown actions, objects moved twice, busy robots), the
     step each object moves at, and every (step, action)."""
     bad: list[str] = []
@@ -97,8 +98,12 @@ def _step_faults(obstacles: dict[Action, tuple[frozenset[str], frozenset[str]]],
     return bad, step_of, placed
 
 
-def _obstacle_faults(obstacles: dict[Action, tuple[frozenset[str], frozenset[str]]],
-                     placed: list[tuple[int, Action]], step_of: dict[str, int], bad: list[str]) -> set[str]:
+def _obstacle_faults(
+    obstacles: dict[Action, tuple[frozenset[str], frozenset[str]]],
+    placed: list[tuple[int, Action]],
+    step_of: dict[str, int],
+    bad: list[str],
+) -> set[str]:
     """Add to ``bad`` the obstacles that do not move in time (pick: strictly earlier, place: no later); the
     objects that obstruct a selected action."""
     obstructing: set[str] = set()
@@ -119,8 +124,9 @@ def _obstacle_faults(obstacles: dict[Action, tuple[frozenset[str], frozenset[str
 
 
 # ------------------------------------------------------------------ (b) brute force
-def _valid_selection(graph: TaskGraph, actions: Iterable[Action],
-                     obstacles: Mapping[Action, tuple[frozenset[str], frozenset[str]]]) -> bool:
+def _valid_selection(
+    graph: TaskGraph, actions: Iterable[Action], obstacles: Mapping[Action, tuple[frozenset[str], frozenset[str]]]
+) -> bool:
     """The schedule-free rules: one action per object, M* moved, obstacles moved, no needless move."""
     acts = list(actions)
     moved = [a.obj for a in acts]
@@ -190,8 +196,13 @@ def _assign(rel: list[list[tuple[int, str]]], step: list[int], k: int, m: int) -
         for i, kind in rel[k]:
             # constraint "step[i] kind step[k]" (i < k) or, for i == k, "step[k] kind step[k]"
             x, y = step[i], s
-            if (kind == "<" and not x < y) or (kind == "<=" and not x <= y) or (kind == ">" and not x > y) \
-                    or (kind == ">=" and not x >= y) or (kind == "!=" and not x != y):
+            if (
+                (kind == "<" and not x < y)
+                or (kind == "<=" and not x <= y)
+                or (kind == ">" and not x > y)
+                or (kind == ">=" and not x >= y)
+                or (kind == "!=" and not x != y)
+            ):
                 ok = False
                 break
         if ok and _assign(rel, step, k + 1, m):
@@ -237,10 +248,15 @@ def feasible_action_sets(graph: TaskGraph) -> dict[frozenset[Action], int]:
     return out
 
 
-def _consistent(o: str, choice: dict[str, Action | None], obstacles: dict[Action, tuple[frozenset[str],
-                frozenset[str]]], options: dict[str, list[Action]]) -> bool:
+def _consistent(
+    o: str,
+    choice: dict[str, Action | None],
+    obstacles: dict[Action, tuple[frozenset[str], frozenset[str]]],
+    options: dict[str, list[Action]],
+) -> bool:
     """Whether the choice just made for ``o`` keeps the partial selection consistent: a chosen action's
     obstacles are objects that may still move; an object left unmoved obstructs no chosen action."""
+
     def blockers(a: Action) -> frozenset[str]:
         return obstacles[a][0] | obstacles[a][1]
 
@@ -258,9 +274,14 @@ def oracle_keys(graph: TaskGraph) -> list[tuple[int, int]]:
 
 # ------------------------------------------------------------------ Alg. 1 on raw facts
 def reference_task_graph(
-        robots: Sequence[str], grasps: Mapping[str, Sequence[str]], goal: Mapping[str, str],
-        region: Mapping[str, str], facts: Iterable[tuple[str, ...]], must_move: Sequence[str],
-        moved: Iterable[str] = ()) -> TaskGraph:
+    robots: Sequence[str],
+    grasps: Mapping[str, Sequence[str]],
+    goal: Mapping[str, str],
+    region: Mapping[str, str],
+    facts: Iterable[tuple[str, ...]],
+    must_move: Sequence[str],
+    moved: Iterable[str] = (),
+) -> TaskGraph:
     """Alg. 1 (AddObject for every object of M*) on fact tuples ``(predicate, arg, ...)``.
 
     ``moved`` are the objects of the already grounded suffix S' (they move later, once): they get no node
@@ -297,8 +318,7 @@ def reference_task_graph(
             return
         for a in _actions_of(m, target, m in goal, robots, grasps.get(m, ()), pick, place, hand):
             p = tuple(mj for mj in movable if (mj, m, a.pick_grasp, a.pick_robot) in occ_pick)
-            q = tuple(mj for mj in movable if m in goal
-                      and (mj, m, target, a.place_grasp, a.place_robot) in occ_place)
+            q = tuple(mj for mj in movable if m in goal and (mj, m, target, a.place_grasp, a.place_robot) in occ_place)
             if done & set(p + q):
                 continue
             actions.append(a)
@@ -320,8 +340,16 @@ def reference_task_graph(
     )
 
 
-def _actions_of(m: str, target: str, is_goal: bool, robots: Sequence[str], grasps: Sequence[str],
-                pick: set[tuple[str, ...]], place: set[tuple[str, ...]], hand: set[tuple[str, ...]]) -> list[Action]:
+def _actions_of(
+    m: str,
+    target: str,
+    is_goal: bool,
+    robots: Sequence[str],
+    grasps: Sequence[str],
+    pick: set[tuple[str, ...]],
+    place: set[tuple[str, ...]],
+    hand: set[tuple[str, ...]],
+) -> list[Action]:
     """Object ``m``'s actions into ``target``, by picking robot and grasp: the direct one (same robot and
     grasp), then the handovers (goal objects only)."""
     out = []
@@ -332,19 +360,26 @@ def _actions_of(m: str, target: str, is_goal: bool, robots: Sequence[str], grasp
             if (m, target, g1, r1) in place:
                 out.append(Action(m, target, r1, r1, g1, g1))
             if is_goal:
-                out += [Action(m, target, r1, r2, g1, g2) for r2 in robots if r2 != r1 for g2 in grasps
-                        if (m, g1, g2, r1, r2) in hand and (m, target, g2, r2) in place]
+                out += [
+                    Action(m, target, r1, r2, g1, g2)
+                    for r2 in robots
+                    if r2 != r1
+                    for g2 in grasps
+                    if (m, g1, g2, r1, r2) in hand and (m, target, g2, r2) in place
+                ]
     return out
 
 
-def graph_signature(graph: TaskGraph) -> tuple[frozenset[str], frozenset[str],
-                                               frozenset[tuple[Action, frozenset[str], frozenset[str]]]]:
+def graph_signature(
+    graph: TaskGraph,
+) -> tuple[frozenset[str], frozenset[str], frozenset[tuple[Action, frozenset[str], frozenset[str]]]]:
     """(objects, M*, {(action, pick obstacles, place obstacles)}): a graph up to the order of its lists."""
     return (
         frozenset(graph.objects),
         frozenset(graph.must_move),
-        frozenset((a, frozenset(graph.block_pick[i]), frozenset(graph.block_place[i]))
-                  for i, a in enumerate(graph.actions)),
+        frozenset(
+            (a, frozenset(graph.block_pick[i]), frozenset(graph.block_place[i])) for i, a in enumerate(graph.actions)
+        ),
     )
 
 
@@ -355,6 +390,12 @@ def problem_graph(problem: "Problem", must_move: Sequence[str] | None = None, mo
     region = {f.args[0]: f.args[1] for f in problem.init if f.predicate == "in-region"}
     if must_move is None:
         must_move = [o for o, r in problem.goal_regions.items() if region.get(o) != r]
-    return reference_task_graph([r.name for r in problem.robots],
-                                {m.name: problem.grasps_of(m.name) for m in problem.movable},
-                                problem.goal_regions, region, facts, must_move, moved)
+    return reference_task_graph(
+        [r.name for r in problem.robots],
+        {m.name: problem.grasps_of(m.name) for m in problem.movable},
+        problem.goal_regions,
+        region,
+        facts,
+        must_move,
+        moved,
+    )

@@ -66,8 +66,9 @@ def _set_state(model: RobotModel, q: Array, base: Array | None, fingers: float |
     return pb, cid, body
 
 
-def pybullet_fk(model: RobotModel, q: Sequence[float] | Array, base: Array | None = None,
-                fingers: float | None = None) -> dict[str, Array]:
+def pybullet_fk(
+    model: RobotModel, q: Sequence[float] | Array, base: Array | None = None, fingers: float | None = None
+) -> dict[str, Array]:
     """pybullet's forward kinematics (reference): link name → 4×4 URDF link frame in the world, with the
     base link's frame at ``base`` (identity when None); off-chain joints at their frozen values, the finger
     joints at ``fingers`` when given (clamped into their limits).
@@ -87,8 +88,14 @@ def pybullet_fk(model: RobotModel, q: Sequence[float] | Array, base: Array | Non
     return out
 
 
-def pybullet_box_distance(model: RobotModel, q: Sequence[float] | Array, base: Array | None, size: Sequence[float],
-                          pose: Array, skip_links: Sequence[str] = ()) -> float:
+def pybullet_box_distance(
+    model: RobotModel,
+    q: Sequence[float] | Array,
+    base: Array | None,
+    size: Sequence[float],
+    pose: Array,
+    skip_links: Sequence[str] = (),
+) -> float:
     """Reference signed distance (negative: penetration) between the robot's links at ``q`` and a box of full
     side lengths ``size`` at ``pose``, from pybullet's own collision engine (``getClosestPoints``), the
     second engine the tests compare coal against.  Links named in ``skip_links`` are left out."""
@@ -96,8 +103,9 @@ def pybullet_box_distance(model: RobotModel, q: Sequence[float] | Array, base: A
     _, by_name, _ = _pb_links(model)
     shape = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=[float(v) / 2 for v in size], physicsClientId=cid)
     pos, orn = tf.to_quaternion(np.asarray(pose, dtype=float))
-    box = pb.createMultiBody(baseMass=0, baseCollisionShapeIndex=shape, basePosition=pos, baseOrientation=orn,
-                             physicsClientId=cid)
+    box = pb.createMultiBody(
+        baseMass=0, baseCollisionShapeIndex=shape, basePosition=pos, baseOrientation=orn, physicsClientId=cid
+    )
     # the box body stays (pybullet refuses to remove it in DIRECT mode); only the robot's distance to it is read
     best = float("inf")
     for name, index in by_name.items():
@@ -108,9 +116,17 @@ def pybullet_box_distance(model: RobotModel, q: Sequence[float] | Array, base: A
     return best
 
 
-def pybullet_ik(model: RobotModel, target: Array, seed: int, q_init: Sequence[float] | Array | None = None,
-                restarts: int = 8, tol_pos: float = 1e-4, tol_rot: float = 1e-3, max_iters: int = 200,
-                null_space: bool = False) -> IKResult:
+def pybullet_ik(
+    model: RobotModel,
+    target: Array,
+    seed: int,
+    q_init: Sequence[float] | Array | None = None,
+    restarts: int = 8,
+    tol_pos: float = 1e-4,
+    tol_rot: float = 1e-3,
+    max_iters: int = 200,
+    null_space: bool = False,
+) -> IKResult:
     """pybullet's ``calculateInverseKinematics`` with random restarts, for comparison; ``target`` in the
     base frame.  The starts are ``q_init`` (the middle of the limits when None), then uniform draws within
     the limits from ``default_rng(seed)``; a restart counts when its result, measured with pybullet's own
@@ -136,8 +152,16 @@ def pybullet_ik(model: RobotModel, target: Array, seed: int, q_init: Sequence[fl
         if null_space:
             rest = [float(q0[lk.chain_index]) if lk.chain_index >= 0 else lk.frozen_value for _, lk in movable]
             kw = {"lowerLimits": ll, "upperLimits": ul, "jointRanges": jr, "restPoses": rest}
-        sol = pb.calculateInverseKinematics(body, by_name[model.end_effector], pos, orn, maxNumIterations=max_iters,
-                                            residualThreshold=1e-8, physicsClientId=cid, **kw)
+        sol = pb.calculateInverseKinematics(
+            body,
+            by_name[model.end_effector],
+            pos,
+            orn,
+            maxNumIterations=max_iters,
+            residualThreshold=1e-8,
+            physicsClientId=cid,
+            **kw,
+        )
         q = np.zeros(model.dof)
         for (_, lk), v in zip(movable, sol):
             if lk.chain_index >= 0:

@@ -46,11 +46,18 @@ class SymbolicCase:
         return parse_string(self.text, "<random>").problem()
 
 
-def symbolic_problems(*, robots: tuple[int, int] = (2, 3), objects: tuple[int, int] = (2, 5),
-                      regions: Sequence[str] = ("ra", "rb", "rc"), min_regions: int = 2,
-                      goals: tuple[int, int] = (1, 2),
-                      grasps: Sequence[str] = ("top", "side"), feasible: float | None = 0.5, handover: bool = True,
-                      domain: str = "abstract") -> st.SearchStrategy[SymbolicCase]:
+def symbolic_problems(
+    *,
+    robots: tuple[int, int] = (2, 3),
+    objects: tuple[int, int] = (2, 5),
+    regions: Sequence[str] = ("ra", "rb", "rc"),
+    min_regions: int = 2,
+    goals: tuple[int, int] = (1, 2),
+    grasps: Sequence[str] = ("top", "side"),
+    feasible: float | None = 0.5,
+    handover: bool = True,
+    domain: str = "abstract",
+) -> st.SearchStrategy[SymbolicCase]:
     """Random small symbolic problems (see the module docstring).
 
     ``robots``, ``objects`` and ``goals`` are (least, most) counts; ``regions`` the region names, of which
@@ -63,14 +70,32 @@ def symbolic_problems(*, robots: tuple[int, int] = (2, 3), objects: tuple[int, i
         raise ValueError(f"feasible is a share from 0 to 1, not {feasible}")
     if len(regions) < max(2, min_regions):
         raise ValueError("symbolic_problems needs at least two regions")
-    return _cases((robots[0], robots[1]), (objects[0], objects[1]), tuple(regions), min_regions,
-                  (goals[0], goals[1]), tuple(grasps), feasible, handover, domain)
+    return _cases(
+        (robots[0], robots[1]),
+        (objects[0], objects[1]),
+        tuple(regions),
+        min_regions,
+        (goals[0], goals[1]),
+        tuple(grasps),
+        feasible,
+        handover,
+        domain,
+    )
 
 
 @st.composite
-def _cases(draw: Any, robots_n: tuple[int, int], objects_n: tuple[int, int], region_names: tuple[str, ...],
-           min_regions: int, goals_n: tuple[int, int], grasps: tuple[str, ...], feasible: float | None,
-           handover: bool, domain: str) -> SymbolicCase:
+def _cases(
+    draw: Any,
+    robots_n: tuple[int, int],
+    objects_n: tuple[int, int],
+    region_names: tuple[str, ...],
+    min_regions: int,
+    goals_n: tuple[int, int],
+    grasps: tuple[str, ...],
+    feasible: float | None,
+    handover: bool,
+    domain: str,
+) -> SymbolicCase:
     robots = [f"r{i}" for i in range(1, draw(st.integers(*robots_n)) + 1)]
     objects = [f"o{i}" for i in range(1, draw(st.integers(*objects_n)) + 1)]
     regions = list(region_names[: draw(st.integers(max(2, min_regions), len(region_names)))])
@@ -95,21 +120,49 @@ def _cases(draw: Any, robots_n: tuple[int, int], objects_n: tuple[int, int], reg
 
     facts: list[tuple[str, ...]] = [("in-region", o, region[o]) for o in objects]
     facts += [("reachable-pick", *c) for c in some([(o, g, r) for o in objects for g in grasps for r in robots], True)]
-    facts += [("reachable-place", *c)
-              for c in some([(o, target[o], g, r) for o in objects for g in grasps for r in robots], True)]
-    facts += [("reachable-place", *c)  # decoys: places in regions that are nobody's target
-              for c in some([(o, re, g, r) for o in objects for re in regions if re != target[o]
-                             for g in grasps for r in robots], False, 2)]
-    facts += [("occludes-pick", *c)
-              for c in some([(m1, m2, g, r) for m1 in objects for m2 in objects if m1 != m2
-                             for g in grasps for r in robots], False, 8)]
-    facts += [("occludes-goal-place", *c)
-              for c in some([(m1, m2, goal[m2], g, r) for m1 in objects for m2 in goal if m1 != m2
-                             for g in grasps for r in robots], False, 4)]
+    facts += [
+        ("reachable-place", *c)
+        for c in some([(o, target[o], g, r) for o in objects for g in grasps for r in robots], True)
+    ]
+    facts += [
+        ("reachable-place", *c)  # decoys: places in regions that are nobody's target
+        for c in some(
+            [(o, re, g, r) for o in objects for re in regions if re != target[o] for g in grasps for r in robots],
+            False,
+            2,
+        )
+    ]
+    facts += [
+        ("occludes-pick", *c)
+        for c in some(
+            [(m1, m2, g, r) for m1 in objects for m2 in objects if m1 != m2 for g in grasps for r in robots], False, 8
+        )
+    ]
+    facts += [
+        ("occludes-goal-place", *c)
+        for c in some(
+            [(m1, m2, goal[m2], g, r) for m1 in objects for m2 in goal if m1 != m2 for g in grasps for r in robots],
+            False,
+            4,
+        )
+    ]
     if handover and len(robots) > 1:
-        facts += [("enable-goal-handover", *c)
-                  for c in some([(m, g1, g2, r1, r2) for m in objects for g1 in grasps for g2 in grasps
-                                 for r1 in robots for r2 in robots if r1 != r2], False, 6)]
+        facts += [
+            ("enable-goal-handover", *c)
+            for c in some(
+                [
+                    (m, g1, g2, r1, r2)
+                    for m in objects
+                    for g1 in grasps
+                    for g2 in grasps
+                    for r1 in robots
+                    for r2 in robots
+                    if r1 != r2
+                ],
+                False,
+                6,
+            )
+        ]
 
     must = [o for o in goal_objs if goal[o] != region[o]]
     made: bool | None = None
@@ -118,19 +171,26 @@ def _cases(draw: Any, robots_n: tuple[int, int], objects_n: tuple[int, int], reg
         if made:
             for o in must:  # a witness action with no obstacles for every object that must move
                 r, g = draw(st.sampled_from(robots)), draw(st.sampled_from(grasps))
-                facts = [f for f in facts if not (f[0] == "occludes-pick" and f[2:] == (o, g, r))
-                         and not (f[0] == "occludes-goal-place" and f[2:] == (o, goal[o], g, r))]
+                facts = [
+                    f
+                    for f in facts
+                    if not (f[0] == "occludes-pick" and f[2:] == (o, g, r))
+                    and not (f[0] == "occludes-goal-place" and f[2:] == (o, goal[o], g, r))
+                ]
                 facts += [("reachable-pick", o, g, r), ("reachable-place", o, goal[o], g, r)]
         else:
             o = draw(st.sampled_from(must))
             lose = draw(st.sampled_from(["reachable-pick", "reachable-place"]))
-            facts = [f for f in facts if not (f[0] == lose and f[1] == o and (lose == "reachable-pick"
-                                                                              or f[2] == goal[o]))]
+            facts = [
+                f for f in facts if not (f[0] == lose and f[1] == o and (lose == "reachable-pick" or f[2] == goal[o]))
+            ]
     init = "\n    ".join(f"({' '.join(f)})" for f in dict.fromkeys(facts))
     goals = " ".join(f"(in-region {o} {r})" for o, r in goal.items())
     requirements = ":handover :symbolic" if handover else ":symbolic"
-    text = (f"(define (domain {domain}) (:requirements {requirements}) (:grasps {' '.join(grasps)}))\n"
-            f"(define (problem random)\n  (:domain {domain})\n"
-            f"  (:robots {' '.join(robots)})\n  (:movable {' '.join(objects)})\n  (:regions {' '.join(regions)})\n"
-            f"  (:init\n    {init})\n  (:goal (and {goals})))\n")
+    text = (
+        f"(define (domain {domain}) (:requirements {requirements}) (:grasps {' '.join(grasps)}))\n"
+        f"(define (problem random)\n  (:domain {domain})\n"
+        f"  (:robots {' '.join(robots)})\n  (:movable {' '.join(objects)})\n  (:regions {' '.join(regions)})\n"
+        f"  (:init\n    {init})\n  (:goal (and {goals})))\n"
+    )
     return SymbolicCase(text, made)

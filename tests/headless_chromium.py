@@ -31,12 +31,15 @@ def browser() -> str:
         path = shutil.which(name)
         if path:
             return path
-    raise AssertionError("headless Chromium is needed for the HTML replay test and is not on PATH: "
-                         "apt-get install -y chromium (.ci/run installs it)")
+    raise AssertionError(
+        "headless Chromium is needed for the HTML replay test and is not on PATH: "
+        "apt-get install -y chromium (.ci/run installs it)"
+    )
 
 
-def screenshot_when(url: str, ready: Callable[[np.ndarray], bool], timeout: float = 90.0,
-                    size: tuple[int, int] = (800, 600)) -> tuple[np.ndarray, bool]:
+def screenshot_when(
+    url: str, ready: Callable[[np.ndarray], bool], timeout: float = 90.0, size: tuple[int, int] = (800, 600)
+) -> tuple[np.ndarray, bool]:
     """Load ``url`` and take screenshots (RGB arrays) every half second until ``ready(picture)``; returns
     the last picture and whether it was ready before ``timeout`` seconds."""
     from PIL import Image
@@ -44,11 +47,23 @@ def screenshot_when(url: str, ready: Callable[[np.ndarray], bool], timeout: floa
 
     profile = tempfile.mkdtemp(prefix="mrgc-chromium-")
     proc = subprocess.Popen(
-        [browser(), "--headless=new", "--no-sandbox", "--no-first-run", "--use-angle=swiftshader",
-         "--enable-unsafe-swiftshader", "--hide-scrollbars", "--remote-debugging-port=0",
-         "--remote-debugging-address=127.0.0.1", f"--user-data-dir={profile}", f"--window-size={size[0]},{size[1]}",
-         url],
-        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        [
+            browser(),
+            "--headless=new",
+            "--no-sandbox",
+            "--no-first-run",
+            "--use-angle=swiftshader",
+            "--enable-unsafe-swiftshader",
+            "--hide-scrollbars",
+            "--remote-debugging-port=0",
+            "--remote-debugging-address=127.0.0.1",
+            f"--user-data-dir={profile}",
+            f"--window-size={size[0]},{size[1]}",
+            url,
+        ],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
     try:
         port = _port(profile, proc, deadline=time.monotonic() + 30)
         pages = []
@@ -100,10 +115,12 @@ def _port(profile: str, proc: subprocess.Popen[bytes], deadline: float) -> int:
     raise AssertionError("Chromium did not open its DevTools port within 30 s")
 
 
-def colour_share(picture: np.ndarray, rgb: tuple[int, int, int], hue_tolerance: float = 0.04,
-                 min_saturation: float = 0.25) -> float:
+def colour_share(
+    picture: np.ndarray, rgb: tuple[int, int, int], hue_tolerance: float = 0.04, min_saturation: float = 0.25
+) -> float:
     """The share of pixels whose hue is within ``hue_tolerance`` (of a turn) of ``rgb``'s and that are
     saturated: a colour survives the viewer's shading as its hue."""
+
     def hsv(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         a = a.astype(float) / 255
         mx, mn = a.max(axis=-1), a.min(axis=-1)
@@ -112,6 +129,7 @@ def colour_share(picture: np.ndarray, rgb: tuple[int, int, int], hue_tolerance: 
         h = np.where(mx == r, ((g - b) / d) % 6, np.where(mx == g, (b - r) / d + 2, (r - g) / d + 4)) / 6
         s = np.where(mx == 0, 0, (mx - mn) / np.where(mx == 0, 1, mx))
         return h, s
+
     h, s = hsv(picture)
     h0, _ = hsv(np.array(rgb, dtype=np.uint8).reshape(1, 1, 3))
     dh = np.abs(h - h0[0, 0])

@@ -19,7 +19,9 @@ DOMAIN = """(define (domain kitchen)
   (:grasps top side-x+))
 """
 
-GEOMETRIC = DOMAIN + """
+GEOMETRIC = (
+    DOMAIN
+    + """
 (define (problem swap)
   (:domain kitchen)
   (:robots (r1 :kind panda :base (0 0 0 0)) (r2 :kind panda :base (1.5 0 0 180)))
@@ -32,6 +34,7 @@ GEOMETRIC = DOMAIN + """
   (:init (in-region o1 left) (in-region o2 right))
   (:goal (and (in-region o1 right) (in-region o2 left))))
 """
+)
 
 SYMBOLIC = """(define (domain blocks) (:requirements :symbolic) (:grasps top side))
 (define (problem tiny)
@@ -116,13 +119,16 @@ def test_problem_with_no_problem() -> None:
 
 
 def test_errors_are_input_errors_with_every_diagnostic() -> None:
-    text = DOMAIN + """(define (problem bad)
+    text = (
+        DOMAIN
+        + """(define (problem bad)
   (:domain kitchen)
   (:robots r r)
   (:regions a)
   (:movable o)
   (:init (in-region o a) (in-regoin o a))
   (:goal (in-region o nowhere)))"""
+    )
     with pytest.raises(InputError) as info:
         mrgc.parse_string(text, "bad.mrg")
     assert isinstance(info.value, mrgc.MrgcError) and info.value.exit_code == 2
@@ -266,8 +272,10 @@ def test_domain_mrg_may_include_the_domain(tmp_path: Path) -> None:
 
 def test_domain_via_include(tmp_path: Path) -> None:
     write(tmp_path / "sub" / "file.mrg", DOMAIN)
-    path = write(tmp_path / "p.mrg", problem_text("p").replace("(:domain kitchen)",
-                                                               '(:domain kitchen)\n  (:include "sub/file.mrg")'))
+    path = write(
+        tmp_path / "p.mrg",
+        problem_text("p").replace("(:domain kitchen)", '(:domain kitchen)\n  (:include "sub/file.mrg")'),
+    )
     p = mrgc.parse_file(path).problem()
     assert p.domain.name == "kitchen"
     assert os.path.samefile(p.domain.source, tmp_path / "sub" / "file.mrg")
@@ -283,8 +291,10 @@ def test_domain_via_transitive_include(tmp_path: Path) -> None:
 def test_ambiguous_domain(tmp_path: Path) -> None:
     write(tmp_path / "one.mrg", DOMAIN)
     write(tmp_path / "two.mrg", DOMAIN)
-    path = write(tmp_path / "p.mrg", problem_text("p").replace(
-        "(:domain kitchen)", '(:domain kitchen) (:include "one.mrg") (:include "two.mrg")'))
+    path = write(
+        tmp_path / "p.mrg",
+        problem_text("p").replace("(:domain kitchen)", '(:domain kitchen) (:include "one.mrg") (:include "two.mrg")'),
+    )
     with pytest.raises(InputError) as info:
         mrgc.parse_file(path)
     assert codes(info) == ["E231"]
@@ -326,8 +336,10 @@ def test_self_include_is_a_cycle(tmp_path: Path) -> None:
 
 def test_include_escaping_the_folder(tmp_path: Path) -> None:
     write(tmp_path / "x.mrg", DOMAIN)  # exists, but outside the checked file's folder tree
-    path = write(tmp_path / "inner" / "p.mrg", problem_text("p").replace(
-        "(:domain kitchen)", '(:domain kitchen) (:include "../x.mrg")'))
+    path = write(
+        tmp_path / "inner" / "p.mrg",
+        problem_text("p").replace("(:domain kitchen)", '(:domain kitchen) (:include "../x.mrg")'),
+    )
     with pytest.raises(InputError) as info:
         mrgc.parse_file(path)
     assert set(codes(info)) == {"E233", "E230"}  # the escape, and so the domain is not found
@@ -345,14 +357,17 @@ def test_include_escaping_via_absolute_path(tmp_path: Path) -> None:
 
 def test_include_inside_the_folder_through_dotdot_is_fine(tmp_path: Path) -> None:
     write(tmp_path / "lib" / "k.mrg", DOMAIN)
-    path = write(tmp_path / "p.mrg", problem_text("p").replace(
-        "(:domain kitchen)", '(:domain kitchen) (:include "lib/../lib/k.mrg")'))
+    path = write(
+        tmp_path / "p.mrg",
+        problem_text("p").replace("(:domain kitchen)", '(:domain kitchen) (:include "lib/../lib/k.mrg")'),
+    )
     assert mrgc.parse_file(path).problem().domain.name == "kitchen"
 
 
 def test_include_not_found(tmp_path: Path) -> None:
-    path = write(tmp_path / "p.mrg",
-                 DOMAIN.replace("(:grasps top side-x+)", '(:grasps top side-x+) (:include "nope.mrg")'))
+    path = write(
+        tmp_path / "p.mrg", DOMAIN.replace("(:grasps top side-x+)", '(:grasps top side-x+) (:include "nope.mrg")')
+    )
     with pytest.raises(InputError) as info:
         mrgc.parse_file(path)
     assert codes(info) == ["E234"]

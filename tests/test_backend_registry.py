@@ -36,11 +36,12 @@ print(h.getSolution().col_value[0], s.Value(x), h2.getSolution().col_value[0])
     assert out.stdout.split() == ["1.0", "1", "0.0"]
 
 
-@pytest.mark.parametrize("backend,library", [("mip", "highspy"), ("smt", "z3"), ("pysmt", "pysmt"),
-                                             ("cpsat", "ortools")])
-def test_missing_library_is_a_one_line_error_with_exit_4(backend: str, library: str,
-                                                         monkeypatch: pytest.MonkeyPatch,
-                                                         capsys: pytest.CaptureFixture[str]) -> None:
+@pytest.mark.parametrize(
+    "backend,library", [("mip", "highspy"), ("smt", "z3"), ("pysmt", "pysmt"), ("cpsat", "ortools")]
+)
+def test_missing_library_is_a_one_line_error_with_exit_4(
+    backend: str, library: str, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
     real_import = builtins.__import__
 
     def fake_import(name: str, *args: Any, **kwargs: Any) -> Any:
@@ -59,8 +60,9 @@ def test_missing_library_is_a_one_line_error_with_exit_4(backend: str, library: 
 class BruteForceBackend(Backend):
     """A plug-in backend for tests: enumerates every assignment of a small model."""
 
-    info = BackendInfo(name="brute", title="brute force (test plug-in)", module="itertools",
-                       distribution="mrgc", features=frozenset())
+    info = BackendInfo(
+        name="brute", title="brute force (test plug-in)", module="itertools", distribution="mrgc", features=frozenset()
+    )
 
     def _load(self, model: SkeletonModel) -> None:
         pass
@@ -90,17 +92,36 @@ class _EntryPoint:
     group = registry.ENTRY_POINT_GROUP
 
 
-def test_entry_point_plugins_are_listed_and_usable(monkeypatch: pytest.MonkeyPatch,
-                                                   capsys: pytest.CaptureFixture[str]) -> None:
+def test_entry_point_plugins_are_listed_and_usable(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
     sys.modules.setdefault(__name__, sys.modules[BruteForceBackend.__module__])
-    monkeypatch.setattr(registry.importlib.metadata, "entry_points",
-                        lambda group=None: [_EntryPoint()] if group == registry.ENTRY_POINT_GROUP else [])
+    monkeypatch.setattr(
+        registry.importlib.metadata,
+        "entry_points",
+        lambda group=None: [_EntryPoint()] if group == registry.ENTRY_POINT_GROUP else [],
+    )
     assert "brute" in registry.names()
     assert cli.main(["backends"]) == 0
     assert "brute" in capsys.readouterr().out
     tiny = ROOT / "tests" / "golden" / "tiny.mrg"
-    assert cli.main(["compile", str(tiny), "--backend", "brute", "--encoding", "time-of-move",
-                     "--skeletons", "3", "--format", "json"]) == 0
+    assert (
+        cli.main(
+            [
+                "compile",
+                str(tiny),
+                "--backend",
+                "brute",
+                "--encoding",
+                "time-of-move",
+                "--skeletons",
+                "3",
+                "--format",
+                "json",
+            ]
+        )
+        == 0
+    )
     out = capsys.readouterr().out
     assert '"backend": "brute"' in out and '"makespan": 1' in out
 

@@ -52,11 +52,16 @@ def test_ap1_solves_a_packaging_problem_and_mrgc_validate_accepts_its_plan(tmp_p
 
 def test_ap1_plans_full_motions_like_the_planner(tmp_path: Path) -> None:
     out = tmp_path / "plan.json"
-    assert cli.main(["plan", str(PLACE_OBSTACLE), "--planner", "ap1", "--motions", "full", "--time-limit", "60",
-                     "-o", str(out)]) == 0
+    assert (
+        cli.main(
+            ["plan", str(PLACE_OBSTACLE), "--planner", "ap1", "--motions", "full", "--time-limit", "60", "-o", str(out)]
+        )
+        == 0
+    )
     doc = json.loads(out.read_text(encoding="utf-8"))
     assert doc["motion_model"]["arms"] == "full" and all(
-        {"to-pick", "to-place", "home"} <= set(a["paths"]) for step in doc["steps"] for a in step["actions"])
+        {"to-pick", "to-place", "home"} <= set(a["paths"]) for step in doc["steps"] for a in step["actions"]
+    )
     assert cli.main(["validate", str(PLACE_OBSTACLE), str(out)]) == 0
 
 
@@ -92,11 +97,13 @@ def test_infeasible_problems_say_why(capsys: Any) -> None:
 
 def test_a_search_run_to_its_end_is_exhausted() -> None:
     # each goal is in the way of placing the other, so both must move in one step; only r1 can move either
-    text = (DOMAIN + "(define (problem one-arm) (:domain abstract) (:robots r1 r2) (:movable a b) (:regions x y)\n"
-            "(:init (in-region a x) (in-region b y) (reachable-pick a top r1) (reachable-place a y top r1)\n"
-            "  (reachable-pick b top r1) (reachable-place b x top r1)\n"
-            "  (occludes-goal-place b a y top r1) (occludes-goal-place a b x top r1))\n"
-            "(:goal (and (in-region a y) (in-region b x))))\n")
+    text = (
+        DOMAIN + "(define (problem one-arm) (:domain abstract) (:robots r1 r2) (:movable a b) (:regions x y)\n"
+        "(:init (in-region a x) (in-region b y) (reachable-pick a top r1) (reachable-place a y top r1)\n"
+        "  (reachable-pick b top r1) (reachable-place b x top r1)\n"
+        "  (occludes-goal-place b a y top r1) (occludes-goal-place a b x top r1))\n"
+        "(:goal (and (in-region a y) (in-region b x))))\n"
+    )
     plan = ap1(parse_string(text).problem())
     assert plan.status is PlanStatus.EXHAUSTED and plan.why and "to its end" in plan.why.summary
     assert plan.why.failures  # the failed steps are told
@@ -125,19 +132,24 @@ def obstacle_problems(draw: Any) -> str:
                     lines.append(f"(reachable-place {o} {goal.get(o, at[o])} {g} {r})")
     pairs = [(a, b) for a in names for b in names if a != b]
     for a, b in draw(st.lists(st.sampled_from(pairs), max_size=6)):
-        lines.append(f"(occludes-pick {a} {b} {draw(st.sampled_from(['top', 'side']))} "
-                     f"{draw(st.sampled_from(robots))})")
+        lines.append(
+            f"(occludes-pick {a} {b} {draw(st.sampled_from(['top', 'side']))} {draw(st.sampled_from(robots))})"
+        )
     for a, b in draw(st.lists(st.sampled_from([p for p in pairs if p[1] in goal]), max_size=3)):
-        lines.append(f"(occludes-goal-place {a} {b} {goal[b]} {draw(st.sampled_from(['top', 'side']))} "
-                     f"{draw(st.sampled_from(robots))})")
+        lines.append(
+            f"(occludes-goal-place {a} {b} {goal[b]} {draw(st.sampled_from(['top', 'side']))} "
+            f"{draw(st.sampled_from(robots))})"
+        )
     if len(robots) > 1:
         for o in goals:
             if draw(st.booleans()):
                 lines.append(f"(enable-goal-handover {o} top side {robots[0]} {robots[-1]})")
-    return (DOMAIN + f"(define (problem random) (:domain abstract) (:robots {' '.join(robots)})\n"
-            f"  (:movable {' '.join(names)}) (:regions {' '.join(regions)})\n"
-            f"  (:init {' '.join(dict.fromkeys(lines))})\n"
-            f"  (:goal (and {' '.join(f'(in-region {o} {r})' for o, r in goal.items())})))\n")
+    return (
+        DOMAIN + f"(define (problem random) (:domain abstract) (:robots {' '.join(robots)})\n"
+        f"  (:movable {' '.join(names)}) (:regions {' '.join(regions)})\n"
+        f"  (:init {' '.join(dict.fromkeys(lines))})\n"
+        f"  (:goal (and {' '.join(f'(in-region {o} {r})' for o, r in goal.items())})))\n"
+    )
 
 
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
@@ -147,9 +159,15 @@ def test_ap1_agrees_with_the_oracle_and_moves_each_object_once(text: str, seed: 
     plan = ap1(problem, seed=seed)
     region = {f.args[0]: f.args[1] for f in problem.init if f.predicate == "in-region"}
     must = [o for o, r in problem.goal_regions.items() if region[o] != r]
-    graph = oracle.reference_task_graph([r.name for r in problem.robots],
-                                        {m.name: ("top", "side") for m in problem.movable}, problem.goal_regions,
-                                        region, [(f.predicate, *f.args) for f in problem.init], must, ())
+    graph = oracle.reference_task_graph(
+        [r.name for r in problem.robots],
+        {m.name: ("top", "side") for m in problem.movable},
+        problem.goal_regions,
+        region,
+        [(f.predicate, *f.args) for f in problem.init],
+        must,
+        (),
+    )
     feasible = bool(oracle.feasible_action_sets(graph))
     event(f"{plan.status}")
     assert plan.status in (PlanStatus.SOLVED, PlanStatus.INFEASIBLE, PlanStatus.EXHAUSTED), plan.why

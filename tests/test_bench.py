@@ -83,15 +83,17 @@ def rows(db: Path) -> list[dict[str, object]]:
 
 # ---------------------------------------------------------------- study files
 def test_a_study_file_is_checked_with_every_error_located() -> None:
-    text = ("study: demo\n"
-            "seeds: 0..x\n"
-            "limits: {time: -1, memory: lots}\n"
-            "instances:\n"
-            "  - file: a.mrg\n"
-            "    glob: '*.mrg'\n"
-            "methods:\n"
-            "  - {name: Ours, planer: mcts}\n"
-            "  - {name: Skel, compile: true, planner: mcts}\n")
+    text = (
+        "study: demo\n"
+        "seeds: 0..x\n"
+        "limits: {time: -1, memory: lots}\n"
+        "instances:\n"
+        "  - file: a.mrg\n"
+        "    glob: '*.mrg'\n"
+        "methods:\n"
+        "  - {name: Ours, planer: mcts}\n"
+        "  - {name: Skel, compile: true, planner: mcts}\n"
+    )
     with pytest.raises(InputError) as err:
         parse_study(text, "s.yaml")
     lines = {(d.span.line, d.span.column, d.code) for d in err.value.diagnostics if d.span}
@@ -108,19 +110,33 @@ def test_a_study_file_is_checked_with_every_error_located() -> None:
 
 
 def test_a_valid_study_and_its_methods_as_mrgc_command_lines() -> None:
-    study = parse_study("study: demo\nseeds: [0, 3..4]\nlimits: {time: 20, memory: 2GB}\n"
-                        "instances: [{file: ../domains/symbolic/chain-3.mrg}]\n"
-                        "methods:\n"
-                        "  - {name: Ours, backend: mip, encoding: paper, options: {skeletons: 3, c: 0.5, anytime: true,"
-                        " max_makespan: 4}, limits: {wall: 9}}\n"
-                        "  - {name: Ap1, planner: ap1}\n"
-                        "  - {name: Skel, compile: true, backend: smt, options: {skeletons: 2}, only: [chain-3]}\n",
-                        str(ROOT / "benchmarks" / "x.yaml"))
+    study = parse_study(
+        "study: demo\nseeds: [0, 3..4]\nlimits: {time: 20, memory: 2GB}\n"
+        "instances: [{file: ../domains/symbolic/chain-3.mrg}]\n"
+        "methods:\n"
+        "  - {name: Ours, backend: mip, encoding: paper, options: {skeletons: 3, c: 0.5, anytime: true,"
+        " max_makespan: 4}, limits: {wall: 9}}\n"
+        "  - {name: Ap1, planner: ap1}\n"
+        "  - {name: Skel, compile: true, backend: smt, options: {skeletons: 2}, only: [chain-3]}\n",
+        str(ROOT / "benchmarks" / "x.yaml"),
+    )
     assert study.seeds == (0, 3, 4)
     ours, ap1, skel = study.methods
     assert ours.limits == Limits(time=20.0, wall=9.0, memory_mb=2048.0) and ap1.limits.wall_seconds == 70
-    assert method_args(ours) == ["plan", "--backend", "mip", "--encoding", "paper", "--skeletons", "3", "-c", "0.5",
-                                 "--anytime", "--max-makespan", "4"]
+    assert method_args(ours) == [
+        "plan",
+        "--backend",
+        "mip",
+        "--encoding",
+        "paper",
+        "--skeletons",
+        "3",
+        "-c",
+        "0.5",
+        "--anytime",
+        "--max-makespan",
+        "4",
+    ]
     assert method_args(ap1) == ["plan", "--planner", "ap1"]
     assert method_args(skel) == ["compile", "--format", "json", "--backend", "smt", "--skeletons", "2"]
     assert check_methods(study) == ([], {})
@@ -129,9 +145,11 @@ def test_a_valid_study_and_its_methods_as_mrgc_command_lines() -> None:
     for m in study.methods:  # every command line is one the real parser accepts
         args = build_parser().parse_args([*method_args(m)[:1], "x.mrg", *method_args(m)[1:]])
         assert args.backend == (m.backend or "cpsat")
-    bad = parse_study("study: d\ninstances: [{file: a.mrg}]\nmethods:\n  - {name: A, options: {skeleton: 3}}\n"
-                      "  - {name: B, backend: cplex, options: {anytime: 3}}\n  - {name: C, options: {seed: 1}}\n",
-                      "s.yaml")
+    bad = parse_study(
+        "study: d\ninstances: [{file: a.mrg}]\nmethods:\n  - {name: A, options: {skeleton: 3}}\n"
+        "  - {name: B, backend: cplex, options: {anytime: 3}}\n  - {name: C, options: {seed: 1}}\n",
+        "s.yaml",
+    )
     diags, _ = check_methods(bad)
     text = "\n".join(d.message for d in diags)
     assert "no option --skeleton (did you mean 'skeletons'?)" in text and "unknown backend 'cplex'" in text
@@ -146,22 +164,37 @@ def test_seed_ranges_are_inclusive(a: int, n: int) -> None:
 
 
 def test_memory_sizes() -> None:
-    assert [parse_megabytes(v) for v in (512, "512MB", "4GB", "4 GiB", "1.5G", "2048k")] == [512, 512, 4096, 4096,
-                                                                                          1536, 2]
+    assert [parse_megabytes(v) for v in (512, "512MB", "4GB", "4 GiB", "1.5G", "2048k")] == [
+        512,
+        512,
+        4096,
+        4096,
+        1536,
+        2,
+    ]
     assert [parse_megabytes(v) for v in ("lots", 0, -3, True, "4 parsecs")] == [None] * 5
 
 
 def test_generated_instances_are_the_generator_s_text_and_bad_calls_are_located(tmp_path: Path) -> None:
-    study = parse_study("study: gen\ninstances:\n  - {generate: packaging, name: tiny, robots: 2, goals: 1, "
-                        "others: 0, seeds: 0..1}\nmethods: [{name: Ours}]\n", str(tmp_path / "s.yaml"))
+    study = parse_study(
+        "study: gen\ninstances:\n  - {generate: packaging, name: tiny, robots: 2, goals: 1, "
+        "others: 0, seeds: 0..1}\nmethods: [{name: Ours}]\n",
+        str(tmp_path / "s.yaml"),
+    )
     instances = expand_instances(study, str(tmp_path / "work"))
     assert [i.name for i in instances] == ["tiny-s0", "tiny-s1"] and instances[0].sha256 != instances[1].sha256
-    cli = subprocess.run([*MRGC, "generate", "packaging", "--robots", "2", "--goals", "1", "--others", "0",
-                          "--seed", "1"], capture_output=True, text=True, check=True)
+    cli = subprocess.run(
+        [*MRGC, "generate", "packaging", "--robots", "2", "--goals", "1", "--others", "0", "--seed", "1"],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
     assert Path(instances[1].path).read_text(encoding="utf-8") == cli.stdout
     assert dict(instances[0].bases) == {"r1": "fixed", "r2": "fixed"}
-    bad = parse_study("study: gen\ninstances:\n  - {generate: packaging, robots: 99}\nmethods: [{name: O}]\n",
-                      str(tmp_path / "s.yaml"))
+    bad = parse_study(
+        "study: gen\ninstances:\n  - {generate: packaging, robots: 99}\nmethods: [{name: O}]\n",
+        str(tmp_path / "s.yaml"),
+    )
     with pytest.raises(InputError) as err:
         expand_instances(bad, str(tmp_path / "work"))
     d = err.value.diagnostics[0]
@@ -171,11 +204,18 @@ def test_generated_instances_are_the_generator_s_text_and_bad_calls_are_located(
 # ---------------------------------------------------------------- running
 def test_a_study_killed_mid_way_and_resumed_loses_no_finished_run_and_repeats_none(tmp_path: Path) -> None:
     symbolic_copy(tmp_path / "p", "chain-3", "parallel", "place-obstacle")
-    study = write_study(tmp_path / "s.yaml", "study: resume\nseeds: 0..1\nlimits: {time: 30}\n"
-                        "instances: [{glob: p/*.mrg, name: sym}]\nmethods: [{name: Ours}]\n")
+    study = write_study(
+        tmp_path / "s.yaml",
+        "study: resume\nseeds: 0..1\nlimits: {time: 30}\n"
+        "instances: [{glob: p/*.mrg, name: sym}]\nmethods: [{name: Ours}]\n",
+    )
     db = tmp_path / "r.db"
-    proc = subprocess.Popen([*MRGC, "bench", "run", str(study), "--db", str(db), "--jobs", "2"], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen(
+        [*MRGC, "bench", "run", str(study), "--db", str(db), "--jobs", "2"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     assert proc.stdout is not None
     seen = []
     deadline = time.monotonic() + 120
@@ -191,8 +231,9 @@ def test_a_study_killed_mid_way_and_resumed_loses_no_finished_run_and_repeats_no
     first = rows(db)
     assert len(first) >= 2 and all(r["success"] for r in first)
     assert not leftover(str(tmp_path / "p")), "a run outlived bench run"
-    again = subprocess.run([*MRGC, "bench", "run", str(study), "--db", str(db)], capture_output=True, text=True,
-                           timeout=300)
+    again = subprocess.run(
+        [*MRGC, "bench", "run", str(study), "--db", str(db)], capture_output=True, text=True, timeout=300
+    )
     assert again.returncode == 0, again.stderr
     assert f"6 runs, {len(first)} already recorded, {6 - len(first)} to run" in again.stdout
     final = rows(db)
@@ -206,8 +247,11 @@ def test_a_run_past_its_wall_clock_limit_is_killed_as_a_group(tmp_path: Path) ->
     """The runner's wall-clock limit (shorter than the planner's own) kills a run as a group: timeout; the
     planner's own time limit ends a run by itself: time limit."""
     folder = packaging_copy(tmp_path / "g", "pa10")
-    study = write_study(tmp_path / "s.yaml", "study: hang\ninstances: [{file: g/pa10.mrg}]\nmethods:\n"
-                        "  - {name: Hang, limits: {time: 600, wall: 2}}\n  - {name: Short, limits: {time: 1}}\n")
+    study = write_study(
+        tmp_path / "s.yaml",
+        "study: hang\ninstances: [{file: g/pa10.mrg}]\nmethods:\n"
+        "  - {name: Hang, limits: {time: 600, wall: 2}}\n  - {name: Short, limits: {time: 1}}\n",
+    )
     summary = run_study(str(study), str(tmp_path / "r.db"), jobs=2)
     hang, short = rows(tmp_path / "r.db")
     assert summary.outcomes == {"timeout": 1, "time limit": 1}
@@ -222,8 +266,10 @@ def test_a_run_over_its_memory_limit_is_recorded_as_memout(tmp_path: Path) -> No
     """A packaging run passes 150 MiB for seconds (pybullet, coal, phase 1); a symbolic one, ending at about
     30 MiB within a second, made the outcome depend on where the samples fell."""
     packaging_copy(tmp_path / "g", "pa10")
-    study = write_study(tmp_path / "s.yaml", "study: mem\nlimits: {memory: 150MB}\n"
-                        "instances: [{file: g/pa10.mrg}]\nmethods: [{name: Ours}]\n")
+    study = write_study(
+        tmp_path / "s.yaml",
+        "study: mem\nlimits: {memory: 150MB}\ninstances: [{file: g/pa10.mrg}]\nmethods: [{name: Ours}]\n",
+    )
     run_study(str(study), str(tmp_path / "r.db"))
     (r,) = rows(tmp_path / "r.db")
     assert r["status"] == "memout" and not r["success"] and r["peak_mb"] > 150  # type: ignore[operator]
@@ -232,8 +278,10 @@ def test_a_run_over_its_memory_limit_is_recorded_as_memout(tmp_path: Path) -> No
 
 def test_a_crashing_run_is_recorded_as_a_crash_with_its_stderr(tmp_path: Path) -> None:
     folder = packaging_copy(tmp_path / "g", "pa10")
-    study = write_study(tmp_path / "s.yaml", "study: crash\nlimits: {time: 600, wall: 120}\n"
-                        "instances: [{file: g/pa10.mrg}]\nmethods: [{name: Ours}]\n")
+    study = write_study(
+        tmp_path / "s.yaml",
+        "study: crash\nlimits: {time: 600, wall: 120}\ninstances: [{file: g/pa10.mrg}]\nmethods: [{name: Ours}]\n",
+    )
 
     def segfault() -> None:  # what a crash in a C extension looks like from outside: SIGSEGV mid-run
         deadline = time.monotonic() + 60
@@ -263,8 +311,9 @@ def test_a_failed_run_records_its_reasons(tmp_path: Path) -> None:
     run infeasible; and, from the recorded ``why`` of a real BO8 run cut by its time limit, the plans the
     validator rejected and the most frequent grounding failures."""
     symbolic_copy(tmp_path / "p", "infeasible")
-    study = parse_study("study: why\ninstances: [{file: p/infeasible.mrg}]\nmethods: [{name: Ours}]\n",
-                        str(tmp_path / "s.yaml"))
+    study = parse_study(
+        "study: why\ninstances: [{file: p/infeasible.mrg}]\nmethods: [{name: Ours}]\n", str(tmp_path / "s.yaml")
+    )
     (inst,) = expand_instances(study, str(tmp_path / "w"))
     task = RunTask("why", inst, "Ours", tuple(method_args(study.methods[0])), 0, Limits(time=30), str(tmp_path / "out"))
     result = classify(execute_run(task))
@@ -272,10 +321,12 @@ def test_a_failed_run_records_its_reasons(tmp_path: Path) -> None:
     assert result.detail.startswith("infeasible by the facts; every action moving o1 is obstructed by")
     why = json.loads((GOLDEN / "why-time-limit.json").read_text(encoding="utf-8"))["why"]
     detail = why_detail(why)
-    assert detail.startswith("no plan within the time limit of 300 s; 42 complete plan(s) rejected by the validator; "
-                             "most frequent grounding failures: 28 x step 1, r2 moves door-s to start (side-x-): "
-                             "carry to the placement: no path; 22 x step 5, validator (1 violation): "
-                             "collision-robot-fixed (home: footprint of r1")
+    assert detail.startswith(
+        "no plan within the time limit of 300 s; 42 complete plan(s) rejected by the validator; "
+        "most frequent grounding failures: 28 x step 1, r2 moves door-s to start (side-x-): "
+        "carry to the placement: no path; 22 x step 5, validator (1 violation): "
+        "collision-robot-fixed (home: footprint of r1"
+    )
     assert detail.count(" x step ") == 3
     assert len(why_detail(why, limit=80)) == 80
 
@@ -283,8 +334,9 @@ def test_a_failed_run_records_its_reasons(tmp_path: Path) -> None:
 def test_an_invalid_plan_is_a_failure(tmp_path: Path) -> None:
     """A real plan, doctored (its goal object put back in the start region), judged by the real validator."""
     symbolic_copy(tmp_path / "p", "chain-3")
-    study = parse_study("study: inv\ninstances: [{file: p/chain-3.mrg}]\nmethods: [{name: Ours}]\n",
-                        str(tmp_path / "s.yaml"))
+    study = parse_study(
+        "study: inv\ninstances: [{file: p/chain-3.mrg}]\nmethods: [{name: Ours}]\n", str(tmp_path / "s.yaml")
+    )
     (inst,) = expand_instances(study, str(tmp_path / "w"))
     task = RunTask("inv", inst, "Ours", tuple(method_args(study.methods[0])), 0, Limits(time=30), str(tmp_path / "out"))
     raw = execute_run(task)
@@ -294,10 +346,16 @@ def test_an_invalid_plan_is_a_failure(tmp_path: Path) -> None:
     plan["steps"][0]["actions"][0]["region"] = "start"
     doctored = tmp_path / "doctored.plan.json"
     doctored.write_text(json.dumps(plan), encoding="utf-8")
-    check = run_limited(mrgc_argv(["validate", inst.path, str(doctored), "--format", "json"]), wall=60,
-                        memory_mb=4096, stdout=str(tmp_path / "v.json"), stderr=str(tmp_path / "v.err"))
-    bad = classify(replace(raw, plan_text=doctored.read_text(), validate=check,
-                           validate_text=(tmp_path / "v.json").read_text()))
+    check = run_limited(
+        mrgc_argv(["validate", inst.path, str(doctored), "--format", "json"]),
+        wall=60,
+        memory_mb=4096,
+        stdout=str(tmp_path / "v.json"),
+        stderr=str(tmp_path / "v.err"),
+    )
+    bad = classify(
+        replace(raw, plan_text=doctored.read_text(), validate=check, validate_text=(tmp_path / "v.json").read_text())
+    )
     assert bad.status == RunStatus.INVALID.value and not bad.success and bad.valid is False
     assert "goal" in bad.detail
     with ResultsDB(str(tmp_path / "r.db")) as db:
@@ -307,19 +365,24 @@ def test_an_invalid_plan_is_a_failure(tmp_path: Path) -> None:
 
 def test_an_unknown_planner_is_skipped_with_its_reason_and_nothing_recorded(tmp_path: Path) -> None:
     symbolic_copy(tmp_path / "p", "chain-3")
-    study = write_study(tmp_path / "s.yaml", "study: skip\nseeds: 0..1\ninstances: [{file: p/chain-3.mrg}]\n"
-                        "methods: [{name: Ours}, {name: Ap9, planner: ap9}]\n")
+    study = write_study(
+        tmp_path / "s.yaml",
+        "study: skip\nseeds: 0..1\ninstances: [{file: p/chain-3.mrg}]\n"
+        "methods: [{name: Ours}, {name: Ap9, planner: ap9}]\n",
+    )
     db = tmp_path / "r.db"
-    out = subprocess.run([*MRGC, "bench", "run", str(study), "--db", str(db)], capture_output=True, text=True,
-                         timeout=300)
+    out = subprocess.run(
+        [*MRGC, "bench", "run", str(study), "--db", str(db)], capture_output=True, text=True, timeout=300
+    )
     assert out.returncode == 0, out.stderr
     assert "skipped method Ap9 (2 runs): planner 'ap9' is not offered by this mrgc" in out.stdout
     assert {r["method"] for r in rows(db)} == {"Ours"}
     report = subprocess.run([*MRGC, "bench", "report", "--db", str(db)], capture_output=True, text=True, timeout=60)
     assert "Skipped: method Ap9 (2 runs): planner 'ap9'" in report.stdout
     changed = write_study(tmp_path / "s.yaml", study.read_text().replace("{name: Ours}", "{name: Ours, backend: mip}"))
-    refused = subprocess.run([*MRGC, "bench", "run", str(changed), "--db", str(db)], capture_output=True, text=True,
-                             timeout=120)
+    refused = subprocess.run(
+        [*MRGC, "bench", "run", str(changed), "--db", str(db)], capture_output=True, text=True, timeout=120
+    )
     assert refused.returncode == 2 and "error[E603]: method 'Ours' of study 'skip' changed" in refused.stderr
 
 
@@ -327,8 +390,9 @@ def test_the_ray_executor_runs_a_two_run_study_on_a_local_ray(tmp_path: Path) ->
     import ray  # the test extra installs it (pip install -e '.[test]')
 
     symbolic_copy(tmp_path / "p", "chain-3")
-    study = write_study(tmp_path / "s.yaml", "study: ray\nseeds: 0..1\ninstances: [{file: p/chain-3.mrg}]\n"
-                        "methods: [{name: Ours}]\n")
+    study = write_study(
+        tmp_path / "s.yaml", "study: ray\nseeds: 0..1\ninstances: [{file: p/chain-3.mrg}]\nmethods: [{name: Ours}]\n"
+    )
     ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
     try:
         summary = run_study(str(study), str(tmp_path / "r.db"), executor="ray")
@@ -344,9 +408,11 @@ def test_the_ray_executor_runs_a_two_run_study_on_a_local_ray(tmp_path: Path) ->
 def test_without_ray_the_ray_executor_says_how_to_get_it(tmp_path: Path) -> None:
     symbolic_copy(tmp_path / "p", "chain-3")
     study = write_study(tmp_path / "s.yaml", "study: noray\ninstances: [{file: p/chain-3.mrg}]\nmethods: [{name: O}]\n")
-    code = ("import sys; sys.modules['ray'] = None\nfrom mrgc.cli import main\n"
-            f"sys.exit(main(['bench', 'run', {str(study)!r}, '--db', {str(tmp_path / 'r.db')!r}, "
-            "'--executor', 'ray']))")
+    code = (
+        "import sys; sys.modules['ray'] = None\nfrom mrgc.cli import main\n"
+        f"sys.exit(main(['bench', 'run', {str(study)!r}, '--db', {str(tmp_path / 'r.db')!r}, "
+        "'--executor', 'ray']))"
+    )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert out.returncode == 4 and "pip install 'mrgc[ray]'" in out.stderr and "Traceback" not in out.stderr
 
@@ -363,8 +429,9 @@ def golden_db(tmp_path: Path) -> Path:
 @pytest.mark.parametrize("fmt, name", [("markdown", "report.md"), ("wide", "report-wide.md"), ("csv", "report.csv")])
 def test_reports_of_a_fixed_database_are_golden(tmp_path: Path, fmt: str, name: str) -> None:
     db = golden_db(tmp_path)
-    out = subprocess.run([*MRGC, "bench", "report", "--db", str(db), "--format", fmt], capture_output=True,
-                         text=True, timeout=60)
+    out = subprocess.run(
+        [*MRGC, "bench", "report", "--db", str(db), "--format", fmt], capture_output=True, text=True, timeout=60
+    )
     assert out.returncode == 0, out.stderr
     golden = GOLDEN / name
     if os.environ.get("MRGC_UPDATE_GOLDEN") == "1":
@@ -392,8 +459,12 @@ def test_report_numbers_are_means_and_standard_errors_of_the_solved_runs(tmp_pat
 
 def test_figures_of_a_fixed_database(tmp_path: Path) -> None:
     db = golden_db(tmp_path)
-    out = subprocess.run([*MRGC, "bench", "report", "--db", str(db), "--figures", str(tmp_path / "fig")],
-                         capture_output=True, text=True, timeout=120)
+    out = subprocess.run(
+        [*MRGC, "bench", "report", "--db", str(db), "--figures", str(tmp_path / "fig")],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert out.returncode == 0, out.stderr
     written = sorted(p.name for p in (tmp_path / "fig").iterdir())
     assert written == ["golden-cactus.png", "golden-success.png", "golden-time-ecdf.png"]
@@ -411,16 +482,35 @@ def test_report_errors_are_one_line_with_exit_code_2(tmp_path: Path) -> None:
 def test_a_ray_address_nobody_answers_is_one_line(tmp_path: Path) -> None:
     symbolic_copy(tmp_path / "p", "chain-3")
     study = write_study(tmp_path / "s.yaml", "study: far\ninstances: [{file: p/chain-3.mrg}]\nmethods: [{name: O}]\n")
-    out = subprocess.run([*MRGC, "bench", "run", str(study), "--db", str(tmp_path / "r.db"), "--executor", "ray",
-                          "--address", "127.0.0.1:1"], capture_output=True, text=True, timeout=120)
+    out = subprocess.run(
+        [
+            *MRGC,
+            "bench",
+            "run",
+            str(study),
+            "--db",
+            str(tmp_path / "r.db"),
+            "--executor",
+            "ray",
+            "--address",
+            "127.0.0.1:1",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert out.returncode == 2 and "error[E000]: --address 127.0.0.1:1: no Ray cluster answers there" in out.stderr
     assert rows(tmp_path / "r.db") == []
 
 
 def test_planner_arena_export_has_ompl_s_tables(tmp_path: Path) -> None:
     db, out = golden_db(tmp_path), tmp_path / "arena.db"
-    done = subprocess.run([*MRGC, "bench", "report", "--db", str(db), "--planner-arena", str(out)],
-                          capture_output=True, text=True, timeout=60)
+    done = subprocess.run(
+        [*MRGC, "bench", "report", "--db", str(db), "--planner-arena", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert done.returncode == 0, done.stderr
     conn = sqlite3.connect(out)
     tables = {r[0] for r in conn.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
@@ -430,8 +520,9 @@ def test_planner_arena_export_has_ompl_s_tables(tmp_path: Path) -> None:
     assert conn.execute("SELECT COUNT(*) FROM runs").fetchone()[0] == len(mine)
     experiments = [r[0] for r in conn.execute("SELECT name FROM experiments ORDER BY id")]
     assert experiments == ["golden: chain-3", "golden: symbolic", "golden: pa3-handover"]
-    solved = conn.execute("SELECT p.name, SUM(r.solved) FROM runs r JOIN plannerConfigs p ON p.id = r.plannerid "
-                          "GROUP BY p.name").fetchall()
+    solved = conn.execute(
+        "SELECT p.name, SUM(r.solved) FROM runs r JOIN plannerConfigs p ON p.id = r.plannerid GROUP BY p.name"
+    ).fetchall()
     assert dict(solved) == {m: sum(r["success"] for r in mine if r["method"] == m) for m in {r["method"] for r in mine}}
     status = dict(conn.execute("SELECT value, description FROM enums WHERE name = 'status'").fetchall())
     for (code,) in conn.execute("SELECT status FROM runs"):
@@ -440,8 +531,10 @@ def test_planner_arena_export_has_ompl_s_tables(tmp_path: Path) -> None:
 
 
 def test_the_python_api_names_resolve_and_importing_it_loads_no_heavy_library() -> None:
-    code = ("import sys, mrgc.bench as b\n"
-            "names = [getattr(b, n) for n in b.__all__]\n"
-            "print(sorted(m for m in ('ray', 'matplotlib', 'pybullet', 'ortools') if m in sys.modules))")
+    code = (
+        "import sys, mrgc.bench as b\n"
+        "names = [getattr(b, n) for n in b.__all__]\n"
+        "print(sorted(m for m in ('ray', 'matplotlib', 'pybullet', 'ortools') if m in sys.modules))"
+    )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60, check=True)
     assert out.stdout.strip() == "[]"

@@ -18,10 +18,22 @@ def run(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
 
 def test_planning_takes_paths_of_mrg_files(tmp_path: Path) -> None:
     own = tmp_path / "mine.mrg"
-    own.write_text((ROOT / "domains" / "symbolic" / "domain.mrg").read_text(encoding="utf-8") + "\n"
-                   + (ROOT / "domains" / "symbolic" / "chain-3.mrg").read_text(encoding="utf-8"), encoding="utf-8")
-    out = run("--problems", "mine.mrg", str(ROOT / "domains" / "symbolic" / "handover.mrg"), "--seeds", "1",
-              "--time-limit", "30", cwd=tmp_path)
+    own.write_text(
+        (ROOT / "domains" / "symbolic" / "domain.mrg").read_text(encoding="utf-8")
+        + "\n"
+        + (ROOT / "domains" / "symbolic" / "chain-3.mrg").read_text(encoding="utf-8"),
+        encoding="utf-8",
+    )
+    out = run(
+        "--problems",
+        "mine.mrg",
+        str(ROOT / "domains" / "symbolic" / "handover.mrg"),
+        "--seeds",
+        "1",
+        "--time-limit",
+        "30",
+        cwd=tmp_path,
+    )
     assert out.returncode == 0, out.stderr
     rows = [line.split(" | ") for line in out.stdout.splitlines()[2:]]
     assert [(r[0], r[1]) for r in rows] == [("| mine", "1/1"), ("| handover", "1/1")], out.stdout

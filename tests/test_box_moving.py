@@ -38,7 +38,9 @@ WALLS = """
 
 # two rooms joined by a 0.8 m doorway at x = 0 that a box stands in; the robot is in the west room,
 # `target` in the east room
-DOORWAY = DOMAIN + f"""
+DOORWAY = (
+    DOMAIN
+    + f"""
 (define (problem doorway)
   (:domain movers)
   (:robots (r1 :kind mover :base (-1.2 0 0 0)))
@@ -54,9 +56,12 @@ DOORWAY = DOMAIN + f"""
     (side :shape (box 0.3 0.3 0.3) :pose (-1.2 1 0.15 0) :grasps (top side-x+)))
   (:goal (in-region target west)))
 """
+)
 
 # the same rooms, with no gap in the divider
-SEALED = DOMAIN + f"""
+SEALED = (
+    DOMAIN
+    + f"""
 (define (problem sealed)
   (:domain movers)
   (:robots (r1 :kind mover :base (-1.2 0 0 0)))
@@ -68,6 +73,7 @@ SEALED = DOMAIN + f"""
   (:movable (box1 :shape (box 0.3 0.3 0.3) :pose (-0.8 0.8 0.15 0)))
   (:goal (in-region box1 east)))
 """
+)
 
 
 def problem_of(text: str) -> Problem:
@@ -85,8 +91,12 @@ def all_facts(problem: Problem, seed: int = 0) -> set[Fact]:
     """What phase 1 computes for a box-moving problem: the robots' facts and ``in-region``."""
     scene = scene_from_problem(problem)
     facts = robot_facts(scene, seed)
-    facts.update(Fact("in-region", (m.name, reg.name)) for m in scene.movable for reg in scene.regions
-                 if inside(reg, m.shape, m.pose))
+    facts.update(
+        Fact("in-region", (m.name, reg.name))
+        for m in scene.movable
+        for reg in scene.regions
+        if inside(reg, m.shape, m.pose)
+    )
     return facts
 
 
@@ -137,8 +147,10 @@ def test_disc_grid_separates_blocked_rooms_only(doorway: tuple[SceneSpec, set[Fa
 
 @pytest.mark.parametrize("door_y", [0.0, 0.08, 0.16, 0.22, 0.3])
 def test_disc_grid_never_rules_out_a_path_the_planner_finds(door_y: float) -> None:
-    moved = DOORWAY.replace("(door :shape (box 0.3 0.3 0.3) :pose (0 0 0.15 0))",
-                            f"(door :shape (box 0.3 0.3 0.3) :pose (0 {door_y} 0.15 0))")
+    moved = DOORWAY.replace(
+        "(door :shape (box 0.3 0.3 0.3) :pose (0 0 0.15 0))",
+        f"(door :shape (box 0.3 0.3 0.3) :pose (0 {door_y} 0.15 0))",
+    )
     scene = scene_from_problem(problem_of(moved))
     ev = PlanarEvaluator(scene, "r1")
     ev.grid.enabled = False
@@ -171,8 +183,9 @@ def test_box_in_the_doorway_occludes_the_pick_behind_it(doorway: tuple[SceneSpec
     assert not {f for f in of(facts, "occludes-pick") if f[1] == "door"}
     # carrying target home to the west room also crosses the door
     assert {(m1, g) for (m1, m, _, g, _) in of(facts, "occludes-goal-place")} == {("door", g) for g in picks}
-    assert {(re, g) for (o, re, g, r) in of(facts, "reachable-place") if o == "target"} == \
-        {(re, g) for re in ("west", "east") for g in picks}
+    assert {(re, g) for (o, re, g, r) in of(facts, "reachable-place") if o == "target"} == {
+        (re, g) for re in ("west", "east") for g in picks
+    }
 
 
 def test_top_and_narrowed_grasps_give_no_facts(doorway: tuple[SceneSpec, set[Fact]]) -> None:

@@ -88,8 +88,10 @@ MULTI = """; two problems and a comment that must survive
 """
 
 
-@pytest.mark.parametrize("case", ["plan-self", "plan-domain", "plan-hard-link", "plan-symlink", "facts-domain",
-                                  "facts-multi", "plan-include"])
+@pytest.mark.parametrize(
+    "case",
+    ["plan-self", "plan-domain", "plan-hard-link", "plan-symlink", "facts-domain", "facts-multi", "plan-include"],
+)
 def test_an_output_that_is_an_input_is_refused(tmp_path: Path, symbolic: Path, case: str, mrgc) -> None:  # type: ignore[no-untyped-def]
     folder = symbolic
     if case == "plan-self":
@@ -112,9 +114,12 @@ def test_an_output_that_is_an_input_is_refused(tmp_path: Path, symbolic: Path, c
     else:  # an included file
         (folder / "sub").mkdir()
         (folder / "sub" / "dom.mrg").write_text("(define (domain inc) (:grasps top))\n", encoding="utf-8")
-        (folder / "p.mrg").write_text(MULTI.replace("(define (domain d) (:grasps top))", "")
-                                      .replace("(:domain d)", '(:domain inc) (:include "sub/dom.mrg")'),
-                                      encoding="utf-8")
+        (folder / "p.mrg").write_text(
+            MULTI.replace("(define (domain d) (:grasps top))", "").replace(
+                "(:domain d)", '(:domain inc) (:include "sub/dom.mrg")'
+            ),
+            encoding="utf-8",
+        )
         argv = ["plan", "p.mrg", "--problem", "p1", "-o", "sub/dom.mrg"]
     before = snapshot(folder)
     proc = mrgc(*argv, cwd=folder)
@@ -213,8 +218,9 @@ def test_nothing_is_written_after_a_signal(tmp_path: Path) -> None:
 
 
 # ------------------------------------------------------------------ model exports
-@pytest.mark.parametrize(("backend", "emit"), [("mip", "missing-dir/m.lp"), ("cpsat", "missing-dir/x.pbtxt"),
-                                               ("smt", "missing-dir/m.smt2")])
+@pytest.mark.parametrize(
+    ("backend", "emit"), [("mip", "missing-dir/m.lp"), ("cpsat", "missing-dir/x.pbtxt"), ("smt", "missing-dir/m.smt2")]
+)
 def test_emit_into_a_missing_folder_is_a_usage_error(symbolic: Path, backend: str, emit: str, mrgc) -> None:  # type: ignore[no-untyped-def]
     proc = mrgc("compile", "chain-3.mrg", "--backend", backend, "--emit", emit, cwd=symbolic)
     assert proc.returncode == 2 and "error[E006]" in proc.stderr and "model written" not in proc.stdout
@@ -233,14 +239,28 @@ def test_an_export_format_the_backend_lacks_fails_before_solving(symbolic: Path,
 
 
 # ------------------------------------------------------------------ numbers on the command line
-@pytest.mark.parametrize("argv", [
-    ["plan", "--time-limit", "nan"], ["plan", "--time-limit", "inf"], ["plan", "--time-limit", "0"],
-    ["plan", "--time-limit", "-1"], ["plan", "--time-limit", "1e7"], ["compile", "--time-limit", "nan"],
-    ["compile", "--max-makespan", "100000000000"], ["plan", "--max-makespan", "0"], ["plan", "--skeletons", "0"],
-    ["plan", "--seed", "-1"], ["compile", "--seed", "2147483648"], ["plan", "-c", "nan"], ["plan", "--alpha", "-1"],
-    ["facts", "--workers", "-1"], ["facts", "--workers", "0"], ["facts", "--workers", "x"],
-    ["plan", "--seed", "9" * 5000],
-])
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["plan", "--time-limit", "nan"],
+        ["plan", "--time-limit", "inf"],
+        ["plan", "--time-limit", "0"],
+        ["plan", "--time-limit", "-1"],
+        ["plan", "--time-limit", "1e7"],
+        ["compile", "--time-limit", "nan"],
+        ["compile", "--max-makespan", "100000000000"],
+        ["plan", "--max-makespan", "0"],
+        ["plan", "--skeletons", "0"],
+        ["plan", "--seed", "-1"],
+        ["compile", "--seed", "2147483648"],
+        ["plan", "-c", "nan"],
+        ["plan", "--alpha", "-1"],
+        ["facts", "--workers", "-1"],
+        ["facts", "--workers", "0"],
+        ["facts", "--workers", "x"],
+        ["plan", "--seed", "9" * 5000],
+    ],
+)
 def test_every_number_is_validated(capsys: pytest.CaptureFixture[str], argv: list[str]) -> None:
     assert cli.main([argv[0], str(SYMBOLIC / "chain-3.mrg"), *argv[1:]]) == 2
     err = capsys.readouterr().err
@@ -284,14 +304,22 @@ def alive(pid: int) -> bool:
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
-@pytest.mark.parametrize(("sig", "code", "word"), [(signal.SIGTERM, 143, "terminated (SIGTERM)"),
-                                                   (signal.SIGINT, 130, "interrupted (SIGINT)")])
+@pytest.mark.parametrize(
+    ("sig", "code", "word"),
+    [(signal.SIGTERM, 143, "terminated (SIGTERM)"), (signal.SIGINT, 130, "interrupted (SIGINT)")],
+)
 def test_a_signal_during_phase_1_kills_every_worker(tmp_path: Path, sig: int, code: int, word: str) -> None:
     (tmp_path / "domain.mrg").write_bytes((PACKAGING / "domain.mrg").read_bytes())
     (tmp_path / "P.mrg").write_bytes((PACKAGING / "pa10.mrg").read_bytes())
     before = snapshot(tmp_path)
-    proc = subprocess.Popen([*MRGC, "facts", "P.mrg", "-o", "facts.mrg", "--workers", "2"], cwd=tmp_path,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    proc = subprocess.Popen(
+        [*MRGC, "facts", "P.mrg", "-o", "facts.mrg", "--workers", "2"],
+        cwd=tmp_path,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
     deadline = time.monotonic() + 120
     kids: set[int] = set()
     while len(kids) < 2 and time.monotonic() < deadline and proc.poll() is None:
@@ -316,9 +344,13 @@ def test_a_signal_during_a_solve_stops_the_solver_and_never_gives_a_verdict(tmp_
     """A long skeleton search (paper encoding of a generated 80-object problem) interrupted by Ctrl-C:
     exit 130 at once, not the time limit's 3, nothing on standard output."""
     (tmp_path / "big.mrg").write_text(big_symbolic(80), encoding="utf-8")
-    proc = subprocess.Popen([*MRGC, "compile", "big.mrg", "--backend", backend, "--encoding", "paper",
-                             "--time-limit", "600"], cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True)
+    proc = subprocess.Popen(
+        [*MRGC, "compile", "big.mrg", "--backend", backend, "--encoding", "paper", "--time-limit", "600"],
+        cwd=tmp_path,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     time.sleep(3.0)  # parsing and the task graph take well under a second: the solver is running
     proc.send_signal(signal.SIGINT)
     stdout, stderr = proc.communicate(timeout=120)  # the solver is stopped: far sooner than its 600 s limit
@@ -326,8 +358,9 @@ def test_a_signal_during_a_solve_stops_the_solver_and_never_gives_a_verdict(tmp_
     assert stdout == "" and "interrupted (SIGINT)" in stderr and "Traceback" not in stderr
 
 
-def test_cpsat_never_installs_its_own_sigint_handler(monkeypatch: pytest.MonkeyPatch,
-                                                       capsys: pytest.CaptureFixture[str]) -> None:
+def test_cpsat_never_installs_its_own_sigint_handler(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
     from ortools.sat.python import cp_model_helper
 
     seen: list[bool] = []
@@ -342,8 +375,13 @@ def test_cpsat_never_installs_its_own_sigint_handler(monkeypatch: pytest.MonkeyP
     assert cli.main(["plan", str(SYMBOLIC / "medium.mrg")]) == 0
     capsys.readouterr()
     assert len(seen) >= 4 and not any(seen)
-    users = [p for p in ROOT.rglob("*.py") if ".venv" not in p.parts and "tests" not in p.parts
-             and ("SolveWrapper(" in (text := p.read_text(encoding="utf-8")) or "CpSolver(" in text)]
+    users = [
+        p
+        for p in ROOT.rglob("*.py")
+        if ".venv" not in p.parts
+        and "tests" not in p.parts
+        and ("SolveWrapper(" in (text := p.read_text(encoding="utf-8")) or "CpSolver(" in text)
+    ]
     assert [p.relative_to(ROOT).as_posix() for p in users] == ["backends/cpsat.py"]
 
 
@@ -359,18 +397,27 @@ def big_symbolic(n: int) -> str:
 
     class Capture:
         @staticmethod
-        def from_facts(robots: list[str], objs: list[str], grasps: object, goal: dict[str, str],
-                       facts: list) -> None:  # type: ignore[type-arg]
+        def from_facts(robots: list[str], objs: list[str], grasps: object, goal: dict[str, str], facts: list) -> None:  # type: ignore[type-arg]
             captured.update(robots=robots, objs=objs, goal=goal, facts=facts)
 
     module.FactBase = Capture
     module.instance(n, 4, 0)
-    lines = ["(define (domain gen) (:grasps top side))", f"(define (problem big{n})", "  (:domain gen)",
-             f"  (:robots {' '.join(captured['robots'])})", f"  (:movable {' '.join(captured['objs'])})",  # type: ignore
-             "  (:regions start bin-a bin-b bin-c)", "  (:init"]
+    lines = [
+        "(define (domain gen) (:grasps top side))",
+        f"(define (problem big{n})",
+        "  (:domain gen)",
+        f"  (:robots {' '.join(captured['robots'])})",  # type: ignore
+        f"  (:movable {' '.join(captured['objs'])})",  # type: ignore
+        "  (:regions start bin-a bin-b bin-c)",
+        "  (:init",
+    ]
     lines += [f"    {f}" for f in captured["facts"]]  # type: ignore[attr-defined]
-    lines += ["  )", "  (:goal (and " + " ".join(f"(in-region {o} {b})" for o, b in captured["goal"].items())  # type: ignore
-              + ")))"]
+    lines += [
+        "  )",
+        "  (:goal (and "
+        + " ".join(f"(in-region {o} {b})" for o, b in captured["goal"].items())  # type: ignore
+        + ")))",
+    ]
     return "\n".join(lines) + "\n"
 
 
@@ -425,19 +472,29 @@ def arm_folder(root: Path, urdf: str = URDF, obj: str = "v 0 0 0\nv 0.3 0 0\nv 0
     return root
 
 
-@pytest.mark.parametrize(("edit", "line", "words"), [
-    # a joint cycle: upper and hand move each other (it used to loop forever with growing memory)
-    (lambda u: u.replace('<parent link="upper"/><child link="hand"/>', '<parent link="hand"/><child link="upper"/>')
-     .replace('<parent link="base"/><child link="upper"/>', '<parent link="upper"/><child link="hand"/>'),
-     10, "joint cycle"),
-    (lambda u: u.replace('xyz="0 0 0.1"', 'xyz="nan 0 0.1"'), 8, "not a finite number"),
-    (lambda u: u.replace('upper="3"', 'upper="inf"'), 8, "not a finite number"),
-    (lambda u: u.replace('size="0.1 0.1 0.1"', 'size="1e999 0.1 0.1"'), 3, "not a finite number"),
-    (lambda u: u.replace('<origin xyz="0.3 0 0"/>', '<origin xyz="1e300 0 0"/>'), 11, "within"),
-    (lambda u: u.replace("</robot>", "<oops></robot"), 13, "not well-formed"),
-    (lambda u: u.replace('<robot name="arm">', '<!DOCTYPE r [<!ENTITY a "aaaa">]>\n<robot name="arm">'), 2,
-     "entity"),
-])
+@pytest.mark.parametrize(
+    ("edit", "line", "words"),
+    [
+        # a joint cycle: upper and hand move each other (it used to loop forever with growing memory)
+        (
+            lambda u: u.replace(
+                '<parent link="upper"/><child link="hand"/>', '<parent link="hand"/><child link="upper"/>'
+            ).replace('<parent link="base"/><child link="upper"/>', '<parent link="upper"/><child link="hand"/>'),
+            10,
+            "joint cycle",
+        ),
+        (lambda u: u.replace('xyz="0 0 0.1"', 'xyz="nan 0 0.1"'), 8, "not a finite number"),
+        (lambda u: u.replace('upper="3"', 'upper="inf"'), 8, "not a finite number"),
+        (lambda u: u.replace('size="0.1 0.1 0.1"', 'size="1e999 0.1 0.1"'), 3, "not a finite number"),
+        (lambda u: u.replace('<origin xyz="0.3 0 0"/>', '<origin xyz="1e300 0 0"/>'), 11, "within"),
+        (lambda u: u.replace("</robot>", "<oops></robot"), 13, "not well-formed"),
+        (
+            lambda u: u.replace('<robot name="arm">', '<!DOCTYPE r [<!ENTITY a "aaaa">]>\n<robot name="arm">'),
+            2,
+            "entity",
+        ),
+    ],
+)
 def test_bad_urdfs_are_located(tmp_path: Path, edit, line: int, words: str) -> None:  # type: ignore[no-untyped-def]
     folder = arm_folder(tmp_path, edit(URDF))
     proc = run("facts", "p.mrg", cwd=folder, timeout=120)
@@ -447,10 +504,15 @@ def test_bad_urdfs_are_located(tmp_path: Path, edit, line: int, words: str) -> N
     assert words in first and "RuntimeWarning" not in proc.stderr
 
 
-@pytest.mark.parametrize(("obj", "line", "words"), [("v 0 0 0\nv nan 0 0\nv 0 1 0\n", 2, "not a finite number"),
-                                                    ("v 0 0 0\nv 1e999 0 0\n", 2, "not a finite number"),
-                                                    ("v 0 0 0\nf 1 2 3\n", 2, "vertices"),
-                                                    ("v 0 0 0\nv 0 zz 0\n", 2, "not a number")])
+@pytest.mark.parametrize(
+    ("obj", "line", "words"),
+    [
+        ("v 0 0 0\nv nan 0 0\nv 0 1 0\n", 2, "not a finite number"),
+        ("v 0 0 0\nv 1e999 0 0\n", 2, "not a finite number"),
+        ("v 0 0 0\nf 1 2 3\n", 2, "vertices"),
+        ("v 0 0 0\nv 0 zz 0\n", 2, "not a number"),
+    ],
+)
 def test_bad_meshes_are_located(tmp_path: Path, obj: str, line: int, words: str, mrgc) -> None:  # type: ignore[no-untyped-def]
     folder = arm_folder(tmp_path, obj=obj)
     proc = mrgc("facts", "p.mrg", cwd=folder)
@@ -483,26 +545,34 @@ def test_geometry_files_are_confined_to_the_problems_tree(tmp_path: Path, mrgc) 
     (outside / "block.obj").write_text("v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nv 0 0 0.1\n", encoding="utf-8")
     folder = tmp_path / "problem"
     folder.mkdir()
-    text = (PACKAGING / "pa-basic.mrg").read_text(encoding="utf-8").replace(
-        "(o3 :shape (box 0.05 0.05 0.1)", '(o3 :shape (mesh "../outside/block.obj")')
+    text = (
+        (PACKAGING / "pa-basic.mrg")
+        .read_text(encoding="utf-8")
+        .replace("(o3 :shape (box 0.05 0.05 0.1)", '(o3 :shape (mesh "../outside/block.obj")')
+    )
     (folder / "p.mrg").write_text(text, encoding="utf-8")
     (folder / "domain.mrg").write_text((PACKAGING / "domain.mrg").read_text(encoding="utf-8"), encoding="utf-8")
     proc = mrgc("check", "p.mrg", cwd=folder)
     assert proc.returncode == 2 and "error[E236]" in proc.stderr and "block.obj" in proc.stderr
     assert mrgc("check", "p.mrg", "--allow-outside", outside, cwd=folder).returncode == 0
-    (folder / "domain.mrg").write_text((PACKAGING / "domain.mrg").read_text(encoding="utf-8")
-                                       .replace('"franka_panda/panda.urdf"', '"/etc/passwd"'), encoding="utf-8")
+    (folder / "domain.mrg").write_text(
+        (PACKAGING / "domain.mrg").read_text(encoding="utf-8").replace('"franka_panda/panda.urdf"', '"/etc/passwd"'),
+        encoding="utf-8",
+    )
     proc = mrgc("facts", "p.mrg", "--allow-outside", outside, cwd=folder)
-    assert proc.returncode == 2 and re.search(r"domain\.mrg:\d+:\d+: error\[E236\]: robot URDF '/etc/passwd'",
-                                              proc.stderr)
+    assert proc.returncode == 2 and re.search(
+        r"domain\.mrg:\d+:\d+: error\[E236\]: robot URDF '/etc/passwd'", proc.stderr
+    )
 
 
 def test_huge_sizes_and_poses_are_refused_without_numpy_warnings(tmp_path: Path, mrgc) -> None:  # type: ignore[no-untyped-def]
     folder = tmp_path
     (folder / "domain.mrg").write_bytes((PACKAGING / "domain.mrg").read_bytes())
     text = (PACKAGING / "pa-basic.mrg").read_text(encoding="utf-8")
-    (folder / "p.mrg").write_text(text.replace("(box 1.6 1.4 0.05)", "(box 1e300 1.4 0.05)")
-                                  .replace("(0 -0.05 0.05 0)", "(0 -0.05 1e300 0)"), encoding="utf-8")
+    (folder / "p.mrg").write_text(
+        text.replace("(box 1.6 1.4 0.05)", "(box 1e300 1.4 0.05)").replace("(0 -0.05 0.05 0)", "(0 -0.05 1e300 0)"),
+        encoding="utf-8",
+    )
     for command in ("check", "facts"):
         proc = mrgc(command, "p.mrg", cwd=folder)
         assert proc.returncode == 2 and proc.stderr.count("error[E259]") == 2, proc.stderr
@@ -534,7 +604,7 @@ def test_did_you_mean_suggests_what_comparing_every_name_would(pool: list[str], 
     if pool and data.draw(st.booleans()):  # often a one-character slip of a real name
         base = data.draw(st.sampled_from(pool))
         i = data.draw(st.integers(0, len(base) - 1))
-        word = base[:i] + data.draw(st.sampled_from("abcde-12")) + base[i + 1:]
+        word = base[:i] + data.draw(st.sampled_from("abcde-12")) + base[i + 1 :]
     assert did_you_mean(word, pool) == brute_force(word, pool)
 
 
@@ -561,10 +631,11 @@ def test_facts_are_byte_reproducible_and_stand_on_their_own_elsewhere(tmp_path: 
     (src / "meshes").mkdir(parents=True)
     (src / "domain.mrg").write_bytes((PACKAGING / "domain.mrg").read_bytes())
     (src / "p.mrg").write_text(TINY, encoding="utf-8")
-    corners = [(x, y, z) for x in (-.025, .025) for y in (-.025, .025) for z in (-.05, .05)]
+    corners = [(x, y, z) for x in (-0.025, 0.025) for y in (-0.025, 0.025) for z in (-0.05, 0.05)]
     faces = ["1 3 4 2", "5 6 8 7", "1 2 6 5", "3 7 8 4", "1 5 7 3", "2 4 8 6"]
-    (src / "meshes" / "block.obj").write_text("".join(f"v {x} {y} {z}\n" for x, y, z in corners)
-                                              + "".join(f"f {f}\n" for f in faces), encoding="utf-8")
+    (src / "meshes" / "block.obj").write_text(
+        "".join(f"v {x} {y} {z}\n" for x, y, z in corners) + "".join(f"f {f}\n" for f in faces), encoding="utf-8"
+    )
     other = tmp_path / "other-dir"
     other.mkdir()
     first = mrgc("facts", "p.mrg", "-o", other / "x.mrg", "--workers", "1", cwd=src)

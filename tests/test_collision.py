@@ -147,8 +147,20 @@ def test_nearly_flat_clouds_do_not_crash_qhull() -> None:
 
 def test_mesh_file(tmp_path: Path) -> None:
     corners = list(itertools.product([-0.5, 0.5], repeat=3))
-    faces = [(1, 2, 4), (1, 4, 3), (5, 7, 8), (5, 8, 6), (1, 5, 6), (1, 6, 2),
-             (3, 4, 8), (3, 8, 7), (1, 3, 7), (1, 7, 5), (2, 6, 8), (2, 8, 4)]
+    faces = [
+        (1, 2, 4),
+        (1, 4, 3),
+        (5, 7, 8),
+        (5, 8, 6),
+        (1, 5, 6),
+        (1, 6, 2),
+        (3, 4, 8),
+        (3, 8, 7),
+        (1, 3, 7),
+        (1, 7, 5),
+        (2, 6, 8),
+        (2, 8, 4),
+    ]
     obj = tmp_path / "cube.obj"
     lines = [f"v {x} {y} {z}" for x, y, z in corners] + [f"f {a} {b} {c}" for a, b, c in faces]
     obj.write_text("\n".join(lines) + "\n")
@@ -324,8 +336,9 @@ def test_axis_aligned_boxes_agree_with_the_exact_test(sa, ca, sb, cb, quarter_tu
 # agreement with coal on meshes: 0.05 mm at most).
 
 BAND = 1e-4  # metres
-ANGLES = st.one_of(st.sampled_from([0.0, math.pi / 2, math.pi, -math.pi / 2, math.pi / 4]),
-                   st.floats(-math.pi, math.pi))
+ANGLES = st.one_of(
+    st.sampled_from([0.0, math.pi / 2, math.pi, -math.pi / 2, math.pi / 4]), st.floats(-math.pi, math.pi)
+)
 
 
 def rotation(rpy: tuple[float, float, float]) -> np.ndarray:
@@ -359,8 +372,20 @@ class MeshFiles:
 
     def box(self, size: np.ndarray) -> tuple[Box, Mesh, np.ndarray]:
         corners = CUBE_POINTS * size
-        faces = [(1, 2, 4), (1, 4, 3), (5, 7, 8), (5, 8, 6), (1, 5, 6), (1, 6, 2),
-                 (3, 4, 8), (3, 8, 7), (1, 3, 7), (1, 7, 5), (2, 6, 8), (2, 8, 4)]
+        faces = [
+            (1, 2, 4),
+            (1, 4, 3),
+            (5, 7, 8),
+            (5, 8, 6),
+            (1, 5, 6),
+            (1, 6, 2),
+            (3, 4, 8),
+            (3, 8, 7),
+            (1, 3, 7),
+            (1, 7, 5),
+            (2, 6, 8),
+            (2, 8, 4),
+        ]
         return Box(*size), self.write(corners, faces), corners
 
     def hull(self, seed: int, axes: np.ndarray) -> tuple[ConvexHull, Mesh, np.ndarray]:
@@ -382,18 +407,39 @@ hull_axes = st.tuples(*[st.integers(10, 150)] * 3).map(lambda mm: np.array(mm) /
 
 
 @settings(max_examples=300, deadline=None)
-@given(st.sampled_from(["box-box", "hull-box", "hull-hull", "same-hull"]), sides, sides, hull_axes,
-       st.integers(0, 2**16), st.tuples(ANGLES, ANGLES, ANGLES), st.tuples(ANGLES, ANGLES, ANGLES),
-       st.tuples(ANGLES, ANGLES), st.floats(-0.02, 0.02))
-def test_near_contact_pairs_agree(bullet, kind: str, size_a, size_b, axes, seed: int, rpy_a, rpy_b,  # type: ignore[no-untyped-def]
-                                  direction, s: float) -> None:
+@given(
+    st.sampled_from(["box-box", "hull-box", "hull-hull", "same-hull"]),
+    sides,
+    sides,
+    hull_axes,
+    st.integers(0, 2**16),
+    st.tuples(ANGLES, ANGLES, ANGLES),
+    st.tuples(ANGLES, ANGLES, ANGLES),
+    st.tuples(ANGLES, ANGLES),
+    st.floats(-0.02, 0.02),
+)
+def test_near_contact_pairs_agree(  # type: ignore[no-untyped-def]
+    bullet,
+    kind: str,
+    size_a,
+    size_b,
+    axes,
+    seed: int,
+    rpy_a,
+    rpy_b,
+    direction,
+    s: float,
+) -> None:
     """Two convex shapes placed so that their extents along a direction ``u`` overlap by ``-s`` (gap ``s``
     along u, |s| <= 20 mm): a near-contact pose, often with faces lined up (angles of 0, 90°, 45°).
     "same-hull" is one hull against a copy of itself, turned (or not), the hard case for GJK."""
     replay, files = bullet
     a = files.hull(seed, axes) if kind != "box-box" else files.box(size_a)
-    b = files.box(size_b) if kind in ("box-box", "hull-box") else files.hull(seed if kind == "same-hull" else seed + 1,
-                                                                            axes)
+    b = (
+        files.box(size_b)
+        if kind in ("box-box", "hull-box")
+        else files.hull(seed if kind == "same-hull" else seed + 1, axes)
+    )
     ta, tb = rotation(rpy_a), rotation(rpy_b)
     u = rpy_matrix(0.0, direction[0], direction[1])[:, 0]
     reach_a = max((ta[:3, :3] @ a[2].T).T @ u)
@@ -420,8 +466,13 @@ def test_near_contact_pairs_agree(bullet, kind: str, size_a, size_b, axes, seed:
 # centre point 5 mm short of the object's centre, and the second hand is pushed along its approach axis by
 # up to 20 mm.  Fingers then overlap tip to tip or just miss each other.
 
-GRASP_AXES = {"top": ((0, 0, -1), (0, 1, 0)), "side-x+": ((-1, 0, 0), (0, 1, 0)), "side-x-": ((1, 0, 0), (0, 1, 0)),
-              "side-y+": ((0, -1, 0), (1, 0, 0)), "side-y-": ((0, 1, 0), (1, 0, 0))}
+GRASP_AXES = {
+    "top": ((0, 0, -1), (0, 1, 0)),
+    "side-x+": ((-1, 0, 0), (0, 1, 0)),
+    "side-x-": ((1, 0, 0), (0, 1, 0)),
+    "side-y+": ((0, -1, 0), (1, 0, 0)),
+    "side-y-": ((0, 1, 0), (1, 0, 0)),
+}
 GRIPPER_LINKS = ("panda_hand", "panda_leftfinger", "panda_rightfinger")
 
 
@@ -446,15 +497,26 @@ def facing_pandas():  # type: ignore[no-untyped-def]
 
 
 @settings(max_examples=150, deadline=None)
-@given(st.one_of(st.sampled_from([math.radians(d) for d in range(0, 180, 5)]), st.floats(-math.pi, math.pi)),
-       st.sampled_from(sorted(GRASP_AXES)), st.sampled_from(sorted(GRASP_AXES)),
-       st.one_of(st.just(0.0), st.floats(-0.02, 0.02)), st.one_of(st.just(0.0), st.floats(-0.1, 0.1)),
-       st.one_of(st.just(0.4), st.floats(0.3, 0.5)))
+@given(
+    st.one_of(st.sampled_from([math.radians(d) for d in range(0, 180, 5)]), st.floats(-math.pi, math.pi)),
+    st.sampled_from(sorted(GRASP_AXES)),
+    st.sampled_from(sorted(GRASP_AXES)),
+    st.one_of(st.just(0.0), st.floats(-0.02, 0.02)),
+    st.one_of(st.just(0.0), st.floats(-0.1, 0.1)),
+    st.one_of(st.just(0.4), st.floats(0.3, 0.5)),
+)
 @example(math.radians(120), "side-x-", "side-x+", 0.0, 0.0, 0.4)  # fingers overlap 4.4 mm: "free" at 1e-9
 @example(math.radians(105), "side-y-", "side-y+", 0.0, 0.0, 0.4)  # the same, along the other axis
 @example(math.radians(120), "top", "top", 0.0, 0.0, 0.4)  # both hands in one place: hand pair "free" at 1e-9
-def test_panda_grippers_in_handover_poses_agree(facing_pandas, yaw: float, g1: str, g2: str,  # type: ignore[no-untyped-def]
-                                                push: float, x: float, z: float) -> None:
+def test_panda_grippers_in_handover_poses_agree(  # type: ignore[no-untyped-def]
+    facing_pandas,
+    yaw: float,
+    g1: str,
+    g2: str,
+    push: float,
+    x: float,
+    z: float,
+) -> None:
     (r1, r2), replay = facing_pandas
     obj = translation(x, 0.0, z) @ rot_z(yaw)
     tools = obj @ hand_pose(g1, 0.005), obj @ hand_pose(g2, 0.005) @ translation(0.0, 0.0, push)

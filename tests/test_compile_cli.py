@@ -38,8 +38,14 @@ def compile_json(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, d
 
 
 def action_sets(doc: dict[str, Any]) -> list[frozenset[tuple[str, ...]]]:
-    return [frozenset((a["object"], a["region"], a["pick_robot"], a["place_robot"], a["pick_grasp"],
-                       a["place_grasp"]) for step in sk["steps"] for a in step) for sk in doc["skeletons"]]
+    return [
+        frozenset(
+            (a["object"], a["region"], a["pick_robot"], a["place_robot"], a["pick_grasp"], a["place_grasp"])
+            for step in sk["steps"]
+            for a in step
+        )
+        for sk in doc["skeletons"]
+    ]
 
 
 # ---------------------------------------------------------------- text output
@@ -47,8 +53,10 @@ def test_text_output_of_chain3(capsys: pytest.CaptureFixture[str]) -> None:
     code, out, err = run(capsys, "compile", CHAIN3)
     assert code == 0, err
     lines = out.splitlines()
-    assert lines[0].startswith("problem chain-3: backend cpsat, encoding time-of-move: optimal, 1 skeleton "
-                               "(3 objects, 5 actions in the task graph, ")
+    assert lines[0].startswith(
+        "problem chain-3: backend cpsat, encoding time-of-move: optimal, 1 skeleton "
+        "(3 objects, 5 actions in the task graph, "
+    )
     assert lines[1:] == ["skeleton 1: makespan 1, moves 1 (o1)", "  step 1: r2 moves o1 to goal (side)"]
 
 
@@ -74,8 +82,12 @@ def test_json_contract(backend: str, capsys: pytest.CaptureFixture[str]) -> None
     code, doc = compile_json(capsys, CHAIN3, "--skeletons", "3", "--backend", backend)
     assert code == 0
     assert {"problem", "backend", "encoding", "status", "skeletons", "stats"} <= set(doc)
-    assert (doc["problem"], doc["backend"], doc["encoding"], doc["status"]) == \
-        ("chain-3", backend, "time-of-move", "optimal")
+    assert (doc["problem"], doc["backend"], doc["encoding"], doc["status"]) == (
+        "chain-3",
+        backend,
+        "time-of-move",
+        "optimal",
+    )
     assert isinstance(doc["stats"], dict) and doc["stats"]["objects"] == 3 and doc["stats"]["actions"] == 5
     sks = doc["skeletons"]
     assert [(s["makespan"], len(s["moved"])) for s in sks] == [(1, 1), (2, 2), (2, 3)]
@@ -119,8 +131,9 @@ def test_unknown_encoding_is_E303(capsys: pytest.CaptureFixture[str]) -> None:
 
 
 @pytest.mark.parametrize(("backend", "ext"), [("mip", "smt2"), ("smt", "lp"), ("cpsat", "mps"), ("pysmt", "lp")])
-def test_emit_with_a_wrong_extension_is_E300(backend: str, ext: str, tmp_path: Path,
-                                              capsys: pytest.CaptureFixture[str]) -> None:
+def test_emit_with_a_wrong_extension_is_E300(
+    backend: str, ext: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     target = tmp_path / f"model.{ext}"
     code, out, err = run(capsys, "compile", CHAIN3, "--backend", backend, "--emit", str(target))
     assert code == 2
@@ -143,8 +156,9 @@ GEOMETRIC = """(define (domain packaging)
 """
 
 
-def test_geometric_problem_without_facts_gets_them_from_phase_1(tmp_path: Path,
-                                                                capsys: pytest.CaptureFixture[str]) -> None:
+def test_geometric_problem_without_facts_gets_them_from_phase_1(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """(Formerly E310; since b81418d compile runs phase 1 itself.)  The :init is empty, so a skeleton and a
     non-empty task graph can only come from facts computed by the geometry layer."""
     path = tmp_path / "geo.mrg"
@@ -167,17 +181,25 @@ def test_bad_skeleton_count_and_missing_file(tmp_path: Path, capsys: pytest.Capt
 
 
 # ---------------------------------------------------------------- --emit
-EMITS = [("mip", "paper", "lp"), ("mip", "time-of-move", "mps"), ("smt", "disaggregated", "smt2"),
-         ("cpsat", "paper", "pbtxt")]
+EMITS = [
+    ("mip", "paper", "lp"),
+    ("mip", "time-of-move", "mps"),
+    ("smt", "disaggregated", "smt2"),
+    ("cpsat", "paper", "pbtxt"),
+]
 # (lines that must occur, substrings that must occur) per format
-MARKERS = {"lp": (["min", "st", "bin", "end"], []), "mps": (["ROWS", "COLUMNS", "RHS", "ENDATA"], []),
-           "smt2": (["(check-sat)"], ["(declare-fun", "(minimize", "(assert"]),
-           "pbtxt": ([], ["variables {", "constraints {", "objective {"])}
+MARKERS = {
+    "lp": (["min", "st", "bin", "end"], []),
+    "mps": (["ROWS", "COLUMNS", "RHS", "ENDATA"], []),
+    "smt2": (["(check-sat)"], ["(declare-fun", "(minimize", "(assert"]),
+    "pbtxt": ([], ["variables {", "constraints {", "objective {"]),
+}
 
 
 @pytest.mark.parametrize(("backend", "encoding", "ext"), EMITS)
-def test_emit_writes_a_model_file(backend: str, encoding: str, ext: str, tmp_path: Path,
-                                  capsys: pytest.CaptureFixture[str]) -> None:
+def test_emit_writes_a_model_file(
+    backend: str, encoding: str, ext: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     target = tmp_path / f"chain-3.{ext}"
     code, out, err = run(capsys, "compile", CHAIN3, "--backend", backend, "--encoding", encoding, "--emit", str(target))
     assert code == 0, err
@@ -201,8 +223,9 @@ def test_emit_with_json_keeps_stdout_json(tmp_path: Path, capsys: pytest.Capture
 
 
 @pytest.mark.parametrize(("backend", "encoding", "ext"), EMITS)
-def test_emit_is_deterministic(backend: str, encoding: str, ext: str, tmp_path: Path,
-                               capsys: pytest.CaptureFixture[str]) -> None:
+def test_emit_is_deterministic(
+    backend: str, encoding: str, ext: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     first, second = tmp_path / f"a.{ext}", tmp_path / f"b.{ext}"
     for target in (first, second):
         assert cli.main(["compile", CHAIN3, "--backend", backend, "--encoding", encoding, "--emit", str(target)]) == 0
@@ -210,13 +233,18 @@ def test_emit_is_deterministic(backend: str, encoding: str, ext: str, tmp_path: 
     assert first.read_bytes() == second.read_bytes()
 
 
-GOLDENS = [("paper", "lp", "mip"), ("paper", "mps", "mip"), ("disaggregated", "lp", "mip"),
-           ("time-of-move", "smt2", "smt")]
+GOLDENS = [
+    ("paper", "lp", "mip"),
+    ("paper", "mps", "mip"),
+    ("disaggregated", "lp", "mip"),
+    ("time-of-move", "smt2", "smt"),
+]
 
 
 @pytest.mark.parametrize(("encoding", "ext", "backend"), GOLDENS)
-def test_golden_export_of_chain3(encoding: str, ext: str, backend: str, tmp_path: Path,
-                                 capsys: pytest.CaptureFixture[str]) -> None:
+def test_golden_export_of_chain3(
+    encoding: str, ext: str, backend: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     golden = GOLDEN / f"chain-3.{encoding}.{ext}"
     target = tmp_path / golden.name
     assert cli.main(["compile", CHAIN3, "--backend", backend, "--encoding", encoding, "--emit", str(target)]) == 0

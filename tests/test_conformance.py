@@ -56,10 +56,15 @@ def test_expected_optima_are_right(name: str) -> None:
 def test_conditional_model_tells_negative_literals_apart() -> None:
     """Reading every negative literal as positive would change the optimum (so the kit can fail)."""
     m = kit.conditional_rows()
-    flipped = SkeletonModel(m.vars, m.rows, [type(cr)(tuple((v, True) for v, _ in cr.when), cr.row, cr.big_m)
-                                              for cr in m.cond_rows], objectives=m.objectives)
-    first_only = SkeletonModel(m.vars, m.rows, [type(cr)(cr.when[:1], cr.row, cr.big_m) for cr in m.cond_rows],
-                               objectives=m.objectives)
+    flipped = SkeletonModel(
+        m.vars,
+        m.rows,
+        [type(cr)(tuple((v, True) for v, _ in cr.when), cr.row, cr.big_m) for cr in m.cond_rows],
+        objectives=m.objectives,
+    )
+    first_only = SkeletonModel(
+        m.vars, m.rows, [type(cr)(cr.when[:1], cr.row, cr.big_m) for cr in m.cond_rows], objectives=m.objectives
+    )
     best = kit.brute_force(m)[1]
     assert kit.brute_force(flipped)[1] != best
     assert kit.brute_force(first_only)[1] != best
@@ -69,8 +74,9 @@ def test_lexicographic_model_tells_weightings_apart() -> None:
     m = kit.lexicographic()
     status, lex, _ = kit.brute_force(m)
     assert status == SolveStatus.OPTIMAL and lex == (0, 8, -1)
-    naive = SkeletonModel(m.vars, m.rows,
-                          objectives=[((m.objectives[0][0][0], 16),) + m.objectives[1] + m.objectives[2]])
+    naive = SkeletonModel(
+        m.vars, m.rows, objectives=[((m.objectives[0][0][0], 16),) + m.objectives[1] + m.objectives[2]]
+    )
     _, _, arg = kit.brute_force(naive)
     assert arg and all(kit.objectives(m, v)[0] == 1 for v in arg)  # a too-small weight picks a = 1
 
@@ -81,8 +87,9 @@ def _broken(name: str, fault: str) -> type:
     base = backend_class("cpsat")
 
     class Broken(base):  # type: ignore[misc, valid-type]
-        info = BackendInfo(name, f"cpsat with {fault}", "ortools", "ortools", base.info.features,
-                           encodings=("time-of-move",))
+        info = BackendInfo(
+            name, f"cpsat with {fault}", "ortools", "ortools", base.info.features, encodings=("time-of-move",)
+        )
 
         def _solve(self, time_limit: float | None) -> Solution:
             sol: Solution = super()._solve(time_limit)
@@ -104,13 +111,18 @@ def _broken(name: str, fault: str) -> type:
     return Broken
 
 
-@pytest.mark.parametrize(("fault", "fails"), [
-    ("infeasible-as-optimal", {"known-optima", "zero-variables"}),
-    ("ignores-added-rows", {"incremental-cuts", "rows-after-solving"}),
-])
+@pytest.mark.parametrize(
+    ("fault", "fails"),
+    [
+        ("infeasible-as-optimal", {"known-optima", "zero-variables"}),
+        ("ignores-added-rows", {"incremental-cuts", "rows-after-solving"}),
+    ],
+)
 def test_the_kit_fails_a_broken_backend(fault: str, fails: set[str]) -> None:
-    report = kit.check_backend(_broken(f"broken-{fault}", fault),
-                               checks=[c for c in kit.CHECKS if c not in ("time-limit", "symbolic-fixtures")])
+    report = kit.check_backend(
+        _broken(f"broken-{fault}", fault),
+        checks=[c for c in kit.CHECKS if c not in ("time-limit", "symbolic-fixtures")],
+    )
     assert not report.ok
     assert fails <= set(report.failed), report.lines()
     assert all(name in kit.CHECKS for name in report.passed)

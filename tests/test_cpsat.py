@@ -46,8 +46,10 @@ class CpModelReference:
         for amo in model.at_most_one:
             m.AddAtMostOne([self.x[v] for v in amo.vars])
         for no in model.no_overlap:
-            intervals = [m.NewOptionalFixedSizeIntervalVar(self.x[s], 1, self.x[p], f"{no.name}#{i}")
-                         for i, (p, s) in enumerate(no.tasks)]
+            intervals = [
+                m.NewOptionalFixedSizeIntervalVar(self.x[s], 1, self.x[p], f"{no.name}#{i}")
+                for i, (p, s) in enumerate(no.tasks)
+            ]
             m.AddNoOverlap(intervals)
         if model.objectives:
             m.Minimize(sum(c * self.x[v] for v, c in model.objectives[0]))
@@ -94,8 +96,12 @@ class Twin(CpSatBackend):
     def _solve(self, time_limit: float | None) -> Solution:
         sol = super()._solve(time_limit)
         name, values = self.reference.solve(time_limit)
-        statuses = {"OPTIMAL": SolveStatus.OPTIMAL, "FEASIBLE": SolveStatus.FEASIBLE,
-                    "INFEASIBLE": SolveStatus.INFEASIBLE, "UNKNOWN": SolveStatus.TIME_LIMIT}
+        statuses = {
+            "OPTIMAL": SolveStatus.OPTIMAL,
+            "FEASIBLE": SolveStatus.FEASIBLE,
+            "INFEASIBLE": SolveStatus.INFEASIBLE,
+            "UNKNOWN": SolveStatus.TIME_LIMIT,
+        }
         expected = statuses.get(name, SolveStatus.ERROR)
         assert (sol.status, sol.values) == (expected, values), name
         Twin.compared.append("solve")
@@ -140,26 +146,49 @@ def corner_cases() -> SkeletonModel:
     empty range, unbounded sides, negative literals, an empty variable domain."""
     b = [Var(f"b{i}", 0, 1, True) for i in range(3)]
     vars_ = [*b, Var("t", 0, 5, False), Var("u", -3, 5, False), Var("empty", 4, 2, False)]
-    rows = [Row((), 0, 1), Row((), 1, 1), Row((), None, None), Row(((0, 1), (0, -1)), 1, 1), Row(((1, 0),), 0, 2),
-            Row(((3, 2), (1, -1), (3, 3), (2, 0)), 1, None), Row(((4, 1),), None, None), Row(((3, 1),), 3, 2),
-            Row(((3, -1), (4, 1)), None, 4)]
-    cond = [CondRow(((0, True), (2, False)), Row(((3, 1), (2, 2)), 0, 3)), CondRow(((1, False),), Row((), 1, 1)),
-            CondRow((), Row(((3, 1),), 1, None))]
-    return SkeletonModel(vars_, rows, cond, [AtMostOne((0, 2)), AtMostOne((1,))],
-                         [NoOverlap(((0, 3), (2, 4)), "no"), NoOverlap((), "none")],
-                         objectives=[((4, 2), (0, 1), (4, 1), (1, 0))])
+    rows = [
+        Row((), 0, 1),
+        Row((), 1, 1),
+        Row((), None, None),
+        Row(((0, 1), (0, -1)), 1, 1),
+        Row(((1, 0),), 0, 2),
+        Row(((3, 2), (1, -1), (3, 3), (2, 0)), 1, None),
+        Row(((4, 1),), None, None),
+        Row(((3, 1),), 3, 2),
+        Row(((3, -1), (4, 1)), None, 4),
+    ]
+    cond = [
+        CondRow(((0, True), (2, False)), Row(((3, 1), (2, 2)), 0, 3)),
+        CondRow(((1, False),), Row((), 1, 1)),
+        CondRow((), Row(((3, 1),), 1, None)),
+    ]
+    return SkeletonModel(
+        vars_,
+        rows,
+        cond,
+        [AtMostOne((0, 2)), AtMostOne((1,))],
+        [NoOverlap(((0, 3), (2, 4)), "no"), NoOverlap((), "none")],
+        objectives=[((4, 2), (0, 1), (4, 1), (1, 0))],
+    )
 
 
 @pytest.mark.parametrize("objective", ["terms", "cancelled", "none", "absent"])
 def test_corner_cases_give_cp_models_message(objective: str) -> None:
     model = corner_cases()
-    model.objectives = {"terms": model.objectives, "cancelled": [((3, 1), (3, -1))], "none": [()],
-                        "absent": []}[objective]
+    model.objectives = {"terms": model.objectives, "cancelled": [((3, 1), (3, -1))], "none": [()], "absent": []}[
+        objective
+    ]
     backend = Twin()
     backend.load(model)
     assert backend.solve().status == SolveStatus.ERROR  # the empty domain makes the model invalid: the same verdict
-    feasible = SkeletonModel(model.vars[:5], [model.rows[k] for k in (0, 2, 4, 5, 6, 8)], model.cond_rows,
-                             model.at_most_one, model.no_overlap, objectives=model.objectives)
+    feasible = SkeletonModel(
+        model.vars[:5],
+        [model.rows[k] for k in (0, 2, 4, 5, 6, 8)],
+        model.cond_rows,
+        model.at_most_one,
+        model.no_overlap,
+        objectives=model.objectives,
+    )
     backend = Twin()
     backend.load(feasible)
     assert backend.solve().status == SolveStatus.OPTIMAL
@@ -176,10 +205,16 @@ def test_normal_form_sums_a_variable_drops_zeros_sorts() -> None:
 
 def test_starting_cpsat_does_not_import_pandas_or_numpy() -> None:
     """The point of writing the message: a symbolic compile with cpsat loads neither (a fresh process)."""
-    code = ("import sys; from mrgc.cli import main; code = main(['compile', sys.argv[1]]); "
-            "print(sorted({m.split('.')[0] for m in sys.modules} & {'pandas', 'numpy', 'google'})); sys.exit(code)")
-    out = subprocess.run([sys.executable, "-c", code, str(ROOT / "domains" / "symbolic" / "chain-3.mrg")],
-                         capture_output=True, text=True, timeout=120)
+    code = (
+        "import sys; from mrgc.cli import main; code = main(['compile', sys.argv[1]]); "
+        "print(sorted({m.split('.')[0] for m in sys.modules} & {'pandas', 'numpy', 'google'})); sys.exit(code)"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code, str(ROOT / "domains" / "symbolic" / "chain-3.mrg")],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert out.returncode == 0, out.stderr
     assert "optimal" in out.stdout and out.stdout.strip().splitlines()[-1] == "[]"
 
@@ -189,11 +224,17 @@ def test_cpsat_and_mip_share_a_process_in_either_order(order: tuple[str, ...]) -
     """The highspy / ortools pin (docs/backends.md) still holds with cp_model_helper loaded first or second:
     both backends solve the same problem in one fresh process, to the same (makespan, objects moved) keys, and
     the backend used twice to the same skeletons both times."""
-    code = ("import sys, mrgc; p = mrgc.parse_file(sys.argv[1]).problem(); "
-            "print([[s.makespan, list(s.moved)] for b in sys.argv[2:] "
-            "for s in mrgc.compile(p, backend=b, skeletons=3).skeletons])")
-    out = subprocess.run([sys.executable, "-c", code, str(ROOT / "domains" / "symbolic" / "medium.mrg"), *order],
-                         capture_output=True, text=True, timeout=120)
+    code = (
+        "import sys, mrgc; p = mrgc.parse_file(sys.argv[1]).problem(); "
+        "print([[s.makespan, list(s.moved)] for b in sys.argv[2:] "
+        "for s in mrgc.compile(p, backend=b, skeletons=3).skeletons])"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code, str(ROOT / "domains" / "symbolic" / "medium.mrg"), *order],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert out.returncode == 0, out.stderr
     found = eval(out.stdout)  # noqa: S307 - our own printed list
     assert len(found) == 9 and found[:3] == found[6:]

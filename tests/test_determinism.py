@@ -20,14 +20,21 @@ import pytest
 from support import ROOT
 
 # two rooms (4 × 3 m) joined by a 0.8 m doorway at x = 0: (sx, sy, x, y) of each wall
-WALLS = [(4.2, 0.1, 0, -1.55), (4.2, 0.1, 0, 1.55), (0.1, 3.2, -2.05, 0), (0.1, 3.2, 2.05, 0),
-         (0.1, 1.1, 0, -0.95), (0.1, 1.1, 0, 0.95)]
+WALLS = [
+    (4.2, 0.1, 0, -1.55),
+    (4.2, 0.1, 0, 1.55),
+    (0.1, 3.2, -2.05, 0),
+    (0.1, 3.2, 2.05, 0),
+    (0.1, 1.1, 0, -0.95),
+    (0.1, 1.1, 0, 0.95),
+]
 DOORWAY = f"""
 (define (problem bo-through-the-door)
   (:domain box-moving)
   (:robots (r1 :kind mover :base (-1.2 0.8 0 0)))
-  (:fixed {" ".join(f"(wall{i} :shape (box {sx} {sy} 0.5) :pose ({x} {y} 0.25 0))"
-                    for i, (sx, sy, x, y) in enumerate(WALLS))})
+  (:fixed {
+    " ".join(f"(wall{i} :shape (box {sx} {sy} 0.5) :pose ({x} {y} 0.25 0))" for i, (sx, sy, x, y) in enumerate(WALLS))
+})
   (:regions
     (start :shape (box 2 3 0.5) :pose (-1 0 0.25 0))
     (goal :shape (box 1.6 2 0.5) :pose (1 0 0.25 0)))
@@ -40,8 +47,12 @@ BURN = "while True:\n    pass\n"
 
 def plan_steps(problem: Path, seed: int, out: Path) -> str:
     """The ``steps`` of ``mrgc plan problem --seed seed``, as canonical JSON text."""
-    run = subprocess.run([sys.executable, "-m", "mrgc.cli", "plan", str(problem), "--seed", str(seed), "-o", str(out)],
-                         capture_output=True, text=True, timeout=300)
+    run = subprocess.run(
+        [sys.executable, "-m", "mrgc.cli", "plan", str(problem), "--seed", str(seed), "-o", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert run.returncode == 0, (run.returncode, run.stdout[-2000:], run.stderr[-2000:])
     plan = json.loads(out.read_text())
     assert plan["status"] == "solved" and plan["steps"], plan.get("why")

@@ -65,7 +65,7 @@ def test_a_removed_closing_parenthesis_is_reported_at_its_opening_one(path: Path
     pairs = _pairs(text)
     close = data.draw(st.sampled_from(sorted(pairs)))
     opener, ancestors = pairs[close]
-    broken = text[:close] + text[close + 1:]
+    broken = text[:close] + text[close + 1 :]
     found = parse_text(broken, "x.mrg")
     assert isinstance(found, Diagnostic), "a file with a ')' less parsed"
     assert found.code in ("E102", "E104"), found.headline()
@@ -74,15 +74,29 @@ def test_a_removed_closing_parenthesis_is_reported_at_its_opening_one(path: Path
 
 
 CASES = {
-    "atom": ("  (:init (in-region o1 a)\n         (reachable-pick o1 top r1\n  (:goal (in-region o1 b)))\n",
-             "E104", (8, 10), "'(reachable-pick' is not closed before '(:goal' on line 9"),
-    "section": ("  (:init (in-region o1 a)\n  (:goal (in-region o1 b)))\n",
-                "E104", (7, 3), "'(:init' is not closed before '(:goal' on line 8"),
-    "end of file": ("  (:init (in-region o1 a))\n  (:goal (in-region o1 b))\n", "E102", (2, 1),
-                    "'(define' is never closed: the file ends inside it"),
+    "atom": (
+        "  (:init (in-region o1 a)\n         (reachable-pick o1 top r1\n  (:goal (in-region o1 b)))\n",
+        "E104",
+        (8, 10),
+        "'(reachable-pick' is not closed before '(:goal' on line 9",
+    ),
+    "section": (
+        "  (:init (in-region o1 a)\n  (:goal (in-region o1 b)))\n",
+        "E104",
+        (7, 3),
+        "'(:init' is not closed before '(:goal' on line 8",
+    ),
+    "end of file": (
+        "  (:init (in-region o1 a))\n  (:goal (in-region o1 b))\n",
+        "E102",
+        (2, 1),
+        "'(define' is never closed: the file ends inside it",
+    ),
 }
-HEAD = "(define (domain d) (:requirements :symbolic) (:grasps top))\n(define (problem p)\n  (:domain d)\n" \
-       "  (:robots r1)\n  (:movable o1)\n  (:regions a b)\n"
+HEAD = (
+    "(define (domain d) (:requirements :symbolic) (:grasps top))\n(define (problem p)\n  (:domain d)\n"
+    "  (:robots r1)\n  (:movable o1)\n  (:regions a b)\n"
+)
 
 
 @pytest.mark.parametrize("case", CASES)
@@ -108,15 +122,18 @@ def test_parentheses_in_comments_and_strings_do_not_count() -> None:
 
 
 # ---------------------------------------------------------------- predicates suggested by meaning
-@pytest.mark.parametrize(("word", "hint"), [
-    ("handover", "'enable-goal-handover'"),
-    ("Hand_Over", "'enable-goal-handover'"),
-    ("reachable", "'reachable-pick' or 'reachable-place'"),
-    ("goal-place", "'occludes-goal-place'"),
-    ("in", "'in-region'"),
-    ("blocks", "'occludes-pick' or 'occludes-goal-place'"),
-    ("reachable-pik", "'reachable-pick'"),  # by spelling when the meaning gives nothing
-])
+@pytest.mark.parametrize(
+    ("word", "hint"),
+    [
+        ("handover", "'enable-goal-handover'"),
+        ("Hand_Over", "'enable-goal-handover'"),
+        ("reachable", "'reachable-pick' or 'reachable-place'"),
+        ("goal-place", "'occludes-goal-place'"),
+        ("in", "'in-region'"),
+        ("blocks", "'occludes-pick' or 'occludes-goal-place'"),
+        ("reachable-pik", "'reachable-pick'"),  # by spelling when the meaning gives nothing
+    ],
+)
 def test_unknown_predicates_are_suggested_by_meaning(word: str, hint: str) -> None:
     assert by_meaning(word, PREDICATES, PREDICATE_WORDS) == f" (did you mean {hint}?)"
     assert by_meaning("frobnicate", PREDICATES, PREDICATE_WORDS) == ""
@@ -175,7 +192,8 @@ TINY = """(define (domain cell)
 
 
 def test_a_plan_made_from_the_facts_file_validates_against_the_problem_file(
-        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     problem, facts, plan = tmp_path / "tiny.mrg", tmp_path / "out" / "tiny.facts.mrg", tmp_path / "plan.json"
     problem.write_text(TINY, encoding="utf-8")
     facts.parent.mkdir()
@@ -200,12 +218,10 @@ def test_a_reformatted_problem_keeps_its_plans_and_edited_facts_do_not(tmp_path:
     text = CHAIN3.read_text(encoding="utf-8")
     domain = (CHAIN3.parent / "domain.mrg").read_text(encoding="utf-8")
     other = tmp_path / "chain-3.mrg"
-    other.write_text("; moved, with its domain inlined and one more comment\n" + domain + "\n" + text,
-                     encoding="utf-8")
+    other.write_text("; moved, with its domain inlined and one more comment\n" + domain + "\n" + text, encoding="utf-8")
     assert mrgc.validate(other, plan).ok
     edited = tmp_path / "edited.mrg"
-    edited.write_text(domain + "\n" + text.replace("(:init", "(:init (reachable-pick o2 side r2)", 1),
-                      encoding="utf-8")
+    edited.write_text(domain + "\n" + text.replace("(:init", "(:init (reachable-pick o2 side r2)", 1), encoding="utf-8")
     report = mrgc.validate(edited, plan)
     assert not report.ok and [v.code for v in report.violations] == ["problem-changed"]
 
@@ -217,6 +233,5 @@ def test_a_plan_without_a_digest_still_compares_file_bytes(tmp_path: Path) -> No
     assert mrgc.validate(CHAIN3, doc).ok
     copy = tmp_path / "chain-3.mrg"
     copy.write_text("; another comment\n" + CHAIN3.read_text(encoding="utf-8"), encoding="utf-8")
-    (tmp_path / "domain.mrg").write_text((CHAIN3.parent / "domain.mrg").read_text(encoding="utf-8"),
-                                         encoding="utf-8")
+    (tmp_path / "domain.mrg").write_text((CHAIN3.parent / "domain.mrg").read_text(encoding="utf-8"), encoding="utf-8")
     assert [v.code for v in mrgc.validate(copy, doc).violations] == ["problem-changed"]

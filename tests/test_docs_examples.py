@@ -31,10 +31,15 @@ def test_the_examples_run(page: str, tmp_path: Path, monkeypatch: pytest.MonkeyP
         first = code.splitlines()[0]
         if first.startswith("# file: "):
             files += 1
-            path = tmp_path / first[len("# file: "):].strip()
+            path = tmp_path / first[len("# file: ") :].strip()
             path.write_text(code, encoding="utf-8")
-            out = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", str(path)],
-                                 capture_output=True, text=True, cwd=ROOT, timeout=600)
+            out = subprocess.run(
+                [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", str(path)],
+                capture_output=True,
+                text=True,
+                cwd=ROOT,
+                timeout=600,
+            )
             assert out.returncode == 0, f"docs/{page}, block {k} ({path.name}):\n{out.stdout[-3000:]}"
             assert re.search(r"\d+ passed", out.stdout) and "failed" not in out.stdout
             continue

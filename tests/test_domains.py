@@ -15,8 +15,9 @@ from mrgc.language.printer import format_source
 FILES = sorted((ROOT / "domains").rglob("*.mrg"))
 
 
-@pytest.mark.parametrize("folder,domain", [("symbolic", "abstract"), ("packaging", "packaging"),
-                                           ("box-moving", "box-moving")])
+@pytest.mark.parametrize(
+    "folder,domain", [("symbolic", "abstract"), ("packaging", "packaging"), ("box-moving", "box-moving")]
+)
 def test_each_domain_folder_holds_its_domain_and_problems_of_it(folder: str, domain: str) -> None:
     """domains/FOLDER/domain.mrg defines the domain, and every other file there holds problems of it."""
     files = sorted((ROOT / "domains" / folder).glob("*.mrg"))
@@ -64,8 +65,11 @@ def doc_blocks() -> list[tuple[str, int, str]]:
     return out
 
 
-@pytest.mark.parametrize("doc,line,body", [b for b in doc_blocks() if b[0] != "errors.md"],
-                         ids=lambda v: str(v) if isinstance(v, (str, int)) else "")
+@pytest.mark.parametrize(
+    "doc,line,body",
+    [b for b in doc_blocks() if b[0] != "errors.md"],
+    ids=lambda v: str(v) if isinstance(v, (str, int)) else "",
+)
 def test_doc_examples_check(doc: str, line: int, body: str, tmp_path: Path) -> None:
     path = tmp_path / "example.mrg"
     path.write_text(body, encoding="utf-8")

@@ -75,8 +75,9 @@ def reload(path: Path) -> tuple[SolveStatus, tuple[int, ...]]:
 @pytest.mark.parametrize("encoding", ENCODINGS)
 @pytest.mark.parametrize(("backend", "ext"), KINDS)
 @pytest.mark.parametrize("name", PROBLEMS)
-def test_every_export_reloads_to_the_same_optimum(name: str, backend: str, ext: str, encoding: str,
-                                                  tmp_path: Path) -> None:
+def test_every_export_reloads_to_the_same_optimum(
+    name: str, backend: str, ext: str, encoding: str, tmp_path: Path
+) -> None:
     problem = mrgc.parse_file(SYMBOLIC / f"{name}.mrg").problem()
     path = tmp_path / f"{name}.{ext}"
     horizon = mrgc.export_model(problem, path, backend=backend, encoding=encoding)
@@ -105,13 +106,18 @@ def test_an_infeasible_problem_exports_the_horizon_limit(tmp_path: Path) -> None
 
 
 @pytest.mark.parametrize(("backend", "ext"), KINDS)
-def test_the_horizon_option_chooses_the_model(backend: str, ext: str, tmp_path: Path,
-                                              capsys: pytest.CaptureFixture[str]) -> None:
+def test_the_horizon_option_chooses_the_model(
+    backend: str, ext: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """medium: the first skeleton has makespan 3; the paper model of exactly 4 steps is another model."""
     target = tmp_path / f"m.{ext}"
     path = str(SYMBOLIC / "medium.mrg")
-    assert cli.main(["compile", path, "--backend", backend, "--encoding", "paper", "--emit", str(target),
-                     "--horizon", "4"]) == 0
+    assert (
+        cli.main(
+            ["compile", path, "--backend", backend, "--encoding", "paper", "--emit", str(target), "--horizon", "4"]
+        )
+        == 0
+    )
     assert capsys.readouterr().out.splitlines()[-1] == f"model written to {target} (horizon 4)"
     problem = mrgc.parse_file(path).problem()
     four, three = reference(problem, backend, "paper", 4), reference(problem, backend, "paper", 3)
@@ -123,8 +129,9 @@ def test_the_horizon_option_chooses_the_model(backend: str, ext: str, tmp_path: 
 
 
 def test_a_horizon_below_one_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    assert cli.main(["compile", str(SYMBOLIC / "chain-3.mrg"), "--emit", str(tmp_path / "m.pbtxt"),
-                     "--horizon", "0"]) == 2
+    assert (
+        cli.main(["compile", str(SYMBOLIC / "chain-3.mrg"), "--emit", str(tmp_path / "m.pbtxt"), "--horizon", "0"]) == 2
+    )
     assert "error[E000]" in capsys.readouterr().err and not (tmp_path / "m.pbtxt").exists()
     with pytest.raises(mrgc.InputError):
         mrgc.export_model(SYMBOLIC / "chain-3.mrg", tmp_path / "m.pbtxt", horizon=0)

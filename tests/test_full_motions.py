@@ -16,8 +16,9 @@ HANDOVER = ROOT / "domains" / "packaging" / "pa3-handover.mrg"
 
 def test_full_motions_plan_every_path_and_validate() -> None:
     problem = parse_file(HANDOVER).problem()
-    plan = plan_problem(problem, str(HANDOVER), file_sha256(str(HANDOVER)), __version__, seed=0, time_limit=120,
-                        motions="full")
+    plan = plan_problem(
+        problem, str(HANDOVER), file_sha256(str(HANDOVER)), __version__, seed=0, time_limit=120, motions="full"
+    )
     assert plan.status == "solved", plan.why.lines() if plan.why else plan.stats
     doc = plan.to_json()
     assert doc["motion_model"]["arms"] == "full"

@@ -83,8 +83,11 @@ def geometry(problem: Problem) -> tuple[dict, dict, dict]:
         assert isinstance(o.shape, (Box, Cylinder)) and o.pose is not None
         return o.shape, o.pose
 
-    return ({o.name: body(o) for o in problem.movable}, {o.name: body(o) for o in problem.fixed},
-            {o.name: body(o) for o in problem.regions})
+    return (
+        {o.name: body(o) for o in problem.movable},
+        {o.name: body(o) for o in problem.fixed},
+        {o.name: body(o) for o in problem.regions},
+    )
 
 
 def check_layout(problem: Problem) -> None:
@@ -92,7 +95,7 @@ def check_layout(problem: Problem) -> None:
     movable, fixed, regions = geometry(problem)
     names = sorted(movable)
     for i, a in enumerate(names):
-        for b in names[i + 1:]:
+        for b in names[i + 1 :]:
             assert not overlap(movable[a], movable[b]), (a, b)
         for f, fb in fixed.items():
             assert not overlap(movable[a], fb), (a, f)
@@ -154,8 +157,13 @@ def test_packaging_varies_pitch_sizes_and_shapes() -> None:
     assert any(isinstance(s, Cylinder) for s in shapes) and any(isinstance(s, Box) for s in shapes)
     heights = {round(height(s), 3) for s in shapes}
     assert min(heights) < 0.08 and max(heights) > 0.16
-    nearest = min(math.hypot(a.pose.x - b.pose.x, a.pose.y - b.pose.y) for p in problems
-                  for i, a in enumerate(p.movable) for b in p.movable[i + 1:] if a.pose and b.pose)
+    nearest = min(
+        math.hypot(a.pose.x - b.pose.x, a.pose.y - b.pose.y)
+        for p in problems
+        for i, a in enumerate(p.movable)
+        for b in p.movable[i + 1 :]
+        if a.pose and b.pose
+    )
     assert nearest < 0.075  # neighbours packed down to about 7 cm, centre to centre
 
 
@@ -172,10 +180,13 @@ def test_box_moving_instances_are_valid(robots: int, goals: int, others: int, se
         assert region == "goal" and inside(movable[g], regions["start"])
     footprint = problem.domain.robot_kinds[0].footprint
     assert isinstance(footprint, Box)
-    carts = [(footprint, Pose(r.base.x, r.base.y, footprint.sz / 2 + 0.001, r.base.yaw))
-             for r in problem.robots if r.base is not None]
+    carts = [
+        (footprint, Pose(r.base.x, r.base.y, footprint.sz / 2 + 0.001, r.base.yaw))
+        for r in problem.robots
+        if r.base is not None
+    ]
     for i, c in enumerate(carts):
-        for other in (*carts[i + 1:], *movable.values(), *fixed.values()):
+        for other in (*carts[i + 1 :], *movable.values(), *fixed.values()):
             assert not overlap(c, other), (problem.robots[i].name, other)
 
 
@@ -193,8 +204,9 @@ def test_box_moving_has_rooms_doorways_and_blockers() -> None:
 
 
 # ---------------------------------------------------------------- the paper's suites (presets)
-@pytest.mark.parametrize("name,robots", [("pa5", None), ("pa7", None), ("pa10", None), ("bo8", None),
-                                         *[("pa18", r) for r in range(2, 7)]])
+@pytest.mark.parametrize(
+    "name,robots", [("pa5", None), ("pa7", None), ("pa10", None), ("bo8", None), *[("pa18", r) for r in range(2, 7)]]
+)
 def test_presets_are_valid_instances_of_the_papers_suites(name: str, robots: int | None) -> None:
     suite = PRESETS[name]
     for seed in range(4):
@@ -255,14 +267,25 @@ def test_shipped_pa_problems_are_reproduced() -> None:
 
 
 # ---------------------------------------------------------------- command line
-@pytest.mark.parametrize("argv", [
-    ["packaging", "--robots", "1"], ["packaging", "--robots", "7"], ["packaging", "--goals", "0"],
-    ["packaging", "--others", "-1"], ["box-moving", "--robots", "5"], ["box-moving", "--seed", "-3"],
-    ["crates"], ["packaging", "--robots", "two"],
-    ["packaging", "--preset", "bo8"], ["packaging", "--preset", "pa10", "--robots", "3"],
-    ["packaging", "--preset", "pa10", "--goals", "3"], ["box-moving", "--preset", "nope"],
-    ["packaging", "--preset", "pa18", "--robots", "7"], ["packaging", "--preset", "pa5", "--seed", "-1"],
-])
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["packaging", "--robots", "1"],
+        ["packaging", "--robots", "7"],
+        ["packaging", "--goals", "0"],
+        ["packaging", "--others", "-1"],
+        ["box-moving", "--robots", "5"],
+        ["box-moving", "--seed", "-3"],
+        ["crates"],
+        ["packaging", "--robots", "two"],
+        ["packaging", "--preset", "bo8"],
+        ["packaging", "--preset", "pa10", "--robots", "3"],
+        ["packaging", "--preset", "pa10", "--goals", "3"],
+        ["box-moving", "--preset", "nope"],
+        ["packaging", "--preset", "pa18", "--robots", "7"],
+        ["packaging", "--preset", "pa5", "--seed", "-1"],
+    ],
+)
 def test_bad_arguments_are_usage_errors(argv: list[str], capsys: pytest.CaptureFixture[str]) -> None:
     assert cli.main(["generate", *argv]) == 2
     err = capsys.readouterr().err
@@ -286,8 +309,11 @@ def test_output_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None
 
 # ---------------------------------------------------------------- phase 1 runs on generated problems
 @pytest.mark.slow
-@pytest.mark.parametrize("text", [packaging(robots=2, goals=1, others=2, seed=3),
-                                  box_moving(robots=1, goals=1, others=1, seed=3)], ids=["packaging", "box-moving"])
+@pytest.mark.parametrize(
+    "text",
+    [packaging(robots=2, goals=1, others=2, seed=3), box_moving(robots=1, goals=1, others=1, seed=3)],
+    ids=["packaging", "box-moving"],
+)
 def test_phase1_yields_facts(text: str) -> None:
     from mrgc.planner.phase1 import compute_problem_facts
 
@@ -317,8 +343,12 @@ def test_packaging_goals_are_reach_connected_to_their_bins(robots: int, goals: i
         placers = {r for r, s in shoulders.items() if math.dist(s, (b.x, b.y, 0.1)) <= REACH + 1e-6}
         if pickers & placers:
             continue
-        linked = any(math.dist(shoulders[p], h) <= REACH + 1e-6 and math.dist(shoulders[q], h) <= REACH + 1e-6
-                     for h in points for p in pickers for q in placers)
+        linked = any(
+            math.dist(shoulders[p], h) <= REACH + 1e-6 and math.dist(shoulders[q], h) <= REACH + 1e-6
+            for h in points
+            for p in pickers
+            for q in placers
+        )
         # two shoulders 1 m apart share many points 25 - 50 cm above the table within REACH of both
         close = any(math.dist(shoulders[p][:2], shoulders[q][:2]) <= 1.0 for p in pickers for q in placers)
         assert linked or not close, (name, region, pickers, placers)

@@ -69,8 +69,9 @@ def test_usage_error_e000(capsys: pytest.CaptureFixture[str]) -> None:
     assert "error[E000]" in capsys.readouterr().err
 
 
-def test_internal_errors_are_one_line(capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch,
-                                      tmp_path: Path) -> None:
+def test_internal_errors_are_one_line(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
     def boom(path: str, **options: object) -> None:
         raise KeyError("x")
 

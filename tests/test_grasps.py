@@ -76,13 +76,20 @@ def test_mrgc_fmt_check_accepts_the_canonical_form(tmp_path: Path, capsys: pytes
 
 
 @settings(max_examples=40, deadline=None)
-@given(st.sampled_from([w for w in AXES if w[0] in "+-"]), st.sampled_from(list(AXES)),
-       st.floats(0, 0.1), st.tuples(*[st.floats(-0.1, 0.1)] * 3))
-def test_any_declared_grasp_prints_and_reads_back(approach: str, fingers: str, depth: float,
-                                                 offset: tuple[float, float, float]) -> None:
+@given(
+    st.sampled_from([w for w in AXES if w[0] in "+-"]),
+    st.sampled_from(list(AXES)),
+    st.floats(0, 0.1),
+    st.tuples(*[st.floats(-0.1, 0.1)] * 3),
+)
+def test_any_declared_grasp_prints_and_reads_back(
+    approach: str, fingers: str, depth: float, offset: tuple[float, float, float]
+) -> None:
     off = " ".join(repr(x) for x in offset)
-    text = (f"(define (domain d) {KIND}\n  (:grasps (g :approach {approach} :fingers {fingers} :depth {depth!r} "
-            f":offset ({off}))))\n")
+    text = (
+        f"(define (domain d) {KIND}\n  (:grasps (g :approach {approach} :fingers {fingers} :depth {depth!r} "
+        f":offset ({off}))))\n"
+    )
     perpendicular = sum(a * b for a, b in zip(AXES[approach], AXES[fingers])) == 0
     codes = check_codes(text)
     assert [c for c, _ in codes] == ([] if perpendicular else ["E241"])
@@ -94,24 +101,33 @@ def test_any_declared_grasp_prints_and_reads_back(approach: str, fingers: str, d
 
 
 # ---------------------------------------------------------------------------------------------- checks
-@pytest.mark.parametrize("grasps, code, words", [
-    ("(g :approach -w :fingers x)", "E240", "unknown axis '-w' for ':approach' (did you mean '-x'?)"),
-    ("(g :approach -z :fingers 1)", "E240", "':fingers' must be an axis"),
-    ("(g :approach -z :fingers -z)", "E241", "must be perpendicular"),
-    ("(g :approach -z :fingers y :depth -0.01)", "E242", "must not be negative"),
-    ("(g :approach -z :fingers y :dept 0)", "E254", "unknown property ':dept' for grasp 'g' (did you mean 'depth'?)"),
-    ("(g :approach -z)", "E255", "grasp 'g' needs ':fingers'"),
-    ("(g :approach -z :fingers y :offset (0 0))", "E252", "needs 3 numbers"),
-    ("tpo", "E243", "grasp 'tpo' has no geometry"),
-    ("top (top :approach -z :fingers x)", "E200", "grasp 'top' declared twice"),
-])
+@pytest.mark.parametrize(
+    "grasps, code, words",
+    [
+        ("(g :approach -w :fingers x)", "E240", "unknown axis '-w' for ':approach' (did you mean '-x'?)"),
+        ("(g :approach -z :fingers 1)", "E240", "':fingers' must be an axis"),
+        ("(g :approach -z :fingers -z)", "E241", "must be perpendicular"),
+        ("(g :approach -z :fingers y :depth -0.01)", "E242", "must not be negative"),
+        (
+            "(g :approach -z :fingers y :dept 0)",
+            "E254",
+            "unknown property ':dept' for grasp 'g' (did you mean 'depth'?)",
+        ),
+        ("(g :approach -z)", "E255", "grasp 'g' needs ':fingers'"),
+        ("(g :approach -z :fingers y :offset (0 0))", "E252", "needs 3 numbers"),
+        ("tpo", "E243", "grasp 'tpo' has no geometry"),
+        ("top (top :approach -z :fingers x)", "E200", "grasp 'top' declared twice"),
+    ],
+)
 def test_grasp_diagnostics(grasps: str, code: str, words: str) -> None:
     codes = check_codes(f"(define (domain d) {KIND} (:grasps {grasps}))")
     assert [c for c, _ in codes] == [code] and words in codes[0][1], codes
 
 
 def test_unknown_grasp_on_a_geometric_problem_is_located_with_did_you_mean() -> None:
-    problem = DOMAIN + """
+    problem = (
+        DOMAIN
+        + """
 (define (problem p)
   (:domain cell)
   (:robots (r1 :kind panda :base (0 -0.6 0 90)))
@@ -119,11 +135,12 @@ def test_unknown_grasp_on_a_geometric_problem_is_located_with_did_you_mean() -> 
   (:movable (o :shape (box 0.04 0.04 0.1) :pose (0 0 0.05 0) :grasps (top-x side-y+ topx)))
   (:goal (in-region o start)))
 """
+    )
     with pytest.raises(InputError) as info:
         parse_string(problem, "g.mrg")
     (d,) = info.value.diagnostics
     assert d.code == "E213" and "undeclared grasp 'topx'" in d.message and "did you mean" in d.message
-    assert d.span is not None and problem.split("\n")[d.span.line - 1][d.span.column - 1:].startswith("topx)")
+    assert d.span is not None and problem.split("\n")[d.span.line - 1][d.span.column - 1 :].startswith("topx)")
     # side-y+ is built in though the domain leaves it out: a geometric problem's object may name it
     ok = parse_string(problem.replace(" topx", ""), "g.mrg").problem()
     assert ok.grasps_of("o") == ("top-x", "side-y+") and set(ok.grasp_specs) == {"top-x", "side-y+"}
@@ -141,8 +158,13 @@ def test_symbolic_domains_accept_any_grasp_name() -> None:
 def test_built_in_grasps_keep_their_meaning() -> None:
     """The tool frames of the five original names are what they were (approach, fingers, 2 cm deep)."""
     shape = Box(0.06, 0.04, 0.12)
-    old = {"top": ((0, 0, -1), (0, 1, 0)), "side-x+": ((-1, 0, 0), (0, 1, 0)), "side-x-": ((1, 0, 0), (0, 1, 0)),
-           "side-y+": ((0, -1, 0), (1, 0, 0)), "side-y-": ((0, 1, 0), (1, 0, 0))}
+    old = {
+        "top": ((0, 0, -1), (0, 1, 0)),
+        "side-x+": ((-1, 0, 0), (0, 1, 0)),
+        "side-x-": ((1, 0, 0), (0, 1, 0)),
+        "side-y+": ((0, -1, 0), (1, 0, 0)),
+        "side-y-": ((0, 1, 0), (1, 0, 0)),
+    }
     for name, (approach, fingers) in old.items():
         t = grasp_transform(BUILTIN_GRASPS[name], shape)
         z, y = np.array(approach, dtype=float), np.array(fingers, dtype=float)

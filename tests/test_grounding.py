@@ -30,8 +30,11 @@ def test_placement_lies_inside_the_region_and_avoids_objects(pa3: Grounder) -> N
 def test_placement_avoids_a_swept_volume(pa3: Grounder) -> None:
     # a wall of volume over the whole start region except nothing: no placement can be found
     region = pa3.scene.body("start")
-    volume = [(pa3.shape("o1"), region.pose @ translation(x, y, -0.09)) for x in np.linspace(-0.15, 0.15, 7)
-              for y in np.linspace(-0.15, 0.15, 7)]
+    volume = [
+        (pa3.shape("o1"), region.pose @ translation(x, y, -0.09))
+        for x in np.linspace(-0.15, 0.15, 7)
+        for y in np.linspace(-0.15, 0.15, 7)
+    ]
     assert pa3.placement("o2", "start", volume=volume, samples=40).status is GroundStatus.NO_PLACEMENT
     assert pa3.placement("o2", "start", volume=volume[:1], samples=40).ok
 
@@ -78,7 +81,7 @@ def test_transfer_lifts_then_carries_to_the_pre_place(pa3: Grounder) -> None:
     arm = pa3.arm("r1")
     z = arm.tool_world(path)[:, 2, 3]
     rise = next(i for i, h in enumerate(z) if h >= z[0] + 0.08 - 1e-4)
-    tools = arm.tool_world(path[:rise + 1])[:, :2, 3]
+    tools = arm.tool_world(path[: rise + 1])[:, :2, 3]
     assert np.abs(tools - tools[0]).max() < 2e-3  # straight up
     start = next(i for i, h in enumerate(z) if h >= z[0] + 0.01 - 1e-4)
     volume = pa3.arm_volume("r1", path[start:], holding=("o1", "top"))
@@ -157,7 +160,7 @@ def test_a_transfer_lifts_the_object_clear_of_taller_neighbours(pa3: Grounder) -
     arm = pa3.arm("r1")
     z = arm.tool_world(path)[:, 2, 3]
     rise = next(i for i, h in enumerate(z) if h >= z[0] + 0.23 - 1e-4)
-    tools = arm.tool_world(path[:rise + 1])[:, :2, 3]
+    tools = arm.tool_world(path[: rise + 1])[:, :2, 3]
     assert np.abs(tools - tools[0]).max() < 2e-3  # straight up all the way
     volume = pa3.arm_volume("r1", path[1:], holding=("o1", "top"))
     assert pa3.hits(volume, among=["o2", "o3"]) == set()

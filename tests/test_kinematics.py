@@ -41,6 +41,7 @@ def assert_same_frames(ref: dict[str, np.ndarray], ours: np.ndarray, model, tol:
 
 # ---------------------------------------------------------------------------------------------- models
 
+
 def test_panda_model(panda) -> None:
     assert panda.dof == 7
     assert panda.joint_names == tuple(f"panda_joint{i}" for i in range(1, 8))
@@ -99,9 +100,11 @@ def test_missing_end_effector_is_a_diagnostic() -> None:
 
 
 def test_loading_prints_nothing() -> None:
-    code = ("from mrgc.geometry.kinematics import load_robot_model; "
-            "from mrgc.testing.pybullet_reference import pybullet_fk; "
-            f"m = load_robot_model({PANDA!r}, '.', 'panda_hand'); pybullet_fk(m, [0.0] * 7); print('ok')")
+    code = (
+        "from mrgc.geometry.kinematics import load_robot_model; "
+        "from mrgc.testing.pybullet_reference import pybullet_fk; "
+        f"m = load_robot_model({PANDA!r}, '.', 'panda_hand'); pybullet_fk(m, [0.0] * 7); print('ok')"
+    )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout == "ok\n"
     assert "pybullet" not in out.stderr
@@ -161,8 +164,9 @@ TOY = """<?xml version="1.0"?>
 def toy(tmp_path_factory):
     folder = tmp_path_factory.mktemp("toy")
     (folder / "meshes").mkdir()
-    (folder / "meshes" / "tri.obj").write_text("# tri\nv 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nv 0 0 0.1\nf 1 2 3 4\n",
-                                               encoding="utf-8")
+    (folder / "meshes" / "tri.obj").write_text(
+        "# tri\nv 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nv 0 0 0.1\nf 1 2 3 4\n", encoding="utf-8"
+    )
     (folder / "toy.urdf").write_text(TOY, encoding="utf-8")
     return load_robot_model("toy.urdf", str(folder), "tool")
 
@@ -182,8 +186,11 @@ def test_toy_model(toy) -> None:
 
 
 @settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
-@given(u=unit_floats(4), xyz=st.lists(st.floats(-1, 1), min_size=3, max_size=3),
-       rpy=st.lists(st.floats(-3.1, 3.1), min_size=3, max_size=3))
+@given(
+    u=unit_floats(4),
+    xyz=st.lists(st.floats(-1, 1), min_size=3, max_size=3),
+    rpy=st.lists(st.floats(-3.1, 3.1), min_size=3, max_size=3),
+)
 def test_toy_fk_matches_pybullet(toy, u, xyz, rpy) -> None:
     q = in_limits(toy, u)
     base = tf.from_xyz_rpy(xyz, rpy)
@@ -191,6 +198,7 @@ def test_toy_fk_matches_pybullet(toy, u, xyz, rpy) -> None:
 
 
 # ---------------------------------------------------------------------------------------------- FK
+
 
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(u=unit_floats(7))
@@ -268,13 +276,15 @@ def test_collision_points(panda) -> None:
 
 def test_obj_reader(tmp_path: Path) -> None:
     path = tmp_path / "quad.obj"
-    path.write_text("v 0 0 0\nv 1 0 0\nvn 0 0 1\nv 1 1 0\nv 0 1 0\nf 1//1 2//1 3//1 4//1\nf -1 -2 -3\n",
-                    encoding="utf-8")
+    path.write_text(
+        "v 0 0 0\nv 1 0 0\nvn 0 0 1\nv 1 1 0\nv 0 1 0\nf 1//1 2//1 3//1 4//1\nf -1 -2 -3\n", encoding="utf-8"
+    )
     v, f = read_mesh(str(path))
     assert v.shape == (4, 3) and f.tolist() == [[0, 1, 2], [0, 2, 3], [3, 2, 1]]
 
 
 # ---------------------------------------------------------------------------------------------- IK
+
 
 @pytest.fixture(scope="module")
 def round_trip(panda):

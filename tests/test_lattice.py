@@ -25,8 +25,10 @@ BOUNDS = (0.0, 4.0, 0.0, 3.0)
 def wall_with_door(door_y: float, width: float) -> list[tuple[str, Box, np.ndarray]]:
     """A wall at x = 2 from y = 0 to 3 with a door of ``width`` centred at ``door_y``."""
     lo, hi = door_y - width / 2, door_y + width / 2
-    return [("south", Box(0.1, lo, 0.5), translation(2.0, lo / 2, 0.25)),
-            ("north", Box(0.1, 3.0 - hi, 0.5), translation(2.0, (3.0 + hi) / 2, 0.25))]
+    return [
+        ("south", Box(0.1, lo, 0.5), translation(2.0, lo / 2, 0.25)),
+        ("north", Box(0.1, 3.0 - hi, 0.5), translation(2.0, (3.0 + hi) / 2, 0.25)),
+    ]
 
 
 def validity(obstacles: list[tuple[str, Box, np.ndarray]], parts: list[tuple[Box, np.ndarray]]):
@@ -61,8 +63,14 @@ def assert_valid_path(res, start, goal, valid) -> None:
 
 
 @settings(max_examples=30, deadline=None)
-@given(ox=st.floats(1.0, 3.0), oy=st.floats(0.8, 2.2), oyaw=st.floats(-math.pi, math.pi),
-       sx=st.floats(0.05, 0.8), sy=st.floats(0.05, 0.8), seed=st.integers(0, 2**16))
+@given(
+    ox=st.floats(1.0, 3.0),
+    oy=st.floats(0.8, 2.2),
+    oyaw=st.floats(-math.pi, math.pi),
+    sx=st.floats(0.05, 0.8),
+    sy=st.floats(0.05, 0.8),
+    seed=st.integers(0, 2**16),
+)
 def test_occupancy_is_exact_at_lattice_states(ox, oy, oyaw, sx, sy, seed) -> None:
     """At lattice states near a box the rasterised occupancy says what coal says of the footprint and the
     box (both standing on the floor: the floor projection loses nothing), away from touching."""

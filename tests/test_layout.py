@@ -47,12 +47,29 @@ ONLY_IMPORTS: dict[str, set[str]] = {
 }
 #: the validator (docs/validator.md) and the modules it reads: none of the planner's search and grounding,
 #: coal or the numpy kinematics; it replays in pybullet (geometry/replay_world.py)
-VALIDATOR = ["planner/validate.py", "planner/violation.py", "planner/plan_reader.py", "planner/replay.py",
-             "planner/replay_actions.py", "planner/sampling.py", "geometry/replay_world.py"]
-NOT_FOR_THE_VALIDATOR = {"mrgc.planner.ground", "mrgc.planner.mcts", "mrgc.planner.search",
-                         "mrgc.geometry.grounding", "mrgc.geometry.predicates", "mrgc.geometry.path_predicates",
-                         "mrgc.geometry.collision", "mrgc.geometry.fk", "mrgc.geometry.ik", "mrgc.geometry.arm",
-                         "mrgc.geometry.motion", "mrgc.geometry.lattice"}
+VALIDATOR = [
+    "planner/validate.py",
+    "planner/violation.py",
+    "planner/plan_reader.py",
+    "planner/replay.py",
+    "planner/replay_actions.py",
+    "planner/sampling.py",
+    "geometry/replay_world.py",
+]
+NOT_FOR_THE_VALIDATOR = {
+    "mrgc.planner.ground",
+    "mrgc.planner.mcts",
+    "mrgc.planner.search",
+    "mrgc.geometry.grounding",
+    "mrgc.geometry.predicates",
+    "mrgc.geometry.path_predicates",
+    "mrgc.geometry.collision",
+    "mrgc.geometry.fk",
+    "mrgc.geometry.ik",
+    "mrgc.geometry.arm",
+    "mrgc.geometry.motion",
+    "mrgc.geometry.lattice",
+}
 
 #: heavy library -> the one module allowed to import it (filled in as backends/geometry modules land)
 HEAVY = {
@@ -114,7 +131,7 @@ def imports(path: Path, rel: Path | None = None) -> list[tuple[str, bool]]:
             base = node.module or ""
             if node.level:
                 parts = package.split(".")
-                base = ".".join(parts[:len(parts) - node.level + 1] + ([node.module] if node.module else []))
+                base = ".".join(parts[: len(parts) - node.level + 1] + ([node.module] if node.module else []))
             for a in node.names:
                 name = f"{base}.{a.name}"
                 out.append((name if name in MODULES else base, id(node) in top))
@@ -177,8 +194,20 @@ def test_every_code_folder_is_packaged() -> None:
 
 
 def test_the_user_layout_exists() -> None:
-    for name in ["pyproject.toml", "language", "compiler", "backends", "geometry", "planner", "domains",
-                 "benchmarks", "tests", "docs", "README.md", "py.typed"]:
+    for name in [
+        "pyproject.toml",
+        "language",
+        "compiler",
+        "backends",
+        "geometry",
+        "planner",
+        "domains",
+        "benchmarks",
+        "tests",
+        "docs",
+        "README.md",
+        "py.typed",
+    ]:
         assert (ROOT / name).exists(), name
     assert not (ROOT / "tests" / "__init__.py").exists()
 
@@ -198,16 +227,19 @@ def test_import_rules(path: Path) -> None:
             assert target != "cli", f"{rel} imports the CLI (bench/ reads the commands' parser from commands.py)"
             assert target != "bench" or me in {"cli", "bench"}, f"{rel} imports mrgc.bench (only the CLI may)"
             assert target != "render" or me in {"cli", "render"}, f"{rel} imports mrgc.render (only the CLI may)"
-            assert "*" in allowed or target in {me, "exits"} or target in allowed, \
+            assert "*" in allowed or target in {me, "exits"} or target in allowed, (
                 f"{rel} ({me}) may not import {module}"
+            )
         if parts[0] in HEAVY:
-            assert str(rel) == HEAVY[parts[0]] or parts[0] in ALSO_HEAVY.get(str(rel), set()), \
+            assert str(rel) == HEAVY[parts[0]] or parts[0] in ALSO_HEAVY.get(str(rel), set()), (
                 f"{rel} imports {parts[0]}; only {HEAVY[parts[0]]} may"
+            )
     if str(rel) in ONLY_IMPORTS:
         assert mrgc_imports(path) <= ONLY_IMPORTS[str(rel)], f"{rel} imports {mrgc_imports(path)}"
     if str(rel) in VALIDATOR:
-        assert not mrgc_imports(path) & NOT_FOR_THE_VALIDATOR, \
+        assert not mrgc_imports(path) & NOT_FOR_THE_VALIDATOR, (
             f"the validator's {rel} imports {mrgc_imports(path) & NOT_FOR_THE_VALIDATOR}"
+        )
 
 
 def test_no_module_imports_itself_through_others() -> None:
@@ -219,16 +251,23 @@ def test_the_import_reader_sees_relative_and_late_imports(tmp_path: Path) -> Non
     """The reader behind these rules: relative imports resolved, imports inside functions and
     TYPE_CHECKING blocks read, ``from package import module`` naming the module."""
     path = tmp_path / "probe.py"
-    path.write_text("from typing import TYPE_CHECKING\n"
-                    "from . import transforms\n"
-                    "from ..planner import search\n"
-                    "if TYPE_CHECKING:\n"
-                    "    from .scene import SceneSpec\n"
-                    "def f():\n"
-                    "    from mrgc.geometry.ik import solve_ik\n", encoding="utf-8")
+    path.write_text(
+        "from typing import TYPE_CHECKING\n"
+        "from . import transforms\n"
+        "from ..planner import search\n"
+        "if TYPE_CHECKING:\n"
+        "    from .scene import SceneSpec\n"
+        "def f():\n"
+        "    from mrgc.geometry.ik import solve_ik\n",
+        encoding="utf-8",
+    )
     rel = Path("geometry", "probe.py")
-    assert mrgc_imports(path, rel) == {"mrgc.geometry.transforms", "mrgc.planner.search", "mrgc.geometry.scene",
-                                       "mrgc.geometry.ik"}
+    assert mrgc_imports(path, rel) == {
+        "mrgc.geometry.transforms",
+        "mrgc.planner.search",
+        "mrgc.geometry.scene",
+        "mrgc.geometry.ik",
+    }
     assert [top for m, top in imports(path, rel) if m.startswith("mrgc.")] == [True, True, False, False]
 
 
@@ -241,8 +280,7 @@ def test_heavy_libraries_are_imported_lazily(path: Path) -> None:
 
 
 def test_importing_mrgc_loads_no_heavy_library() -> None:
-    code = ("import sys, mrgc, mrgc.cli, mrgc.language; "
-            "print(sorted(m for m in %r if m in sys.modules))" % sorted(HEAVY))
+    code = "import sys, mrgc, mrgc.cli, mrgc.language; print(sorted(m for m in %r if m in sys.modules))" % sorted(HEAVY)
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]"
 
@@ -256,7 +294,9 @@ def test_the_skeleton_oracle_shares_no_code_with_the_compiler() -> None:
 
 
 def test_importing_mrgc_testing_loads_neither_hypothesis_nor_a_solver() -> None:
-    code = ("import sys, mrgc.testing, mrgc.testing.oracle, mrgc.testing.conformance; "
-            "print(sorted(m for m in %r if m in sys.modules))" % sorted([*HEAVY, "hypothesis"]))
+    code = (
+        "import sys, mrgc.testing, mrgc.testing.oracle, mrgc.testing.conformance; "
+        "print(sorted(m for m in %r if m in sys.modules))" % sorted([*HEAVY, "hypothesis"])
+    )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]"

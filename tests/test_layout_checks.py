@@ -21,9 +21,15 @@ CELL = """(define (domain cell)
 """
 
 
-def cell(movable: str, regions: str = "(start :shape (box 0.4 0.4 0.3) :pose (0 0 0.15 0))",
-         fixed: str = "(table :shape (box 1.4 1.4 0.05) :pose (0 0 -0.025 0))", goal: str = "o1 start") -> str:
-    return CELL + f"""(define (problem p)
+def cell(
+    movable: str,
+    regions: str = "(start :shape (box 0.4 0.4 0.3) :pose (0 0 0.15 0))",
+    fixed: str = "(table :shape (box 1.4 1.4 0.05) :pose (0 0 -0.025 0))",
+    goal: str = "o1 start",
+) -> str:
+    return (
+        CELL
+        + f"""(define (problem p)
   (:domain cell)
   (:robots (r1 :kind panda :base (0 -0.6 0 90)))
   (:fixed {fixed})
@@ -31,6 +37,7 @@ def cell(movable: str, regions: str = "(start :shape (box 0.4 0.4 0.3) :pose (0 
   (:movable {movable})
   (:goal (in-region {goal})))
 """
+    )
 
 
 def codes(text: str, robots: bool = False) -> list[tuple[str, int]]:
@@ -44,14 +51,18 @@ BOX = "(box 0.04 0.04 0.1)"
 
 def test_touching_is_not_overlapping() -> None:
     """Side by side, on the table, on each other: nothing to report."""
-    text = cell(f"(o1 :shape {BOX} :pose (0 0 0.05 0)) (o2 :shape {BOX} :pose (0.04 0 0.05 0)) "
-                f"(o3 :shape {BOX} :pose (0 0 0.15 0))")
+    text = cell(
+        f"(o1 :shape {BOX} :pose (0 0 0.05 0)) (o2 :shape {BOX} :pose (0.04 0 0.05 0)) "
+        f"(o3 :shape {BOX} :pose (0 0 0.15 0))"
+    )
     assert codes(text, robots=True) == []
 
 
 def test_objects_overlapping_each_other_or_the_table() -> None:
-    text = cell(f"(o1 :shape {BOX} :pose (0 0 0.05 0))\n (o2 :shape {BOX} :pose (0.035 0 0.05 0))\n"
-                f" (o3 :shape (cylinder 0.02 0.1) :pose (0.1 0.1 0.045 0))")
+    text = cell(
+        f"(o1 :shape {BOX} :pose (0 0 0.05 0))\n (o2 :shape {BOX} :pose (0.035 0 0.05 0))\n"
+        f" (o3 :shape (cylinder 0.02 0.1) :pose (0.1 0.1 0.045 0))"
+    )
     found = mrgc.parse_string(text, "p.mrg").problem()
     diags = layout_diagnostics(found)
     assert [(d.code, d.span.line) for d in diags] == [("E264", 11), ("E265", 12), ("W271", 12)]
@@ -79,13 +90,18 @@ def test_home_length_against_the_arms_joints() -> None:
         problem = mrgc.parse_string(text, "p.mrg").problem()
         (diag,) = layout_diagnostics(problem)
         assert diag.code == "E263" and (diag.span.line, diag.span.column) == (3, 11)
-        assert f":home has {values.count('0')} values, but the arm of 'franka_panda/panda.urdf' has 7 joints" \
+        assert (
+            f":home has {values.count('0')} values, but the arm of 'franka_panda/panda.urdf' has 7 joints"
             in diag.message
+        )
 
 
 def test_an_unreadable_urdf_is_left_to_facts() -> None:
-    text = cell(f"(o1 :shape {BOX} :pose (0 0 0.05 0))").replace("franka_panda/panda.urdf", "nowhere.urdf") \
+    text = (
+        cell(f"(o1 :shape {BOX} :pose (0 0 0.05 0))")
+        .replace("franka_panda/panda.urdf", "nowhere.urdf")
         .replace("(0 -0.785 0 -2.356 0 1.571 0.785)", "(0 0)")
+    )
     assert codes(text) == []
 
 
@@ -106,27 +122,30 @@ def test_an_arm_at_home_inside_an_object_is_found_with_its_model() -> None:
     assert ("E266", 7) in found
     problem = mrgc.parse_string(text, "p.mrg").problem()
     (hit,) = [d for d in robot_diagnostics(problem) if d.code == "E266"]
-    assert "robot 'r1' (panda_" in hit.message and "at its home configuration overlaps movable object 'post'" \
-        in hit.message
+    assert (
+        "robot 'r1' (panda_" in hit.message
+        and "at its home configuration overlaps movable object 'post'" in hit.message
+    )
 
 
 def test_regions_out_of_every_arms_reach() -> None:
-    text = cell(f"(o1 :shape {BOX} :pose (0 0 0.05 0))",
-                regions="(start :shape (box 0.4 0.4 0.3) :pose (0 0 0.15 0)) "
-                        "(far :shape (box 0.3 0.3 0.3) :pose (3 0 0.15 0))")
+    text = cell(
+        f"(o1 :shape {BOX} :pose (0 0 0.05 0))",
+        regions="(start :shape (box 0.4 0.4 0.3) :pose (0 0 0.15 0)) (far :shape (box 0.3 0.3 0.3) :pose (3 0 0.15 0))",
+    )
     assert codes(text, robots=True) == [("W272", 9)]
 
 
-@pytest.mark.parametrize("path", sorted(p for p in (ROOT / "domains").glob("*/*.mrg") if p.name != "domain.mrg"),
-                         ids=lambda p: p.name)
+@pytest.mark.parametrize(
+    "path", sorted(p for p in (ROOT / "domains").glob("*/*.mrg") if p.name != "domain.mrg"), ids=lambda p: p.name
+)
 def test_the_shipped_problems_have_clean_layouts(path: Path) -> None:
     for problem in mrgc.parse_file(path).problems:
         found = layout_diagnostics(problem) + robot_diagnostics(problem)
         assert [d.headline() for d in found if d.code != "W270"] == []
 
 
-@pytest.mark.parametrize(("kind", "robots"), [("packaging", 2), ("packaging", 3), ("box-moving", 2),
-                                              ("box-moving", 3)])
+@pytest.mark.parametrize(("kind", "robots"), [("packaging", 2), ("packaging", 3), ("box-moving", 2), ("box-moving", 3)])
 def test_generated_problems_have_no_layout_errors(kind: str, robots: int) -> None:
     for seed in range(4):
         text = generate(kind, seed=seed, robots=robots)
@@ -137,8 +156,9 @@ def test_generated_problems_have_no_layout_errors(kind: str, robots: int) -> Non
 
 def test_commands_refuse_an_impossible_start(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     path = tmp_path / "p.mrg"
-    path.write_text(cell(f"(o1 :shape {BOX} :pose (0 0 0.05 0)) (o2 :shape {BOX} :pose (0.02 0 0.05 0))"),
-                    encoding="utf-8")
+    path.write_text(
+        cell(f"(o1 :shape {BOX} :pose (0 0 0.05 0)) (o2 :shape {BOX} :pose (0.02 0 0.05 0))"), encoding="utf-8"
+    )
     for command in (["check"], ["facts"], ["compile"], ["plan", "--time-limit", "5"]):
         assert cli.main([command[0], str(path), *command[1:]]) == 2, command
         err = capsys.readouterr().err

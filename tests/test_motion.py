@@ -33,8 +33,7 @@ def check_path(result: MotionResult, start, goal, is_valid, step: float, yaw: bo
 
 
 def test_point_through_the_gap() -> None:
-    result = plan_joint_path(LOWER, UPPER, [0.1, 0.1], [0.9, 0.9], wall_with_gap, seed=1,
-                             resolution=0.01)
+    result = plan_joint_path(LOWER, UPPER, [0.1, 0.1], [0.9, 0.9], wall_with_gap, seed=1, resolution=0.01)
     check_path(result, [0.1, 0.1], [0.9, 0.9], wall_with_gap, 0.01)
     # it really went through the gap
     crossing = [q for q in result.path if 0.45 <= q[0] <= 0.55]
@@ -48,8 +47,7 @@ def test_every_checked_state_is_returned() -> None:
         calls.append(q)
         return wall_with_gap(q)
 
-    result = plan_joint_path(LOWER, UPPER, [0.1, 0.1], [0.9, 0.9], valid, seed=3,
-                             resolution=0.02)
+    result = plan_joint_path(LOWER, UPPER, [0.1, 0.1], [0.9, 0.9], valid, seed=3, resolution=0.02)
     assert result.solved
     assert all(isinstance(q, np.ndarray) and q.shape == (2,) for q in calls)
     checked = {tuple(np.round(q, 12)) for q in calls}
@@ -111,6 +109,7 @@ def test_same_seed_same_path_and_other_seed_other_path() -> None:
 
 def slowed(is_valid, pause: float):  # type: ignore[no-untyped-def]
     """``is_valid``, taking ``pause`` seconds longer per call (as on a machine busy with other work)."""
+
     def valid(q: np.ndarray) -> bool:
         end = time.perf_counter() + pause
         while time.perf_counter() < end:
@@ -121,27 +120,34 @@ def slowed(is_valid, pause: float):  # type: ignore[no-untyped-def]
 
 
 def same_result(a: MotionResult, b: MotionResult) -> bool:
-    return (a.status is b.status and a.checks == b.checks and len(a.path) == len(b.path)
-            and all(np.array_equal(p, q) for p, q in zip(a.path, b.path)))
+    return (
+        a.status is b.status
+        and a.checks == b.checks
+        and len(a.path) == len(b.path)
+        and all(np.array_equal(p, q) for p, q in zip(a.path, b.path))
+    )
 
 
 def test_no_clock_decides_a_result() -> None:
     """A validity test 50 times slower (as on a loaded machine) changes no result: the budget counts checks,
     and a wall-clock limit between the two solves' durations (15 ms and 0.5 s) would have decided differently."""
+
     def maze(q: np.ndarray) -> bool:  # three walls with gaps at alternating ends
         x, y = q
-        return not any(abs(x - w) < 0.02 and (y < 0.9 if k % 2 == 0 else y > 0.1)
-                       for k, w in enumerate((0.25, 0.5, 0.75)))
+        return not any(
+            abs(x - w) < 0.02 and (y < 0.9 if k % 2 == 0 else y > 0.1) for k, w in enumerate((0.25, 0.5, 0.75))
+        )
 
     for budget in (400, 5000):
-        fast = plan_joint_path(LOWER, UPPER, [0.1, 0.1], [0.9, 0.9], maze, max_checks=budget, seed=5,
-                               resolution=0.01)
-        slow = plan_joint_path(LOWER, UPPER, [0.1, 0.1], [0.9, 0.9], slowed(maze, 2e-4), max_checks=budget,
-                               seed=5, resolution=0.01)
+        fast = plan_joint_path(LOWER, UPPER, [0.1, 0.1], [0.9, 0.9], maze, max_checks=budget, seed=5, resolution=0.01)
+        slow = plan_joint_path(
+            LOWER, UPPER, [0.1, 0.1], [0.9, 0.9], slowed(maze, 2e-4), max_checks=budget, seed=5, resolution=0.01
+        )
         assert same_result(fast, slow), (budget, fast.status, slow.status, fast.checks, slow.checks)
     assert not plan_joint_path(LOWER, UPPER, [0.1, 0.1], [0.9, 0.9], maze, max_checks=400, seed=5).solved
-    assert fast.solved and same_result(fast, plan_joint_path(LOWER, UPPER, [0.1, 0.1], [0.9, 0.9], maze, seed=5,
-                                                             resolution=0.01))  # the default budget MAX_CHECKS
+    assert fast.solved and same_result(
+        fast, plan_joint_path(LOWER, UPPER, [0.1, 0.1], [0.9, 0.9], maze, seed=5, resolution=0.01)
+    )  # the default budget MAX_CHECKS
     assert fast.checks < MAX_CHECKS
 
 

@@ -31,11 +31,16 @@ PA3 = (ROOT / "domains" / "packaging" / "pa3-handover.mrg").read_text(encoding="
 def run_plan(tmp_path: Path, text: str, *extra: str) -> tuple[int, dict[str, Any], str]:
     src = tmp_path / "p.mrg"
     src.write_text(text, encoding="utf-8")
-    (tmp_path / "domain.mrg").write_text((ROOT / "domains" / "packaging" / "domain.mrg").read_text(encoding="utf-8"),
-                                         encoding="utf-8")
+    (tmp_path / "domain.mrg").write_text(
+        (ROOT / "domains" / "packaging" / "domain.mrg").read_text(encoding="utf-8"), encoding="utf-8"
+    )
     out = tmp_path / "plan.json"
-    proc = subprocess.run([sys.executable, "-m", "mrgc.cli", "plan", str(src), "-o", str(out), *extra],
-                          capture_output=True, text=True, timeout=300)
+    proc = subprocess.run(
+        [sys.executable, "-m", "mrgc.cli", "plan", str(src), "-o", str(out), *extra],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     data = json.loads(out.read_text(encoding="utf-8")) if out.exists() else {}
     return proc.returncode, data, proc.stdout + proc.stderr
 
@@ -56,8 +61,10 @@ def test_a_blocking_cycle_is_named(capsys: pytest.CaptureFixture[str]) -> None:
 
 
 def test_a_goal_nobody_can_reach_is_infeasible_with_the_missing_fact(tmp_path: Path) -> None:
-    far = PA3.replace("(bin-b :shape (box 0.2 0.2 0.3) :pose (-0.3 0.35 0.15 0))",
-                      "(bin-b :shape (box 0.2 0.2 0.3) :pose (-3 3.5 0.15 0))")
+    far = PA3.replace(
+        "(bin-b :shape (box 0.2 0.2 0.3) :pose (-0.3 0.35 0.15 0))",
+        "(bin-b :shape (box 0.2 0.2 0.3) :pose (-3 3.5 0.15 0))",
+    )
     code, data, text = run_plan(tmp_path, far, "--time-limit", "60")
     assert code == 1 and data["status"] == "infeasible"
     assert data["why"]["facts"] == ["no robot can reach goal region bin-b"]
@@ -66,12 +73,13 @@ def test_a_goal_nobody_can_reach_is_infeasible_with_the_missing_fact(tmp_path: P
 
 def test_a_geometric_blocking_cycle_shows_the_bodies_and_the_depth(tmp_path: Path) -> None:
     """Two boxes 7 cm apart, each allowed only the side grasp whose approach comes through the other."""
-    cycle = PA3.replace("""    (o1 :shape (box 0.05 0.05 0.12) :pose (0 -0.25 0.06 0))
+    cycle = PA3.replace(
+        """    (o1 :shape (box 0.05 0.05 0.12) :pose (0 -0.25 0.06 0))
     (o2 :shape (box 0.05 0.05 0.12) :pose (0.07 -0.25 0.06 0))
     (o3 :shape (box 0.05 0.05 0.12) :pose (-0.07 -0.25 0.06 0)))""",
         """    (o1 :shape (box 0.05 0.05 0.12) :pose (0 -0.25 0.06 0) :grasps (side-x+))
-    (o2 :shape (box 0.05 0.05 0.12) :pose (0.07 -0.25 0.06 0) :grasps (side-x-)))""").replace(
-        "(:goal (in-region o1 bin-b))", "(:goal (and (in-region o1 bin-a) (in-region o2 bin-a)))")
+    (o2 :shape (box 0.05 0.05 0.12) :pose (0.07 -0.25 0.06 0) :grasps (side-x-)))""",
+    ).replace("(:goal (in-region o1 bin-b))", "(:goal (and (in-region o1 bin-a) (in-region o2 bin-a)))")
     code, data, text = run_plan(tmp_path, cycle, "--time-limit", "60")
     assert code == 1 and data["status"] == "infeasible", text
     (found,) = data["why"]["cycles"]
@@ -87,9 +95,12 @@ def test_a_geometric_blocking_cycle_shows_the_bodies_and_the_depth(tmp_path: Pat
 def test_facts_that_no_geometry_backs_exhaust_the_search(tmp_path: Path) -> None:
     """Facts claiming r1 can pick and place o1 with a grasp whose approach hits the table every time: the
     compiler finds skeletons, grounding fails each one, and the run says which check failed."""
-    lying = PA3.replace("(:goal (in-region o1 bin-b))", """(:init (in-region o1 start) (in-region o2 start)
+    lying = PA3.replace(
+        "(:goal (in-region o1 bin-b))",
+        """(:init (in-region o1 start) (in-region o2 start)
            (in-region o3 start) (reachable-pick o1 side-x+ r2) (reachable-place o1 bin-b side-x+ r2))
-    (:goal (in-region o1 bin-b))""")
+    (:goal (in-region o1 bin-b))""",
+    )
     code, data, text = run_plan(tmp_path, lying, "--time-limit", "60")
     assert code == 5 and data["status"] == "exhausted", text
     failures = data["why"]["grounding_failures"]
@@ -105,14 +116,26 @@ def test_a_time_limit_names_itself(capsys: pytest.CaptureFixture[str]) -> None:
     assert data["status"] == "time limit" and "time limit" in data["why"]["summary"]
 
 
-@pytest.mark.parametrize(("sig", "code", "word"), [(signal.SIGINT, 130, "interrupted"),
-                                                   (signal.SIGTERM, 143, "terminated")])
-def test_a_signal_during_the_search_reports_and_writes_nothing(tmp_path: Path, sig: int, code: int,
-                                                               word: str) -> None:
+@pytest.mark.parametrize(
+    ("sig", "code", "word"), [(signal.SIGINT, 130, "interrupted"), (signal.SIGTERM, 143, "terminated")]
+)
+def test_a_signal_during_the_search_reports_and_writes_nothing(tmp_path: Path, sig: int, code: int, word: str) -> None:
     out = tmp_path / "plan.json"
-    proc = subprocess.Popen([sys.executable, "-m", "mrgc.cli", "plan",
-                             str(ROOT / "domains" / "box-moving" / "bo8-two-doors.mrg"), "-o", str(out), "-v"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "mrgc.cli",
+            "plan",
+            str(ROOT / "domains" / "box-moving" / "bo8-two-doors.mrg"),
+            "-o",
+            str(out),
+            "-v",
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     assert proc.stderr is not None
     first = proc.stderr.readline()  # the first search log line: the search is running
     assert first.startswith("[t="), first
@@ -157,10 +180,16 @@ class ScriptedGrounder:
     """Answers the reverse grounder's geometric queries from a script: picks of an object fail while any
     object of ``blocked_by[obj]`` must be avoided; volumes are tokens, and ``hits`` reads them."""
 
-    def __init__(self, movable: list[str], blocked_by: dict[str, set[str]], sweeps: dict[str, set[str]],
-                 crowded: frozenset[str] = frozenset()) -> None:
-        self.scene = SimpleNamespace(movable=[SimpleNamespace(name=m) for m in movable], handover_of={},
-                                     handover_points={})
+    def __init__(
+        self,
+        movable: list[str],
+        blocked_by: dict[str, set[str]],
+        sweeps: dict[str, set[str]],
+        crowded: frozenset[str] = frozenset(),
+    ) -> None:
+        self.scene = SimpleNamespace(
+            movable=[SimpleNamespace(name=m) for m in movable], handover_of={}, handover_points={}
+        )
         self.blocked_by, self.sweeps = blocked_by, sweeps
         self.crowded = crowded  # objects whose pick collides with whatever another robot of the step sweeps
         self.poses = {m: np.eye(4) for m in movable}
@@ -183,16 +212,43 @@ class ScriptedGrounder:
     def place(self, robot: str, obj: str, grasp: str, pose: np.ndarray, avoid: Any = (), busy: Any = ()) -> Answer:
         return Answer(GroundStatus.OK, configs=np.array([[1.0], [0.0]]))
 
-    def transfer(self, robot: str, obj: str, grasp: str, start: np.ndarray, goal: np.ndarray, avoid: Any = (),
-                 lift: bool = False, busy: Any = (), partner: Any = None, lower: bool = False) -> Answer:
+    def transfer(
+        self,
+        robot: str,
+        obj: str,
+        grasp: str,
+        start: np.ndarray,
+        goal: np.ndarray,
+        avoid: Any = (),
+        lift: bool = False,
+        busy: Any = (),
+        partner: Any = None,
+        lower: bool = False,
+    ) -> Answer:
         return Answer(GroundStatus.OK, path=[np.asarray(start), np.asarray(goal)])
 
-    def placement(self, obj: str, region: str, avoid: Any = (), volume: Any = None, key: str = "",
-                  skip: int = 0, packed: bool = False) -> Answer:
+    def placement(
+        self,
+        obj: str,
+        region: str,
+        avoid: Any = (),
+        volume: Any = None,
+        key: str = "",
+        skip: int = 0,
+        packed: bool = False,
+    ) -> Answer:
         return Answer(GroundStatus.OK, pose=np.eye(4))
 
-    def placements(self, obj: str, region: str, avoid: Any = (), volume: Any = None, key: str = "",
-                   packed: bool = False, prefer: Any = None) -> Any:
+    def placements(
+        self,
+        obj: str,
+        region: str,
+        avoid: Any = (),
+        volume: Any = None,
+        key: str = "",
+        packed: bool = False,
+        prefer: Any = None,
+    ) -> Any:
         yield np.eye(4)
 
     def comfortable(self, robot: str, obj: str, grasp: str) -> Any:
@@ -218,10 +274,10 @@ def test_m_star_keeps_the_blockers_of_an_older_suffix() -> None:
     sweeps = {"suffix-volume": {"b"}, "arm:r1:": {"d"}}
     grounder = ScriptedGrounder(movable, blocked_by={"c": {"d"}}, sweeps=sweeps)
     reverse = ReverseGrounder(grounder, {"g": "goal"})  # type: ignore[arg-type]
-    suffix = [GroundedStep([PlannedAction("g", "goal", "r1", "r1", "top", "top")], [("suffix-volume", None)],
-                           ("g",))]
-    skeleton = Skeleton(((Action("b", "start", "r1", "r1", "top", "top"),),
-                         (Action("c", "start", "r1", "r1", "top", "top"),)))
+    suffix = [GroundedStep([PlannedAction("g", "goal", "r1", "r1", "top", "top")], [("suffix-volume", None)], ("g",))]
+    skeleton = Skeleton(
+        ((Action("b", "start", "r1", "r1", "top", "top"),), (Action("c", "start", "r1", "r1", "top", "top"),))
+    )
     result = reverse.ground(skeleton, suffix)
     assert result.outcome is Outcome.PARTIAL
     assert [s.moved for s in result.steps] == [("c",), ("g",)]
@@ -236,8 +292,9 @@ def test_a_step_whose_robots_collide_is_split() -> None:
     each time which arms pick and place in the step (arms of the step are not at home then)."""
     grounder = ScriptedGrounder(["a", "b"], blocked_by={}, sweeps={}, crowded=frozenset({"b"}))
     reverse = ReverseGrounder(grounder, {"a": "goal", "b": "goal"})  # type: ignore[arg-type]
-    skeleton = Skeleton(((Action("a", "goal", "r1", "r1", "top", "top"),
-                          Action("b", "goal", "r2", "r2", "top", "top")),))
+    skeleton = Skeleton(
+        ((Action("a", "goal", "r1", "r1", "top", "top"), Action("b", "goal", "r2", "r2", "top", "top")),)
+    )
     result = reverse.ground(skeleton, [])
     assert result.outcome is Outcome.SUCCESS
     assert [s.moved for s in result.steps] == [("a",), ("b",)]
@@ -254,8 +311,9 @@ def test_a_step_is_not_split_for_other_failures(monkeypatch: pytest.MonkeyPatch)
     monkeypatch.setattr(ground_module, "_volumes_collide", lambda a, b: False)  # the script's volumes are tokens
     grounder = ScriptedGrounder(["a", "b", "c"], blocked_by={"b": {"c"}}, sweeps={"arm:r2:": {"c"}})
     reverse = ReverseGrounder(grounder, {"a": "goal", "b": "goal"})  # type: ignore[arg-type]
-    skeleton = Skeleton(((Action("a", "goal", "r1", "r1", "top", "top"),
-                          Action("b", "goal", "r2", "r2", "top", "top")),))
+    skeleton = Skeleton(
+        ((Action("a", "goal", "r1", "r1", "top", "top"), Action("b", "goal", "r2", "r2", "top", "top")),)
+    )
     result = reverse.ground(skeleton, [])
     assert result.outcome is Outcome.PARTIAL and result.must_move >= {"c"}
     assert len(result.steps) == 1 and result.steps[0].moved == ("a", "b")

@@ -17,13 +17,15 @@ from mrgc.planner.plan import PlannedAction, file_sha256
 from mrgc.planner.search import plan_problem
 from mrgc.planner.validate import validate
 
-GEOMETRIC = (sorted((ROOT / "domains" / "packaging").glob("pa*.mrg"))
-             + sorted((ROOT / "domains" / "box-moving").glob("bo*.mrg")))
+GEOMETRIC = sorted((ROOT / "domains" / "packaging").glob("pa*.mrg")) + sorted(
+    (ROOT / "domains" / "box-moving").glob("bo*.mrg")
+)
 
 
 def plan_of(path: Path, seed: int = 0, time_limit: float = 120.0):  # type: ignore[no-untyped-def]
-    return plan_problem(parse_file(path).problem(), str(path), file_sha256(str(path)), __version__, seed=seed,
-                        time_limit=time_limit)
+    return plan_problem(
+        parse_file(path).problem(), str(path), file_sha256(str(path)), __version__, seed=seed, time_limit=time_limit
+    )
 
 
 @pytest.mark.slow
@@ -134,8 +136,9 @@ def test_mcts_memoises_failures_and_reports_no_plan() -> None:
 
 
 def test_puct_prefers_fewer_objects_at_first() -> None:
-    search = MCTS(lambda s, x: Grounding(Outcome.FAIL), lambda n, m: (lambda k: [SKEL_CLEAR, SKEL_DIRECT][:k]),
-                  {"o1"}, k=2)
+    search = MCTS(
+        lambda s, x: Grounding(Outcome.FAIL), lambda n, m: lambda k: [SKEL_CLEAR, SKEL_DIRECT][:k], {"o1"}, k=2
+    )
     search.root.visits = 1
     q = {len(e.skeleton.moved): search.q(search.root, e) for e in search.root.edges}
     assert q[1] == pytest.approx(1.0) and q[2] == pytest.approx(0.5)

@@ -58,11 +58,16 @@ def tiny_facts(tmp_path_factory: pytest.TempPathFactory) -> set[Fact]:
 
 
 def facts_of(facts: set[Fact], predicate: str, **where: str) -> set[tuple[str, ...]]:
-    names = {"reachable-pick": ("obj", "grasp", "robot"), "reachable-place": ("obj", "region", "grasp", "robot"),
-             "occludes-pick": ("blocker", "obj", "grasp", "robot"),
-             "enable-goal-handover": ("obj", "g1", "g2", "r1", "r2"), "in-region": ("obj", "region")}[predicate]
-    return {f.args for f in facts if f.predicate == predicate
-            and all(f.args[names.index(k)] == v for k, v in where.items())}
+    names = {
+        "reachable-pick": ("obj", "grasp", "robot"),
+        "reachable-place": ("obj", "region", "grasp", "robot"),
+        "occludes-pick": ("blocker", "obj", "grasp", "robot"),
+        "enable-goal-handover": ("obj", "g1", "g2", "r1", "r2"),
+        "in-region": ("obj", "region"),
+    }[predicate]
+    return {
+        f.args for f in facts if f.predicate == predicate and all(f.args[names.index(k)] == v for k, v in where.items())
+    }
 
 
 def test_an_object_out_of_reach_has_no_pick(tiny_facts: set[Fact]) -> None:
@@ -139,12 +144,15 @@ SHAPES = [collision_shape(ConvexHull(np.asarray(link.points, dtype=float))) for 
 
 
 @settings(max_examples=60, deadline=None)
-@given(st.lists(st.floats(0, 1), min_size=PANDA.dof, max_size=PANDA.dof),
-       st.tuples(st.floats(-0.6, 0.6), st.floats(-0.6, 0.6), st.floats(0.0, 0.9)),
-       st.tuples(st.floats(0.03, 0.3), st.floats(0.03, 0.3), st.floats(0.03, 0.3)),
-       st.floats(-3.14, 3.14))
-def test_coal_and_pybullet_agree_on_robot_box_collisions(u: list[float], xyz: tuple[float, float, float],
-                                                         size: tuple[float, float, float], yaw: float) -> None:
+@given(
+    st.lists(st.floats(0, 1), min_size=PANDA.dof, max_size=PANDA.dof),
+    st.tuples(st.floats(-0.6, 0.6), st.floats(-0.6, 0.6), st.floats(0.0, 0.9)),
+    st.tuples(st.floats(0.03, 0.3), st.floats(0.03, 0.3), st.floats(0.03, 0.3)),
+    st.floats(-3.14, 3.14),
+)
+def test_coal_and_pybullet_agree_on_robot_box_collisions(
+    u: list[float], xyz: tuple[float, float, float], size: tuple[float, float, float], yaw: float
+) -> None:
     q = PANDA.lower + np.array(u) * (PANDA.upper - PANDA.lower)
     pose = translation(*xyz) @ rot_z(yaw)
     reference = pybullet_box_distance(PANDA, q, None, size, pose, skip_links=(PANDA.links[0].name,))

@@ -35,8 +35,14 @@ class BranchAndBound(mrgc.Backend):
     """A pure-Python backend: depth-first branch and bound with interval propagation on the rows (every
     feature lowered to rows by mrgc; one objective: lexicographic ones arrive as one weighted sum)."""
 
-    info = mrgc.BackendInfo(name="bnb", title="pure-Python branch and bound", module="mrgc", distribution="mrgc",
-                            features=frozenset(), encodings=("time-of-move",))
+    info = mrgc.BackendInfo(
+        name="bnb",
+        title="pure-Python branch and bound",
+        module="mrgc",
+        distribution="mrgc",
+        features=frozenset(),
+        encodings=("time-of-move",),
+    )
 
     def _load(self, model: mrgc.SkeletonModel) -> None:
         self.rows = list(model.rows)
@@ -107,13 +113,19 @@ def test_the_kit_fails_the_plugin_when_it_is_wrong() -> None:
     class Careless(BranchAndBound):
         """Stops at the first solution it finds: not optimal, though it says so."""
 
-        info = mrgc.BackendInfo(name="careless", title="first solution", module="mrgc", distribution="mrgc",
-                                features=frozenset(), encodings=("time-of-move",))
+        info = mrgc.BackendInfo(
+            name="careless",
+            title="first solution",
+            module="mrgc",
+            distribution="mrgc",
+            features=frozenset(),
+            encodings=("time-of-move",),
+        )
 
         def _search(self, lo: list[int], hi: list[int]) -> None:
             if self.best is None:
                 super()._search(lo, hi)
-                self.best_value = -10**9  # prunes everything after the first solution
+                self.best_value = -(10**9)  # prunes everything after the first solution
 
     report = mrgc.testing.check_backend(Careless, checks=["known-optima", "symbolic-fixtures"])
     assert not report.ok and "known-optima" in report.failed, report.lines()
@@ -152,8 +164,13 @@ def _tighten(row: mrgc.Row, lo: list[int], hi: list[int]) -> tuple[bool, bool]:
 
 
 # ---------------------------------------------------------------- a domain of one's own, property-tested
-WAREHOUSE = {"robots": (2, 3), "objects": (2, 4), "regions": ("dock", "aisle", "shelf"),
-             "grasps": ("claw", "suction"), "domain": "warehouse"}
+WAREHOUSE = {
+    "robots": (2, 3),
+    "objects": (2, 4),
+    "regions": ("dock", "aisle", "shelf"),
+    "grasps": ("claw", "suction"),
+    "domain": "warehouse",
+}
 
 
 @settings(max_examples=20, deadline=None, suppress_health_check=[HealthCheck.too_slow])

@@ -52,8 +52,9 @@ def non_blank(img: np.ndarray) -> bool:
     return len(np.unique(flat, axis=0)) > 20 and float(flat.std()) > 20
 
 
-def test_gif_has_a_frame_for_every_phase_of_every_step(plan_file: Path, tmp_path: Path,
-                                                       capsys: pytest.CaptureFixture[str]) -> None:
+def test_gif_has_a_frame_for_every_phase_of_every_step(
+    plan_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     out = tmp_path / "plan.gif"
     code, stdout, _ = run(["render", HANDOVER, plan_file, "-o", out, *SMALL], capsys)
     assert code == 0 and str(out.resolve()) in stdout
@@ -76,8 +77,7 @@ def test_gif_has_a_frame_for_every_phase_of_every_step(plan_file: Path, tmp_path
     assert any(not np.array_equal(frames[0], f) for f in frames[1:]), "nothing moves"
 
 
-def test_drawing_in_worker_processes_gives_the_same_images(plan_file: Path, monkeypatch: pytest.MonkeyPatch
-                                                            ) -> None:
+def test_drawing_in_worker_processes_gives_the_same_images(plan_file: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     from mrgc.render import outputs
 
     plan = json.loads(plan_file.read_text())
@@ -101,8 +101,9 @@ def test_held_objects_follow_the_grasp_and_land_on_the_place_pose(plan_file: Pat
     for before, after in zip(frames, frames[1:]):
         for obj in world.objects:
             jump = float(np.linalg.norm(after.poses[obj][:3, 3] - before.poses[obj][:3, 3]))
-            if after.phase in ("to-handover", "to-place") or (after.phase in ("pick", "handover", "place")
-                                                            and before.phase == after.phase):
+            if after.phase in ("to-handover", "to-place") or (
+                after.phase in ("pick", "handover", "place") and before.phase == after.phase
+            ):
                 continue  # moving with a robot (a transfer is a long path whose frames lie far apart)
             assert jump < 0.25, (after.step, after.phase, obj, jump)
     last = frames[-1]
@@ -141,8 +142,12 @@ def test_sheet_scene_and_camera_presets(plan_file: Path, tmp_path: Path, capsys:
 def test_generated_problems_are_drawn(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     for kind, seed in (("packaging", 7), ("box-moving", 3)):
         problem = tmp_path / f"{kind}.mrg"
-        assert run(["generate", kind, "--seed", seed, "--robots", 2, "--goals", 2, "--others", 1, "-o", problem],
-                   capsys)[0] == 0
+        assert (
+            run(["generate", kind, "--seed", seed, "--robots", 2, "--goals", 2, "--others", 1, "-o", problem], capsys)[
+                0
+            ]
+            == 0
+        )
         out = tmp_path / f"{kind}.png"
         code, _, err = run(["render", problem, "-o", out, "--size", "320x240"], capsys)
         assert code == 0, err
@@ -176,8 +181,9 @@ def test_gantt_svg_and_png(plan_file: Path, tmp_path: Path, capsys: pytest.Captu
     assert img.shape[1] > 300 and non_blank(img)
 
 
-def test_mp4(plan_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str],
-             monkeypatch: pytest.MonkeyPatch) -> None:
+def test_mp4(
+    plan_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
     from mrgc.render import video
 
     out = tmp_path / "plan.mp4"
@@ -195,8 +201,9 @@ def test_mp4(plan_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
     assert code == 4 and "pip install imageio-ffmpeg" in err and not (tmp_path / "no.mp4").exists()
 
 
-def test_html_replay_is_self_contained_and_shows_the_robots_in_chromium(plan_file: Path, tmp_path: Path,
-                                                                        capsys: pytest.CaptureFixture[str]) -> None:
+def test_html_replay_is_self_contained_and_shows_the_robots_in_chromium(
+    plan_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     out = tmp_path / "plan.html"
     code, stdout, _ = run(["render", HANDOVER, plan_file, "-o", out, "--fps", "5"], capsys)
     assert code == 0 and str(out.resolve()) in stdout and "web browser" in stdout
@@ -205,12 +212,18 @@ def test_html_replay_is_self_contained_and_shows_the_robots_in_chromium(plan_fil
     # nothing is fetched from elsewhere: no script, stylesheet or image from a URL
     assert not re.search(r"""<(script|link|img)[^>]+(src|href)=["']?(https?:)?//""", page, re.I)
     blue, purple = (byte_colour(c) for c in ROBOT_COLOURS[:2])
-    picture, ok = screenshot_when(out.as_uri(), lambda p: colour_share(p, blue) > 0.004
-                                  and colour_share(p, purple) > 0.004, timeout=150, size=(640, 480))
+    picture, ok = screenshot_when(
+        out.as_uri(),
+        lambda p: colour_share(p, blue) > 0.004 and colour_share(p, purple) > 0.004,
+        timeout=150,
+        size=(640, 480),
+    )
     Image.fromarray(picture).save(tmp_path / "chromium.png")
     assert non_blank(picture), "the page stayed blank"
-    assert ok, (f"the robots did not appear (blue {colour_share(picture, blue):.4f}, purple "
-                f"{colour_share(picture, purple):.4f}); screenshot at {tmp_path / 'chromium.png'}")
+    assert ok, (
+        f"the robots did not appear (blue {colour_share(picture, blue):.4f}, purple "
+        f"{colour_share(picture, purple):.4f}); screenshot at {tmp_path / 'chromium.png'}"
+    )
 
 
 def test_bad_requests_are_one_line_errors(plan_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -241,8 +254,9 @@ GOLDEN_GRAPH = ROOT / "tests" / "golden" / "graph"
 
 
 @pytest.mark.parametrize("name,skeleton", [("place-obstacle", None), ("chain-3", 1), ("handover", None)])
-def test_graph_dot_is_golden(name: str, skeleton: int | None, tmp_path: Path, capsys: pytest.CaptureFixture[str]
-                             ) -> None:
+def test_graph_dot_is_golden(
+    name: str, skeleton: int | None, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     out = tmp_path / f"{name}.dot"
     args = ["graph", ROOT / "domains" / "symbolic" / f"{name}.mrg", "-o", out]
     if skeleton:
@@ -266,8 +280,9 @@ def test_graph_styles_edges_as_the_paper(tmp_path: Path, capsys: pytest.CaptureF
     assert any(BLOCK_PICK in ln for ln in edges) or any(BLOCK_PLACE in ln for ln in edges)
 
 
-def test_graph_svg_through_dot_and_a_clear_message_without_it(tmp_path: Path, capsys: pytest.CaptureFixture[str],
-                                                             monkeypatch: pytest.MonkeyPatch) -> None:
+def test_graph_svg_through_dot_and_a_clear_message_without_it(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
     import shutil
 
     from mrgc.render import graph
@@ -281,14 +296,16 @@ def test_graph_svg_through_dot_and_a_clear_message_without_it(tmp_path: Path, ca
     monkeypatch.setattr(graph.shutil, "which", lambda name: None)
     code, _, err = run(["graph", ROOT / "domains/symbolic/handover.mrg", "-o", tmp_path / "h.png"], capsys)
     assert code == 4 and "apt-get install graphviz" in err and not (tmp_path / "h.png").exists()
-    code, _, err = run(["graph", ROOT / "domains/symbolic/handover.mrg", "-o", tmp_path / "h.dot",
-                        "--skeleton", 99], capsys)
+    code, _, err = run(
+        ["graph", ROOT / "domains/symbolic/handover.mrg", "-o", tmp_path / "h.dot", "--skeleton", 99], capsys
+    )
     assert code == 2 and "--skeleton 99" in err
 
 
 # ------------------------------------------------------------------------------------------- frames
-configs = st.integers(2, 6).flatmap(lambda m: st.lists(
-    st.lists(st.floats(-3, 3), min_size=3, max_size=3), min_size=m, max_size=m))
+configs = st.integers(2, 6).flatmap(
+    lambda m: st.lists(st.lists(st.floats(-3, 3), min_size=3, max_size=3), min_size=m, max_size=m)
+)
 
 
 @settings(max_examples=60, deadline=None)

@@ -84,8 +84,9 @@ def try_load(fn, *args, **kwargs) -> tuple[mrgc.MrgFile | None, set[str]]:
     return mf, set()
 
 
-def sweep(capsys: pytest.CaptureFixture[str], folder: Path, data: str | bytes, *, limit: float = 10.0,
-          name: str = "f.mrg") -> set[str]:
+def sweep(
+    capsys: pytest.CaptureFixture[str], folder: Path, data: str | bytes, *, limit: float = 10.0, name: str = "f.mrg"
+) -> set[str]:
     """Feed ``data`` to every entry point; return the diagnostic codes parse_file reported."""
     path = folder / name
     raw = data.encode("utf-8", "surrogatepass") if isinstance(data, str) else data
@@ -145,19 +146,107 @@ def test_arbitrary_bytes(capsys, folder, data: bytes) -> None:
 
 
 TOKENS = [
-    "(", ")", "(", ")", "(define", "(domain", "(problem", "define", "domain", "problem", "and", "(and",
-    ":goal", ":init", ":domain", ":robots", ":fixed", ":regions", ":movable", ":handover-points", ":include",
-    ":grasps", ":requirements", ":robot-kind", ":shape", ":pose", ":kind", ":base", ":position", ":handover",
-    ":urdf", ":end-effector", ":home", ":footprint", ":carry", ":reach", ":", "::", ":9",
-    "box", "sphere", "cylinder", "mesh", "fixed", "planar", *PREDICATES,
-    "r1", "o1", "a", "Z9_+-", "x", "-", "+", ".", "1.2.3", "1e", "--1", "9x",
-    "0", "-0", "1", "-2.5", ".5", "5.", "1e-5", "+3E+2", "1e999", "-1e999", "nan", "inf", "-inf", "NaN",
-    '"x"', '"m.obj"', '"dom.mrg"', '"../x.mrg"', '"f.mrg"', '"a\\"b"', '"\\', '"', '"unterminated', '""',
-    ";", "; comment", ";(", "\n", "\n", "\t", "\r\n", "\r", "\\", "\ufeff", "\x00", "é", "😀", "#", "\u2028",
+    "(",
+    ")",
+    "(",
+    ")",
+    "(define",
+    "(domain",
+    "(problem",
+    "define",
+    "domain",
+    "problem",
+    "and",
+    "(and",
+    ":goal",
+    ":init",
+    ":domain",
+    ":robots",
+    ":fixed",
+    ":regions",
+    ":movable",
+    ":handover-points",
+    ":include",
+    ":grasps",
+    ":requirements",
+    ":robot-kind",
+    ":shape",
+    ":pose",
+    ":kind",
+    ":base",
+    ":position",
+    ":handover",
+    ":urdf",
+    ":end-effector",
+    ":home",
+    ":footprint",
+    ":carry",
+    ":reach",
+    ":",
+    "::",
+    ":9",
+    "box",
+    "sphere",
+    "cylinder",
+    "mesh",
+    "fixed",
+    "planar",
+    *PREDICATES,
+    "r1",
+    "o1",
+    "a",
+    "Z9_+-",
+    "x",
+    "-",
+    "+",
+    ".",
+    "1.2.3",
+    "1e",
+    "--1",
+    "9x",
+    "0",
+    "-0",
+    "1",
+    "-2.5",
+    ".5",
+    "5.",
+    "1e-5",
+    "+3E+2",
+    "1e999",
+    "-1e999",
+    "nan",
+    "inf",
+    "-inf",
+    "NaN",
+    '"x"',
+    '"m.obj"',
+    '"dom.mrg"',
+    '"../x.mrg"',
+    '"f.mrg"',
+    '"a\\"b"',
+    '"\\',
+    '"',
+    '"unterminated',
+    '""',
+    ";",
+    "; comment",
+    ";(",
+    "\n",
+    "\n",
+    "\t",
+    "\r\n",
+    "\r",
+    "\\",
+    "\ufeff",
+    "\x00",
+    "é",
+    "😀",
+    "#",
+    "\u2028",
 ]
-token_soup = st.lists(
-    st.tuples(st.sampled_from(TOKENS), st.sampled_from(["", " ", " ", "\n", "  "])), max_size=80
-).map(lambda parts: "".join(t + sep for t, sep in parts))
+token_soup = st.lists(st.tuples(st.sampled_from(TOKENS), st.sampled_from(["", " ", " ", "\n", "  "])), max_size=80).map(
+    lambda parts: "".join(t + sep for t, sep in parts)
+)
 
 
 @SETTINGS
@@ -185,39 +274,68 @@ num = st.one_of(
 )
 item = st.one_of(num, names, st.sampled_from(["box", "sphere", "cylinder", "mesh", "nan", "inf", '"m.obj"', '"x"']))
 value = st.one_of(
-    num, names, item,
-    st.sampled_from(["fixed", "planar", "nan", '"m.obj"', '"u.urdf"', "(box 1 1 1)", "(sphere 0)", "(cylinder 1)",
-                     '(mesh "m.obj" 2)', '(mesh "m.obj")', '(mesh "missing.obj")', "(mesh 1)", "(cone 1)", "()",
-                     "(0 0 0)", "(0 0 0 0)", "(1 2 3 4 5)", "(top side)", "(top bogus)", "(h)"]),
+    num,
+    names,
+    item,
+    st.sampled_from(
+        [
+            "fixed",
+            "planar",
+            "nan",
+            '"m.obj"',
+            '"u.urdf"',
+            "(box 1 1 1)",
+            "(sphere 0)",
+            "(cylinder 1)",
+            '(mesh "m.obj" 2)',
+            '(mesh "m.obj")',
+            '(mesh "missing.obj")',
+            "(mesh 1)",
+            "(cone 1)",
+            "()",
+            "(0 0 0)",
+            "(0 0 0 0)",
+            "(1 2 3 4 5)",
+            "(top side)",
+            "(top bogus)",
+            "(h)",
+        ]
+    ),
     st.lists(item, max_size=6).map(lambda xs: "(" + " ".join(xs) + ")"),
 )
 prop = st.tuples(st.sampled_from(ALL_KEYS), value).map(lambda kv: f":{kv[0]} {kv[1]}")
 decl = st.one_of(names, st.tuples(names, st.lists(prop, max_size=4)).map(lambda t: f"({t[0]} {' '.join(t[1])})"))
 atom = st.tuples(st.sampled_from([*PREDICATES, "at", "and"]), st.lists(names, max_size=5)).map(
-    lambda t: "(" + " ".join([t[0], *t[1]]) + ")")
+    lambda t: "(" + " ".join([t[0], *t[1]]) + ")"
+)
 include = st.sampled_from(['"dom.mrg"', '"../x.mrg"', '"missing.mrg"', '"f.mrg"', '"."', '""', '"sub/../dom.mrg"'])
 problem_section = st.one_of(
     st.sampled_from(["d", "e", "zz"]).map(lambda n: f"(:domain {n})"),
-    st.tuples(st.sampled_from(["robots", "fixed", "regions", "movable", "handover-points"]),
-              st.lists(decl, max_size=4)).map(lambda t: f"(:{t[0]} {' '.join(t[1])})"),
+    st.tuples(
+        st.sampled_from(["robots", "fixed", "regions", "movable", "handover-points"]), st.lists(decl, max_size=4)
+    ).map(lambda t: f"(:{t[0]} {' '.join(t[1])})"),
     st.lists(atom, max_size=5).map(lambda xs: f"(:init {' '.join(xs)})"),
     atom.filter(lambda a: not a.startswith("(and")).map(lambda a: f"(:goal {a})"),
     st.lists(atom.filter(lambda a: not a.startswith("(and")), max_size=4).map(
-        lambda xs: f"(:goal (and {' '.join(xs)}))"),
+        lambda xs: f"(:goal (and {' '.join(xs)}))"
+    ),
     include.map(lambda p: f"(:include {p})"),
 )
 domain_section = st.one_of(
     st.lists(st.sampled_from(["handover", "planar-base", "symbolic", "bogus"]), max_size=3).map(
-        lambda fs: "(:requirements " + " ".join(":" + f for f in fs) + ")"),
+        lambda fs: "(:requirements " + " ".join(":" + f for f in fs) + ")"
+    ),
     st.tuples(names, st.lists(prop, max_size=5)).map(lambda t: f"(:robot-kind {t[0]} {' '.join(t[1])})"),
     st.lists(names, max_size=4).map(lambda ns: f"(:grasps {' '.join(ns)})"),
     include.map(lambda p: f"(:include {p})"),
 )
 definition = st.one_of(
     st.tuples(st.sampled_from(["d", "e"]), st.lists(domain_section, max_size=4)).map(
-        lambda t: f"(define (domain {t[0]}) {' '.join(t[1])})"),
+        lambda t: f"(define (domain {t[0]}) {' '.join(t[1])})"
+    ),
     st.tuples(names, st.lists(problem_section, max_size=9)).map(
-        lambda t: f"(define (problem {t[0]}) {' '.join(t[1])})"),
+        lambda t: f"(define (problem {t[0]}) {' '.join(t[1])})"
+    ),
 )
 semantic_files = st.lists(definition, max_size=4).map("\n".join)
 
@@ -279,8 +397,10 @@ def test_one_megabyte_comment_line(capsys, tmp_path) -> None:
 def test_one_megabyte_line_of_code(capsys, tmp_path) -> None:
     """A valid problem written on a single 1 MB line."""
     atoms = " (reachable-pick o top r)" * ((1 << 20) // 25)
-    text = ("(define (domain d) (:grasps top)) (define (problem p) (:domain d) (:robots r) (:regions a b) "
-            "(:movable o) (:init (in-region o a)" + atoms + ") (:goal (in-region o b)))")
+    text = (
+        "(define (domain d) (:grasps top)) (define (problem p) (:domain d) (:robots r) (:regions a b) "
+        "(:movable o) (:init (in-region o a)" + atoms + ") (:goal (in-region o b)))"
+    )
     assert "\n" not in text and len(text) > 1 << 20
     path = tmp_path / "big.mrg"
     path.write_text(text, encoding="utf-8")
@@ -298,8 +418,9 @@ def test_one_megabyte_line_of_errors(capsys, tmp_path) -> None:
     tabs on the whole 1 MB line once per diagnostic, so `mrgc check` was quadratic: ~7 s here for a file
     checked in 0.1 s (and ~9 minutes for 500,000 duplicate one-letter names on a 1 MB line).
     """
-    text = ("(define (domain d)) (define (problem p) (:domain d) (:robots" + (" " + "r" * 200) * 5000
-            + ") (:goal (and)))")
+    text = (
+        "(define (domain d)) (define (problem p) (:domain d) (:robots" + (" " + "r" * 200) * 5000 + ") (:goal (and)))"
+    )
     path = tmp_path / "dups.mrg"
     path.write_text(text, encoding="utf-8")
     with time_limit(20):
@@ -476,14 +597,27 @@ numbers = st.sampled_from(["0", "1", "-0.5", "nan", "inf", "-inf", "1e999", "1e3
 def urdf_texts(draw: st.DrawFn) -> str:
     """URDFs with random links and joints: cycles, two parents, unknown links, bad numbers."""
     names = draw(links)
-    joints = draw(st.lists(st.tuples(st.sampled_from(names + ["zz"]), st.sampled_from(names),
-                                     st.sampled_from(["revolute", "fixed", "prismatic", "continuous", "bogus"]),
-                                     numbers, numbers), max_size=6))
-    body = [f'<link name="{n}"><collision><geometry><box size="0.1 0.1 {draw(numbers)}"/></geometry></collision>'
-            f"</link>" for n in names]
+    joints = draw(
+        st.lists(
+            st.tuples(
+                st.sampled_from(names + ["zz"]),
+                st.sampled_from(names),
+                st.sampled_from(["revolute", "fixed", "prismatic", "continuous", "bogus"]),
+                numbers,
+                numbers,
+            ),
+            max_size=6,
+        )
+    )
+    body = [
+        f'<link name="{n}"><collision><geometry><box size="0.1 0.1 {draw(numbers)}"/></geometry></collision></link>'
+        for n in names
+    ]
     for k, (parent, child, kind, x, lim) in enumerate(joints):
-        body.append(f'<joint name="j{k}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>'
-                    f'<origin xyz="{x} 0 0"/><axis xyz="0 0 1"/><limit lower="-1" upper="{lim}"/></joint>')
+        body.append(
+            f'<joint name="j{k}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>'
+            f'<origin xyz="{x} 0 0"/><axis xyz="0 0 1"/><limit lower="-1" upper="{lim}"/></joint>'
+        )
     return '<robot name="r">\n' + "\n".join(body) + "\n</robot>\n"
 
 
@@ -518,10 +652,18 @@ def test_arbitrary_urdf_bytes(folder: Path, data: str | bytes) -> None:
 
 
 @SETTINGS
-@given(st.lists(st.one_of(st.tuples(st.just("v"), numbers, numbers, numbers).map(" ".join),
-                          st.tuples(st.just("f"), st.integers(-5, 8).map(str), st.integers(-5, 8).map(str),
-                                    st.integers(-5, 8).map(str)).map(" ".join),
-                          st.text(max_size=20)), max_size=20).map("\n".join))
+@given(
+    st.lists(
+        st.one_of(
+            st.tuples(st.just("v"), numbers, numbers, numbers).map(" ".join),
+            st.tuples(
+                st.just("f"), st.integers(-5, 8).map(str), st.integers(-5, 8).map(str), st.integers(-5, 8).map(str)
+            ).map(" ".join),
+            st.text(max_size=20),
+        ),
+        max_size=20,
+    ).map("\n".join)
+)
 def test_random_meshes_are_finite_or_refused_at_a_line(folder: Path, text: str) -> None:
     import numpy as np
 
@@ -541,9 +683,11 @@ def test_a_fifo_include_does_not_block(tmp_path: Path) -> None:
     import os
 
     os.mkfifo(tmp_path / "dom.mrg")
-    (tmp_path / "p.mrg").write_text('(define (problem p) (:domain d) (:include "dom.mrg") (:robots r) (:movable o)'
-                                    ' (:regions a b) (:init (in-region o a)) (:goal (in-region o b)))\n',
-                                    encoding="utf-8")
+    (tmp_path / "p.mrg").write_text(
+        '(define (problem p) (:domain d) (:include "dom.mrg") (:robots r) (:movable o)'
+        " (:regions a b) (:init (in-region o a)) (:goal (in-region o b)))\n",
+        encoding="utf-8",
+    )
     with time_limit(10):
         _, codes = try_load(parse_file, tmp_path / "p.mrg")
     assert codes == {"E234", "E230"}  # the include is refused (not read), so the domain is missing too

@@ -29,14 +29,33 @@ SETTINGS = settings(max_examples=150, deadline=None, suppress_health_check=[Heal
 # after the `(` of a goal expression, so it cannot be the predicate of a goal atom (`(:goal (and x))` is a
 # conjunction).  See test_reserved_words_as_names below.
 RESERVED = ("define", "domain", "problem", "and")
-SECTION_WORDS = ("goal", "init", "domain", "include", "robots", "fixed", "regions", "movable",
-                 "handover-points", "grasps", "requirements", "robot-kind")
+SECTION_WORDS = (
+    "goal",
+    "init",
+    "domain",
+    "include",
+    "robots",
+    "fixed",
+    "regions",
+    "movable",
+    "handover-points",
+    "grasps",
+    "requirements",
+    "robot-kind",
+)
 
 _tail = st.text(alphabet="abcXYZ019_+-", max_size=8)
-plain_names = st.builds(lambda head, tail: head + tail,
-                        st.sampled_from("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"), _tail)
-names = st.one_of(plain_names, plain_names, plain_names, st.sampled_from(
-    RESERVED + ("e5", "E1", "inf", "nan", "Infinity", "x-1", "a+b", "in-region", "box", "and-x", "definex")))
+plain_names = st.builds(
+    lambda head, tail: head + tail, st.sampled_from("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"), _tail
+)
+names = st.one_of(
+    plain_names,
+    plain_names,
+    plain_names,
+    st.sampled_from(
+        RESERVED + ("e5", "E1", "inf", "nan", "Infinity", "x-1", "a+b", "in-region", "box", "and-x", "definex")
+    ),
+)
 #: a goal atom's predicate may not be `and`
 goal_predicates = names.filter(lambda n: n != "and")
 #: property keys / requirement flags: also the section words, to check they stay keys
@@ -44,14 +63,32 @@ keys = st.one_of(plain_names, plain_names, st.sampled_from(SECTION_WORDS + RESER
 
 finite_floats = st.one_of(
     st.floats(allow_nan=False, allow_infinity=False),
-    st.integers(min_value=-10**20, max_value=10**20).map(float),
-    st.sampled_from([0.0, -0.0, 1.0, -1.0, 0.5, 1e-5, -1e-300, 5e-324, 1.7976931348623157e308, 1e16, 1e15 + 0.5,
-                     123456789012345680.0, 0.1, 1 / 3]),
+    st.integers(min_value=-(10**20), max_value=10**20).map(float),
+    st.sampled_from(
+        [
+            0.0,
+            -0.0,
+            1.0,
+            -1.0,
+            0.5,
+            1e-5,
+            -1e-300,
+            5e-324,
+            1.7976931348623157e308,
+            1e16,
+            1e15 + 0.5,
+            123456789012345680.0,
+            0.1,
+            1 / 3,
+        ]
+    ),
 )
 texts = st.one_of(
     st.text(),
-    st.lists(st.sampled_from(['"', "\\", "\n", "\t", "\r", ";", "(", ")", "a", " ", "é", "😀", "\\n", "\\t", '\\"']),
-             max_size=12).map("".join),
+    st.lists(
+        st.sampled_from(['"', "\\", "\n", "\t", "\r", ";", "(", ")", "a", " ", "é", "😀", "\\n", "\\t", '\\"']),
+        max_size=12,
+    ).map("".join),
 )
 
 numbers = st.builds(ast.Number, finite_floats)
@@ -146,26 +183,62 @@ def test_strategy_reaches_every_section_kind() -> None:
                     seen.update("item-" + type(i).__name__ for i in getattr(p.value, "items", ()))
 
     collect()
-    want = {"Requirements", "RobotKindDecl", "Grasps", "Include", "DomainRef", "Init", "Goal", "robots", "fixed",
-            "regions", "movable", "handover-points", "bare", "full", "Number", "Symbol", "String", "ListValue",
-            "item-Number", "item-Symbol", "item-String"}
+    want = {
+        "Requirements",
+        "RobotKindDecl",
+        "Grasps",
+        "Include",
+        "DomainRef",
+        "Init",
+        "Goal",
+        "robots",
+        "fixed",
+        "regions",
+        "movable",
+        "handover-points",
+        "bare",
+        "full",
+        "Number",
+        "Symbol",
+        "String",
+        "ListValue",
+        "item-Number",
+        "item-Symbol",
+        "item-String",
+    }
     assert want <= seen, want - seen
 
 
 @pytest.mark.parametrize("word", ["define", "domain", "problem", "and"])
 def test_reserved_words_as_names(word: str) -> None:
     """`define`/`domain`/`problem`/`and` survive as names in every position but a goal atom's predicate."""
-    tree = ast.SourceFile((
-        ast.DomainDef(word, (ast.RobotKindDecl(word, (ast.Property(word, ast.Symbol(word)),)),
-                             ast.Grasps((ast.Decl(word),)), ast.Requirements((word,)))),
-        ast.ProblemDef(word, (
-            ast.DomainRef(word),
-            ast.DeclSection("robots", (ast.Decl(word), ast.Decl(word, (ast.Property(word, ast.ListValue(
-                (ast.Symbol(word),))),), bare=False))),
-            ast.Init((ast.Atom(word, (word, word)),)),
-            ast.Goal((ast.Atom("p", (word, word)),), conjunction=True),
-        )),
-    ))
+    tree = ast.SourceFile(
+        (
+            ast.DomainDef(
+                word,
+                (
+                    ast.RobotKindDecl(word, (ast.Property(word, ast.Symbol(word)),)),
+                    ast.Grasps((ast.Decl(word),)),
+                    ast.Requirements((word,)),
+                ),
+            ),
+            ast.ProblemDef(
+                word,
+                (
+                    ast.DomainRef(word),
+                    ast.DeclSection(
+                        "robots",
+                        (
+                            ast.Decl(word),
+                            ast.Decl(word, (ast.Property(word, ast.ListValue((ast.Symbol(word),))),), bare=False),
+                        ),
+                    ),
+                    ast.Init((ast.Atom(word, (word, word)),)),
+                    ast.Goal((ast.Atom("p", (word, word)),), conjunction=True),
+                ),
+            ),
+        )
+    )
     assert parsed(format_source(tree)) == tree
 
 
@@ -185,8 +258,13 @@ def test_and_cannot_be_a_goal_predicate() -> None:
 @example(-0.0)
 @example(1e16)
 def test_numbers_round_trip_exactly(x: float) -> None:
-    tree = ast.SourceFile((ast.ProblemDef("p", (ast.DeclSection("fixed", (
-        ast.Decl("t", (ast.Property("v", ast.Number(x)),), bare=False),)),)),))
+    tree = ast.SourceFile(
+        (
+            ast.ProblemDef(
+                "p", (ast.DeclSection("fixed", (ast.Decl("t", (ast.Property("v", ast.Number(x)),), bare=False),)),)
+            ),
+        )
+    )
     back = parsed(format_source(tree))
     got = back.definitions[0].sections[0].decls[0].props[0].value
     assert isinstance(got, ast.Number)
@@ -212,8 +290,9 @@ def test_huge_number_written_1e999_keeps_its_meaning_through_fmt() -> None:
 
 
 # ---------------------------------------------------------------- comments
-comment_bodies = st.text(alphabet=st.characters(blacklist_characters="\n", blacklist_categories=("Cs",)),
-                         max_size=20).map(lambda s: (";" + s).rstrip())
+comment_bodies = st.text(
+    alphabet=st.characters(blacklist_characters="\n", blacklist_categories=("Cs",)), max_size=20
+).map(lambda s: (";" + s).rstrip())
 
 
 @st.composite

@@ -83,8 +83,10 @@ def test_every_backend_and_encoding_matches_the_brute_force_oracle(case: Symboli
                     problems_found.append(f"{where}: action set returned twice: {sk.describe()}")
                 seen.add(sk.actions)
                 if sets.get(sk.actions) != sk.makespan:
-                    problems_found.append(f"{where}: {sk.describe()} has makespan {sk.makespan}, the oracle's "
-                                          f"minimum for that action set is {sets.get(sk.actions)}")
+                    problems_found.append(
+                        f"{where}: {sk.describe()} has makespan {sk.makespan}, the oracle's "
+                        f"minimum for that action set is {sets.get(sk.actions)}"
+                    )
     if len({tuple(keys) for keys in runs.values()}) != 1:
         problems_found.insert(0, f"the 12 backend/encoding combinations disagree: {runs}")
     assert not problems_found, "\n".join(problems_found) + "\n\nproblem:\n" + text
@@ -180,24 +182,30 @@ def test_oracle_accepts_valid_and_flags_each_kind_of_violation() -> None:
 
 
 def test_min_makespan_respects_handover_robots_and_strict_pick_order() -> None:
-    text = (DOMAIN + """(define (problem p) (:domain abstract)
+    text = (
+        DOMAIN
+        + """(define (problem p) (:domain abstract)
       (:robots r1 r2 r3) (:movable o1 o2 o3) (:regions ra rb)
       (:init (in-region o1 ra) (in-region o2 ra) (in-region o3 ra)
         (reachable-pick o1 top r1) (enable-goal-handover o1 top side r1 r2) (reachable-place o1 rb side r2)
         (reachable-pick o2 top r2) (reachable-place o2 rb top r2)
         (reachable-pick o3 top r3) (reachable-place o3 rb top r3) (occludes-pick o2 o3 top r3))
-      (:goal (and (in-region o1 rb) (in-region o2 rb) (in-region o3 rb))))""")
+      (:goal (and (in-region o1 rb) (in-region o2 rb) (in-region o3 rb))))"""
+    )
     graph = reference_graph(parse_string(text).problem())
     # o2 before o3 (strict); the o1 handover shares r2 with o2: o1 | o2 | o3 or o2 | o1+o3 -> 2 steps
     assert oracle.oracle_keys(graph) == [(2, 3)]
 
 
 # ---------------------------------------------------------------- a goal that already holds
-ALREADY_DONE = DOMAIN + """(define (problem done) (:domain abstract)
+ALREADY_DONE = (
+    DOMAIN
+    + """(define (problem done) (:domain abstract)
   (:robots r1 r2) (:movable o1 o2) (:regions ra rb)
   (:init (in-region o1 rb) (in-region o2 ra) (reachable-pick o1 top r1) (reachable-place o1 rb top r1))
   (:goal (in-region o1 rb)))
 """
+)
 
 
 def test_oracle_says_a_satisfied_goal_needs_the_empty_skeleton() -> None:

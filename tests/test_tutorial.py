@@ -38,8 +38,9 @@ def test_the_tutorials_files_are_its_code_blocks() -> None:
         assert any(code(block) == body for block in shown), f"docs/tutorial/{name} differs from the tutorial's text"
 
 
-def test_every_command_of_the_tutorial_runs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
-                                            capsys: pytest.CaptureFixture[str]) -> None:
+def test_every_command_of_the_tutorial_runs(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
     work = tmp_path / "tutorial"
     shutil.copytree(ROOT / "docs" / "tutorial", work)
     monkeypatch.chdir(work)

@@ -173,16 +173,16 @@ def test_mutated_plans_are_rejected(name: str, pa3: Any, two_steps: dict[str, An
     assert report.lines()[-1].startswith("invalid: ")
 
 
-def test_a_pick_through_a_neighbour_is_a_robot_object_collision(pa3: Any, one_step: dict[str, Any],
-                                                               grounder: Grounder) -> None:
+def test_a_pick_through_a_neighbour_is_a_robot_object_collision(
+    pa3: Any, one_step: dict[str, Any], grounder: Grounder
+) -> None:
     pick = grounder.pick("r1", "o1", "side-x+")  # avoiding nothing: the hand goes through o2
     assert pick.ok
     plan = copy.deepcopy(one_step)
     _action(plan, 1)["configs"]["pick"] = _l(pick.configs)
     report = validate(pa3, plan, PA3)
     hits = [str(v) for v in report.violations if v.code == "collision-robot-object"]
-    assert any("pick: panda_hand of r1 (" in h and "of 5) and o2 overlap by" in h for h in hits), \
-        report.lines()
+    assert any("pick: panda_hand of r1 (" in h and "of 5) and o2 overlap by" in h for h in hits), report.lines()
 
 
 def test_two_hands_at_one_handover_collide(pa3: Any, one_step: dict[str, Any], grounder: Grounder) -> None:
@@ -197,8 +197,9 @@ def test_two_hands_at_one_handover_collide(pa3: Any, one_step: dict[str, Any], g
     a["configs"]["handover"][1] = [float(v) for v in res.q]
     report = validate(pa3, plan, PA3)
     hits = [str(v) for v in report.violations if v.code == "collision-robot-robot"]
-    assert any(h.startswith("step 1: r1: handover: ") and "of r2 (at its handover (taker) configuration)" in h
-               for h in hits), report.lines()
+    assert any(
+        h.startswith("step 1: r1: handover: ") and "of r2 (at its handover (taker) configuration)" in h for h in hits
+    ), report.lines()
 
 
 def test_paths_are_checked_and_must_connect(pa3: Any, one_step: dict[str, Any]) -> None:
@@ -218,8 +219,9 @@ def test_paths_are_checked_and_must_connect(pa3: Any, one_step: dict[str, Any]) 
 
 
 # ------------------------------------------------------------------------------------- issue 9's doctored plans
-def _cli(tmp_path: Path, problem_path: str, plan: dict[str, Any], capsys: pytest.CaptureFixture[str]
-         ) -> tuple[int, list[str]]:
+def _cli(
+    tmp_path: Path, problem_path: str, plan: dict[str, Any], capsys: pytest.CaptureFixture[str]
+) -> tuple[int, list[str]]:
     """``mrgc validate`` on ``plan``: exit code and output lines (one per violation, then the verdict)."""
     path = tmp_path / "doctored.json"
     path.write_text(json.dumps(plan), encoding="utf-8")
@@ -235,19 +237,25 @@ def _rejected(rc: int, lines: list[str], code: str, *fragments: str) -> None:
     assert any(all(f in x for f in fragments) for x in hits), lines
 
 
-def test_doctored_every_planar_path_deleted(room: tuple[str, Any, dict[str, Any]], tmp_path: Path,
-                                            capsys: pytest.CaptureFixture[str]) -> None:
+def test_doctored_every_planar_path_deleted(
+    room: tuple[str, Any, dict[str, Any]], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     path, _, plan = room
     assert _cli(tmp_path, path, plan, capsys)[0] == 0
     del _action(plan, 1)["paths"]
     rc, lines = _cli(tmp_path, path, plan, capsys)
     for name in ("to-pick", "to-place", "home"):
-        _rejected(rc, lines, "missing", f"r1: the action moving b has no '{name}' path, which the motion model "
-                                        f"(planar 'paths') requires")
+        _rejected(
+            rc,
+            lines,
+            "missing",
+            f"r1: the action moving b has no '{name}' path, which the motion model (planar 'paths') requires",
+        )
 
 
-def test_doctored_only_the_to_place_path_deleted(room: tuple[str, Any, dict[str, Any]], tmp_path: Path,
-                                                 capsys: pytest.CaptureFixture[str]) -> None:
+def test_doctored_only_the_to_place_path_deleted(
+    room: tuple[str, Any, dict[str, Any]], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     path, _, plan = room
     del _action(plan, 1)["paths"]["to-place"]
     rc, lines = _cli(tmp_path, path, plan, capsys)
@@ -255,19 +263,26 @@ def test_doctored_only_the_to_place_path_deleted(room: tuple[str, Any, dict[str,
     assert len(lines) == 2, lines
 
 
-def test_doctored_approach_cut_to_the_grasp(one_step: dict[str, Any], tmp_path: Path,
-                                            capsys: pytest.CaptureFixture[str]) -> None:
+def test_doctored_approach_cut_to_the_grasp(
+    one_step: dict[str, Any], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     a = _action(one_step, 1)
     a["configs"]["pick"] = a["configs"]["pick"][-1:]
     a["paths"]["to-handover"][0] = a["configs"]["pick"][0]
     rc, lines = _cli(tmp_path, PA3, one_step, capsys)
-    _rejected(rc, lines, "approach", "step 1: r1: the pick approach of r1 (moving o1) holds 1 configuration; the "
-                                     "motion model's approaches hold 5, pre-grasp first")
+    _rejected(
+        rc,
+        lines,
+        "approach",
+        "step 1: r1: the pick approach of r1 (moving o1) holds 1 configuration; the "
+        "motion model's approaches hold 5, pre-grasp first",
+    )
     _rejected(rc, lines, "approach", "the first pick configuration of r1 puts the tool 80.0 mm")
 
 
-def test_doctored_approach_through_the_object(one_step: dict[str, Any], grounder: Grounder, tmp_path: Path,
-                                              capsys: pytest.CaptureFixture[str]) -> None:
+def test_doctored_approach_through_the_object(
+    one_step: dict[str, Any], grounder: Grounder, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """The middle approach configuration puts the tool at the grasp depth 31 mm along the finger axis: a
     finger drives through o1 before the contact segment (configurations 4 to 5), where o1 is not exempt."""
     a = _action(one_step, 1)
@@ -280,8 +295,9 @@ def test_doctored_approach_through_the_object(one_step: dict[str, Any], grounder
     assert all("configurations 4 and 5" not in x for x in hits), hits
 
 
-def test_doctored_object_released_in_the_air(one_step: dict[str, Any], grounder: Grounder, tmp_path: Path,
-                                             capsys: pytest.CaptureFixture[str]) -> None:
+def test_doctored_object_released_in_the_air(
+    one_step: dict[str, Any], grounder: Grounder, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """o1 released 12 cm above bin-b's floor, its place approach recomputed to match: only support fails."""
     a = _action(one_step, 1)
     pose = translation(0, 0, 0.12) @ np.array(a["place_pose"])
@@ -291,8 +307,14 @@ def test_doctored_object_released_in_the_air(one_step: dict[str, Any], grounder:
     at = vp.ik(grounder, "r2", vp.tool_at(grounder, "o1", "side-x+", pose), old[-1])
     a["configs"]["place"] = _line(pre, at)
     rc, lines = _cli(tmp_path, PA3, one_step, capsys)
-    _rejected(rc, lines, "floating", "step 1: o1: o1 is released at (", "resting on nothing: its lowest point is "
-                                     "126.0 mm above the floor of bin-b, and nothing is within 10 mm under it")
+    _rejected(
+        rc,
+        lines,
+        "floating",
+        "step 1: o1: o1 is released at (",
+        "resting on nothing: its lowest point is "
+        "126.0 mm above the floor of bin-b, and nothing is within 10 mm under it",
+    )
     assert len(lines) == 2, lines
 
 
@@ -307,19 +329,29 @@ def test_an_object_may_rest_on_another_until_that_one_moves(grounder: Grounder) 
     assert place.ok and place.configs is not None
     up = vp.lifted(g, "r1", "o2", "top", g.poses["o2"], pick.configs[-1])
     down = vp.lifted(g, "r1", "o2", "top", on_o1, place.configs[0])[::-1]
-    stack = PlannedAction("o2", "start", "r1", "r1", "top", "top", place_pose=_l(on_o1),
-                          configs={"pick": _l(pick.configs), "place": _l(place.configs)},
-                          paths={"to-place": _l([pick.configs[-1], *up, *down, place.configs[0]])})
+    stack = PlannedAction(
+        "o2",
+        "start",
+        "r1",
+        "r1",
+        "top",
+        "top",
+        place_pose=_l(on_o1),
+        configs={"pick": _l(pick.configs), "place": _l(place.configs)},
+        paths={"to-place": _l([pick.configs[-1], *up, *down, place.configs[0]])},
+    )
     g.move("o2", on_o1)
     hand = vp.handover(g, ["o3"])
     report = validate(vp.pa3(), _plan(vp.pa3(), PA3, [[stack], [hand]]), PA3)
     assert not any(v.step == 1 for v in report.violations), report.lines()
-    assert "step 2: o2: o2 rested on o1, which the step moves away: nothing holds it up now [floating]" \
-        in report.lines(), report.lines()
+    assert (
+        "step 2: o2: o2 rested on o1, which the step moves away: nothing holds it up now [floating]" in report.lines()
+    ), report.lines()
 
 
-def test_doctored_unknown_robot_waiting(two_steps: dict[str, Any], tmp_path: Path,
-                                        capsys: pytest.CaptureFixture[str]) -> None:
+def test_doctored_unknown_robot_waiting(
+    two_steps: dict[str, Any], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     two_steps["steps"][0]["waiting"].append("r9")
     rc, lines = _cli(tmp_path, PA3, two_steps, capsys)
     _rejected(rc, lines, "unknown-name", "step 1: r9: no robot 'r9' (waiting)")
@@ -328,8 +360,9 @@ def test_doctored_unknown_robot_waiting(two_steps: dict[str, Any], tmp_path: Pat
     _rejected(rc, lines, "waiting", "step 1: r2: r2 is in no action of the step and not listed as waiting")
 
 
-def test_doctored_unknown_fields_are_refused(two_steps: dict[str, Any], tmp_path: Path,
-                                             capsys: pytest.CaptureFixture[str]) -> None:
+def test_doctored_unknown_fields_are_refused(
+    two_steps: dict[str, Any], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """An unknown field may carry meaning the validator cannot check: the plan is refused as bad input
     (exit 2, E502 naming the field), like a plan missing a field."""
     _action(two_steps, 2)["configs"]["retreat"] = [[0.0] * 7]
@@ -337,36 +370,52 @@ def test_doctored_unknown_fields_are_refused(two_steps: dict[str, Any], tmp_path
     path.write_text(json.dumps(two_steps), encoding="utf-8")
     assert cli.main(["validate", PA3, str(path)]) == 2
     err = capsys.readouterr().err.splitlines()
-    assert len(err) == 1 and "error[E502]" in err[0] and "plan.steps[1].actions[0].configs has an unknown field " \
-        "'retreat'" in err[0], err
+    assert (
+        len(err) == 1
+        and "error[E502]" in err[0]
+        and "plan.steps[1].actions[0].configs has an unknown field 'retreat'" in err[0]
+    ), err
 
 
-def test_doctored_transfer_left_out_is_a_straight_move(one_step: dict[str, Any], tmp_path: Path,
-                                                        capsys: pytest.CaptureFixture[str]) -> None:
+def test_doctored_transfer_left_out_is_a_straight_move(
+    one_step: dict[str, Any], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """Without its to-handover path, r1 carries o1 from the grasp to the exchange in a straight joint-space
     line (the paper's packaging model), through its neighbour o3."""
     del _action(one_step, 1)["paths"]
     rc, lines = _cli(tmp_path, PA3, one_step, capsys)
-    _rejected(rc, lines, "collision-object-object", "to-handover: o1 held by r1 (between straight to-handover "
-                                                    "transfer configurations 1 and 2 of 2) and o3 overlap by")
+    _rejected(
+        rc,
+        lines,
+        "collision-object-object",
+        "to-handover: o1 held by r1 (between straight to-handover "
+        "transfer configurations 1 and 2 of 2) and o3 overlap by",
+    )
 
 
-def test_a_transfer_path_is_checked(one_step: dict[str, Any], grounder: Grounder, tmp_path: Path,
-                                    capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_transfer_path_is_checked(
+    one_step: dict[str, Any], grounder: Grounder, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """A given transfer path is followed: lifted only 5 cm before it turns, o1 sweeps through o3."""
     a = _action(one_step, 1)
     path = a["paths"]["to-handover"]
     a["paths"]["to-handover"] = path[:2] + path[-1:]
     rc, lines = _cli(tmp_path, PA3, one_step, capsys)
-    _rejected(rc, lines, "collision-object-object", "to-handover: o1 held by r1 (between to-handover path "
-                                                    "configurations 2 and 3 of 3) and o3 overlap by")
+    _rejected(
+        rc,
+        lines,
+        "collision-object-object",
+        "to-handover: o1 held by r1 (between to-handover path configurations 2 and 3 of 3) and o3 overlap by",
+    )
 
 
 def test_the_motion_model_must_be_one_the_validator_checks(one_step: dict[str, Any]) -> None:
     one_step["motion_model"]["approach"] = {"configurations": 2, "back_off": 0.01}
     lines = validate(vp.pa3(), one_step, PA3).lines()
-    assert "the motion model's approach back-off is 0.01 m; the grasp specification's pre-grasp stands 0.08 m back " \
-           "[motion-model]" in lines, lines
+    assert (
+        "the motion model's approach back-off is 0.01 m; the grasp specification's pre-grasp stands 0.08 m back "
+        "[motion-model]" in lines
+    ), lines
     assert any("the motion model's approaches hold 2 configurations; at least 5 are needed" in x for x in lines)
 
 
@@ -374,8 +423,9 @@ def test_full_motions_require_every_path(one_step: dict[str, Any]) -> None:
     one_step["motion_model"]["arms"] = "full"
     lines = validate(vp.pa3(), one_step, PA3).lines()
     for name in ("to-pick", "taker-to-handover", "to-place", "home", "giver-home"):
-        assert any(f"has no '{name}' path, which the motion model (arms 'full') requires [missing]" in x
-                   for x in lines), lines
+        assert any(
+            f"has no '{name}' path, which the motion model (arms 'full') requires [missing]" in x for x in lines
+        ), lines
     assert not any("'to-handover' path" in x for x in lines)
 
 
@@ -402,8 +452,11 @@ def test_cli_valid_and_invalid(tmp_path: Path, two_steps: dict[str, Any], capsys
     bad.write_text(json.dumps(bad_plan), encoding="utf-8")
     assert cli.main(["validate", PA3, str(bad)]) == 1
     out = capsys.readouterr().out.splitlines()
-    assert out == ["o1: goal (in-region o1 bin-b) does not hold at the end: o1 is at (0.000, -0.250, 0.060), not "
-                   "entirely inside bin-b [goal]", "invalid: 1 violation"]
+    assert out == [
+        "o1: goal (in-region o1 bin-b) does not hold at the end: o1 is at (0.000, -0.250, 0.060), not "
+        "entirely inside bin-b [goal]",
+        "invalid: 1 violation",
+    ]
     assert cli.main(["validate", PA3, str(bad), "--format", "json"]) == 1
     data = json.loads(capsys.readouterr().out)
     assert data["ok"] is False and data["violations"][0]["code"] == "goal"
@@ -418,6 +471,7 @@ def _edit(change: Callable[[dict[str, Any]], None]) -> Callable[[str], str]:
         plan = json.loads(text)
         change(plan)
         return json.dumps(plan, indent=1)
+
     return make
 
 
@@ -445,36 +499,60 @@ MALFORMED: dict[str, tuple[Callable[[str], str | bytes] | None, str, str]] = {
     "binary": (lambda t: b"\x89PNG\r\n\x1a\n\x00\xff", "E500", "it is not UTF-8 text"),
     "a list": (lambda t: "[1, 2]", "E502", "plan should be an object, not [1, 2]"),
     "field missing": (_edit(_del_grasp), "E502", "plan.steps[0].actions[0] lacks 'pick_grasp'"),
-    "wrong type": (_edit(_set("seed", "zero")), "E502", "plan.seed should be an integer, not \"zero\""),
+    "wrong type": (_edit(_set("seed", "zero")), "E502", 'plan.seed should be an integer, not "zero"'),
     "unknown kind": (_edit(_unknown_kind), "E502", "plan.steps[0].actions[0].kind should be one of"),
     "bad matrix": (_edit(_small_matrix), "E502", "plan.steps[0].actions[0].place_pose should hold 4 items, not 1"),
-    "wrong schema": (_edit(_set("schema", "mrgc-plan/7")), "E503",
-                     "schema 'mrgc-plan/7' is not supported (this mrgc reads 'mrgc-plan/1')"),
+    "wrong schema": (
+        _edit(_set("schema", "mrgc-plan/7")),
+        "E503",
+        "schema 'mrgc-plan/7' is not supported (this mrgc reads 'mrgc-plan/1')",
+    ),
     "missing file": (None, "E500", "No such file or directory"),
     # issue 9: unknown fields, limits checked before the JSON parser can explode
-    "unknown field": (_edit(lambda p: _action(p, 1).__setitem__("teleport", True)), "E502",
-                      "plan.steps[0].actions[0] has an unknown field 'teleport'"),
+    "unknown field": (
+        _edit(lambda p: _action(p, 1).__setitem__("teleport", True)),
+        "E502",
+        "plan.steps[0].actions[0] has an unknown field 'teleport'",
+    ),
     "unknown top-level field": (_edit(_set("trust_me", 1)), "E502", "plan has an unknown field 'trust_me'"),
     "motion model missing": (_edit(lambda p: p.pop("motion_model")), "E502", "plan lacks 'motion_model'"),
-    "unknown motion model": (_edit(lambda p: p["motion_model"].__setitem__("arms", "teleport")), "E502",
-                             "plan.motion_model.arms should be one of"),
-    "nested 100k deep": (lambda t: t.replace('"stats": {', '"stats": {"x": ' + "[" * 100_000 + "]" * 100_000 + ", ", 1),
-                         "E504", "plan nests arrays and objects more than 32 deep"),
-    "400-digit integer": (lambda t: t.replace('"seed": 0', '"seed": ' + "9" * 400), "E504",
-                          "plan holds an integer of 400 digits (at most 20)"),
+    "unknown motion model": (
+        _edit(lambda p: p["motion_model"].__setitem__("arms", "teleport")),
+        "E502",
+        "plan.motion_model.arms should be one of",
+    ),
+    "nested 100k deep": (
+        lambda t: t.replace('"stats": {', '"stats": {"x": ' + "[" * 100_000 + "]" * 100_000 + ", ", 1),
+        "E504",
+        "plan nests arrays and objects more than 32 deep",
+    ),
+    "400-digit integer": (
+        lambda t: t.replace('"seed": 0', '"seed": ' + "9" * 400),
+        "E504",
+        "plan holds an integer of 400 digits (at most 20)",
+    ),
     "400-digit integer in a configuration": (
         _edit(lambda p: _action(p, 1)["configs"]["pick"][0].__setitem__(0, int("9" * 400))),
-        "E504", "an integer of 400 digits"),
-    "beyond double precision": (lambda t: t.replace('"seed": 0', '"seed": 1e999'), "E504",
-                                "the number 1e999 lies beyond double precision"),
-    "key twice": (lambda t: t.replace('"seed": 0', '"seed": 0, "seed": 1'), "E501",
-                  "the key 'seed' appears twice in one object"),
+        "E504",
+        "an integer of 400 digits",
+    ),
+    "beyond double precision": (
+        lambda t: t.replace('"seed": 0', '"seed": 1e999'),
+        "E504",
+        "the number 1e999 lies beyond double precision",
+    ),
+    "key twice": (
+        lambda t: t.replace('"seed": 0', '"seed": 0, "seed": 1'),
+        "E501",
+        "the key 'seed' appears twice in one object",
+    ),
 }
 
 
 @pytest.mark.parametrize("name", list(MALFORMED))
-def test_malformed_plan_files_are_input_errors(name: str, tmp_path: Path, two_steps: dict[str, Any],
-                                               capsys: pytest.CaptureFixture[str]) -> None:
+def test_malformed_plan_files_are_input_errors(
+    name: str, tmp_path: Path, two_steps: dict[str, Any], capsys: pytest.CaptureFixture[str]
+) -> None:
     make, code, fragment = MALFORMED[name]
     text = json.dumps(two_steps, indent=1)
     path = tmp_path / "plan.json"
@@ -505,8 +583,10 @@ def test_the_installed_script_validates(tmp_path: Path, one_step: dict[str, Any]
     engine) is never loaded: the validator's collisions are pybullet's alone."""
     path = tmp_path / "plan.json"
     path.write_text(json.dumps(one_step), encoding="utf-8")
-    code = ("import sys; from mrgc import cli; rc = cli.main(['validate', %r, %r]); "
-            "print('coal' in sys.modules, 'mrgc.geometry.grounding' in sys.modules, rc)" % (PA3, str(path)))
+    code = (
+        "import sys; from mrgc import cli; rc = cli.main(['validate', %r, %r]); "
+        "print('coal' in sys.modules, 'mrgc.geometry.grounding' in sys.modules, rc)" % (PA3, str(path))
+    )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=tmp_path)
     lines = out.stdout.splitlines()
     assert len(lines) == 2 and lines[0].startswith("valid: ") and lines[1] == "False False 0", out
@@ -514,15 +594,27 @@ def test_the_installed_script_validates(tmp_path: Path, one_step: dict[str, Any]
 
 
 def test_the_validator_imports_no_planner_search_or_grounding() -> None:
-    banned = {"mrgc.planner.ground", "mrgc.planner.mcts", "mrgc.planner.search", "mrgc.geometry.grounding",
-              "mrgc.geometry.predicates", "mrgc.geometry.path_predicates", "mrgc.geometry.collision",
-              "mrgc.geometry.motion", "mrgc.geometry.ik", "mrgc.geometry.fk", "mrgc.geometry.arm", "mrgc.compiler"}
+    banned = {
+        "mrgc.planner.ground",
+        "mrgc.planner.mcts",
+        "mrgc.planner.search",
+        "mrgc.geometry.grounding",
+        "mrgc.geometry.predicates",
+        "mrgc.geometry.path_predicates",
+        "mrgc.geometry.collision",
+        "mrgc.geometry.motion",
+        "mrgc.geometry.ik",
+        "mrgc.geometry.fk",
+        "mrgc.geometry.arm",
+        "mrgc.compiler",
+    }
     for name in ("validate.py", "replay.py", "replay_actions.py", "sampling.py", "plan_reader.py"):
         tree = ast.parse((ROOT / "planner" / name).read_text(encoding="utf-8"))
         for node in ast.walk(tree):
             if isinstance(node, ast.ImportFrom) and node.module:
-                assert not any(node.module == b or node.module.startswith(b + ".") for b in banned), \
+                assert not any(node.module == b or node.module.startswith(b + ".") for b in banned), (
                     f"planner/{name} imports {node.module}"
+                )
 
 
 # ------------------------------------------------------------------------------------- the replay scene
@@ -533,8 +625,7 @@ def test_replay_scene_distances_and_kinematics(pa3: Any, grounder: Grounder, tmp
 
     cube = tmp_path / "cube.obj"
     corners = "".join(f"v {x} {y} {z}\n" for x in (-0.05, 0.05) for y in (-0.05, 0.05) for z in (-0.05, 0.05))
-    faces = ["1 2 4", "1 4 3", "5 7 8", "5 8 6", "1 5 6", "1 6 2", "3 4 8", "3 8 7", "1 3 7", "1 7 5", "2 6 8",
-             "2 8 4"]
+    faces = ["1 2 4", "1 4 3", "5 7 8", "5 8 6", "1 5 6", "1 6 2", "3 4 8", "3 8 7", "1 3 7", "1 7 5", "2 6 8", "2 8 4"]
     cube.write_text(corners + "".join(f"f {f}\n" for f in faces), encoding="utf-8")
     scene = grounder.scene
     with ReplayScene(scene) as rs:
@@ -573,11 +664,15 @@ def test_replay_boxes_are_exact_at_edges(gap: float, diagonal: bool) -> None:
         assert c is not None and abs(c.distance - exact) < 5e-5, (c, exact)
 
 
-@given(st.lists(st.lists(st.floats(-3, 3), min_size=3, max_size=3), min_size=2, max_size=40),
-       st.sampled_from([0.01, 0.003]), st.booleans())
+@given(
+    st.lists(st.lists(st.floats(-3, 3), min_size=3, max_size=3), min_size=2, max_size=40),
+    st.sampled_from([0.01, 0.003]),
+    st.booleans(),
+)
 @settings(max_examples=60, deadline=None, derandomize=True)
-def test_samples_are_never_farther_apart_than_the_resolution(configs: list[list[float]], resolution: float,
-                                                             planar: bool) -> None:
+def test_samples_are_never_farther_apart_than_the_resolution(
+    configs: list[list[float]], resolution: float, planar: bool
+) -> None:
     """Between two consecutive samples of a motion no coordinate moves more than the resolution, whether the
     motion has few configurations (every one sampled) or many (equal steps along its length)."""
     from mrgc.planner.sampling import config_at, deltas, sample_count, sample_times
@@ -628,20 +723,37 @@ def test_symbolic_plans_of_chain3_are_valid(name: str, chain3: Any) -> None:
 
 
 INVALID_SYMBOLIC: dict[str, tuple[list[list[tuple[str, ...]]], str, str]] = {
-    "pick obstacle in the same step": ([[B, A1], [C]], "pick-obstacle",
-                                       "o2 blocks r1 picking o1 with top and moves at step 1; it must move at an "
-                                       "earlier step"),
-    "place obstacle later": ([[B], [A1], [C]], "place-obstacle",
-                             "o3 blocks r1 placing o1 in goal with top and moves at step 3; it must move by step 2"),
-    "place obstacle never moved": ([[B], [A1]], "place-obstacle", "o3 blocks r1 placing o1 in goal with top and "
-                                                                  "never moves"),
+    "pick obstacle in the same step": (
+        [[B, A1], [C]],
+        "pick-obstacle",
+        "o2 blocks r1 picking o1 with top and moves at step 1; it must move at an earlier step",
+    ),
+    "place obstacle later": (
+        [[B], [A1], [C]],
+        "place-obstacle",
+        "o3 blocks r1 placing o1 in goal with top and moves at step 3; it must move by step 2",
+    ),
+    "place obstacle never moved": (
+        [[B], [A1]],
+        "place-obstacle",
+        "o3 blocks r1 placing o1 in goal with top and never moves",
+    ),
     "handover before its pick obstacle": ([[A3], [B]], "pick-obstacle", "o2 blocks r1 picking o1 with top"),
-    "unsupported grasp": ([[("o1", "goal", "r1", "side")]], "unsupported",
-                          "no fact (reachable-pick o1 side r1) supports 'r1 moves o1 to goal (side)'"),
-    "unsupported handover": ([[("o1", "goal", "r2", "side", "r1", "top")]], "unsupported",
-                             "no fact (enable-goal-handover o1 side top r2 r1)"),
-    "obstacle to the goal": ([[("o2", "goal", "r1", "top")], [A2]], "region",
-                             "o2 goes to 'goal', but the model moves it only into 'start'"),
+    "unsupported grasp": (
+        [[("o1", "goal", "r1", "side")]],
+        "unsupported",
+        "no fact (reachable-pick o1 side r1) supports 'r1 moves o1 to goal (side)'",
+    ),
+    "unsupported handover": (
+        [[("o1", "goal", "r2", "side", "r1", "top")]],
+        "unsupported",
+        "no fact (enable-goal-handover o1 side top r2 r1)",
+    ),
+    "obstacle to the goal": (
+        [[("o2", "goal", "r1", "top")], [A2]],
+        "region",
+        "o2 goes to 'goal', but the model moves it only into 'start'",
+    ),
     "goal missed": ([[B]], "goal", "goal (in-region o1 goal) does not hold at the end: o1 is in 'start'"),
     "moved twice": ([[A2], [A2]], "moved-twice", "o1 is moved again (first at step 1)"),
     "robot busy": ([[B, A3]], "robot-busy", "r1 is in two actions of the step (moving o2 and o1)"),
@@ -685,12 +797,16 @@ def test_a_planar_plan_is_valid_and_its_mutations_are_not(room: tuple[str, Any, 
     a["configs"]["pick"] = [[-0.5, 0.0, 0.0]]  # 5 cm short of the box, where the to-pick path does not go
     a["paths"]["home"] = _line([1.25, 0, 0], [0, 1.2, 0], 10) + _line([0, 1.2, 0], [-1, 0, 0], 10)  # through the wall
     lines = validate(problem, bad, path).lines()
-    assert any("the last pick base pose of r1 is 50.0 mm, 0.000 rad from where grasp 'side-x-' of b puts it" in x
-               for x in lines), lines
-    assert any("[collision-robot-fixed]" in x and "footprint of r1 (" in x and "and wall overlap by" in x
-               for x in lines), lines
-    assert any("path 'to-pick' (moving b) ends 50.0 mm, 0.000 rad away from the first pick configuration" in x
-               for x in lines), lines
+    assert any(
+        "the last pick base pose of r1 is 50.0 mm, 0.000 rad from where grasp 'side-x-' of b puts it" in x
+        for x in lines
+    ), lines
+    assert any(
+        "[collision-robot-fixed]" in x and "footprint of r1 (" in x and "and wall overlap by" in x for x in lines
+    ), lines
+    assert any(
+        "path 'to-pick' (moving b) ends 50.0 mm, 0.000 rad away from the first pick configuration" in x for x in lines
+    ), lines
     bad = copy.deepcopy(plan)
     detour = [-1.3, -1.5, 0]  # carrying the box through r2, standing at home
     _action(bad, 1)["paths"]["to-place"] = _line([-0.45, 0, 0], detour) + _line(detour, [1.25, 0, 0])

@@ -38,8 +38,12 @@ from hypothesis import strategies as st
 from mrgc.geometry.transforms import rot_z, translation
 from mrgc.planner.validate import validate
 
-FUZZ = settings(max_examples=10, deadline=None, derandomize=True,
-                suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
+FUZZ = settings(
+    max_examples=10,
+    deadline=None,
+    derandomize=True,
+    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
+)
 GEOMETRY = {"grasp", "approach", "handover", "path", "config", "action", "missing", "joint-limits"}
 
 
@@ -50,8 +54,11 @@ def room(tmp_path_factory: pytest.TempPathFactory) -> tuple[str, Any, dict[str, 
 
 def _plans(room: tuple[str, Any, dict[str, Any]]) -> dict[str, tuple[str, Any, Callable[[], dict[str, Any]]]]:
     path, problem, plan = room
-    return {"one step": (vp.PA3, vp.pa3(), vp.one_step), "two steps": (vp.PA3, vp.pa3(), vp.two_steps),
-            "room": (path, problem, lambda: copy.deepcopy(plan))}
+    return {
+        "one step": (vp.PA3, vp.pa3(), vp.one_step),
+        "two steps": (vp.PA3, vp.pa3(), vp.two_steps),
+        "room": (path, problem, lambda: copy.deepcopy(plan)),
+    }
 
 
 def _reject(problem_path: str, problem: Any, plan: dict[str, Any], codes: set[str], what: str) -> None:
@@ -68,8 +75,9 @@ def _actions(plan: dict[str, Any]) -> list[dict[str, Any]]:
     return [a for s in plan["steps"] for a in s["actions"]]
 
 
-def _draw(room: tuple[str, Any, dict[str, Any]], data: st.DataObject
-          ) -> tuple[str, str, Any, dict[str, Any], dict[str, Any]]:
+def _draw(
+    room: tuple[str, Any, dict[str, Any]], data: st.DataObject
+) -> tuple[str, str, Any, dict[str, Any], dict[str, Any]]:
     """A fresh copy of one of the valid plans and one of its actions: (name, problem path, problem, plan,
     action)."""
     which = data.draw(st.sampled_from(["one step", "two steps", "room"]), label="plan")
@@ -101,8 +109,9 @@ def test_independent_steps_swapped_stay_valid() -> None:
 def test_deleted_or_cut_motions_are_rejected(room: tuple[str, Any, dict[str, Any]], data: st.DataObject) -> None:
     which, path, problem, plan, a = _draw(room, data)
     planar = which == "room"
-    moves = ["delete configs", "delete place_pose"] + (["delete path", "cut path"] if planar else
-                                                       ["cut approach", "cut path"])
+    moves = ["delete configs", "delete place_pose"] + (
+        ["delete path", "cut path"] if planar else ["cut approach", "cut path"]
+    )
     move = data.draw(st.sampled_from(moves), label="edit")
     if move == "delete configs":
         phase = data.draw(st.sampled_from(sorted(a["configs"])), label="phase")
@@ -133,8 +142,7 @@ def test_deleted_or_cut_motions_are_rejected(room: tuple[str, Any, dict[str, Any
 # ------------------------------------------------------------------------------------- shift and move
 @FUZZ
 @given(data=st.data())
-def test_shifted_pinned_configurations_are_rejected(room: tuple[str, Any, dict[str, Any]],
-                                                    data: st.DataObject) -> None:
+def test_shifted_pinned_configurations_are_rejected(room: tuple[str, Any, dict[str, Any]], data: st.DataObject) -> None:
     which, path, problem, plan, a = _draw(room, data)
     pinned: list[tuple[list[list[float]], int]] = []
     for phase, qs in a["configs"].items():
@@ -171,8 +179,12 @@ def test_moved_placements_are_rejected(room: tuple[str, Any, dict[str, Any]], da
     _reject(path, problem, plan, {"grasp", "floating", "outside-region"}, f"{which}: placement moved")
 
 
-@settings(max_examples=4, deadline=None, derandomize=True,
-          suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
+@settings(
+    max_examples=4,
+    deadline=None,
+    derandomize=True,
+    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
+)
 @given(height=st.floats(0.015, 0.2), which=st.sampled_from(["one step", "two steps"]))
 def test_placements_without_support_are_rejected(height: float, which: str) -> None:
     """The placement raised and the place approach re-solved by IK to match: only the support is wrong."""
@@ -193,8 +205,9 @@ def test_placements_without_support_are_rejected(height: float, which: str) -> N
 # ------------------------------------------------------------------------------------- swap and inject
 @FUZZ
 @given(data=st.data())
-def test_swapped_robots_grasps_and_steps_are_rejected(room: tuple[str, Any, dict[str, Any]],
-                                                      data: st.DataObject) -> None:
+def test_swapped_robots_grasps_and_steps_are_rejected(
+    room: tuple[str, Any, dict[str, Any]], data: st.DataObject
+) -> None:
     which = data.draw(st.sampled_from(["one step", "two steps"]), label="plan")
     path, problem, make = _plans(room)[which]
     plan = make()
@@ -218,8 +231,11 @@ def test_swapped_robots_grasps_and_steps_are_rejected(room: tuple[str, Any, dict
 
         specs = vp.grounder().scene.grasp_specs
         current = grasp_transform(specs[a[role]], shape)
-        others = [g for g in problem.grasps_of(a["object"])
-                  if g in specs and np.abs(grasp_transform(specs[g], shape) - current).max() > 1e-6]
+        others = [
+            g
+            for g in problem.grasps_of(a["object"])
+            if g in specs and np.abs(grasp_transform(specs[g], shape) - current).max() > 1e-6
+        ]
         a[role] = data.draw(st.sampled_from(others), label="grasp")
         if a["kind"] == "pick-place":  # keep it one grasp: otherwise it is a regrasp, also wrong
             a["pick_grasp"] = a["place_grasp"] = a[role]
@@ -234,8 +250,16 @@ def test_swapped_robots_grasps_and_steps_are_rejected(room: tuple[str, Any, dict
     _reject(path, problem, plan, GEOMETRY, f"{which}: swapped {move}")
 
 
-NAME_FIELDS = ["object", "region", "pick_robot", "place_robot", "pick_grasp", "place_grasp", "handover_point",
-               "waiting"]
+NAME_FIELDS = [
+    "object",
+    "region",
+    "pick_robot",
+    "place_robot",
+    "pick_grasp",
+    "place_grasp",
+    "handover_point",
+    "waiting",
+]
 
 
 @FUZZ
@@ -243,9 +267,14 @@ NAME_FIELDS = ["object", "region", "pick_robot", "place_robot", "pick_grasp", "p
 def test_injected_names_are_rejected(room: tuple[str, Any, dict[str, Any]], data: st.DataObject, name: str) -> None:
     which = data.draw(st.sampled_from(["one step", "two steps", "room"]), label="plan")
     path, problem, make = _plans(room)[which]
-    known = {x.name for x in (*problem.robots, *problem.movable, *problem.fixed, *problem.regions,
-                              *problem.handover_points)} | set(problem.grasp_specs) | {"side-x+", "side-x-",
-                                                                                        "side-y+", "side-y-"}
+    known = (
+        {
+            x.name
+            for x in (*problem.robots, *problem.movable, *problem.fixed, *problem.regions, *problem.handover_points)
+        }
+        | set(problem.grasp_specs)
+        | {"side-x+", "side-x-", "side-y+", "side-y-"}
+    )
     if name in known:
         name += "-x"
     plan = make()

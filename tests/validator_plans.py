@@ -56,8 +56,19 @@ def line(a: Any, b: Any, n: int = 5) -> list[list[float]]:
 
 def as_file(problem: Any, path: str, steps: list[list[PlannedAction]], symbolic: bool = False) -> dict[str, Any]:
     """The plan JSON a file would hold for ``steps`` (status solved)."""
-    plan = Plan(problem.name, path, file_sha256(path), "0.1.0", "cpsat", "time-of-move", 0, "solved", steps,
-                symbolic=symbolic, stats={"robots": [r.name for r in problem.robots]})
+    plan = Plan(
+        problem.name,
+        path,
+        file_sha256(path),
+        "0.1.0",
+        "cpsat",
+        "time-of-move",
+        0,
+        "solved",
+        steps,
+        symbolic=symbolic,
+        stats={"robots": [r.name for r in problem.robots]},
+    )
     return json.loads(plan.dumps())  # type: ignore[no-any-return]
 
 
@@ -114,10 +125,18 @@ def handover(g: Grounder, avoid: list[str]) -> PlannedAction:
     place = g.place("r2", "o1", "side-x+", spot.pose, avoid=avoid)
     assert place.ok and pick.configs is not None and hand.configs is not None
     up = lifted(g, "r1", "o1", "top", g.poses["o1"], pick.configs[-1])
-    return PlannedAction("o1", "bin-b", "r1", "r2", "top", "side-x+", place_pose=rows(spot.pose), handover_point="h1",
-                         configs={"pick": rows(pick.configs), "handover": rows(hand.configs),
-                                  "place": rows(place.configs)},
-                         paths={"to-handover": rows([pick.configs[-1], *up, hand.configs[0]])})
+    return PlannedAction(
+        "o1",
+        "bin-b",
+        "r1",
+        "r2",
+        "top",
+        "side-x+",
+        place_pose=rows(spot.pose),
+        handover_point="h1",
+        configs={"pick": rows(pick.configs), "handover": rows(hand.configs), "place": rows(place.configs)},
+        paths={"to-handover": rows([pick.configs[-1], *up, hand.configs[0]])},
+    )
 
 
 @lru_cache(maxsize=1)
@@ -137,9 +156,17 @@ def _two_steps() -> str:
     assert place.ok and place.configs is not None
     up = lifted(g, "r1", "o2", "top", g.poses["o2"], pick.configs[-1])
     down = lifted(g, "r1", "o2", "top", spot.pose, place.configs[0])[::-1]
-    first = PlannedAction("o2", "start", "r1", "r1", "top", "top", place_pose=rows(spot.pose),
-                          configs={"pick": rows(pick.configs), "place": rows(place.configs)},
-                          paths={"to-place": rows([pick.configs[-1], *up, *down, place.configs[0]])})
+    first = PlannedAction(
+        "o2",
+        "start",
+        "r1",
+        "r1",
+        "top",
+        "top",
+        place_pose=rows(spot.pose),
+        configs={"pick": rows(pick.configs), "place": rows(place.configs)},
+        paths={"to-place": rows([pick.configs[-1], *up, *down, place.configs[0]])},
+    )
     g.move("o2", spot.pose)
     return json.dumps(as_file(pa3(), PA3, [[first], [handover(g, ["o2", "o3"])]]))
 
@@ -164,10 +191,21 @@ def _room(folder: str) -> tuple[str, str]:
     # 0.25 (half length) + 0.05 + 0.15 (half the box) = 0.45 m from the box's centre
     q_pick, place = [-0.45, 0.0, 0.0], translation(1.7, 0.0, 0.151)
     q_place = [1.25, 0.0, 0.0]
-    act = PlannedAction("b", "goal", "r1", "r1", "side-x-", "side-x-", place_pose=rows(place),
-                        configs={"pick": [q_pick], "place": [q_place]},
-                        paths={"to-pick": line([-1, 0, 0], q_pick), "to-place": line(q_pick, q_place, 20),
-                               "home": line(q_place, [-1, 0, 0], 30)})
+    act = PlannedAction(
+        "b",
+        "goal",
+        "r1",
+        "r1",
+        "side-x-",
+        "side-x-",
+        place_pose=rows(place),
+        configs={"pick": [q_pick], "place": [q_place]},
+        paths={
+            "to-pick": line([-1, 0, 0], q_pick),
+            "to-place": line(q_pick, q_place, 20),
+            "home": line(q_place, [-1, 0, 0], 30),
+        },
+    )
     return str(path), json.dumps(as_file(problem, str(path), [[act]]))
 
 

@@ -22,8 +22,9 @@ class DisaggregatedEncoding(PaperEncoding):
 
     name = "disaggregated"
 
-    def precedence(self, m: SkeletonModel, graph: TaskGraph, X: list[list[int]], of: dict[str, list[int]],
-                   T: int) -> None:
+    def precedence(
+        self, m: SkeletonModel, graph: TaskGraph, X: list[list[int]], of: dict[str, list[int]], T: int
+    ) -> None:
         """The obstacle precedences: ``Y_M@t + X_a@1 - X_a@(t+1) <= 1`` (pick) or ``... - X_a@t <= 1`` (place) for
         every step t."""
         for a in range(len(graph.actions)):

@@ -53,18 +53,25 @@ class PaperEncoding(Encoding):
 
         return Encoded(m, select, T, decode)
 
-    def precedence(self, m: SkeletonModel, graph: TaskGraph, X: list[list[int]], of: dict[str, list[int]],
-                   T: int) -> None:
+    def precedence(
+        self, m: SkeletonModel, graph: TaskGraph, X: list[list[int]], of: dict[str, list[int]], T: int
+    ) -> None:
         """(11) pick obstacles strictly earlier, (12) place obstacles no later, as conditional rows."""
         for a in range(len(graph.actions)):
             for o, strict in graph.obstacles(a):
                 terms = [(v, 1) for v in X[a]] + [(v, -1) for a2 in of[o] for v in X[a2]]
-                m.add_if([(X[a][0], True)], terms, lo=1 if strict else 0,
-                         name=f"c{11 if strict else 12}[{a},{o}]", big_m=T + 1 if strict else T)
+                m.add_if(
+                    [(X[a][0], True)],
+                    terms,
+                    lo=1 if strict else 0,
+                    name=f"c{11 if strict else 12}[{a},{o}]",
+                    big_m=T + 1 if strict else T,
+                )
 
 
-def _monotone_and_pending(m: SkeletonModel, graph: TaskGraph, X: list[list[int]], of: dict[str, list[int]],
-                          must: set[str], T: int) -> None:
+def _monotone_and_pending(
+    m: SkeletonModel, graph: TaskGraph, X: list[list[int]], of: dict[str, list[int]], must: set[str], T: int
+) -> None:
     """(1) "at or after t" is monotone; (3) objects outside M* move only while an action they block is
     pending."""
     A = range(len(graph.actions))
@@ -89,15 +96,17 @@ def _per_step(m: SkeletonModel, graph: TaskGraph, X: list[list[int]], uses: dict
     m.add([(X[a][T - 1], 1) for a in A], lo=1, name="c5")  # (5) the last step is not empty
     for t in range(T - 1):
         for r, acts in uses.items():  # (6) each robot at most one action per step
-            m.add([(X[a][t], 1) for a in acts] + [(X[a][t + 1], -1) for a in acts], hi=1,
-                  name=f"c6[{r},{t + 1}]")
+            m.add([(X[a][t], 1) for a in acts] + [(X[a][t + 1], -1) for a in acts], hi=1, name=f"c6[{r},{t + 1}]")
         m.add([(X[a][t], 1) for a in A] + [(X[a][t + 1], -1) for a in A], lo=1, name=f"c7[{t + 1}]")  # (7)
     handovers = [a for a in A if graph.actions[a].handover]
     if graph.single_handover_point and len(handovers) > 1:  # one handover point: one handover per step
         m.add([(X[a][T - 1], 1) for a in handovers], hi=1, name="handover-point")
         for t in range(T - 1):
-            m.add([(X[a][t], 1) for a in handovers] + [(X[a][t + 1], -1) for a in handovers], hi=1,
-                  name=f"handover-point[{t + 1}]")
+            m.add(
+                [(X[a][t], 1) for a in handovers] + [(X[a][t + 1], -1) for a in handovers],
+                hi=1,
+                name=f"handover-point[{t + 1}]",
+            )
 
 
 def _moved(m: SkeletonModel, graph: TaskGraph, X: list[list[int]], of: dict[str, list[int]], must: set[str]) -> None:

@@ -52,21 +52,27 @@ class TimeOfMoveEncoding(Encoding):
             me = graph.actions[a].obj
             for o, strict in graph.obstacles(a):
                 m.add([(y[a2], 1) for a2 in of[o]] + [(y[a], -1)], lo=0, name=f"obstacle[{a},{o}]")
-                m.add_if([(y[a], True)], [(tau[me], 1), (tau[o], -1)], lo=1 if strict else 0,
-                         name=f"{'pick' if strict else 'place'}-before[{a},{o}]")
+                m.add_if(
+                    [(y[a], True)],
+                    [(tau[me], 1), (tau[o], -1)],
+                    lo=1 if strict else 0,
+                    name=f"{'pick' if strict else 'place'}-before[{a},{o}]",
+                )
         _one_object_per_step(m, graph, y, tau, of)
         handovers = [a for a in A if graph.actions[a].handover]
         if graph.single_handover_point and len(handovers) > 1:  # one handover point: one handover per step
-            m.no_overlap.append(NoOverlap(tuple((y[a], tau[graph.actions[a].obj]) for a in handovers),
-                                          name="handover-point"))
+            m.no_overlap.append(
+                NoOverlap(tuple((y[a], tau[graph.actions[a].obj]) for a in handovers), name="handover-point")
+            )
         # redundant capacity rows (valid for every skeleton, they tighten the makespan bound): a robot
         # acts at most once per step, and all robots together at most |R| times per step
         for r in graph.robots:
             acts = [(y[a], 1) for a in A if r in graph.actions[a].robots]
             if acts:
                 m.add([*acts, (makespan, -1)], hi=0, name=f"load[{r}]")
-        m.add([*((y[a], len(graph.actions[a].robots)) for a in A), (makespan, -len(graph.robots))], hi=0,
-              name="load[all]")
+        m.add(
+            [*((y[a], len(graph.actions[a].robots)) for a in A), (makespan, -len(graph.robots))], hi=0, name="load[all]"
+        )
         m.objectives.append(((makespan, 1),))
         m.objectives.append(tuple((y[a], 1) for a in A))
 
@@ -77,8 +83,9 @@ class TimeOfMoveEncoding(Encoding):
         return Encoded(m, list(y), H, decode)
 
 
-def _one_object_per_step(m: SkeletonModel, graph: TaskGraph, y: list[int], tau: dict[str, int],
-                         of: dict[str, list[int]]) -> None:
+def _one_object_per_step(
+    m: SkeletonModel, graph: TaskGraph, y: list[int], tau: dict[str, int], of: dict[str, list[int]]
+) -> None:
     """Per robot, the objects it handles occupy distinct steps: a no-overlap of unit tasks, one per object,
     present when one of the robot's actions on it is selected."""
     for r in graph.robots:

@@ -83,8 +83,16 @@ class GeometricSteps:
         self.grounder = Grounder(scene_from_problem(problem), seed=seed)
         self.reverse = ReverseGrounder(self.grounder, problem.goal_regions, full=full)
 
-    def ground(self, actions: tuple[Action, ...], fut: set[str], free: set[str], strict: bool, v_fut: list[Any],
-               key: str, index: int) -> Attempt | Failure:
+    def ground(
+        self,
+        actions: tuple[Action, ...],
+        fut: set[str],
+        free: set[str],
+        strict: bool,
+        v_fut: list[Any],
+        key: str,
+        index: int,
+    ) -> Attempt | Failure:
         """Ground ``actions`` as one step before the suffix: ``fut`` (moved later) are always obstacles, ``free``
         (moved by nothing yet) too when ``strict``, else the objects of ``free`` the step hits are returned."""
         same = {a.obj for a in actions}
@@ -103,16 +111,27 @@ class SymbolicSteps:
     def __init__(self, facts: FactBase) -> None:
         self.facts = facts
 
-    def ground(self, actions: tuple[Action, ...], fut: set[str], free: set[str], strict: bool, v_fut: list[Any],
-               key: str, index: int) -> Attempt | Failure:
+    def ground(
+        self,
+        actions: tuple[Action, ...],
+        fut: set[str],
+        free: set[str],
+        strict: bool,
+        v_fut: list[Any],
+        key: str,
+        index: int,
+    ) -> Attempt | Failure:
         """Ground the step ``actions`` against the future volume (reverse search): an :class:`Attempt` or the
         :class:`~mrgc.planner.outcome.Failure` that stopped it."""
         facts, same = self.facts, {a.obj for a in actions}
         hits: set[str] = set()
         for a in actions:
             pick = facts.occludes_pick.get((a.obj, a.pick_grasp, a.pick_robot), ())
-            place = facts.occludes_place.get((a.obj, a.region, a.place_grasp, a.place_robot), ()) \
-                if a.obj in facts.goal else ()
+            place = (
+                facts.occludes_place.get((a.obj, a.region, a.place_grasp, a.place_robot), ())
+                if a.obj in facts.goal
+                else ()
+            )
             for b in pick + place:
                 if b in fut:
                     return Failure(index, label(a), "obstructed by an object that moves later", (b,))
@@ -122,8 +141,9 @@ class SymbolicSteps:
                     hits.add(b)
         if strict and hits:
             return Failure(index, " + ".join(label(a) for a in actions), "obstructed", tuple(sorted(hits)))
-        planned = [PlannedAction(a.obj, a.region, a.pick_robot, a.place_robot, a.pick_grasp, a.place_grasp)
-                   for a in actions]
+        planned = [
+            PlannedAction(a.obj, a.region, a.pick_robot, a.place_robot, a.pick_grasp, a.place_grasp) for a in actions
+        ]
         return Attempt(GroundedStep(planned, [], tuple(a.obj for a in actions)), hits)
 
 
@@ -137,8 +157,9 @@ class Ap1Search:
     deadline: float
     why: Why
     one_handover: bool = False
-    stats: dict[str, float] = field(default_factory=lambda: {"groundings": 0, "grounding_seconds": 0.0, "nodes": 0,
-                                                             "restarts": 0})
+    stats: dict[str, float] = field(
+        default_factory=lambda: {"groundings": 0, "grounding_seconds": 0.0, "nodes": 0, "restarts": 0}
+    )
     left: int = 0  # groundings left in this run
     rank: dict[str, int] = field(default_factory=dict)  # this run's order of the objects
     ordered: bool = False
@@ -182,8 +203,9 @@ class Ap1Search:
             rng.shuffle(order)
 
     # ------------------------------------------------------------ the recursion
-    def _resolve(self, pending: tuple[str, ...], suffix: list[GroundedStep],
-                 signature: tuple[Any, ...]) -> list[GroundedStep] | None:
+    def _resolve(
+        self, pending: tuple[str, ...], suffix: list[GroundedStep], signature: tuple[Any, ...]
+    ) -> list[GroundedStep] | None:
         if not pending:
             return suffix if self.accept(suffix) else None
         state = (pending, signature)
@@ -213,19 +235,30 @@ class Ap1Search:
                             return plan
         return None
 
-    def _descend(self, got: Attempt, pending: tuple[str, ...], suffix: list[GroundedStep],
-                 signature: tuple[Any, ...]) -> list[GroundedStep] | None:
+    def _descend(
+        self, got: Attempt, pending: tuple[str, ...], suffix: list[GroundedStep], signature: tuple[Any, ...]
+    ) -> list[GroundedStep] | None:
         """Recurse below a grounded step: the objects it hits go on top of the stack, by this run's order."""
-        rest = tuple(sorted(got.hits, key=self.rank.__getitem__)) + tuple(
-            p for p in pending if p not in got.step.moved)
+        rest = tuple(sorted(got.hits, key=self.rank.__getitem__)) + tuple(p for p in pending if p not in got.step.moved)
         # the state names the whole path (each step with the stack it was grounded under); the grounding's
         # random streams derive from it
-        step_sig = tuple((x.object, x.region, x.pick_robot, x.place_robot, x.pick_grasp, x.place_grasp)
-                         for x in got.step.actions)
+        step_sig = tuple(
+            (x.object, x.region, x.pick_robot, x.place_robot, x.pick_grasp, x.place_grasp) for x in got.step.actions
+        )
         return self._resolve(rest, [got.step] + suffix, ((pending, step_sig),) + signature)
 
-    def _fill(self, actions: tuple[Action, ...], got: Attempt, pending: tuple[str, ...], fut: set[str],
-              free: set[str], strict: bool, v_fut: list[Any], key: str, index: int) -> Attempt:
+    def _fill(
+        self,
+        actions: tuple[Action, ...],
+        got: Attempt,
+        pending: tuple[str, ...],
+        fut: set[str],
+        free: set[str],
+        strict: bool,
+        v_fut: list[Any],
+        key: str,
+        index: int,
+    ) -> Attempt:
         """The composite robot's idle robots take other objects of the stack, in stack order, when an action
         of theirs grounds in the same step without hitting anything the step did not hit already."""
         busy = {r for a in actions for r in a.robots}
@@ -250,8 +283,17 @@ class Ap1Search:
                     break
         return got
 
-    def _ground(self, actions: tuple[Action, ...], fut: set[str], free: set[str], strict: bool, v_fut: list[Any],
-                key: str, index: int, record: bool) -> Attempt | None:
+    def _ground(
+        self,
+        actions: tuple[Action, ...],
+        fut: set[str],
+        free: set[str],
+        strict: bool,
+        v_fut: list[Any],
+        key: str,
+        index: int,
+        record: bool,
+    ) -> Attempt | None:
         if time.perf_counter() >= self.deadline:
             raise _Stop()
         if self.left <= 0:
@@ -268,8 +310,16 @@ class Ap1Search:
         return got
 
 
-def plan_ap1(problem: Problem, problem_file: str, sha256: str, version: str, seed: int = 0,
-             time_limit: float = 60.0, log: Log | None = None, motions: str = "configurations") -> Plan:
+def plan_ap1(
+    problem: Problem,
+    problem_file: str,
+    sha256: str,
+    version: str,
+    seed: int = 0,
+    time_limit: float = 60.0,
+    log: Log | None = None,
+    motions: str = "configurations",
+) -> Plan:
     """Plan ``problem`` with Ap1 (see the module docstring); the same Plan, statuses and validation as
     :func:`mrgc.planner.search.plan_problem`, and the same ``motions`` (``full``: arms' empty-handed
     motions planned too)."""
@@ -280,12 +330,25 @@ def plan_ap1(problem: Problem, problem_file: str, sha256: str, version: str, see
     facts, facts_seconds = problem_facts(problem, seed=seed)
     base = FactBase.from_problem(problem, facts)
     robots = [r.name for r in problem.robots]
-    plan = Plan(problem.name, problem_file, sha256, version, "none", "none", seed, PlanStatus.EXHAUSTED,
-                symbolic=problem.symbolic)
+    plan = Plan(
+        problem.name,
+        problem_file,
+        sha256,
+        version,
+        "none",
+        "none",
+        seed,
+        PlanStatus.EXHAUSTED,
+        symbolic=problem.symbolic,
+    )
     plan.motion_model = None if problem.symbolic else planner_motion_model(motions)
     why = plan.why = Why()
-    stats: dict[str, Any] = {"planner": "ap1", "robots": robots, "facts": len(facts),
-                             "facts_seconds": round(facts_seconds, 4)}
+    stats: dict[str, Any] = {
+        "planner": "ap1",
+        "robots": robots,
+        "facts": len(facts),
+        "facts_seconds": round(facts_seconds, 4),
+    }
     goals = must_move(problem, facts)
     reasons = _infeasible(base, goals)
     if reasons:
@@ -305,11 +368,15 @@ def plan_ap1(problem: Problem, problem_file: str, sha256: str, version: str, see
         if found is not None:
             plan.steps = [s.actions for s in found]
             plan.status = PlanStatus.SOLVED
-            plan.validation = {"valid": True, "validator": "mrgc validate (independent replay)",
-                               "plans_checked": int(verdicts["checked"])}
+            plan.validation = {
+                "valid": True,
+                "validator": "mrgc validate (independent replay)",
+                "plans_checked": int(verdicts["checked"]),
+            }
         else:
             plan.status = {"time limit": PlanStatus.TIME_LIMIT, "interrupted": PlanStatus.INTERRUPTED}.get(
-                ended, PlanStatus.EXHAUSTED)
+                ended, PlanStatus.EXHAUSTED
+            )
         why.summary = _summary(plan.status, time_limit, why)
         stats.update({k: (round(v, 4) if isinstance(v, float) else int(v)) for k, v in search.stats.items()})
         stats["validation_seconds"] = round(verdicts["seconds"], 4)
@@ -334,10 +401,20 @@ def _referee(problem: Problem, plan: Plan, steps: list[GroundedStep], why: Why, 
     from mrgc.planner.validate import validate
 
     t0 = time.perf_counter()
-    candidate = Plan(plan.problem, plan.problem_file, plan.problem_sha256, plan.mrgc_version, plan.backend,
-                     plan.encoding, plan.seed, PlanStatus.SOLVED, [s.actions for s in steps],
-                     symbolic=problem.symbolic, stats={"robots": [r.name for r in problem.robots]},
-                     motion_model=plan.motion_model)
+    candidate = Plan(
+        plan.problem,
+        plan.problem_file,
+        plan.problem_sha256,
+        plan.mrgc_version,
+        plan.backend,
+        plan.encoding,
+        plan.seed,
+        PlanStatus.SOLVED,
+        [s.actions for s in steps],
+        symbolic=problem.symbolic,
+        stats={"robots": [r.name for r in problem.robots]},
+        motion_model=plan.motion_model,
+    )
     # the referee judges the plan against the problem it was made for (no file need exist: a problem parsed
     # from a string is planned too); ``mrgc validate`` checks the file's digest besides.  The first violation
     # is the verdict, so the replay stops there.
@@ -359,5 +436,7 @@ def _summary(status: PlanStatus, time_limit: float, why: Why) -> str:
         return f"no plan within the time limit of {time_limit:g} s"
     if status is PlanStatus.INTERRUPTED:
         return "interrupted"
-    return ("the depth-first search ran to its end (every object of the stack, with every action, at every "
-            "step); no valid plan")
+    return (
+        "the depth-first search ran to its end (every object of the stack, with every action, at every "
+        "step); no valid plan"
+    )

@@ -1,7 +1,7 @@
 """Style and types, checked by the tools with the configuration in pyproject.toml (docs/architecture.md,
-"Style and type checks"): ruff's rules (with a complexity limit) on every Python file of the repository, and
-mypy, strict, on the package.  They run here so that the one test command of the README (and .ci/run)
-checks them too."""
+"Style and type checks"): ruff's rules (with a complexity limit) and ruff's formatting on every Python file of
+the repository, and mypy, strict, on the package.  They run here so that the one test command of the README
+(and .ci/run) checks them too."""
 
 from __future__ import annotations
 
@@ -13,12 +13,18 @@ from support import ROOT
 
 
 def run(*args: str, cwd: Path = ROOT, env: dict[str, str] | None = None) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", *args], cwd=cwd, env=env, capture_output=True, text=True,
-                          timeout=900)
+    return subprocess.run([sys.executable, "-m", *args], cwd=cwd, env=env, capture_output=True, text=True, timeout=900)
 
 
 def test_ruff_finds_nothing() -> None:
     out = run("ruff", "check", "--no-cache", "--output-format", "concise", ".")
+    assert out.returncode == 0, out.stdout + out.stderr
+
+
+def test_ruff_format_changes_nothing() -> None:
+    """Every Python file (and Python block of the Markdown docs) is as ``ruff format`` writes it, with the
+    settings of pyproject.toml's [tool.ruff.format]."""
+    out = run("ruff", "format", "--check", "--no-cache", ".")
     assert out.returncode == 0, out.stdout + out.stderr
 
 
@@ -34,6 +40,14 @@ def test_mypy_finds_nothing() -> None:
     if not link.is_symlink():
         link.symlink_to(ROOT, target_is_directory=True)
     env = {**os.environ, "MYPYPATH": str(path)}
-    out = run("mypy", "--config-file", str(ROOT / "pyproject.toml"), "--cache-dir", str(ROOT / ".mypy_cache"),
-              "-p", "mrgc", env=env)
+    out = run(
+        "mypy",
+        "--config-file",
+        str(ROOT / "pyproject.toml"),
+        "--cache-dir",
+        str(ROOT / ".mypy_cache"),
+        "-p",
+        "mrgc",
+        env=env,
+    )
     assert out.returncode == 0, out.stdout + out.stderr

@@ -119,7 +119,7 @@ def category(row: dict[str, object]) -> str:
     assert isinstance(why, dict)
     if out == "infeasible":
         facts = " ".join(why.get("facts", []))
-        if "blocking cycle" in facts:
+        if "blocking cycle" in facts or why.get("cycles"):  # cycles told with evidence are not in facts
             return "infeasible: blocking cycle"
         if "no robot can reach" in facts:
             return "infeasible: a goal region out of reach"

@@ -594,14 +594,7 @@ class Grounder:
         the same moving robots and arms at home) gets the same answer without a second search (the reverse
         search asks again when it splits a step or grounds a skeleton that shares a suffix)."""
         avoid = tuple(sorted(set(avoid)))
-        digest = hashlib.sha1()
-        for part in (
-            np.asarray(start, dtype=float),
-            np.asarray(goal, dtype=float),
-            *(self.poses[o] for o in sorted(self.poses)),
-            *(t for _, t in busy),
-        ):
-            digest.update(np.ascontiguousarray(part).tobytes())
+        poses = [self.poses[o] for o in sorted(self.poses)]  # lift_height reads every object's pose
         key = (
             "transfer",
             robot,
@@ -611,10 +604,8 @@ class Grounder:
             lift,
             lower,
             partner,
-            tuple(id(shape) for shape, _ in busy),
             tuple(sorted(self._away.items())),
-            digest.digest(),
-        )
+        ) + _fingerprint([start, goal, *poses], busy)
         if key not in self._paths:
             self._remember(key, self._transfer(robot, obj, grasp, start, goal, avoid, lift, busy, partner, lower))
         return self._paths[key]
@@ -820,15 +811,7 @@ class Grounder:
         inscribed-disc grid test.  Answers are cached: the same query (same obstacles at the same poses)
         gets the same answer, and the search never asks twice."""
         movers = sorted({a for a in avoid if not holding or a != holding[0]})
-        digest = hashlib.sha1()
-        for part in (
-            np.asarray(start, dtype=float),
-            np.asarray(goal, dtype=float),
-            *(self.poses[a] for a in movers),
-            *(t for _, t in busy),
-        ):
-            digest.update(np.ascontiguousarray(part).tobytes())
-        key = (robot, holding, tuple(movers), tuple(id(shape) for shape, _ in busy), digest.digest())
+        key = (robot, holding, tuple(movers), *_fingerprint([start, goal, *(self.poses[a] for a in movers)], busy))
         if key not in self._paths:
             self._remember(key, self._base_path(robot, start, goal, holding, movers, busy))
         return self._paths[key]
@@ -933,6 +916,15 @@ def _packing_grid(room: np.ndarray, cells: int = 15) -> list[tuple[float, float,
     # at one corner (out of reach) is tried at the others before another yaw
     cands = [(level(float(x), float(y)), k, float(x), float(y)) for x in axes[0] for y in axes[1] for k in range(4)]
     return [(k * np.pi / 2, x, y) for _, k, x, y in sorted(cands)]
+
+
+def _fingerprint(arrays: Iterable[np.ndarray], busy: Pieces) -> tuple[tuple[int, ...], bytes]:
+    """What a path query's answer depends on besides its names: the shapes of ``busy`` and a digest of
+    ``arrays`` (configurations, object poses) and of ``busy``'s transforms (the path caches' keys)."""
+    digest = hashlib.sha1()
+    for part in (*arrays, *(t for _, t in busy)):
+        digest.update(np.ascontiguousarray(np.asarray(part, dtype=float)).tobytes())
+    return tuple(id(shape) for shape, _ in busy), digest.digest()
 
 
 def joint_line(configs: np.ndarray, step: float) -> np.ndarray:

@@ -12,15 +12,24 @@ from mrgc.errors import Diagnostic
 from mrgc.language.model import Fact
 
 
+@dataclass(frozen=True)
+class HandoverConfig:
+    """One configuration of an arm holding a goal object at a handover point, free of the fixed objects;
+    ``homes``: the other arms whose links at home it hits."""
+
+    q: np.ndarray
+    homes: frozenset[str]
+
+
 @dataclass
 class RobotFacts:
     """What one robot's worker found: facts, handover configurations and counters."""
 
     facts: list[Fact] = field(default_factory=list)
-    handover: dict[tuple[str, str, str], np.ndarray] = field(default_factory=dict)  # (M, point, g) -> q
-    #: the other arms whose links at home each handover configuration hits (the partner may be one of them:
-    #: it is at the exchange then, not at home)
-    handover_homes: dict[tuple[str, str, str], frozenset[str]] = field(default_factory=dict)
+    #: (M, point, g) -> the distinct configurations found holding M with g at the point, each with the other
+    #: arms whose links at home it hits (the partner may be one of them: it is at the exchange then, not at
+    #: home); the first one found from home first
+    handover: dict[tuple[str, str, str], list[HandoverConfig]] = field(default_factory=dict)
     ik_solves: int = 0
     collision_checks: int = 0
 

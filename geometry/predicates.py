@@ -13,7 +13,9 @@ For every robot R (in parallel, one process per robot when there are cores to sp
 - ``occludes-goal-place M1 M Re g R`` (goal pairs only): M1 is hit by R's links or by M along the
   approach to the placement, or by M at the placement, the placement chosen free of movables if possible;
 - ``enable-goal-handover M g1 g2 R1 R2`` (goal objects): at some handover point of M, R1 holding M with
-  g1 and R2 holding it with g2 are both collision-free with respect to the fixed objects and to each other.
+  g1 and R2 holding it with g2 are both collision-free with respect to the fixed objects and to each other
+  (up to HANDOVER_CONFIGS distinct IK solutions per arm are tried in pairs: one branch of an arm may reach
+  into a waiting arm or into its partner where another does not).
 
 and ``in-region M Re`` from the initial poses.  Everything is deterministic for a seed.
 """
@@ -27,7 +29,7 @@ import numpy as np
 from mrgc.geometry.arm import Arm
 from mrgc.geometry.collision import CollisionWorld, scene_world
 from mrgc.geometry.conventions import APPROACH_SAMPLES, ARM_PLACE_LIFT, lattice_offsets, refine, seed_for
-from mrgc.geometry.facts import FactsResult, RobotFacts
+from mrgc.geometry.facts import FactsResult, HandoverConfig, RobotFacts
 from mrgc.geometry.grasps import finger_opening, fits, grasp_transform, pregrasp_transform
 from mrgc.geometry.ik import solve_ik_many
 from mrgc.geometry.kinematics import model_for_kind
@@ -39,6 +41,9 @@ from mrgc.workers import map_in_workers, worker_count
 PLACEMENT_GRID = 3  # placements tried per region: a GRID × GRID lattice, centre first
 IK_SEEDS = 3  # IK solutions tried per target when looking for one free of movable objects
 IK_ITERS = 100  # Levenberg-Marquardt iterations per solve (reachable targets converge in far fewer)
+HANDOVER_STARTS = 4  # IK solves per handover target: from home, then from seeded random configurations
+HANDOVER_CONFIGS = 3  # distinct handover configurations kept per (object, point, grasp)
+DISTINCT_CONFIG = 0.1  # rad: configurations closer than this in every joint count as one
 
 
 class RobotEvaluator:
@@ -244,6 +249,9 @@ class RobotEvaluator:
         return self.out
 
     def _handover_configs(self) -> None:
+        """Up to HANDOVER_CONFIGS distinct configurations per (goal object, handover point, grasp), from
+        HANDOVER_STARTS IK solves (the first from home, the others from seeded random starts): one solution
+        may hit an arm waiting at home or the partner's links where another branch of the arm does not."""
         keys, tools = [], []
         for obj in self.scene.goal:
             body = self.scene.body(obj)
@@ -257,20 +265,30 @@ class RobotEvaluator:
                     if self.usable(obj, g):
                         keys.append((obj, point, g))
                         tools.append(pose @ grasp_transform(self.scene.grasp(g), body.shape))
+        model = self.arm.model
+        for attempt in range(HANDOVER_STARTS):
+            start = None
+            if attempt:  # another branch of the arm: start the solve from a seeded random configuration
+                rng = np.random.default_rng(seed_for(self.arm.name, "handover-start", str(attempt), seed=self.seed))
+                start = rng.uniform(model.lower, model.upper)
+            todo = [i for i, k in enumerate(keys) if len(self.out.handover.get(k, ())) < HANDOVER_CONFIGS]
+            for i, q in zip(todo, self._ik([tools[i] for i in todo], "handover", q_init=start, attempt=attempt)):
+                if q is not None:
+                    self._keep_handover(keys[i], q)
+
+    def _keep_handover(self, key: tuple[str, str, str], q: np.ndarray) -> None:
+        """Keep ``q`` as a handover configuration of ``key`` if it is free of the fixed objects (arms at
+        home aside) and differs from those kept."""
+        kept = self.out.handover.setdefault(key, [])
+        if any(np.max(np.abs(c.q - q)) < DISTINCT_CONFIG for c in kept):
+            return
         shapes, _ = self.arm.probes
-        for key, q in zip(keys, self._ik(tools, "handover")):
-            if q is None:
-                continue
-            self.out.collision_checks += 1
-            hits = self.world.batch_hits(
-                shapes,
-                self.arm.link_transforms(q[None], self.opening(key[0], key[2])),
-                against="fixed",
-                ignore=(key[0],),
-            )
-            if all(h.startswith("@") for h in hits):  # only arms at home: fine if the partner is the one hit
-                self.out.handover[key] = q
-                self.out.handover_homes[key] = frozenset(h[1:].split(":")[0] for h in hits)
+        self.out.collision_checks += 1
+        hits = self.world.batch_hits(
+            shapes, self.arm.link_transforms(q[None], self.opening(key[0], key[2])), against="fixed", ignore=(key[0],)
+        )
+        if all(h.startswith("@") for h in hits):  # only arms at home: fine if the partner is the one hit
+            kept.append(HandoverConfig(q, frozenset(h[1:].split(":")[0] for h in hits)))
 
 
 def _robot_worker(args: tuple[SceneSpec, str, int]) -> RobotFacts:
@@ -331,27 +349,24 @@ def _handovers(scene: SceneSpec, per_robot: dict[str, RobotFacts]) -> set[Fact]:
             for r2 in per_robot:
                 if r1 == r2:
                     continue
-                for (o1, point, g1), q1 in per_robot[r1].handover.items():
+                for (o1, point, g1), c1s in per_robot[r1].handover.items():
                     if o1 != obj:
                         continue
-                    for (o2, point2, g2), q2 in per_robot[r2].handover.items():
-                        if o2 != obj or point2 != point:
-                            continue
+                    for (o2, point2, g2), c2s in per_robot[r2].handover.items():
                         fact = Fact("enable-goal-handover", (obj, g1, g2, r1, r2))
-                        if fact in out:
-                            continue
-                        # an arm may reach into the other one's home only: that one is at the exchange
-                        if not (
-                            per_robot[r1].handover_homes[(o1, point, g1)] <= {r2}
-                            and per_robot[r2].handover_homes[(o2, point2, g2)] <= {r1}
-                        ):
+                        if o2 != obj or point2 != point or fact in out:
                             continue
                         a1 = arms.setdefault(r1, Arm(scene.robot(r1)))
                         a2 = arms.setdefault(r2, Arm(scene.robot(r2)))
                         shape = scene.body(obj).shape
                         w1 = finger_opening(scene.grasp(g1), shape)
                         w2 = finger_opening(scene.grasp(g2), shape)
-                        if not _arms_collide(a1, q1, w1, a2, q2, w2):
+                        if any(
+                            # an arm may reach into the other one's home only: that one is at the exchange
+                            c1.homes <= {r2} and c2.homes <= {r1} and not _arms_collide(a1, c1.q, w1, a2, c2.q, w2)
+                            for c1 in c1s
+                            for c2 in c2s
+                        ):
                             out.add(fact)
     return out
 

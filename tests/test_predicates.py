@@ -13,7 +13,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from support import ROOT, panda_model
 
-from mrgc import cli, parse_file
+from mrgc import cli, parse_file, parse_string
 from mrgc.geometry.collision import CollisionWorld, ConvexHull, collision_shape
 from mrgc.geometry.fk import fk_world
 from mrgc.geometry.predicates import compute_facts
@@ -100,6 +100,24 @@ def test_facts_are_deterministic_and_independent_of_the_worker_count() -> None:
     one = compute_facts(scene, seed=3, workers=1).facts
     two = compute_facts(scene, seed=3, workers=2).facts
     assert one == two
+
+
+def test_a_handover_is_found_on_another_branch_of_the_arm() -> None:
+    """Generated packaging i41 (4 arms): r3's first IK solution holding o10 at h2 (side-y+) reaches into r1
+    waiting at home, which rules it out; phase 1 tries other solutions of the arm, finds one clear of r1 and
+    enables r3 -> r2 (before, the fact depended on the seed: seed 1 found it, seed 0 did not)."""
+    from mrgc.generate import packaging
+    from mrgc.geometry.predicates import RobotEvaluator, _handovers
+
+    text = packaging(robots=4, goals=4, others=13, seed=1041)
+    scene = scene_from_problem(parse_string(text, "i41.mrg").problem())
+    per_robot = {r.name: RobotEvaluator(scene, r.name, seed=0).run() for r in scene.robots}
+    configs = per_robot["r3"].handover[("o10", "h2", "side-y+")]
+    assert configs[0].homes == {"r1"}  # the solution found from home: the old answer
+    assert any(not c.homes for c in configs[1:])
+    assert all(np.max(np.abs(a.q - b.q)) >= 0.1 for a in configs for b in configs if a is not b)
+    facts = _handovers(scene, per_robot)
+    assert Fact("enable-goal-handover", ("o10", "side-y+", "side-y-", "r3", "r2")) in facts
 
 
 def test_golden_facts_of_a_hand_made_scene() -> None:

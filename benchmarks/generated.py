@@ -121,6 +121,8 @@ def category(row: dict[str, object]) -> str:
         facts = " ".join(why.get("facts", []))
         if "blocking cycle" in facts or why.get("cycles"):  # cycles told with evidence are not in facts
             return "infeasible: blocking cycle"
+        if "no order of moves" in facts:
+            return "infeasible: objects wait for each other (no order of moves)"
         if "no robot can reach" in facts:
             return "infeasible: a goal region out of reach"
         if "no robot can pick" in facts:

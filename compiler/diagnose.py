@@ -8,6 +8,15 @@ Blocking cycles: when *every* live action of object A is obstructed at its pick 
 before A (and, for an obstruction at the place, no later than A).  Such forced orders among the objects
 that must move (M* and, transitively, what they force) that close a cycle through a strict edge admit no
 schedule at all: :func:`blocking_cycles` names them (two boxes that each block every pick of the other).
+
+Waits with alternatives: an object may have several actions, each obstructed by a different object (a cart
+can leave a room through either of two doorways, each blocked by a box), so no single blocker is forced and
+there is no blocking cycle, yet no order exists: every way out waits for an object that itself waits.
+:func:`orderable` computes, to a fixpoint, the objects some order of moves can move (each moved once, to its
+target region: a goal object only into its goal region); :func:`explain_waits` names the objects of M*
+left out and, per object, what each of its actions waits for.  The fixpoint relaxes the skeleton model
+(no robot capacity, no horizon; a non-strict place obstacle may move in the same step), so an object it
+leaves out cannot be moved by any skeleton: the reason is sound.
 """
 
 from __future__ import annotations
@@ -57,7 +66,70 @@ def explain_infeasible(graph: TaskGraph, facts: FactBase) -> list[str]:
             reasons.append(_no_action(facts, obj))
     if not reasons:
         reasons = [describe_cycle(c) for c in blocking_cycles(graph)]
+    if not reasons:
+        reasons = explain_waits(graph)
     return reasons
+
+
+def orderable(graph: TaskGraph) -> set[str]:
+    """The objects some order of moves can move, layer by layer: an object joins a layer when one of its
+    actions has every strict obstacle in earlier layers and every other obstacle in earlier layers or this
+    one (the layer is the largest such set).  A relaxation of the skeleton model (module docstring)."""
+    done: set[str] = set()
+    while True:
+        layer = {o for o in graph.objects if o not in done and graph.actions_of(o)}
+        changed = True
+        while changed:
+            ready = {o for o in layer if any(_ready(graph, i, done, layer) for i in graph.actions_of(o))}
+            changed = ready != layer
+            layer = ready
+        if not layer:
+            return done
+        done |= layer
+
+
+def _ready(graph: TaskGraph, i: int, done: set[str], layer: set[str]) -> bool:
+    return all(b in done or (not strict and b in layer) for b, strict in graph.obstacles(i))
+
+
+def explain_waits(graph: TaskGraph) -> list[str]:
+    """One sentence when objects of M* wait for each other with alternatives (module docstring): the
+    objects that no order of moves reaches, and per object what each group of its actions waits for;
+    empty when every object of M* is :func:`orderable`."""
+    ok = orderable(graph)
+    stuck = [o for o in graph.must_move if o not in ok]
+    if not stuck:
+        return []
+    told: list[str] = []
+    todo = list(stuck)
+    parts = []
+    while todo:
+        obj = todo.pop(0)
+        if obj in told:
+            continue
+        told.append(obj)
+        groups: dict[tuple[tuple[str, ...], str], list[Action]] = {}
+        for i in graph.actions_of(obj):
+            waits = tuple(dict.fromkeys(b for b, _ in graph.obstacles(i) if b not in ok))
+            where = " and ".join(
+                w
+                for w, blocks in (("pick", graph.block_pick[i]), ("place", graph.block_place[i]))
+                if any(b in blocks for b in waits)
+            )
+            groups.setdefault((waits, where), []).append(graph.actions[i])
+            todo.extend(b for b in waits if b not in told)
+        parts.append(f"{obj} waits for " + " or ".join(_wait(w, where, acts) for (w, where), acts in groups.items()))
+    return [
+        f"no order of moves exists for {', '.join(stuck)} (each object moves once, a goal object only into its "
+        f"goal region; every action waits for an object that itself waits): " + "; ".join(parts)
+    ]
+
+
+def _wait(waits: tuple[str, ...], where: str, actions: list[Action], shown: int = 2) -> str:
+    listed = ", ".join(_short(a) for a in actions[:shown]) + (
+        f", +{len(actions) - shown} more" if len(actions) > shown else ""
+    )
+    return f"{' and '.join(waits)} (the {where} of {listed})"
 
 
 def blocking_cycles(graph: TaskGraph) -> list[list[Forced]]:

@@ -8,7 +8,8 @@ status           exit  meaning
 ===============  ====  ==========================================================================
 ``solved``       0     a plan was found **and the independent validator accepted it**
 ``infeasible``   1     no task skeleton exists under the facts (the reasons name the goals, the
-                       missing facts or the blocking cycle); more time cannot help
+                       missing facts, the blocking cycle or the objects that wait for each
+                       other); more time cannot help
 ``exhausted``    5     every skeleton the compiler could generate was tried and none could be
                        grounded into a valid plan (the grounding-failure summary says why)
 ``time limit``   3     the time limit (or the search's iteration limit) ended the search first

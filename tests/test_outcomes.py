@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 import pytest
-from support import ROOT
+from support import ROOT, run_cli
 
 from mrgc import __version__, cli, parse_file
 from mrgc.compiler.skeleton import Skeleton
@@ -89,6 +89,22 @@ def test_a_geometric_blocking_cycle_shows_the_bodies_and_the_depth(tmp_path: Pat
         match = re.search(rf"of r1 overlaps {blocker} by ([0-9.]+) mm", edge["how"])
         assert match and float(match.group(1)) > 1.0, edge["how"]
     assert "blocking cycle o1 -> o2 -> o1" in text and "overlaps" in text
+
+
+def test_objects_waiting_for_each_other_with_alternatives_are_named(capsys: pytest.CaptureFixture[str]) -> None:
+    """No single blocker is forced, so no blocking cycle: b1 blocks the doorway to the goal (every place of
+    g1 and g2), and the carts leave the start room only through a doorway g1 or g2 stands in (r1's way to b1
+    crosses g2, r2's crosses g1; no path avoids both, checked on a 1 cm x 128-heading lattice); g1 and g2
+    may only move into the goal.  Generated: mrgc generate box-moving --robots 2 --goals 2 --others 3
+    --seed 1016."""
+    code, out, err = run_cli(capsys, "plan", ROOT / "tests" / "data" / "bo-doorways-wait.mrg", "--time-limit", "120")
+    data = json.loads(out)
+    assert code == 1 and data["status"] == "infeasible" and data["why"]["cycles"] == []
+    (reason,) = data["why"]["facts"]
+    assert reason.startswith("no order of moves exists for g1, g2 "), reason
+    assert "b1 waits for g2 (the pick of side-x- by r1) or g1 (the pick of side-x- by r2)" in reason, reason
+    assert "g1 waits for b1 (the place of side-y+ by r1" in reason, reason
+    assert "no order of moves exists for g1, g2" in err
 
 
 # ------------------------------------------------------------------ every skeleton tried

@@ -13,6 +13,7 @@ A problem whose goal already holds must give the empty skeleton, not "infeasible
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 from typing import Any, Sequence
 
@@ -21,6 +22,7 @@ from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
 from mrgc import cli, parse_file, parse_string
+from mrgc.compiler.diagnose import explain_infeasible, explain_waits, orderable
 from mrgc.compiler.facts import FactBase
 from mrgc.compiler.task_graph import Action, build_task_graph
 from mrgc.language.model import Problem
@@ -231,3 +233,52 @@ def test_cli_compile_of_a_satisfied_goal_exits_0(tmp_path: Path, capsys: pytest.
     code = cli.main(["compile", str(path)])
     out = capsys.readouterr().out
     assert code == 0, out
+
+
+# ---------------------------------------------------------------- the cheap reasons are sound
+@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@given(symbolic_problems(feasible=0.3, objects=(3, 5)), st.booleans())
+def test_a_cheap_infeasibility_reason_means_the_oracle_finds_no_skeleton(case: SymbolicCase, drives: bool) -> None:
+    """explain_infeasible (dead actions, blocking cycles, objects that wait for each other with
+    alternatives) runs before any solver and stops the search: it must never fire on a problem with a
+    skeleton.  Also with every robot driving (place obstacles strict, as for carts)."""
+    problem = case.problem()
+    base = FactBase.from_problem(problem)
+    if drives:
+        base = replace(base, drivers=frozenset(base.robots))
+    graph = build_task_graph(base, must_move(problem))
+    reasons = explain_infeasible(graph, base)
+    has_skeleton = bool(oracle.feasible_action_sets(graph))
+    event(f"{'reason' if reasons else 'no reason'}, {'feasible' if has_skeleton else 'infeasible'}")
+    event(f"waits: {bool(explain_waits(graph))}, orderable M*: {set(graph.must_move) <= orderable(graph)}")
+    assert not (reasons and has_skeleton), f"{reasons}\n\n{case.text}"
+    # the fixpoint is a relaxation: an unorderable object of M* means no skeleton
+    assert has_skeleton <= (set(graph.must_move) <= orderable(graph)), case.text
+
+
+def test_objects_that_wait_for_each_other_with_alternatives_are_named() -> None:
+    """o3 blocks every place of o1 and o2 (a doorway); r1's pick of o3 waits for o1, r2's for o2: no single
+    blocker is forced (no blocking cycle), yet no order of moves exists."""
+    text = (
+        DOMAIN
+        + """(define (problem waits) (:domain abstract)
+  (:robots r1 r2) (:movable o1 o2 o3) (:regions ra rb)
+  (:init (in-region o1 ra) (in-region o2 ra) (in-region o3 ra)
+    (reachable-pick o1 top r1) (reachable-place o1 rb top r1) (occludes-goal-place o3 o1 rb top r1)
+    (reachable-pick o2 top r2) (reachable-place o2 rb top r2) (occludes-goal-place o3 o2 rb top r2)
+    (reachable-pick o3 top r1) (reachable-pick o3 side r2) (reachable-place o3 ra top r1)
+    (reachable-place o3 ra side r2) (occludes-pick o1 o3 top r1) (occludes-pick o2 o3 side r2))
+  (:goal (and (in-region o1 rb) (in-region o2 rb))))"""
+    )
+    problem = parse_string(text).problem()
+    base = FactBase.from_problem(problem)
+    graph = build_task_graph(base, must_move(problem))
+    assert not oracle.feasible_action_sets(graph) and orderable(graph) == set()
+    assert explain_infeasible(graph, base) == [
+        "no order of moves exists for o1, o2 (each object moves once, a goal object only into its goal region; "
+        "every action waits for an object that itself waits): o1 waits for o3 (the place of top by r1); "
+        "o2 waits for o3 (the place of top by r2); o3 waits for o1 (the pick of top by r1) or o2 (the pick of "
+        "side by r2)"
+    ]
+    res = compile_problem(problem)
+    assert res.status == "infeasible" and res.reasons == explain_infeasible(graph, base)

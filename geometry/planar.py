@@ -41,8 +41,9 @@ from functools import cached_property
 
 import numpy as np
 
-from mrgc.geometry.collision import CollisionShape, collision_shape
+from mrgc.geometry.collision import CollisionShape, ConvexHull, collision_shape
 from mrgc.geometry.conventions import PLANAR_LIFT, lattice_offsets, se2, to_se2, wrap_angle, yaw_of
+from mrgc.geometry.lattice import box_corners
 from mrgc.geometry.scene import Body, RobotSpec, SceneSpec, half_extents, inside, outline
 from mrgc.geometry.transforms import from_pose, rot_z, translation
 from mrgc.language.model import Box, Cylinder, RobotKind, Shape
@@ -105,18 +106,57 @@ class PlanarRobot:
         return carry_transform(self.spec.kind, shape, grasp)
 
     def probe(
-        self, q: np.ndarray, carried: tuple[CollisionShape, np.ndarray] | None = None
+        self, q: np.ndarray, carried: tuple[CollisionShape, np.ndarray] | None = None, margin: float = 0.0
     ) -> list[tuple[CollisionShape, np.ndarray]]:
-        """Collision probe of the robot at ``q`` (and of the object it carries, given its carry transform)."""
+        """Collision probe of the robot at ``q`` (and of the object it carries, given its carry transform);
+        with a ``margin``, each part grown horizontally by it (:func:`grown`)."""
         base = se2(q[0], q[1], q[2])
-        out = [(self.shape, base @ self.lift)]
+        out = [(grown(self.shape, margin), base @ self.lift)]
         if carried is not None:
-            out.append((carried[0], base @ carried[1]))
+            out.append((grown(carried[0], margin), base @ carried[1]))
         return out
+
+    def reach(self, carried: tuple[CollisionShape, np.ndarray] | None = None) -> float:
+        """How far (m) from the base origin, in the floor plane, the robot (and what it carries) extends: the
+        farthest corner of each part's bounding box."""
+        parts = [(self.shape, self.lift)] + ([carried] if carried is not None else [])
+        return max(_reach(shape, t) for shape, t in parts)
 
     def grasp_base(self, pose: np.ndarray, shape: Shape, grasp: str) -> np.ndarray:
         """The base pose ``(x, y, yaw)`` from which the robot picks (or places) an object at ``pose``."""
         return grasp_base(self.spec.kind, pose, shape, grasp)
+
+
+def _reach(shape: CollisionShape, t: np.ndarray) -> float:
+    xy = box_corners(shape) @ t[:2, :3].T + t[:2, 3]
+    return float(np.hypot(xy[:, 0], xy[:, 1]).max())
+
+
+_GROWN: dict[tuple[object, ...], CollisionShape] = {}
+
+
+def grown(shape: CollisionShape, margin: float) -> CollisionShape:
+    """``shape`` grown horizontally by ``margin`` (m) in its own frame: a box or a vertical cylinder by its
+    sides, anything else to its bounding box so grown.  A part of a planar robot is only ever turned about
+    the vertical, so the grown shape holds every point within ``margin`` of the shape in the floor plane."""
+    if margin <= 0.0:
+        return shape
+    geometry = shape.geometry
+    key: tuple[object, ...]
+    if isinstance(geometry, (Box, Cylinder)):
+        key = (geometry, margin)
+    else:
+        key = (tuple(np.round(shape.center, 9)), tuple(np.round(shape.half, 9)), margin)
+    out = _GROWN.get(key)
+    if out is None:
+        if isinstance(geometry, Box):
+            out = collision_shape(Box(geometry.sx + 2 * margin, geometry.sy + 2 * margin, geometry.sz))
+        elif isinstance(geometry, Cylinder):
+            out = collision_shape(Cylinder(geometry.radius + margin, geometry.height))
+        else:
+            out = collision_shape(ConvexHull(box_corners(shape, (margin, margin, 0.0))))
+        _GROWN[key] = out
+    return out
 
 
 def _footprint_half(kind: RobotKind) -> np.ndarray:

@@ -7,13 +7,14 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from hypothesis import given, settings
+from hypothesis import event, given, settings
 from hypothesis import strategies as st
 
 from mrgc.geometry.collision import CollisionWorld, collision_shape
 from mrgc.geometry.conventions import se2, wrap_angle
-from mrgc.geometry.lattice import LatticePlanner, hull2d, interpolate
+from mrgc.geometry.lattice import SLACK, LatticePlanner, hull2d, interpolate, segment_clear
 from mrgc.geometry.motion import MotionStatus
+from mrgc.geometry.planar import grown
 from mrgc.geometry.transforms import rot_z, translation
 from mrgc.language.model import Box
 
@@ -140,3 +141,93 @@ def test_start_and_goal_states_are_reported() -> None:
     obstacles = wall_with_door(1.5, 0.6)
     assert plan(obstacles, (2.0, 0.5, 0.0), (3.0, 1.5, 0.0))[0].status is MotionStatus.INVALID_START
     assert plan(obstacles, (1.0, 1.5, 0.0), (2.0, 2.5, 0.0))[0].status is MotionStatus.INVALID_GOAL
+
+
+# ------------------------------------------------------------------ between the checked states
+CARRIED = (Box(0.3, 0.3, 0.2), translation(0.45, 0, 0.2))
+
+
+def clearance(obstacles: list[tuple[str, Box, np.ndarray]], parts: list[tuple[Box, np.ndarray]]):
+    """``clear(q, margin)`` as grounding builds it (planar.grown parts), and the deepest overlap (m, >= 0)
+    of the robot at q with an obstacle by coal's signed distance."""
+    world = CollisionWorld()
+    for name, shape, t in obstacles:
+        world.add(name, collision_shape(shape), t, "fixed")
+    for i, (shape, t) in enumerate(parts):
+        world.add(f"part{i}", collision_shape(shape), t, "robot")
+
+    def clear(q: np.ndarray, margin: float) -> bool:
+        probe = [(grown(collision_shape(s), margin), se2(*q) @ t) for s, t in parts]
+        return not world.probe_collides(probe, against="fixed")
+
+    def overlap(q: np.ndarray) -> float:
+        for i, (_, t) in enumerate(parts):
+            world.set_transform(f"part{i}", se2(*q) @ t)
+        return max(0.0, -min(world.distance(f"part{i}", name) for i in range(len(parts)) for name, _, _ in obstacles))
+
+    return clear, overlap
+
+
+def deepest_between(a: np.ndarray, b: np.ndarray, overlap, samples: int = 41) -> float:
+    d = np.array([b[0] - a[0], b[1] - a[1], wrap_angle(b[2] - a[2])])
+    return max(overlap(a + s * d) for s in np.linspace(0.0, 1.0, samples))
+
+
+CORNER = [("wall", Box(0.1, 1.0, 0.5), translation(2.0, 0.5, 0.25))]  # its corner at (1.95, 1.0)
+
+
+def test_two_free_states_can_hide_an_overlap_that_the_segment_test_finds() -> None:
+    """The footprint slides past a wall corner: free at both states 1 cm apart (what a state-by-state test
+    accepts), 3.9 mm deep in the wall between them (found by a search over random steps near the corner)."""
+    clear, overlap = clearance(CORNER, [(ROBOT, LIFT)])
+    a, b = np.array([1.692229, 1.181759, 0.037857]), np.array([1.701503, 1.191633, 0.044935])
+    assert clear(a, 0.0) and clear(b, 0.0)
+    assert deepest_between(a, b, overlap) > 3e-3
+    assert not segment_clear(a, b, 0.33, clear)
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    dx=st.floats(-0.012, 0.004),
+    dy=st.floats(-0.012, 0.004),
+    yaw=st.floats(-0.05, 0.05),
+    step=st.tuples(st.floats(-0.003, 0.01), st.floats(-0.003, 0.01), st.floats(-0.01, 0.01)),
+    carrying=st.booleans(),
+)
+def test_an_accepted_segment_overlaps_nothing_deeper_than_the_slack(dx, dy, yaw, step, carrying) -> None:
+    """Random steps of the validator's size (1 cm, 0.01 rad) that take the robot's corner (or its load's)
+    round a wall's corner, often cutting it between two free states: what segment_clear accepts overlaps
+    the wall by at most SLACK anywhere between."""
+    parts = [(ROBOT, LIFT), CARRIED] if carrying else [(ROBOT, LIFT)]
+    reach = math.hypot(0.6, 0.15) if carrying else math.hypot(0.25, 0.2)
+    corner = (1.95 - 0.6, 1.0 + 0.15) if carrying else (1.95 - 0.25, 1.0 + 0.2)
+    clear, overlap = clearance(CORNER, parts)
+    a = np.array([corner[0] + dx, corner[1] + dy, yaw])
+    b = a + np.array(step)
+    accepted, deepest = segment_clear(a, b, reach, clear), deepest_between(a, b, overlap)
+    ends_free = clear(a, 0.0) and clear(b, 0.0)
+    event(f"accepted {accepted}, ends free {ends_free}, overlap between {deepest > SLACK}")
+    if accepted:
+        assert deepest <= SLACK + 1e-6
+
+
+def test_a_path_planned_with_a_clearance_test_keeps_clear_between_its_states() -> None:
+    """Carrying a box through a door 0.6 m wide: the dense path's every motion, sampled 20 times finer,
+    overlaps nothing deeper than SLACK."""
+    parts = [(ROBOT, LIFT), CARRIED]
+    obstacles = wall_with_door(1.5, 0.6)
+    clear, overlap = clearance(obstacles, parts)
+    lattice = LatticePlanner(BOUNDS)
+    start, goal = np.array([1.0, 1.5, math.pi / 2]), np.array([3.0, 1.5, -math.pi / 2])
+    res = lattice.plan(
+        lattice.occupancy(parts, obstacles),
+        start,
+        goal,
+        lambda q: clear(q, 0.0),
+        0.01,
+        0.01,
+        clear,
+        math.hypot(0.6, 0.15),
+    )
+    assert res.status is MotionStatus.SOLVED
+    assert max(deepest_between(a, b, overlap, 21) for a, b in zip(res.path, res.path[1:])) <= SLACK + 1e-6

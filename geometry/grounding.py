@@ -54,6 +54,11 @@ NEIGHBOURHOOD = 0.10
 #: search costs all of them, at 0.5-1.5 ms a check (an arm holding an object, 1 cm steps), and a step tries
 #: several placements; 20,000 (motion.MAX_CHECKS) let one grounding run for minutes on a loaded machine
 TRANSFER_CHECKS = 4_000
+#: joint-space distance (rad) between the states an arm's path search checks when a finer path is asked
+#: for (:meth:`Grounder.arm_path`): the path found is checked again, densely, before it is used
+COARSE_RESOLUTION = 0.04
+#: the share of the budget of checks the coarse search may spend (each of its checks covers 4x the motion)
+COARSE_BUDGET = 0.5
 #: the share of an arm's reach bound that :meth:`Grounder.comfortable` placements keep within
 COMFORT = 0.85
 #: path answers (transfers, base paths) remembered per grounder
@@ -134,6 +139,7 @@ class Grounder:
                 self.parked[spec.name] = f"@{spec.name}"
                 self.world.add(f"@{spec.name}", shape, pose, "robots")
         self.queries = 0
+        self.coarse_misses = 0  # coarse arm paths that collided between their states (searched again, finely)
         #: arms wait at home while others move (the validator's rule): each arm's links at home, group
         #: ``home:<arm>``, an obstacle to the other arms' motions
         self.homes: tuple[str, ...] = ()
@@ -546,7 +552,10 @@ class Grounder:
         phase: str = "*",
     ) -> Answer:
         """A joint-space path (RRTConnect, at most ``max_checks`` validity checks: no clock decides) free of
-        fixed objects, ``avoid`` and ``busy`` (and of the held object's collisions with them)."""
+        fixed objects, ``avoid`` and ``busy`` (and of the held object's collisions with them), no two of its
+        configurations more than ``resolution`` apart.  A ``resolution`` finer than
+        :data:`COARSE_RESOLUTION` is searched coarsely first (:data:`COARSE_BUDGET` of the checks) and the
+        result checked at ``resolution``."""
         arm = self.arm(robot)
         against = (
             "fixed",
@@ -556,24 +565,40 @@ class Grounder:
         ignore = (holding[0],) if holding else ()
         moving = self._busy_world(busy) if busy else None
 
-        def valid(q: np.ndarray) -> bool:
+        def free(configs: np.ndarray) -> bool:
             self.queries += 1
-            volume = self.arm_volume(robot, q[None], holding)
+            volume = self.arm_volume(robot, configs, holding)
             if moving is not None and moving.probe_collides(volume, against="volume"):
                 return False
             return not self.world.probe_collides(volume, against=against, ignore=ignore)
 
-        res = plan_joint_path(
-            arm.model.lower,
-            arm.model.upper,
-            start,
-            goal,
-            valid,
-            max_checks=max_checks,
-            seed=seed_for(robot, "arm-path", seed=self.seed),
-            resolution=resolution,
-        )
-        return Answer(GroundStatus.OK if res.solved else GroundStatus.NO_PATH, path=list(res.path))
+        def solve(step: float, budget: int) -> list[np.ndarray]:
+            res = plan_joint_path(
+                arm.model.lower,
+                arm.model.upper,
+                start,
+                goal,
+                lambda q: free(q[None]),
+                max_checks=budget,
+                seed=seed_for(robot, "arm-path", seed=self.seed),
+                resolution=step,
+            )
+            return list(res.path)
+
+        if resolution < COARSE_RESOLUTION:
+            # the search checks states COARSE_RESOLUTION apart; the path it finds is then checked at every
+            # ``resolution`` (one batch) and returned at that density; a path that collides between the coarse
+            # states sends the search back to ``resolution`` with the whole budget
+            coarse = solve(COARSE_RESOLUTION, max(1, round(max_checks * COARSE_BUDGET)))
+            if coarse:
+                dense = joint_line(np.array(coarse), resolution)
+                if free(dense):
+                    return Answer(GroundStatus.OK, path=list(dense))
+                self.coarse_misses += 1
+            else:
+                return Answer(GroundStatus.NO_PATH)
+        path = solve(resolution, max_checks)
+        return Answer(GroundStatus.OK if path else GroundStatus.NO_PATH, path=path)
 
     def transfer(
         self,

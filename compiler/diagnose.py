@@ -21,6 +21,8 @@ leaves out cannot be moved by any skeleton: the reason is sound.
 
 from __future__ import annotations
 
+from typing import Iterable
+
 from mrgc.compiler.facts import FactBase
 from mrgc.compiler.task_graph import Action, TaskGraph
 
@@ -215,9 +217,34 @@ def _no_action(facts: FactBase, obj: str) -> str:
         return f"no robot can reach {where} {region}"
     if not any(p[0] == obj and p[1] == region for p in facts.reachable_place):
         return f"no robot can place {obj} in {where} {region}"
-    return f"no robot that can pick {obj} can also place it in {region}" + (
-        ", and no handover of it is enabled" if is_goal else ""
+    return (
+        f"no robot that can pick {obj} can also place it in {region}"
+        + (", and no handover of it is enabled" if is_goal else "")
+        + _pick_and_place(facts, obj, region, is_goal)
     )
+
+
+def _pick_and_place(facts: FactBase, obj: str, region: str, is_goal: bool) -> str:
+    """Who picks ``obj`` with which grasps, who places it in ``region``, and (a goal object) the handovers of
+    it that are enabled, none of which links the two: `` (picked by r1 with top/top-x; ...)``."""
+
+    def by(entries: Iterable[tuple[str, str]]) -> str:
+        grasps: dict[str, list[str]] = {}
+        for g, r in sorted(entries, key=lambda e: (facts.robots.index(e[1]), e[0])):
+            grasps.setdefault(r, []).append(g)
+        return ", ".join(f"{r} with {'/'.join(gs)}" for r, gs in grasps.items())
+
+    picks = by((g, r) for o, g, r in facts.reachable_pick if o == obj)
+    places = by((g, r) for o, re, g, r in facts.reachable_place if o == obj and re == region)
+    text = f" (picked by {picks}; placed in {region} by {places}"
+    if is_goal:
+        pairs = sorted({(g1, g2) for o, g1, g2, _, _ in facts.handover if o == obj})
+        text += (
+            f"; handovers of it only between grasps {', '.join(f'{a}->{b}' for a, b in pairs)}"
+            if pairs
+            else "; no handover of it between any grasps"
+        )
+    return text + ")"
 
 
 def prune(graph: TaskGraph) -> TaskGraph:

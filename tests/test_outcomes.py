@@ -60,6 +60,19 @@ def test_a_blocking_cycle_is_named(capsys: pytest.CaptureFixture[str]) -> None:
     assert "blocking cycle" in cap.err
 
 
+def test_a_handover_with_the_wrong_grasps_names_pickers_placers_and_grasp_pairs(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """r1 picks o1 only by top, r2 places it only by top, and the only handover is side -> side."""
+    assert cli.main(["plan", str(ROOT / "domains" / "symbolic" / "grasp-mismatch.mrg")]) == 1
+    data = json.loads(capsys.readouterr().out)
+    assert data["status"] == "infeasible"
+    assert data["why"]["facts"] == [
+        "no robot that can pick o1 can also place it in goal, and no handover of it is enabled (picked by r1 "
+        "with top; placed in goal by r2 with top; handovers of it only between grasps side->side)"
+    ]
+
+
 def test_a_goal_nobody_can_reach_is_infeasible_with_the_missing_fact(tmp_path: Path) -> None:
     far = PA3.replace(
         "(bin-b :shape (box 0.2 0.2 0.3) :pose (-0.3 0.35 0.15 0))",

@@ -32,7 +32,7 @@ from mrgc.geometry.grasps import APPROACH, finger_opening, fits, grasp_transform
 from mrgc.geometry.ik import solve_ik_many
 from mrgc.geometry.lattice import Body, LatticePlanner, box_corners
 from mrgc.geometry.motion import MAX_CHECKS, plan_joint_path
-from mrgc.geometry.planar import PLANAR_GRASPS, DiscGrid, PlanarRobot, is_planar, scene_bounds
+from mrgc.geometry.planar import DiscGrid, PlanarRobot, is_planar, scene_bounds
 from mrgc.geometry.scene import SceneSpec, half_extents, inside
 from mrgc.geometry.transforms import rot_z, translation
 from mrgc.language.model import Box, Shape
@@ -125,7 +125,6 @@ class Grounder:
         self._planar: dict[str, PlanarRobot] = {}
         self._grids: dict[str, DiscGrid] = {}
         self._lattices: dict[str, LatticePlanner] = {}
-        self._spread: float | None = None
         self._paths: dict[tuple[object, ...], Answer] = {}
         self._grips: dict[tuple[str, str], tuple[float, np.ndarray]] = {}
         self._vol_world = _PieceWorld()
@@ -831,9 +830,9 @@ class Grounder:
         at the same time sweep), searched on the robot's lattice
         (:mod:`mrgc.geometry.lattice`: deterministic, complete at the lattice's resolution), its states at
         the validator's resolution and every motion between two of them checked (the lattice's segment test,
-        the margin against ``busy`` grown by :meth:`_path_spread`); hopeless queries are refused at once by
-        an inscribed-disc grid test.  Answers are cached: the same query (same obstacles at the same poses)
-        gets the same answer, and the search never asks twice."""
+        against ``busy`` too: the states of what the other robots sweep, not the motions between them);
+        hopeless queries are refused at once by an inscribed-disc grid test.  Answers are cached: the same
+        query (same obstacles at the same poses) gets the same answer, and the search never asks twice."""
         movers = sorted({a for a in avoid if not holding or a != holding[0]})
         key = (robot, holding, tuple(movers), *_fingerprint([start, goal, *(self.poses[a] for a in movers)], busy))
         if key not in self._paths:
@@ -871,14 +870,13 @@ class Grounder:
 
         pr = self.planar(robot)
         carried = self._carried(robot, holding)
-        # what the other robots sweep is their dense paths' states: between two of them they deviate too
-        spread = self._path_spread() if sweep is not None else 0.0
 
         def clear(q: np.ndarray, margin: float) -> bool:
             self.queries += 1
-            if sweep is not None and sweep.probe_collides(pr.probe(q, carried, margin + spread), against="busy"):
+            probe = pr.probe(q, carried, margin)
+            if sweep is not None and sweep.probe_collides(probe, against="busy"):
                 return False
-            return not self.world.probe_collides(pr.probe(q, carried, margin), against=against, ignore=ignore)
+            return not self.world.probe_collides(probe, against=against, ignore=ignore)
 
         def valid(q: np.ndarray) -> bool:
             return clear(q, 0.0)
@@ -913,19 +911,6 @@ class Grounder:
             return None
         obj, grasp = holding
         return self.shape(obj), self.planar(robot).carry_transform(self.scene.body(obj).shape, grasp)
-
-    def _path_spread(self) -> float:
-        """How far (m) a planar robot of the scene, carrying any object, may stray between two states of
-        one of its base paths (:func:`~mrgc.geometry.lattice.travel` of a step at :data:`PATH_RESOLUTION`,
-        halved): the margin that a swept volume of such states leaves uncovered."""
-        if self._spread is None:
-            reach = 0.0
-            for spec in self.scene.robots:
-                if is_planar(spec):
-                    carried = [self._carried(spec.name, (m.name, g)) for m in self.scene.movable for g in PLANAR_GRASPS]
-                    reach = max(reach, *(self.planar(spec.name).reach(c) for c in [None, *carried]))
-            self._spread = PATH_RESOLUTION * (1.0 + reach) / 2
-        return self._spread
 
 
 class _PieceWorld:

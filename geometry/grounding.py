@@ -332,6 +332,22 @@ class Grounder:
             if volume:  # the caller may have asked other placements meanwhile: the world holds ours again
                 vol_world = self._volume_world(volume)
 
+    def crowded_out(
+        self, objs: Iterable[str], region: str, avoid: Iterable[str] = (), volume: Volume | None = None, key: str = ""
+    ) -> str | None:
+        """The first of ``objs`` that has no free pose left in ``region`` (the candidates and checks of a
+        packed :meth:`placements`: fixed objects, ``avoid``, ``volume``), or None when each has one; objects
+        already inside the region are not asked.  The reverse search asks it after grounding a placement
+        into a bin that objects placed *earlier* still have to reach: a placement whose approach and carry
+        sweep the whole bin leaves them none, and every grounding of an earlier step would then fail on it."""
+        avoid, reg = tuple(avoid), self.scene.body(region)
+        for obj in objs:
+            if inside(reg, self.scene.body(obj).shape, self.poses[obj]):
+                continue
+            if next(self.placements(obj, region, avoid, volume, key=f"room:{key}", packed=True), None) is None:
+                return obj
+        return None
+
     def comfortable(self, robot: str, obj: str, grasp: str, share: float = COMFORT) -> Callable[[np.ndarray], float]:
         """A rank of placements of ``obj`` for ``robot`` holding it with ``grasp``: 0 where the end effector
         lies within ``share`` of the arm's reach bound from the shoulder, else its distance from the shoulder

@@ -93,6 +93,8 @@ class ReverseGrounder:
         #: :class:`DeadlineReached` before its next action (wall-clock time only ends the search; it never
         #: decides what a grounding finds)
         self.deadline = deadline
+        #: the objects the steps grounded so far move (later in the plan than the step being grounded)
+        self.grounded: set[str] = set()
 
     def ground(self, skeleton: Skeleton, suffix: list[GroundedStep], key: str = "") -> Grounding:
         """Ground ``skeleton``'s steps, last first, before the already grounded ``suffix`` (see the module
@@ -105,6 +107,7 @@ class ReverseGrounder:
         for t in range(skeleton.makespan - 1, -1, -1):
             step = skeleton.steps[t]
             same = {a.obj for a in step}
+            self.grounded = set(fut_objs)
             strict = self._steps(step, fut_objs | out_objs, volume, f"{key}:{t}", t + 1)
             if isinstance(strict, Failure):
                 relaxed = self._steps(step, fut_objs, volume, f"{key}:{t}:relaxed", t + 1)
@@ -155,13 +158,18 @@ class ReverseGrounder:
             tail = self._steps(later, avoid, v_fut, f"{key}:late", index)
             if isinstance(tail, Failure):
                 continue
-            head = self._steps(
-                earlier,
-                avoid | {a.obj for a in later},
-                v_fut + [p for s in tail for p in s.volume],
-                f"{key}:early",
-                index,
-            )
+            before = self.grounded
+            self.grounded = before | {a.obj for a in later}
+            try:
+                head = self._steps(
+                    earlier,
+                    avoid | {a.obj for a in later},
+                    v_fut + [p for s in tail for p in s.volume],
+                    f"{key}:early",
+                    index,
+                )
+            finally:
+                self.grounded = before
             if not isinstance(head, Failure):
                 return head + tail
         return done
@@ -326,14 +334,37 @@ class ReverseGrounder:
             planned.place_pose = _matrix(pose)
             planned.configs["place"] = _configs(place.configs)
             planned.paths["to-place"] = _configs(np.array(carry.path))
-            if self.full:
-                transits = self._transits(a, planned, avoid, busy, {**(placed or {}), a.obj: pose})
-                if isinstance(transits, Failure):
-                    last = transits
-                    continue
+            # the arm's empty-handed motions (``full``), and room left in the bin for what comes before
+            after = self._transits(a, planned, avoid, busy, {**(placed or {}), a.obj: pose}) if self.full else None
+            after = after or self._crowds(a, planned, avoid, v_fut, placed or {}, key)
+            if after:
+                last = after
+                continue
             return planned
         assert last is not None
         return last
+
+    def _crowds(
+        self,
+        a: Action,
+        planned: PlannedAction,
+        avoid: list[str],
+        v_fut: Volume,
+        placed: dict[str, np.ndarray],
+        key: str,
+    ) -> Failure | None:
+        """A failure when the grounded ``planned`` (its motions and the object at its placement) leaves one of
+        the goal objects that the earlier steps still have to put into the same bin no free pose there
+        (see :meth:`Grounder.crowded_out`); None when each still has one, or none is left to come."""
+        later = {a.obj, *placed, *self.grounded}
+        still = [o for o in sorted(self.goal) if self.goal[o] == a.region and o not in later]
+        if not still:
+            return None
+        mine = [p for phases in self._motions(planned).values() for vols in phases.values() for v in vols for p in v]
+        crowded = self.g.crowded_out(still, a.region, avoid, v_fut + mine, key)
+        if crowded is None:
+            return None
+        return Failure(0, "", f"placement: leaves no free pose of {crowded} in {a.region}")
 
     def _hand_over(
         self, a: Action, planned: PlannedAction, grasped: np.ndarray, avoid: list[str], busy: dict[str, Volume]

@@ -2,15 +2,22 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from support import ROOT
 
+import mrgc
 from mrgc import parse_file
+from mrgc.compiler.skeleton import Skeleton
+from mrgc.compiler.task_graph import Action
+from mrgc.geometry.collision import CollisionShape
 from mrgc.geometry.conventions import to_se2
 from mrgc.geometry.grounding import Grounder, GroundStatus
 from mrgc.geometry.scene import inside, scene_from_problem
 from mrgc.geometry.transforms import translation
+from mrgc.planner.ground import Outcome, ReverseGrounder
 
 
 @pytest.fixture()
@@ -27,14 +34,19 @@ def test_placement_lies_inside_the_region_and_avoids_objects(pa3: Grounder) -> N
     assert pa3.hits(volume, among=["o1", "o3"]) == set()
 
 
-def test_placement_avoids_a_swept_volume(pa3: Grounder) -> None:
-    # a wall of volume over the whole start region except nothing: no placement can be found
-    region = pa3.scene.body("start")
-    volume = [
-        (pa3.shape("o1"), region.pose @ translation(x, y, -0.09))
+def _wall(g: Grounder, region: str) -> list[tuple[CollisionShape, np.ndarray]]:
+    """A volume of o1's covering a 30 × 30 cm square around ``region``'s centre, near its floor."""
+    pose = g.scene.body(region).pose
+    return [
+        (g.shape("o1"), pose @ translation(x, y, -0.09))
         for x in np.linspace(-0.15, 0.15, 7)
         for y in np.linspace(-0.15, 0.15, 7)
     ]
+
+
+def test_placement_avoids_a_swept_volume(pa3: Grounder) -> None:
+    # a wall of volume over the whole start region except nothing: no placement can be found
+    volume = _wall(pa3, "start")
     assert pa3.placement("o2", "start", volume=volume, samples=40).status is GroundStatus.NO_PLACEMENT
     assert pa3.placement("o2", "start", volume=volume[:1], samples=40).ok
 
@@ -184,3 +196,56 @@ def test_a_transfer_with_lower_comes_straight_down_onto_its_goal(pa3: Grounder) 
     above = next(i for i in range(len(z) - 1, -1, -1) if z[i] >= z[-1] + 0.05 - 1e-4)  # 5 cm above the end
     assert np.abs(tools[above:, :2] - tools[-1, :2]).max() < 2e-3  # straight down from there
     assert np.all(np.diff(z[above:]) <= 1e-4)
+
+
+#: one Panda beside a 22 x 30 cm bin whose near corner is 30 cm from its base; three objects to put in it with
+#: side grasps (the hand comes from +y, the arm's side): o2 (19 cm tall) first in the plan, so the reverse search
+#: places o10 and o13 first, and the arm reaching across the bin to put one of them in a far corner sweeps
+#: wherever o2 could stand (the situation of generated packaging i51, seed 1051, with its other objects gone)
+PACKED_BIN = """
+(define (domain packaging)
+  (:requirements :handover)
+  (:robot-kind panda :urdf "franka_panda/panda.urdf" :base fixed :end-effector "panda_hand"
+    :tcp (0 0 0.105 0) :home (0 -0.785 0 -2.356 0 1.571 0.785) :gripper-opening 0.08)
+  (:grasps top top-x side-x+ side-x- side-y+ side-y-))
+(define (problem packed-bin)
+  (:domain packaging)
+  (:robots (r2 :kind panda :base (0.31 0.542 0 -139)))
+  (:fixed (table :shape (box 1.28 1.19 0.05) :pose (0 0 -0.025 0)))
+  (:regions
+    (start :shape (box 0.556 0.48 0.3) :pose (0.289 -0.185 0.15 0))
+    (bin-a :shape (box 0.22 0.3 0.3) :pose (0.481 0.249 0.15 0)))
+  (:movable
+    (o2 :shape (cylinder 0.031 0.192) :pose (0.214 -0.016 0.096 0))
+    (o10 :shape (box 0.049 0.044 0.155) :pose (0.259 -0.271 0.0775 3))
+    (o13 :shape (box 0.054 0.074 0.104) :pose (0.113 -0.352 0.052 1)))
+  (:goal (and (in-region o2 bin-a) (in-region o10 bin-a) (in-region o13 bin-a))))
+"""
+
+
+def test_crowded_out_names_an_object_left_no_free_pose(pa3: Grounder) -> None:
+    wall = _wall(pa3, "bin-b")
+    assert pa3.crowded_out(["o2", "o3"], "bin-b") is None
+    assert pa3.crowded_out(["o2", "o3"], "bin-b", volume=wall) == "o2"
+    assert pa3.placement("o2", "bin-b", volume=wall, packed=True).status is GroundStatus.NO_PLACEMENT
+
+
+def test_a_placement_that_leaves_no_room_for_an_earlier_object_is_passed_over(tmp_path: Path) -> None:
+    """Grounding o2, o10, o13 into the bin in that order: before, the first placement of the last object swept
+    the whole bin and o2 had no free pose ("placement: no free pose of o2 in bin-a" on every skeleton, the
+    search exhausted); now a placement that leaves an object still to come no free pose is not taken, and
+    the plan is found and valid."""
+    path = tmp_path / "packed-bin.mrg"
+    path.write_text(PACKED_BIN, encoding="utf-8")
+    problem = parse_file(path).problem()
+    g = Grounder(scene_from_problem(problem), seed=0)
+    steps = tuple((Action(o, "bin-a", "r2", "r2", "side-y+", "side-y+"),) for o in ("o2", "o10", "o13"))
+    grounding = ReverseGrounder(g, {"o2": "bin-a", "o10": "bin-a", "o13": "bin-a"}).ground(Skeleton(steps), [])
+    assert grounding.outcome is Outcome.SUCCESS, grounding.reason
+    bin_a = g.scene.body("bin-a")
+    for step in grounding.steps:
+        assert inside(bin_a, g.scene.body(step.actions[0].object).shape, np.array(step.actions[0].place_pose))
+    plan = mrgc.plan(str(path), seed=0, time_limit=300)
+    assert plan.status is mrgc.PlanStatus.SOLVED, plan.summary()
+    report = mrgc.validate(str(path), plan)
+    assert report.ok, report.lines()

@@ -283,6 +283,9 @@ class ScriptedGrounder:
     def comfortable(self, robot: str, obj: str, grasp: str) -> Any:
         return lambda pose: 0.0
 
+    def crowded_out(self, objs: Any, region: str, avoid: Any = (), volume: Any = None, key: str = "") -> str | None:
+        return None
+
     def arm_volume(self, robot: str, configs: np.ndarray, holding: Any = None, grasp: Any = None) -> list[Any]:
         return [(f"arm:{robot}:{holding[0] if holding else ''}", None)]
 

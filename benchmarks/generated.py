@@ -6,7 +6,8 @@
 
 Instance i of each family is generated with `mrgc generate` from parameters derived from i alone
 (packaging: 2-4 arms, 3-5 goals, 2-13 others; box-moving: 2 carts, 2 goals, 2-6 others; generator seed
-1000 + i), so the suite is reproducible.  Each run is a fresh `mrgc plan --seed S --time-limit T`
+1000 + i, or --seed-base + i: layouts nobody looked at for the same parameters; --first skips the first
+instances), so the suite is reproducible.  Each run is a fresh `mrgc plan --seed S --time-limit T`
 process; a plan it calls solved is then checked by a separate `mrgc validate` process.  Every finished
 run is appended to the JSONL file at once, and a rerun skips the runs already there (an interrupted study
 loses nothing it finished).  The report counts the outcomes by category: solved and valid, solved but
@@ -27,14 +28,17 @@ from collections import Counter
 from pathlib import Path
 
 
-def instances(packaging: int, box_moving: int) -> list[tuple[str, list[str]]]:
-    """(name, `mrgc generate` arguments), the two families interleaved so a partial run samples both."""
+def instances(packaging: int, box_moving: int, seed_base: int = 1000, first: int = 0) -> list[tuple[str, list[str]]]:
+    """(name, `mrgc generate` arguments), the two families interleaved so a partial run samples both:
+    instances ``first`` to ``first + n - 1`` of each family, generator seed ``seed_base + i`` (another base
+    draws other layouts for the same parameters; their names end in ``-g<generator seed>``)."""
+    tag = (lambda i: "") if seed_base == 1000 else (lambda i: f"-g{seed_base + i}")
     pa = []
-    for i in range(packaging):
+    for i in range(first, first + packaging):
         robots, goals, others = 2 + i % 3, 3 + (i // 3) % 3, 2 + (7 * i) % 12
         pa.append(
             (
-                f"pa-r{robots}-g{goals}-o{others}-i{i}",
+                f"pa-r{robots}-g{goals}-o{others}-i{i}{tag(i)}",
                 [
                     "packaging",
                     "--robots",
@@ -44,17 +48,17 @@ def instances(packaging: int, box_moving: int) -> list[tuple[str, list[str]]]:
                     "--others",
                     str(others),
                     "--seed",
-                    str(1000 + i),
+                    str(seed_base + i),
                 ],
             )
         )
     bo = []
-    for i in range(box_moving):
+    for i in range(first, first + box_moving):
         others = 2 + i % 5
         bo.append(
             (
-                f"bo-r2-g2-o{others}-i{i}",
-                ["box-moving", "--robots", "2", "--goals", "2", "--others", str(others), "--seed", str(1000 + i)],
+                f"bo-r2-g2-o{others}-i{i}{tag(i)}",
+                ["box-moving", "--robots", "2", "--goals", "2", "--others", str(others), "--seed", str(seed_base + i)],
             )
         )
     out: list[tuple[str, list[str]]] = []
@@ -176,6 +180,10 @@ def main() -> None:
     ap.add_argument("--packaging", type=int, default=60)
     ap.add_argument("--box-moving", type=int, default=20)
     ap.add_argument("--seeds", type=int, nargs="+", default=[0, 1])
+    ap.add_argument("--first", type=int, default=0, help="index of the first instance of each family (default 0)")
+    ap.add_argument(
+        "--seed-base", type=int, default=1000, help="generator seed of instance i is this + i (default 1000)"
+    )
     ap.add_argument("--time-limit", type=float, default=120.0)
     ap.add_argument("--out", type=Path, default=Path("benchmarks/results/generated.jsonl"))
     ap.add_argument("--work", type=Path, default=None, help="folder for instances and plans (default: a temp dir)")
@@ -190,7 +198,7 @@ def main() -> None:
         done = {(r["instance"], r["seed"]) for r in map(json.loads, args.out.read_text().splitlines()) if r}
     work = args.work or Path(tempfile.mkdtemp(prefix="mrgc-generated-"))
     work.mkdir(parents=True, exist_ok=True)
-    for name, gen in instances(args.packaging, args.box_moving):
+    for name, gen in instances(args.packaging, args.box_moving, args.seed_base, args.first):
         for seed in args.seeds:
             if (name, seed) in done:
                 continue

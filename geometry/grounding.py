@@ -48,6 +48,9 @@ PATH_RESOLUTION = 0.01
 #: when taller objects stand around the one picked (see :meth:`Grounder.lift_height`), up to MAX_LIFT
 TRANSFER_LIFT = 0.08
 MAX_LIFT = 0.30
+#: a carry's joint-space line is checked for low points (and they are raised) every this much of the tool's
+#: horizontal travel (m)
+CARRY_STEP = 0.08
 #: objects whose footprint comes this close (m, horizontally) to the picked one's count as its neighbours
 NEIGHBOURHOOD = 0.10
 #: validity checks an arm's transfer or transit path may spend when its straight line collides: a failed
@@ -698,7 +701,7 @@ class Grounder:
             return self.world.probe_hits(volume, against=others, ignore=(obj,)) if others else set()
 
         if lift:
-            up = self._lift(robot, back[0], self.lift_height(obj))
+            up = self._lift(robot, back[0], self.lift_height(obj, start=True))
             if up is None:
                 return Answer(GroundStatus.NO_IK)
             first = joint_line(up[:2], PATH_RESOLUTION)  # the object leaves what it rests on: arm alone
@@ -715,10 +718,15 @@ class Grounder:
             back = joint_line(up[: top + 1], PATH_RESOLUTION)
         # with ``lower``, the carry ends above the goal and comes straight down onto it (the mirror of the lift)
         tail = (
-            self._descent(robot, np.asarray(goal, dtype=float), self.lift_height(obj), hits)
+            self._descent(robot, np.asarray(goal, dtype=float), self.lift_height(obj, goal=(robot, grasp, goal)), hits)
             if lower
             else np.asarray(goal, dtype=float)[None]
         )
+        # across the table above whatever may stand in a region by then (a bin filled earlier in the plan,
+        # which the reverse search has not placed yet): the line's low points raised, else the plain line
+        over = self._over(robot, held, back[-1], tail[0])
+        if over is not None and hits(over) is None:
+            return Answer(GroundStatus.OK, path=[*back, *over[1:], *tail[1:]])
         line = joint_line(np.stack([back[-1], tail[0]]), PATH_RESOLUTION)
         blocked = hits(line)
         if blocked is None:
@@ -800,12 +808,14 @@ class Grounder:
             return Answer(GroundStatus.NO_PATH)
         return Answer(GroundStatus.OK, path=[*back, *planned.path[1:]])
 
-    def lift_height(self, obj: str) -> float:
+    def lift_height(self, obj: str, start: bool = False, goal: tuple[str, str, np.ndarray] | None = None) -> float:
         """How far to raise ``obj`` straight up from where it rests before carrying it off: until its bottom
         clears the tops of its neighbours (other objects within :data:`NEIGHBOURHOOD` of its footprint) by
         1 cm, at least :data:`TRANSFER_LIFT`, at most :data:`MAX_LIFT`.  Among taller neighbours (a dense
         start grid) a lift of a few centimetres leaves the object boxed in, and every carry from there has
-        to find the way up by sampling."""
+        to find the way up by sampling.  With ``start`` (lifting it where it rests now) or ``goal`` (the
+        robot, grasp and configuration holding it above its placement), at least until its bottom clears
+        :meth:`standing_top` by 1 cm: a carry crosses the table above anything that may stand there."""
         pose, h = self.poses[obj], half_extents(self.scene.body(obj).shape)
         bottom, reach = pose[2, 3] - h[2], float(np.hypot(h[0], h[1])) + NEIGHBOURHOOD
         top = bottom
@@ -815,7 +825,59 @@ class Grounder:
             other, g = self.poses[body.name], half_extents(body.shape)
             if np.hypot(*(other[:2, 3] - pose[:2, 3])) <= reach + float(np.hypot(g[0], g[1])):
                 top = max(top, other[2, 3] + g[2])
-        return float(np.clip(top - bottom + 0.01, TRANSFER_LIFT, MAX_LIFT))
+        lift = top - bottom + 0.01
+        if start or goal is not None:
+            if goal is not None:
+                robot, grasp, q = goal
+                bottom = self._held_bottom(robot, (obj, grasp), np.asarray(q)[None])[0]
+            lift = max(lift, self.standing_top() - bottom + 0.01)
+        return float(np.clip(lift, TRANSFER_LIFT, MAX_LIFT))
+
+    def standing_top(self) -> float:
+        """The highest top of a movable object standing on the lowest region floor (the top of the tallest
+        object wherever it is placed), world z."""
+        floor = (
+            min(float(r.pose[2, 3] - half_extents(r.shape)[2]) for r in self.scene.regions)
+            if self.scene.regions
+            else 0.0
+        )
+        return floor + max((2 * float(half_extents(b.shape)[2]) for b in self.scene.movable), default=0.0)
+
+    def _held_bottom(self, robot: str, held: tuple[str, str], configs: np.ndarray) -> np.ndarray:
+        """The world z of the lowest point of the bounding box of ``held`` (object, grasp) in ``robot``'s hand
+        at each of ``configs``."""
+        obj, grasp = held
+        h = half_extents(self.scene.body(obj).shape)
+        poses = self.arm(robot).tool_world(configs) @ self._grip(obj, grasp)[1]
+        out: np.ndarray = poses[:, 2, 3] - np.abs(poses[:, 2, :3]) @ h
+        return out
+
+    def _over(self, robot: str, held: tuple[str, str], a: np.ndarray, b: np.ndarray) -> np.ndarray | None:
+        """The joint-space line from ``a`` to ``b`` (both holding ``held``) with its points every
+        :data:`CARRY_STEP` of the tool's horizontal travel raised (the tool straight up, by IK from the
+        line's configuration) where the held object's bottom dips below :meth:`standing_top` + 1 cm or
+        below both ends, whichever is lower; at :data:`PATH_RESOLUTION`.  None when the line does not dip
+        or a raised point has no IK solution near the line."""
+        arm = self.arm(robot)
+        ends = arm.tool_world(np.stack([a, b]))
+        n = int(np.ceil(np.linalg.norm(ends[1][:2, 3] - ends[0][:2, 3]) / CARRY_STEP))
+        if n < 2:
+            return None
+        s = np.linspace(0.0, 1.0, n + 1)[:, None]
+        configs = a[None] * (1 - s) + b[None] * s
+        bottoms = self._held_bottom(robot, held, configs)
+        floor = min(self.standing_top() + 0.01, max(bottoms[0], bottoms[-1]))
+        low = [k for k in range(1, n) if bottoms[k] < floor - 0.005]
+        if not low:
+            return None
+        tools = arm.tool_world(configs)
+        for k in low:
+            target = arm.ee_target(translation(0.0, 0.0, float(floor - bottoms[k])) @ tools[k])
+            ik = solve_ik_many(arm.model, target[None], 0, q_init=configs[k], restarts=0)[0]
+            if not ik.solved or ik.q is None or float(np.abs(ik.q - configs[k]).max()) > 0.5:
+                return None
+            configs[k] = ik.q
+        return joint_line(configs, PATH_RESOLUTION)
 
     def _lift(self, robot: str, q: np.ndarray, height: float = TRANSFER_LIFT) -> np.ndarray | None:
         """Configurations raising the tool straight up from its pose at ``q`` by up to :data:`TRANSFER_LIFT`

@@ -14,7 +14,7 @@ from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action
 from mrgc.geometry.collision import CollisionShape
 from mrgc.geometry.conventions import to_se2
-from mrgc.geometry.grounding import Grounder, GroundStatus
+from mrgc.geometry.grounding import PATH_RESOLUTION, Grounder, GroundStatus, joint_line
 from mrgc.geometry.scene import inside, scene_from_problem
 from mrgc.geometry.transforms import translation
 from mrgc.planner.ground import Outcome, ReverseGrounder
@@ -249,3 +249,30 @@ def test_a_placement_that_leaves_no_room_for_an_earlier_object_is_passed_over(tm
     assert plan.status is mrgc.PlanStatus.SOLVED, plan.summary()
     report = mrgc.validate(str(path), plan)
     assert report.ok, report.lines()
+
+
+def test_a_carry_crosses_the_table_above_what_may_stand_there() -> None:
+    """pa18-4arms, r4 carrying o1 from its pick to a placement in start: between the lift and the descent, the
+    plain joint-space line sags the held box to 7 cm above the table, below the top of the tallest object that
+    may stand on it (12 cm: a bin the reverse search fills later would have no room under it); the carry's
+    low points raised keep it above that top, and both lift and descent now reach it."""
+    g = Grounder(scene_from_problem(parse_file(ROOT / "domains" / "packaging" / "pa18-4arms.mrg").problem()), seed=0)
+    held = ("o1", "top")
+    pick = g.pick("r4", *held)
+    assert pick.ok and pick.configs is not None
+    place = next(a for pose in g.placements("o1", "start", packed=True) if (a := g.place("r4", *held, pose)).ok)
+    assert place.configs is not None
+    top = g.standing_top()
+    assert top == pytest.approx(0.12)  # the tallest movable object, on the table
+    up = g._lift("r4", pick.configs[-1], g.lift_height("o1", start=True))
+    down = g._lift("r4", place.configs[0], g.lift_height("o1", goal=("r4", "top", place.configs[0])))
+    assert up is not None and down is not None
+    a, b = up[-1], down[-1]
+    assert g._held_bottom("r4", held, np.stack([a, b])).min() >= top  # both ends above it
+    line = joint_line(np.stack([a, b]), PATH_RESOLUTION)
+    assert g._held_bottom("r4", held, line).min() < top - 0.04  # the plain line sags 5 cm under it
+    over = g._over("r4", held, a, b)
+    assert over is not None
+    assert np.allclose(over[0], a) and np.allclose(over[-1], b)
+    assert np.abs(np.diff(over, axis=0)).max() <= PATH_RESOLUTION + 1e-9
+    assert g._held_bottom("r4", held, over).min() >= top  # raised: above whatever may stand there

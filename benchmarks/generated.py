@@ -8,7 +8,9 @@ Instance i of each family is generated with `mrgc generate` from parameters deri
 (packaging: 2-4 arms, 3-5 goals, 2-13 others; box-moving: 2 carts, 2 goals, 2-6 others; generator seed
 1000 + i, or --seed-base + i: layouts nobody looked at for the same parameters; --first skips the first
 instances), so the suite is reproducible.  Each run is a fresh `mrgc plan --seed S --time-limit T`
-process; a plan it calls solved is then checked by a separate `mrgc validate` process.  Every finished
+process (with --cpu-time, through benchmarks/cpu_plan.py: the limit in CPU seconds of that process, so two
+trees compared on a loaded machine are not compared by its load); a plan it calls solved is then checked by
+a separate `mrgc validate` process.  Every finished
 run is appended to the JSONL file at once, and a rerun skips the runs already there (an interrupted study
 loses nothing it finished).  The report counts the outcomes by category: solved and valid, solved but
 INVALID (must be 0), infeasible by the facts (with the reason), every skeleton tried, time limit, crash.
@@ -69,11 +71,17 @@ def instances(packaging: int, box_moving: int, seed_base: int = 1000, first: int
     return out
 
 
-def mrgc(*args: str, timeout: float) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "mrgc.cli", *args], capture_output=True, text=True, timeout=timeout)
+#: `mrgc plan` with its clock in CPU seconds (--cpu-time)
+CPU_PLAN = Path(__file__).with_name("cpu_plan.py")
 
 
-def run_one(name: str, gen: list[str], seed: int, limit: float, work: Path) -> dict[str, object]:
+def mrgc(*args: str, timeout: float, cpu: bool = False) -> subprocess.CompletedProcess[str]:
+    """Run an `mrgc` command; with ``cpu``, `mrgc plan` (args without the command) through CPU_PLAN."""
+    command = [str(CPU_PLAN)] if cpu else ["-m", "mrgc.cli"]
+    return subprocess.run([sys.executable, *command, *args], capture_output=True, text=True, timeout=timeout)
+
+
+def run_one(name: str, gen: list[str], seed: int, limit: float, work: Path, cpu: bool = False) -> dict[str, object]:
     src, plan = work / f"{name}.mrg", work / f"{name}-s{seed}.plan.json"
     if not src.exists():
         made = mrgc("generate", *gen, "-o", str(src), timeout=120)
@@ -81,9 +89,8 @@ def run_one(name: str, gen: list[str], seed: int, limit: float, work: Path) -> d
             return {"outcome": "generator error", "detail": made.stderr.strip()[-300:]}
     t0 = time.perf_counter()
     try:
-        proc = mrgc(
-            "plan", str(src), "--seed", str(seed), "--time-limit", str(limit), "-o", str(plan), timeout=limit * 3 + 300
-        )
+        args = (str(src), "--seed", str(seed), "--time-limit", str(limit), "-o", str(plan))
+        proc = mrgc(*args, timeout=limit * 6 + 300, cpu=True) if cpu else mrgc("plan", *args, timeout=limit * 3 + 300)
     except subprocess.TimeoutExpired:
         return {"outcome": "crash", "detail": "plan process hung past 3x its time limit"}
     wall = time.perf_counter() - t0
@@ -99,7 +106,8 @@ def run_one(name: str, gen: list[str], seed: int, limit: float, work: Path) -> d
         "exit": proc.returncode,
         "status": data["status"],
         "seconds": round(wall, 2),
-        "planner_seconds": data["stats"].get("seconds"),
+        "planner_seconds": data["stats"].get("seconds"),  # CPU seconds with --cpu-time
+        "clock": "cpu" if cpu else "wall",
         "facts_seconds": data["stats"].get("facts_seconds"),
         "makespan": data["makespan"],
         "moved": data["motion_cost"],
@@ -163,12 +171,13 @@ def report(path: Path) -> None:
             continue
         cats = Counter(category(r) for r in mine)
         solved = [r for r in mine if r["outcome"] == "solved, valid"]
-        secs = sorted(float(r["seconds"]) for r in solved)
+        cpu = any(r.get("clock") == "cpu" for r in mine)  # then the planner's CPU seconds
+        secs = sorted(float(r["planner_seconds"] if cpu else r["seconds"]) for r in solved)
         med = secs[len(secs) // 2] if secs else float("nan")
         print(
             f"\n{'packaging' if family == 'pa' else 'box-moving'}: {len(mine)} runs "
             f"({len({r['instance'] for r in mine})} instances), solved and valid {len(solved)} "
-            f"({100 * len(solved) / len(mine):.0f} %), median wall time of those {med:.1f} s\n"
+            f"({100 * len(solved) / len(mine):.0f} %), median {'CPU' if cpu else 'wall'} time of those {med:.1f} s\n"
         )
         print("| outcome | runs |\n| --- | --- |")
         for cat, n in sorted(cats.items(), key=lambda kv: -kv[1]):
@@ -185,6 +194,11 @@ def main() -> None:
         "--seed-base", type=int, default=1000, help="generator seed of instance i is this + i (default 1000)"
     )
     ap.add_argument("--time-limit", type=float, default=120.0)
+    ap.add_argument(
+        "--cpu-time",
+        action="store_true",
+        help="the time limit in CPU seconds of each plan process (benchmarks/cpu_plan.py), not wall-clock ones",
+    )
     ap.add_argument("--out", type=Path, default=Path("benchmarks/results/generated.jsonl"))
     ap.add_argument("--work", type=Path, default=None, help="folder for instances and plans (default: a temp dir)")
     ap.add_argument("--report", type=Path, default=None, help="only print the tables of a results file")
@@ -207,7 +221,7 @@ def main() -> None:
                 "generate": "mrgc generate " + " ".join(gen),
                 "seed": seed,
                 "time_limit": args.time_limit,
-                **run_one(name, gen, seed, args.time_limit, work),
+                **run_one(name, gen, seed, args.time_limit, work, args.cpu_time),
             }
             with open(args.out, "a", encoding="utf-8") as fh:
                 fh.write(json.dumps(row) + "\n")

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import hashlib
 import json
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 from mrgc.planner.outcome import PlanStatus, Why
@@ -170,6 +170,20 @@ class Plan:
     def motion_cost(self) -> int:
         """The number of objects moved (the paper's cost)."""
         return sum(len(step) for step in self.steps)
+
+    def candidate(self, steps: list[list[PlannedAction]], robots: list[str], symbolic: bool = False) -> "Plan":
+        """This run's plan with ``steps`` as a complete, solved plan, for the validator to judge (the
+        referee of the search and of the Ap1 baseline), under the motion model the plan will state."""
+        return replace(
+            self,
+            status=PlanStatus.SOLVED,
+            steps=steps,
+            symbolic=symbolic,
+            stats={"robots": robots},
+            why=None,
+            validation=None,
+            problem_digest=None,
+        )
 
     def to_json(self) -> dict[str, Any]:
         """The plan as its JSON file holds it (docs/plan.schema.json)."""

@@ -267,20 +267,7 @@ def _referee(
     from mrgc.planner.ground import Grounding, Outcome
     from mrgc.planner.validate import validate
 
-    candidate = Plan(
-        plan.problem,
-        plan.problem_file,
-        plan.problem_sha256,
-        plan.mrgc_version,
-        plan.backend,
-        plan.encoding,
-        plan.seed,
-        PlanStatus.SOLVED,
-        [s.actions for s in result.steps],
-        symbolic=False,
-        stats={"robots": [r.name for r in problem.robots]},
-        motion_model=plan.motion_model,
-    )  # judged under the model the plan will state
+    candidate = plan.candidate([s.actions for s in result.steps], [r.name for r in problem.robots])
     t0 = time.perf_counter()
     report = validate(problem, candidate.to_json(), problem_file, first_only=True)  # the verdict, fast
     seconds = time.perf_counter() - t0

@@ -401,20 +401,7 @@ def _referee(problem: Problem, plan: Plan, steps: list[GroundedStep], why: Why, 
     from mrgc.planner.validate import validate
 
     t0 = time.perf_counter()
-    candidate = Plan(
-        plan.problem,
-        plan.problem_file,
-        plan.problem_sha256,
-        plan.mrgc_version,
-        plan.backend,
-        plan.encoding,
-        plan.seed,
-        PlanStatus.SOLVED,
-        [s.actions for s in steps],
-        symbolic=problem.symbolic,
-        stats={"robots": [r.name for r in problem.robots]},
-        motion_model=plan.motion_model,
-    )
+    candidate = plan.candidate([s.actions for s in steps], [r.name for r in problem.robots], symbolic=problem.symbolic)
     # the referee judges the plan against the problem it was made for (no file need exist: a problem parsed
     # from a string is planned too); ``mrgc validate`` checks the file's digest besides.  The first violation
     # is the verdict, so the replay stops there.

@@ -100,6 +100,9 @@ class PlannedAction:
     handover_point: str | None = None
     configs: dict[str, list[list[float]]] = field(default_factory=dict)
     paths: dict[str, list[list[float]]] = field(default_factory=dict)
+    #: the object is only set down in ``region`` on its way (a relay, beyond the paper: ``enable-relay``);
+    #: a later action, the onward move, takes it from there to its goal
+    relay: bool = False
 
     @property
     def kind(self) -> str:
@@ -125,6 +128,8 @@ class PlannedAction:
             out["place_pose"] = self.place_pose
         if self.handover_point is not None:
             out["handover_point"] = self.handover_point
+        if self.relay:
+            out["relay"] = True
         if self.configs:
             out["configs"] = self.configs
         if self.paths:
@@ -230,7 +235,8 @@ class Plan:
             for a in step:
                 who = a.pick_robot if a.kind == "pick-place" else f"{a.pick_robot}->{a.place_robot}"
                 grasp = a.pick_grasp if a.kind == "pick-place" else f"{a.pick_grasp}->{a.place_grasp}"
-                parts.append(f"{who} moves {a.object} to {a.region} ({grasp})")
+                verb = "sets down" if a.relay else "moves"
+                parts.append(f"{who} {verb} {a.object} {'in' if a.relay else 'to'} {a.region} ({grasp})")
             lines.append(f"  step {i}: " + "; ".join(parts))
         if self.why is not None and self.status is not PlanStatus.SOLVED:
             lines += self.why.lines()

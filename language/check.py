@@ -65,6 +65,8 @@ class Checker:
         self.props = PropReader(self.diags, file)
         # names of each sort, for suggestions: built once per name table, not once per misspelt name
         self._sorted_names: dict[str, tuple[dict[str, tuple[str, Span]], frozenset[str]]] = {}
+        #: where each fact of ``:init`` is first stated (checks that need the goal point there)
+        self._fact_spans: dict[Fact, Span] = {}
 
     def err(self, code: str, message: str, span: Span) -> None:
         """Record a diagnostic."""
@@ -249,6 +251,7 @@ class Checker:
         init = self._facts(secs.get("init"), sort_of, grasps, obj_grasps)
         goal = self._goal(secs.get("goal"), sort_of, p)
         self._initial_regions(init, secs.get("init"), movable, geometric)
+        self._relays(init, goal)
 
         domain_ref = secs.get("domain")
         return Problem(
@@ -379,6 +382,7 @@ class Checker:
         grasps: set[str],
         obj_grasps: dict[str, set[str]],
     ) -> list[Fact]:
+        self._fact_spans = {}
         if init is None:
             return []
         facts: dict[Fact, None] = {}
@@ -386,8 +390,9 @@ class Checker:
             fact = self._atom(atom, sort_of, grasps)
             if fact is None:
                 continue
-            if _self_referential(fact):
-                self.err("E229", f"'{fact.predicate}' relates {_self_referential(fact)} to itself", atom.span)
+            same, note = _self_referential(fact)
+            if same:
+                self.err("E229", f"'{fact.predicate}' relates {same} to itself{note}", atom.span)
                 continue
             for obj, grasp in _grasp_uses(fact):
                 if grasp not in obj_grasps.get(obj, {grasp}):
@@ -397,6 +402,7 @@ class Checker:
                         atom.span,
                     )
             facts[fact] = None
+            self._fact_spans.setdefault(fact, atom.span)
         return list(facts)
 
     def _goal(self, goal: ast.Goal | None, sort_of: dict[str, tuple[str, Span]], p: ast.ProblemDef) -> list[Fact]:
@@ -445,15 +451,30 @@ class Checker:
             elif not regions and not geometric and m.name not in attempted:
                 self.err("E228", f"'{m.name}' has no initial region: add (in-region {m.name} REGION) to :init", m.span)
 
+    def _relays(self, init: list[Fact], goal: list[Fact]) -> None:
+        """A relay sets its object down on the way, never in its goal region (E217)."""
+        goal_of = {f.args[0]: f.args[1] for f in goal}
+        for f in init:
+            if f.predicate == "enable-relay" and goal_of.get(f.args[0]) == f.args[1]:
+                self.err(
+                    "E217",
+                    f"'enable-relay' sets '{f.args[0]}' down in its goal region '{f.args[1]}': a relay is a "
+                    "stop on the way to the goal, in another region",
+                    self._fact_spans[f],
+                )
 
-def _self_referential(fact: Fact) -> str:
-    """What a fact wrongly relates to itself: an object occluding itself, a handover to the same robot."""
+
+def _self_referential(fact: Fact) -> tuple[str, str]:
+    """What a fact wrongly relates to itself ("" if nothing), and a note: an object occluding itself, a
+    handover to the same robot, a relay to the same robot with the same grasp."""
     a = fact.args
     if fact.predicate in ("occludes-pick", "occludes-goal-place") and a[0] == a[1]:
-        return f"object '{a[0]}'"
+        return f"object '{a[0]}'", ""
     if fact.predicate == "enable-goal-handover" and a[3] == a[4]:
-        return f"robot '{a[3]}'"
-    return ""
+        return f"robot '{a[3]}'", ""
+    if fact.predicate == "enable-relay" and a[4] == a[5] and a[2] == a[3]:
+        return f"robot '{a[4]}' with grasp '{a[2]}'", ": a relay back to the same robot must change the grasp"
+    return "", ""
 
 
 def _grasp_uses(fact: Fact) -> list[tuple[str, str]]:
@@ -469,6 +490,8 @@ def _grasp_uses(fact: Fact) -> list[tuple[str, str]]:
         return [(a[1], a[3])]
     if fact.predicate == "enable-goal-handover":
         return [(a[0], a[1]), (a[0], a[2])]
+    if fact.predicate == "enable-relay":
+        return [(a[0], a[2]), (a[0], a[3])]
     return []
 
 

@@ -40,6 +40,7 @@ CODES: dict[str, str] = {
     "E227": "grasp not allowed for this object",
     "E228": "initial region missing or ambiguous",
     "E229": "fact relates a thing to itself",
+    "E217": "relay into the object's goal region",
     # domains and includes
     "E230": "missing domain",
     "E231": "ambiguous domain",
@@ -181,7 +182,7 @@ HELP: dict[str, str] = {
     "E214": "A robot's `:kind` that the domain does not define with `(:robot-kind ...)`.",
     "E215": "A movable object's `:handover` list names a handover point the problem does not declare.",
     "E216": "A declared name used where another sort belongs, e.g. a robot in a movable object's place.",
-    "E220": "A predicate other than the six of the language.",
+    "E220": "A predicate other than the seven of the language (docs/language.md): the paper's six and `enable-relay`.",
     "E221": "A predicate with too few or too many arguments; the message gives its signature.",
     "E222": "A goal asks to move a fixed object, which can never move.",
     "E223": "Goals are conjunctions of `(in-region OBJECT REGION)` literals only.",
@@ -191,7 +192,12 @@ HELP: dict[str, str] = {
     "E227": "A fact uses a grasp the object's `:grasps` list does not allow.",
     "E228": "In a symbolic problem every movable object needs exactly one `(in-region OBJECT REGION)` in "
     "`:init`; in any problem at most one.",
-    "E229": "An object that occludes itself, or a handover from a robot to itself.",
+    "E229": "An object that occludes itself, a handover from a robot to itself, or a relay "
+    "`(enable-relay M Re g1 g2 R1 R2)` back to the same robot with the same grasp (R1 = R2 needs g1 != g2: a "
+    "regrasp).",
+    "E217": "`(enable-relay M Re g1 g2 R1 R2)` names M's goal region as Re. A relay sets a goal object down on "
+    "its way to the goal, in another region, where R2 picks it up again; placing M in its goal region is "
+    "`reachable-place`.",
     "E230": "A problem names no domain, or a domain that is not in the file, in `domain.mrg` beside it, "
     "or in its includes; also used when a file does not hold the problem asked for.",
     "E231": "The domain's name is defined in more than one place at the same lookup level.",

@@ -15,7 +15,8 @@ from typing import Union
 from mrgc.errors import Span
 from mrgc.language.ast import NOWHERE
 
-# The six predicates of the paper: name -> sorts of the arguments, in order.
+# The predicates: name -> sorts of the arguments, in order.  The paper's six, and ``enable-relay`` (beyond
+# the paper: a goal object set down on its way and picked up again; docs/language.md).
 PREDICATES: dict[str, tuple[str, ...]] = {
     "in-region": ("movable", "region"),
     "reachable-pick": ("movable", "grasp", "robot"),
@@ -23,6 +24,7 @@ PREDICATES: dict[str, tuple[str, ...]] = {
     "occludes-pick": ("movable", "movable", "grasp", "robot"),
     "occludes-goal-place": ("movable", "movable", "region", "grasp", "robot"),
     "enable-goal-handover": ("movable", "grasp", "grasp", "robot", "robot"),
+    "enable-relay": ("movable", "region", "grasp", "grasp", "robot", "robot"),
 }
 
 #: words users write for a predicate -> the predicates they mean (E220's "did you mean"; a word that is a
@@ -47,6 +49,12 @@ PREDICATE_WORDS: dict[str, tuple[str, ...]] = {
     "blocks-pick": ("occludes-pick",),
     "blocks-place": ("occludes-goal-place",),
     "occludes-place": ("occludes-goal-place",),
+    "regrasp": ("enable-relay",),
+    "re-grasp": ("enable-relay",),
+    "set-down": ("enable-relay",),
+    "setdown": ("enable-relay",),
+    "put-down": ("enable-relay",),
+    "can-relay": ("enable-relay",),
 }
 
 #: requirement flags a domain may declare (informational; see docs/language.md)

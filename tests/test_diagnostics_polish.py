@@ -132,6 +132,9 @@ def test_parentheses_in_comments_and_strings_do_not_count() -> None:
         ("in", "'in-region'"),
         ("blocks", "'occludes-pick' or 'occludes-goal-place'"),
         ("reachable-pik", "'reachable-pick'"),  # by spelling when the meaning gives nothing
+        ("relay", "'enable-relay'"),
+        ("regrasp", "'enable-relay'"),
+        ("set-down", "'enable-relay'"),
     ],
 )
 def test_unknown_predicates_are_suggested_by_meaning(word: str, hint: str) -> None:
@@ -141,6 +144,83 @@ def test_unknown_predicates_are_suggested_by_meaning(word: str, hint: str) -> No
 
 def test_every_meaning_names_real_predicates() -> None:
     assert all(set(targets) <= set(PREDICATES) for targets in PREDICATE_WORDS.values())
+
+
+# ---------------------------------------------------------------- the relay fact (enable-relay)
+RELAY = ROOT / "tests" / "data" / "relay.mrg"
+RELAY_FACTS = """(define (domain d) (:grasps top side))
+(define (problem p)
+  (:domain d) (:robots r1 r2) (:movable o1 o2) (:regions start mid goal)
+  (:init (in-region o1 start) (in-region o2 start)
+    FACTS)
+  (:goal (in-region o1 goal)))
+"""
+
+
+def _relay_diagnostics(facts: str) -> list[Diagnostic]:
+    with pytest.raises(mrgc.InputError) as exc:
+        mrgc.parse_string(RELAY_FACTS.replace("FACTS", facts), "p.mrg")
+    return list(exc.value.diagnostics)
+
+
+def test_relay_facts_are_read_with_their_argument_sorts() -> None:
+    problem = mrgc.parse_file(str(RELAY)).problem(None)
+    assert PREDICATES["enable-relay"] == ("movable", "region", "grasp", "grasp", "robot", "robot")
+    relays = sorted(f.args for f in problem.init if f.predicate == "enable-relay")
+    assert relays == [("o1", "mid", "top", "side", "r1", "r1"), ("o1", "mid", "top", "side", "r1", "r2")]
+    # a regrasp (one robot, two grasps) and an object without a goal are accepted
+    text = RELAY_FACTS.replace("FACTS", "(enable-relay o1 mid top side r1 r1) (enable-relay o2 goal top top r1 r2)")
+    assert len(mrgc.parse_string(text).problem(None).init) == 4
+
+
+@pytest.mark.parametrize(
+    ("fact", "code", "column", "message"),
+    [
+        (
+            "(enable-relay o1 mid top top r2 r2)",
+            "E229",
+            5,
+            "'enable-relay' relates robot 'r2' with grasp 'top' to itself: a relay back to the same robot must "
+            "change the grasp",
+        ),
+        (
+            "(enable-relay o1 goal top side r1 r2)",
+            "E217",
+            5,
+            "'enable-relay' sets 'o1' down in its goal region 'goal': a relay is a stop on the way to the goal, "
+            "in another region",
+        ),
+        ("(enable-relay o1 r1 top side r1 r2)", "E216", 22, "'r1' is a robot, but 'enable-relay' expects a region"),
+        ("(enable-relay o1 nowhere top side r1 r2)", "E212", 22, "undeclared region 'nowhere'"),
+        ("(enable-relay o1 mid top grip r1 r2)", "E213", 30, "undeclared grasp 'grip'"),
+        ("(enable-relay o1 mid top side r1)", "E221", 5, "'enable-relay' takes 6 arguments"),
+    ],
+)
+def test_relay_facts_are_checked_where_they_are_written(fact: str, code: str, column: int, message: str) -> None:
+    (d,) = _relay_diagnostics(fact)
+    assert (d.code, d.span.line, d.span.column) == (code, 5, column)
+    assert message in d.message
+
+
+def test_relay_grasps_must_be_the_objects() -> None:
+    text = RELAY_FACTS.replace("(:movable o1 o2)", "(:movable (o1 :grasps (top)) o2)")
+    with pytest.raises(mrgc.InputError) as exc:
+        mrgc.parse_string(text.replace("FACTS", "(enable-relay o1 mid top side r1 r2)"), "p.mrg")
+    assert [(d.code, d.message) for d in exc.value.diagnostics] == [
+        ("E227", "grasp 'side' is not among the grasps of 'o1' (top)")
+    ]
+
+
+def test_fmt_keeps_relay_facts(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    path = tmp_path / "relay.mrg"
+    squeezed = RELAY.read_text(encoding="utf-8").replace("\n    (enable-relay", " (enable-relay")
+    assert squeezed.count("\n    (enable-relay") == 0 and squeezed != RELAY.read_text(encoding="utf-8")
+    path.write_text(squeezed, encoding="utf-8")
+    assert cli.main(["fmt", "--write", str(path)]) == 0
+    capsys.readouterr()
+    assert path.read_text(encoding="utf-8") == RELAY.read_text(encoding="utf-8")
+    before, after = (mrgc.parse_file(str(p)).problem(None) for p in (RELAY, path))
+    assert after.init == before.init and problem_digest(after) == problem_digest(before)
 
 
 # ---------------------------------------------------------------- fmt --check and --diff

@@ -62,6 +62,7 @@ class Action:
     handover_point: str | None = None
     configs: Mapping[str, Motion] = field(default_factory=dict)  # phase -> configurations
     paths: Mapping[str, Motion] = field(default_factory=dict)  # path name -> configurations
+    relay: bool = False  # a relay move: the object is only set down in ``region`` on its way
 
     @property
     def handover(self) -> bool:
@@ -73,13 +74,13 @@ class Action:
         return (self.pick_robot,) if not self.handover else (self.pick_robot, self.place_robot)
 
     def describe(self) -> str:
-        """``r1 moves o1 to bin (top)`` / ``r1->r2 moves o1 to bin (top->side-x+)``."""
-        if not self.handover:
-            return f"{self.pick_robot} moves {self.object} to {self.region} ({self.pick_grasp})"
-        return (
-            f"{self.pick_robot}->{self.place_robot} moves {self.object} to {self.region} "
-            f"({self.pick_grasp}->{self.place_grasp})"
-        )
+        """``r1 moves o1 to bin (top)`` / ``r1->r2 moves o1 to bin (top->side-x+)`` / a relay move ``r1 sets
+        down o1 in start (top)``."""
+        who, grasp = self.pick_robot, self.pick_grasp
+        if self.handover:
+            who, grasp = f"{who}->{self.place_robot}", f"{grasp}->{self.place_grasp}"
+        what = f"sets down {self.object} in" if self.relay else f"moves {self.object} to"
+        return f"{who} {what} {self.region} ({grasp})"
 
 
 @dataclass(frozen=True)
@@ -406,4 +407,5 @@ def _action(a: dict[str, Any]) -> Action:
         a.get("handover_point"),
         {k: _motion(v) for k, v in a.get("configs", {}).items()},
         {k: _motion(v) for k, v in a.get("paths", {}).items()},
+        bool(a.get("relay", False)),
     )

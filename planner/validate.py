@@ -23,16 +23,24 @@ Checks on every plan (codes in brackets):
 - every name is declared (objects, regions, robots of actions and of ``waiting``, handover points), every
   grasp allowed for its object ``[unknown-name]``; the ``kind`` matches the robots, and a pick-and-place
   keeps its grasp (no regrasp in hand) ``[action]``;
-- each object moves at most once ``[moved-twice]``; a robot does at most one action per step, a handover
-  occupying both of its robots ``[robot-busy]``; ``waiting`` lists exactly the robots in no action of the
-  step, once each ``[waiting]``; at the end every goal holds ``[goal]``.
+- each object moves at most once, or twice when its first move is a *relay move* (``"relay": true``: it is
+  only set down on its way; beyond the paper, ``enable-relay``) and its second, the *onward move*, comes at
+  a later step and is no relay ``[moved-twice]``; a relay move with no onward move ``[relay]``; a relay
+  move is a pick-and-place of a goal object into a region other than its goal ``[region]``;
+- a robot does at most one action per step, a handover occupying both of its robots ``[robot-busy]``;
+  ``waiting`` lists exactly the robots in no action of the step, once each ``[waiting]``; at the end every
+  goal holds ``[goal]``.
 
 Symbolic plans (a symbolic problem) are checked against the problem's facts, as the model defines actions
 (DESIGN.md section 5): a pick needs ``reachable-pick``, a place ``reachable-place``, a handover
 ``enable-goal-handover`` and is only for goal objects into their goal region; objects outside the goal
 only move within their own region ``[unsupported]``, ``[region]``; every ``occludes-pick`` obstacle of an
 action moves at a strictly earlier step, every ``occludes-goal-place`` obstacle no later ``[pick-obstacle]``,
-``[place-obstacle]``.  Geometric checks (the motion model, motions, collisions, support) are listed in
+``[place-obstacle]``.  A relay move of M into Re by R1 with g1 needs ``reachable-pick M g1 R1`` and
+``enable-relay M Re g1 g2 R1 R2``, R2 and g2 the robot and grasp that pick M in its onward move; it has pick
+obstacles only.  The onward move needs what a move into the goal needs except ``reachable-pick`` (the relay
+fact covers picking M where it was set down) and has place obstacles only.  Geometric checks (the motion
+model, motions, collisions, support; an onward move picks M where its relay move placed it) are listed in
 :mod:`mrgc.planner.replay`.
 """
 
@@ -51,6 +59,7 @@ from mrgc.planner.plan_reader import (
     E_VERSION,
     Action,
     PlanFile,
+    Step,
     check_schema,
     load_plan,
     read_plan,
@@ -118,7 +127,7 @@ def validate(
     stats: dict[str, Any] = {
         "problem": problem.name,
         "steps": len(steps),
-        "moved": sum(map(len, steps)),
+        "moved": len({a.object for step in steps for a in step}),
         "mode": "symbolic" if problem.symbolic else "geometric",
     }
     _header(problem, doc, problem_path, out)
@@ -126,9 +135,10 @@ def validate(
         out.append(Violation(None, None, "status", f"the plan's status is {doc.status!r}: it holds no plan"))
         return ValidationReport(False, out, stats)
     usable = _names(problem, doc, out)
-    _structure(problem, doc, usable, out)
+    stats["moved"] = len({a.object for step in steps for a in step if id(a) in usable})
+    relays = _structure(problem, doc, usable, out)
     if problem.symbolic:
-        _symbolic(problem, steps, usable, out)
+        _symbolic(problem, steps, usable, relays, out)
         final = dict(problem.initial_regions)
         for step in steps:
             for a in step:
@@ -298,45 +308,123 @@ def _kind(t: int, a: Action, out: list[Violation]) -> None:
         )
 
 
-def _structure(problem: Problem, plan: PlanFile, usable: set[int], out: list[Violation]) -> None:
-    moved_at: dict[str, int] = {}
+@dataclass
+class _Relays:
+    """The relay moves of a plan paired with their onward moves (ids of actions): ``onward`` relay -> the
+    object's next move, at a later step and not a relay itself; ``relay_of`` the reverse."""
+
+    onward: dict[int, Action] = field(default_factory=dict)
+    relay_of: dict[int, Action] = field(default_factory=dict)
+
+
+def _structure(problem: Problem, plan: PlanFile, usable: set[int], out: list[Violation]) -> _Relays:
+    """The structural checks (module docstring): how often objects move ``[moved-twice]``, ``[relay]``,
+    relay moves ``[region]``, robots ``[robot-busy]``, ``[waiting]``; the relay moves and their onward moves."""
+    history: dict[str, list[tuple[int, Action]]] = {}
+    relays = _Relays()
     robots = [r.name for r in problem.robots]
     for t, s in enumerate(plan.steps, 1):
-        busy: dict[str, str] = {}
         for a in s.actions:
-            obj = a.object
-            if id(a) in usable:
-                if obj in moved_at:
-                    out.append(
-                        Violation(
-                            t,
-                            obj,
-                            "moved-twice",
-                            f"{obj} is moved again (first at step {moved_at[obj]}); each object moves at most once",
-                        )
-                    )
-                else:
-                    moved_at[obj] = t
-            for r in dict.fromkeys(a.robots()):
-                if r in busy:
-                    out.append(
-                        Violation(t, r, "robot-busy", f"{r} is in two actions of the step (moving {busy[r]} and {obj})")
-                    )
-                else:
-                    busy[r] = obj
-        seen: set[str] = set()
-        for r in s.waiting:
+            if id(a) not in usable:
+                continue
+            before = history.setdefault(a.object, [])
+            again = _moved_again(t, a, before)
+            if again:
+                out.append(Violation(t, a.object, "moved-twice", again))
+            elif before:  # the onward move of a relay move
+                relays.onward[id(before[0][1])], relays.relay_of[id(a)] = a, before[0][1]
+            before.append((t, a))
+            if a.relay:
+                _relay_region(problem, t, a, out)
+        _robots(t, s, robots, out)
+    for obj, moves in history.items():
+        if len(moves) == 1 and moves[0][1].relay:
+            out.append(
+                Violation(moves[0][0], obj, "relay", f"{obj} is set down at step {moves[0][0]} and never moved on")
+            )
+    return relays
+
+
+def _robots(t: int, s: Step, robots: list[str], out: list[Violation]) -> None:
+    """A robot does at most one action in step ``t`` ``[robot-busy]``; ``waiting`` lists exactly the others
+    ``[waiting]``."""
+    busy: dict[str, str] = {}
+    for a in s.actions:
+        for r in dict.fromkeys(a.robots()):
             if r in busy:
-                out.append(Violation(t, r, "waiting", f"{r} is listed as waiting but moves {busy[r]} in the step"))
-            elif r in seen:
-                out.append(Violation(t, r, "waiting", f"{r} is listed as waiting twice"))
-            seen.add(r)
-        for r in robots:
-            if r not in busy and r not in seen:
-                out.append(Violation(t, r, "waiting", f"{r} is in no action of the step and not listed as waiting"))
+                out.append(
+                    Violation(
+                        t, r, "robot-busy", f"{r} is in two actions of the step (moving {busy[r]} and {a.object})"
+                    )
+                )
+            else:
+                busy[r] = a.object
+    seen: set[str] = set()
+    for r in s.waiting:
+        if r in busy:
+            out.append(Violation(t, r, "waiting", f"{r} is listed as waiting but moves {busy[r]} in the step"))
+        elif r in seen:
+            out.append(Violation(t, r, "waiting", f"{r} is listed as waiting twice"))
+        seen.add(r)
+    for r in robots:
+        if r not in busy and r not in seen:
+            out.append(Violation(t, r, "waiting", f"{r} is in no action of the step and not listed as waiting"))
 
 
-def _symbolic(problem: Problem, steps: list[tuple[Action, ...]], usable: set[int], out: list[Violation]) -> None:
+def _moved_again(t: int, a: Action, before: list[tuple[int, Action]]) -> str:
+    """Why moving ``a.object`` at step ``t`` after its moves ``before`` breaks "each object moves at most
+    once, or twice when the first move is a relay move and the second, at a later step, is not" ("" if it
+    does not)."""
+    obj = a.object
+    if not before:
+        return ""
+    t0, first = before[0]
+    if not first.relay:
+        return f"{obj} is moved again (first at step {t0}); each object moves at most once"
+    if len(before) > 1:
+        return (
+            f"{obj} is moved a third time (set down at step {t0}, moved on at step {before[1][0]}); an object "
+            "moves at most once, or twice through a relay"
+        )
+    if t0 == t:
+        return f"{obj} is moved again in step {t}, where it is set down; its onward move comes at a later step"
+    if a.relay:
+        return f"{obj} is set down again (first at step {t0}); a relay move is followed by its onward move, not a relay"
+    return ""
+
+
+def _relay_region(problem: Problem, t: int, a: Action, out: list[Violation]) -> None:
+    """A relay move is a pick-and-place of a goal object into a region that is not its goal ``[region]``."""
+    o, goal = a.object, problem.goal_regions.get(a.object)
+    if a.handover:
+        out.append(
+            Violation(
+                t,
+                o,
+                "region",
+                f"a relay move is a pick-and-place: {a.pick_robot} sets {o} down itself, not a "
+                f"handover to {a.place_robot}",
+            )
+        )
+    if goal is None:
+        out.append(Violation(t, o, "region", f"{o} is not a goal object: only goal objects are relayed (enable-relay)"))
+    elif a.region == goal:
+        out.append(
+            Violation(
+                t,
+                o,
+                "region",
+                f"{o} is set down in its goal region {goal!r}: a relay move sets it down on its way, in another region",
+            )
+        )
+
+
+Facts = set[tuple[str, tuple[str, ...]]]
+
+
+def _symbolic(
+    problem: Problem, steps: list[tuple[Action, ...]], usable: set[int], relays: _Relays, out: list[Violation]
+) -> None:
     """The checks of a symbolic plan against the problem's facts (module docstring)."""
     facts = {(f.predicate, f.args) for f in problem.init}
     moved_at: dict[str, int] = {}
@@ -346,21 +434,40 @@ def _symbolic(problem: Problem, steps: list[tuple[Action, ...]], usable: set[int
                 moved_at.setdefault(a.object, t)
     for t, step in enumerate(steps, 1):
         for a in step:
-            if id(a) in usable:
-                _supported(problem, facts, t, a, out)
-                _obstacles_moved(facts, moved_at, t, a, out)
+            if id(a) not in usable:
+                continue
+            if a.relay:
+                _relay_supported(facts, t, a, relays.onward.get(id(a)), out)
+            else:
+                _supported(problem, facts, t, a, id(a) in relays.relay_of, out)
+            _obstacles_moved(facts, moved_at, t, a, out, pick=id(a) not in relays.relay_of, place=not a.relay)
 
 
-def _supported(
-    problem: Problem, facts: set[tuple[str, tuple[str, ...]]], t: int, a: Action, out: list[Violation]
-) -> None:
-    """Facts support action ``a`` ``[unsupported]``; only goal objects are handed over, and an object goes
+def _relay_supported(facts: Facts, t: int, a: Action, onward: Action | None, out: list[Violation]) -> None:
+    """A relay move needs ``reachable-pick`` and the ``enable-relay`` fact naming the robot and grasp that
+    pick the object up again in its onward move ``[unsupported]``."""
+    o, re_, r1, g1 = a.object, a.region, a.pick_robot, a.pick_grasp
+    need: list[tuple[str, tuple[str, ...]]] = [("reachable-pick", (o, g1, r1))]
+    if onward is not None:
+        need.append(("enable-relay", (o, re_, g1, onward.pick_grasp, r1, onward.pick_robot)))
+    elif not any(p == "enable-relay" and args[:3] == (o, re_, g1) and args[4] == r1 for p, args in facts):
+        need.append(("enable-relay", (o, re_, g1, "_", r1, "_")))
+    for pred, args in need:
+        if (pred, args) not in facts:
+            out.append(Violation(t, o, "unsupported", f"no fact ({pred} {' '.join(args)}) supports '{a.describe()}'"))
+
+
+def _supported(problem: Problem, facts: Facts, t: int, a: Action, onward: bool, out: list[Violation]) -> None:
+    """Facts support action ``a`` ``[unsupported]`` (an ``onward`` move picks where a relay move set the
+    object down: its relay fact covers the pick); only goal objects are handed over, and an object goes
     only to its goal region or, outside the goal, within its own region ``[region]``."""
     goal = problem.goal_regions
     o, re_, r1, r2, g1, g2 = a.object, a.region, a.pick_robot, a.place_robot, a.pick_grasp, a.place_grasp
-    need = [("reachable-pick", (o, g1, r1)), ("reachable-place", (o, re_, g2, r2))]
+    need: list[tuple[str, tuple[str, ...]]] = [("reachable-place", (o, re_, g2, r2))]
+    if not onward:
+        need.insert(0, ("reachable-pick", (o, g1, r1)))
     if r1 != r2:
-        need.insert(1, ("enable-goal-handover", (o, g1, g2, r1, r2)))
+        need.insert(-1, ("enable-goal-handover", (o, g1, g2, r1, r2)))
         if o not in goal:
             out.append(
                 Violation(
@@ -382,13 +489,15 @@ def _supported(
 
 
 def _obstacles_moved(
-    facts: set[tuple[str, tuple[str, ...]]], moved_at: dict[str, int], t: int, a: Action, out: list[Violation]
+    facts: Facts, moved_at: dict[str, int], t: int, a: Action, out: list[Violation], pick: bool, place: bool
 ) -> None:
     """Every ``occludes-pick`` obstacle of action ``a`` moves at a strictly earlier step, every
-    ``occludes-goal-place`` obstacle no later ``[pick-obstacle]``, ``[place-obstacle]``."""
+    ``occludes-goal-place`` obstacle no later ``[pick-obstacle]``, ``[place-obstacle]``; ``pick``/``place``:
+    whether the action has obstacles of that kind (an onward move picks where its relay move set the object
+    down, a relay move places on the way, outside the facts' view)."""
     o, re_, r1, r2, g1, g2 = a.object, a.region, a.pick_robot, a.place_robot, a.pick_grasp, a.place_grasp
     for pred, args in facts:
-        if pred == "occludes-pick" and args[1:] == (o, g1, r1):
+        if pick and pred == "occludes-pick" and args[1:] == (o, g1, r1):
             when = moved_at.get(args[0])
             if when is None or when >= t:
                 state = "never moves" if when is None else f"moves at step {when}"
@@ -400,7 +509,7 @@ def _obstacles_moved(
                         f"{args[0]} blocks {r1} picking {o} with {g1} and {state}; it must move at an earlier step",
                     )
                 )
-        elif pred == "occludes-goal-place" and args[1:] == (o, re_, g2, r2):
+        elif place and pred == "occludes-goal-place" and args[1:] == (o, re_, g2, r2):
             when = moved_at.get(args[0])
             if when is None or when > t:
                 state = "never moves" if when is None else f"moves at step {when}"

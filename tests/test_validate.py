@@ -30,6 +30,7 @@ from mrgc.geometry.ik import solve_ik_many
 from mrgc.geometry.transforms import translation
 from mrgc.language.loader import parse_file
 from mrgc.planner.plan import PlannedAction
+from mrgc.planner.plan_reader import read_plan
 from mrgc.planner.validate import ValidationReport, load_plan, validate
 
 ROOT = vp.ROOT
@@ -515,6 +516,11 @@ MALFORMED: dict[str, tuple[Callable[[str], str | bytes] | None, str, str]] = {
         "plan.steps[0].actions[0] has an unknown field 'teleport'",
     ),
     "unknown top-level field": (_edit(_set("trust_me", 1)), "E502", "plan has an unknown field 'trust_me'"),
+    "relay not a boolean": (
+        _edit(lambda p: _action(p, 1).__setitem__("relay", "yes")),
+        "E502",
+        'plan.steps[0].actions[0].relay should be true or false, not "yes"',
+    ),
     "motion model missing": (_edit(lambda p: p.pop("motion_model")), "E502", "plan lacks 'motion_model'"),
     "unknown motion model": (
         _edit(lambda p: p["motion_model"].__setitem__("arms", "teleport")),
@@ -779,6 +785,129 @@ def test_symbolic_cli(tmp_path: Path, chain3: Any, capsys: pytest.CaptureFixture
     out = capsys.readouterr().out
     assert "the plan is for problem 'chain-3', not 'pa3-handover' [problem]" in out
     assert "[plan-kind]" in out and "[unknown-name]" in out
+
+
+# ------------------------------------------------------------------------------------- symbolic: relays
+RELAY = str(ROOT / "tests" / "data" / "relay.mrg")
+
+
+@pytest.fixture(scope="module")
+def relay() -> Any:
+    return parse_file(RELAY).problem(None)
+
+
+def _moves(*spec: tuple[str, ...]) -> list[PlannedAction]:
+    """Actions ``(object, region, robot, grasp[, robot2, grasp2][, "relay"])``."""
+    out = []
+    for a in spec:
+        relay, a = a[-1] == "relay", a[:-1] if a[-1] == "relay" else a
+        out.append(PlannedAction(a[0], a[1], a[2], a[4] if len(a) > 4 else a[2], a[3], a[5] if len(a) > 4 else a[3]))
+        out[-1].relay = relay
+    return out
+
+
+O2, O3 = ("o2", "start", "r1", "top"), ("o3", "goal", "r2", "side")
+SET_DOWN = ("o1", "mid", "r1", "top", "relay")  # the relay move: r1 sets o1 down in mid
+ON = ("o1", "goal", "r2", "side")  # the onward move: r2 picks o1 in mid and puts it into goal
+
+
+def _relay_report(problem: Any, *steps: list[tuple[str, ...]]) -> ValidationReport:
+    return validate(problem, _plan(problem, RELAY, [_moves(*step) for step in steps], symbolic=True), RELAY)
+
+
+def test_a_relay_plan_is_valid(relay: Any) -> None:
+    """o2 first (it blocks r1's pick), then o1 set down in mid, then r2 takes it on (o3, which blocks that
+    place, moved by then); no reachable-pick fact for r2's pick in mid, the relay fact covers it; o4's pick
+    obstacle (r2 picking o1 side) and its place fact for mid play no part."""
+    assert ("reachable-pick", ("o1", "side", "r2")) not in {(f.predicate, f.args) for f in relay.init}
+    for steps in ([[O2, O3], [SET_DOWN], [ON]], [[O2], [SET_DOWN, O3], [ON]]):
+        report = _relay_report(relay, *steps)
+        assert report.ok, report.lines()
+        assert report.lines()[0] == "valid: plan for relay: 3 steps, 3 objects moved (symbolic checks)"
+    # a regrasp (r1 sets o1 down and picks it again with side), the onward move a handover to r2
+    regrasp = _relay_report(relay, [O2, O3], [SET_DOWN], [("o1", "goal", "r1", "side", "r2", "side")])
+    assert regrasp.ok, regrasp.lines()
+    top_top = _relay_report(relay, [O2, O3], [SET_DOWN], [("o1", "goal", "r1", "side", "r2", "top")])
+    assert [str(v) for v in top_top.violations] == [
+        "step 3: o1: no fact (enable-goal-handover o1 side top r1 r2) supports 'r1->r2 moves o1 to goal "
+        "(side->top)' [unsupported]"
+    ]
+    plan = read_plan(_plan(relay, RELAY, [_moves(O2, O3), _moves(SET_DOWN), _moves(ON)], symbolic=True))
+    (moved,) = plan.steps[1].actions
+    assert moved.relay and moved.describe() == "r1 sets down o1 in mid (top)"
+    assert not plan.steps[2].actions[0].relay
+
+
+INVALID_RELAYS: dict[str, tuple[list[list[tuple[str, ...]]], str, str]] = {
+    "moved twice without the relay flag": (
+        [[O2, O3], [SET_DOWN[:-1]], [ON]],
+        "moved-twice",
+        "step 3: o1: o1 is moved again (first at step 2); each object moves at most once [moved-twice]",
+    ),
+    "set down and never moved on": (
+        [[O2, O3], [SET_DOWN]],
+        "relay",
+        "step 2: o1: o1 is set down at step 2 and never moved on [relay]",
+    ),
+    "moved on in the same step": (
+        [[O2, O3], [SET_DOWN, ON]],
+        "moved-twice",
+        "o1 is moved again in step 2, where it is set down; its onward move comes at a later step",
+    ),
+    "set down twice": (
+        [[O2, O3], [SET_DOWN], [("o1", "mid", "r1", "top", "relay")], [ON]],
+        "moved-twice",
+        "o1 is set down again (first at step 2); a relay move is followed by its onward move, not a relay",
+    ),
+    "moved a third time": (
+        [[O2, O3], [SET_DOWN], [ON], [ON]],
+        "moved-twice",
+        "o1 is moved a third time (set down at step 2, moved on at step 3)",
+    ),
+    "relay of an object without a goal": (
+        [[("o2", "mid", "r1", "top", "relay")], [("o2", "start", "r1", "top"), O3], [SET_DOWN], [ON]],
+        "region",
+        "step 1: o2: o2 is not a goal object: only goal objects are relayed (enable-relay) [region]",
+    ),
+    "relay into the goal region": (
+        [[O2, O3], [("o1", "goal", "r1", "top", "relay")], [ON]],
+        "region",
+        "o1 is set down in its goal region 'goal': a relay move sets it down on its way, in another region",
+    ),
+    "relay as a handover": (
+        [[O2, O3], [("o1", "mid", "r1", "top", "r2", "side", "relay")], [ON]],
+        "region",
+        "a relay move is a pick-and-place: r1 sets o1 down itself, not a handover to r2",
+    ),
+    "no relay fact for the onward pick": (
+        [[O2, O3], [SET_DOWN], [("o1", "goal", "r2", "top")]],
+        "unsupported",
+        "no fact (enable-relay o1 mid top top r1 r2) supports 'r1 sets down o1 in mid (top)'",
+    ),
+    "no relay fact at all": (
+        [[O2, O3], [("o1", "start", "r1", "top", "relay")]],
+        "unsupported",
+        "no fact (enable-relay o1 start top _ r1 _) supports 'r1 sets down o1 in start (top)'",
+    ),
+    "relay move before its pick obstacle": (
+        [[SET_DOWN, O3], [O2], [ON]],
+        "pick-obstacle",
+        "o2 blocks r1 picking o1 with top and moves at step 2; it must move at an earlier step",
+    ),
+    "onward move before its place obstacle": (
+        [[O2], [SET_DOWN], [ON], [O3]],
+        "place-obstacle",
+        "o3 blocks r2 placing o1 in goal with side and moves at step 4; it must move by step 3",
+    ),
+}
+
+
+@pytest.mark.parametrize("name", list(INVALID_RELAYS))
+def test_broken_relay_plans_are_rejected(name: str, relay: Any) -> None:
+    spec, code, fragment = INVALID_RELAYS[name]
+    report = _relay_report(relay, *spec)
+    hits = [str(v) for v in report.violations if v.code == code]
+    assert any(fragment in h for h in hits), report.lines()
 
 
 # ------------------------------------------------------------------------------------- planar robots

@@ -910,6 +910,82 @@ def test_broken_relay_plans_are_rejected(name: str, relay: Any) -> None:
     assert any(fragment in h for h in hits), report.lines()
 
 
+# ------------------------------------------------------------------------------------- geometric relays
+@pytest.fixture
+def relay_plan() -> dict[str, Any]:
+    return vp.relay()
+
+
+def test_a_geometric_relay_plan_is_valid(pa3: Any, relay_plan: dict[str, Any]) -> None:
+    """o1 set down in bin-a (not its goal) at step 1 stands there between the steps: placed inside its
+    action's region, resting on the bin's floor; step 2 picks it there and hands it on into bin-b."""
+    assert _action(relay_plan, 1)["relay"] is True and "relay" not in _action(relay_plan, 2)
+    report = validate(pa3, relay_plan, PA3)
+    assert report.ok, report.lines()
+    assert report.lines()[0].startswith("valid: plan for pa3-handover: 2 steps, 1 objects moved (geometric")
+
+
+def test_the_onward_pick_is_checked_where_the_relay_move_put_the_object(
+    pa3: Any, relay_plan: dict[str, Any], one_step: dict[str, Any]
+) -> None:
+    """The same onward move, but picking o1 where it stood at the start (one_step's handover): the replay
+    knows o1 is in bin-a now, 364 mm away."""
+    plan = copy.deepcopy(relay_plan)
+    plan["steps"][1]["actions"] = one_step["steps"][0]["actions"]
+    report = validate(pa3, plan, PA3)
+    assert {(v.step, v.code) for v in report.violations} == {(2, "grasp"), (2, "approach")}, report.lines()
+    grasp = next(str(v) for v in report.violations if v.code == "grasp")
+    assert grasp.startswith("step 2: r1: the last pick configuration of r1 puts the tool 364.1 mm")
+
+
+def _no_relay_flag(p: dict[str, Any]) -> None:
+    del _action(p, 1)["relay"]
+
+
+def _never_moved_on(p: dict[str, Any]) -> None:
+    _drop_last_step(p)
+
+
+GEOMETRIC_RELAYS: dict[str, tuple[Callable[[dict[str, Any]], None], list[str]]] = {
+    "moved twice without the flag": (
+        _no_relay_flag,
+        ["step 2: o1: o1 is moved again (first at step 1); each object moves at most once [moved-twice]"],
+    ),
+    "set down and never moved on": (
+        _never_moved_on,
+        [
+            "step 1: o1: o1 is set down at step 1 and never moved on [relay]",
+            "o1: goal (in-region o1 bin-b) does not hold at the end: o1 is at (",
+        ],
+    ),
+}
+
+
+@pytest.mark.parametrize("name", list(GEOMETRIC_RELAYS))
+def test_broken_geometric_relays_are_rejected(name: str, pa3: Any, relay_plan: dict[str, Any]) -> None:
+    change, lines = GEOMETRIC_RELAYS[name]
+    change(relay_plan)
+    found = [str(v) for v in validate(pa3, relay_plan, PA3).violations]
+    assert len(found) == len(lines) and all(f.startswith(line) for f, line in zip(found, lines)), found
+
+
+def test_geometric_relays_only_of_goal_objects_on_their_way(
+    pa3: Any, one_step: dict[str, Any], two_steps: dict[str, Any]
+) -> None:
+    _action(two_steps, 1)["relay"] = True  # o2, not a goal object, within start
+    assert [str(v) for v in validate(pa3, two_steps, PA3).violations] == [
+        "step 1: o2: o2 is not a goal object: only goal objects are relayed (enable-relay) [region]",
+        "step 1: o2: o2 is set down at step 1 and never moved on [relay]",
+    ]
+    _action(one_step, 1)["relay"] = True  # o1 handed over into bin-b, its goal
+    assert [str(v) for v in validate(pa3, one_step, PA3).violations] == [
+        "step 1: o1: a relay move is a pick-and-place: r1 sets o1 down itself, not a handover to r2 [region]",
+        "step 1: o1: o1 is set down in its goal region 'bin-b': a relay move sets it down on its way, in another "
+        "region [region]",
+        "step 1: o1: o1 is set down at step 1 and never moved on [relay]",
+    ]
+
+
 # ------------------------------------------------------------------------------------- planar robots
 @pytest.fixture
 def room(tmp_path_factory: pytest.TempPathFactory) -> tuple[str, Any, dict[str, Any]]:

@@ -145,20 +145,20 @@ def _one_step() -> str:
     return json.dumps(as_file(pa3(), PA3, [[handover(g, ["o2", "o3"])]]))
 
 
-@lru_cache(maxsize=1)
-def _two_steps() -> str:
-    """Step 1: r1 moves o2 within start (top), lifted out and lowered in; step 2: the handover of o1."""
-    g = grounder()
-    pick = g.pick("r1", "o2", "top", avoid=["o1", "o3"])
-    spot = g.placement("o2", "start", avoid=["o1", "o3"])
+def lifted_move(g: Grounder, obj: str, region: str, avoid: list[str], relay: bool = False) -> PlannedAction:
+    """r1 picks ``obj`` from the top, lifts it straight up out of its neighbours, lowers it into ``region``
+    and puts it down there (the grounder's placement); the grounder then has it there."""
+    pick = g.pick("r1", obj, "top", avoid=avoid)
+    spot = g.placement(obj, region, avoid=avoid)
     assert pick.ok and spot.ok and spot.pose is not None and pick.configs is not None
-    place = g.place("r1", "o2", "top", spot.pose, avoid=["o1", "o3"])
+    place = g.place("r1", obj, "top", spot.pose, avoid=avoid)
     assert place.ok and place.configs is not None
-    up = lifted(g, "r1", "o2", "top", g.poses["o2"], pick.configs[-1])
-    down = lifted(g, "r1", "o2", "top", spot.pose, place.configs[0])[::-1]
-    first = PlannedAction(
-        "o2",
-        "start",
+    up = lifted(g, "r1", obj, "top", g.poses[obj], pick.configs[-1])
+    down = lifted(g, "r1", obj, "top", spot.pose, place.configs[0])[::-1]
+    g.move(obj, spot.pose)
+    return PlannedAction(
+        obj,
+        region,
         "r1",
         "r1",
         "top",
@@ -166,9 +166,31 @@ def _two_steps() -> str:
         place_pose=rows(spot.pose),
         configs={"pick": rows(pick.configs), "place": rows(place.configs)},
         paths={"to-place": rows([pick.configs[-1], *up, *down, place.configs[0]])},
+        relay=relay,
     )
-    g.move("o2", spot.pose)
+
+
+@lru_cache(maxsize=1)
+def _two_steps() -> str:
+    """Step 1: r1 moves o2 within start (top), lifted out and lowered in; step 2: the handover of o1."""
+    g = grounder()
+    first = lifted_move(g, "o2", "start", ["o1", "o3"])
     return json.dumps(as_file(pa3(), PA3, [[first], [handover(g, ["o2", "o3"])]]))
+
+
+@lru_cache(maxsize=1)
+def _relay() -> str:
+    """Step 1, the relay move: r1 picks o1 from the top, lifts it out of its neighbours and sets it down in
+    bin-a; step 2, the onward move: r1 picks it there and hands it over to r2, who puts it into bin-b."""
+    g = grounder()
+    first = lifted_move(g, "o1", "bin-a", ["o2", "o3"], relay=True)
+    return json.dumps(as_file(pa3(), PA3, [[first], [handover(g, ["o2", "o3"])]]))
+
+
+def relay() -> dict[str, Any]:
+    """A valid relay plan for pa3-handover: r1 sets o1 down in bin-a, then picks it there and hands it to r2
+    (the onward move), who puts it into bin-b."""
+    return json.loads(_relay())  # type: ignore[no-any-return]
 
 
 def one_step() -> dict[str, Any]:

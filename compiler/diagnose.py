@@ -193,6 +193,8 @@ def describe_cycle(cycle: list[Forced]) -> str:
 
 
 def _short(a: Action) -> str:
+    if a.via is not None:
+        return f"{a.pick_grasp}->{a.place_grasp} by {a.pick_robot}->{a.place_robot} via {a.via}"
     return (
         f"{a.pick_grasp} by {a.pick_robot}"
         if not a.handover
@@ -219,7 +221,7 @@ def _no_action(facts: FactBase, obj: str) -> str:
         return f"no robot can place {obj} in {where} {region}"
     return (
         f"no robot that can pick {obj} can also place it in {region}"
-        + (", and no handover of it is enabled" if is_goal else "")
+        + (", and no handover or relay of it is enabled" if is_goal else "")
         + _pick_and_place(facts, obj, region, is_goal)
     )
 

@@ -29,6 +29,8 @@ class FactBase:
     reachable_pick: frozenset[tuple[str, str, str]] = frozenset()  # (M, g, R)
     reachable_place: frozenset[tuple[str, str, str, str]] = frozenset()  # (M, Re, g, R)
     handover: frozenset[tuple[str, str, str, str, str]] = frozenset()  # (M, g1, g2, R1, R2)
+    #: ``enable-relay`` (beyond the paper): M set down in Re by R1 holding it with g1, picked there by R2 with g2
+    relay: frozenset[tuple[str, str, str, str, str, str]] = frozenset()  # (M, Re, g1, g2, R1, R2)
     occludes_pick: dict[tuple[str, str, str], tuple[str, ...]] = field(default_factory=dict)  # (M2, g, R) -> M1s
     occludes_place: dict[tuple[str, str, str, str], tuple[str, ...]] = field(default_factory=dict)  # (M2, Re, g, R)
     #: handovers that can happen at once (the number of handover points); None: no limit (symbolic)
@@ -68,6 +70,7 @@ class FactBase:
         pick: set[tuple[str, str, str]] = set()
         place: set[tuple[str, str, str, str]] = set()
         hand: set[tuple[str, str, str, str, str]] = set()
+        relay: set[tuple[str, str, str, str, str, str]] = set()
         occ_pick: dict[tuple[str, str, str], list[str]] = defaultdict(list)
         occ_place: dict[tuple[str, str, str, str], list[str]] = defaultdict(list)
         for f in facts:
@@ -80,6 +83,8 @@ class FactBase:
                 place.add((a[0], a[1], a[2], a[3]))
             elif f.predicate == "enable-goal-handover":
                 hand.add((a[0], a[1], a[2], a[3], a[4]))
+            elif f.predicate == "enable-relay":
+                relay.add((a[0], a[1], a[2], a[3], a[4], a[5]))
             elif f.predicate == "occludes-pick":
                 if a[0] != a[1] and a[0] not in occ_pick[(a[1], a[2], a[3])]:
                     occ_pick[(a[1], a[2], a[3])].append(a[0])
@@ -98,6 +103,7 @@ class FactBase:
             reachable_pick=frozenset(pick),
             reachable_place=frozenset(place),
             handover=frozenset(hand),
+            relay=frozenset(relay),
             occludes_pick={k: tuple(sorted(v, key=rank)) for k, v in occ_pick.items()},
             occludes_place={k: tuple(sorted(v, key=rank)) for k, v in occ_place.items()},
             handover_capacity=handover_capacity,

@@ -51,6 +51,7 @@ class Skeleton:
                         "place_robot": a.place_robot,
                         "pick_grasp": a.pick_grasp,
                         "place_grasp": a.place_grasp,
+                        **({"via": a.via} if a.via is not None else {}),
                     }
                     for a in step
                 ]

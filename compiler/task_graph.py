@@ -2,7 +2,10 @@
 
 Object nodes are the objects that must or may move; action nodes are partially grounded pick-and-place
 actions (object, target region, pick robot, place robot, pick grasp, place grasp); block-pick and
-block-place edges say which objects obstruct an action.  A goal object's target region is its goal region,
+block-place edges say which objects obstruct an action.  Beyond the paper, a *relay* action sets a goal
+object down in another region (``via``) and picks it up there with another robot or grasp
+(``enable-relay``); like a handover it occupies both robots for its step, and has the same obstacles (the
+pick's and the goal placement's).  A goal object's target region is its goal region,
 any other object's its current region (it is only moved out of the way).  Handover actions exist only for
 goal objects.  Objects already moved (the grounded suffix during search) get no node: each object moves at
 most once, and an action obstructed by such an object is dropped, because that object is still in place
@@ -21,7 +24,9 @@ from mrgc.compiler.facts import FactBase
 
 @dataclass(frozen=True)
 class Action:
-    """A partially grounded pick-and-place action; a handover when the two robots differ."""
+    """A partially grounded pick-and-place action; a handover when the two robots differ, a relay when the
+    object is set down in region ``via`` on its way (then picked up again there by ``place_robot`` with
+    ``place_grasp``)."""
 
     obj: str
     region: str
@@ -29,6 +34,7 @@ class Action:
     place_robot: str
     pick_grasp: str
     place_grasp: str
+    via: str | None = None
 
     @property
     def robots(self) -> tuple[str, ...]:
@@ -39,13 +45,29 @@ class Action:
 
     @property
     def handover(self) -> bool:
-        """Whether two robots share the action (one picks, the other places)."""
-        return self.pick_robot != self.place_robot
+        """Whether the object changes hands in the air (two robots, no relay)."""
+        return self.pick_robot != self.place_robot and self.via is None
+
+    @property
+    def halves(self) -> tuple["Action", "Action"]:
+        """A relay as two pick-and-place actions: setting the object down in ``via``, and the onward move
+        from there to ``region``."""
+        assert self.via is not None, "only a relay has halves"
+        return (
+            Action(self.obj, self.via, self.pick_robot, self.pick_robot, self.pick_grasp, self.pick_grasp),
+            Action(self.obj, self.region, self.place_robot, self.place_robot, self.place_grasp, self.place_grasp),
+        )
 
     def __str__(self) -> str:
-        who = self.pick_robot if not self.handover else f"{self.pick_robot}->{self.place_robot}"
-        grasp = self.pick_grasp if not self.handover else f"{self.pick_grasp}->{self.place_grasp}"
-        return f"{who} moves {self.obj} to {self.region} ({grasp})"
+        two = self.pick_robot != self.place_robot
+        who = self.pick_robot if not two else f"{self.pick_robot}->{self.place_robot}"
+        grasp = (
+            self.pick_grasp
+            if self.pick_grasp == self.place_grasp and not two
+            else f"{self.pick_grasp}->{self.place_grasp}"
+        )
+        via = f" via {self.via}" if self.via is not None else ""
+        return f"{who} moves {self.obj} to {self.region}{via} ({grasp})"
 
 
 @dataclass(frozen=True)
@@ -149,7 +171,8 @@ def build_task_graph(facts: FactBase, must_move: Iterable[str], moved: Iterable[
 
 
 def _actions_for(facts: FactBase, obj: str) -> list[Action]:
-    """Lines 5-20 of Alg. 1: the direct and handover actions moving ``obj`` to its target region."""
+    """Lines 5-20 of Alg. 1: the direct and handover actions moving ``obj`` to its target region (and the
+    relays of a goal object, after them)."""
     is_goal = obj in facts.goal
     region = facts.goal[obj] if is_goal else facts.region.get(obj)
     if region is None:
@@ -175,4 +198,21 @@ def _actions_for(facts: FactBase, obj: str) -> list[Action]:
                         r_place,
                     ) in facts.reachable_place:
                         out.append(Action(obj, region, r_pick, r_place, g_pick, g_place))
+    if is_goal:
+        out += _relays_for(facts, obj, region)
+    return out
+
+
+def _relays_for(facts: FactBase, obj: str, region: str) -> list[Action]:
+    """The relay actions of goal object ``obj``: picked, set down in another region, picked up there and
+    placed in its goal ``region`` (``enable-relay`` with the pick's and the goal placement's facts)."""
+    out = []
+    for o, via, g_pick, g_place, r_pick, r_place in sorted(facts.relay):
+        if (
+            o == obj
+            and via != region
+            and (obj, g_pick, r_pick) in facts.reachable_pick
+            and (obj, region, g_place, r_place) in facts.reachable_place
+        ):
+            out.append(Action(obj, region, r_pick, r_place, g_pick, g_place, via))
     return out

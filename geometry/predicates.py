@@ -15,7 +15,10 @@ For every robot R (in parallel, one process per robot when there are cores to sp
 - ``enable-goal-handover M g1 g2 R1 R2`` (goal objects): at some handover point of M, R1 holding M with
   g1 and R2 holding it with g2 are both collision-free with respect to the fixed objects and to each other
   (up to HANDOVER_CONFIGS distinct IK solutions per arm are tried in pairs: one branch of an arm may reach
-  into a waiting arm or into its partner where another does not).
+  into a waiting arm or into its partner where another does not);
+- ``enable-relay M Re g1 g2 R1 R2`` (beyond the paper; only for goal objects no single action takes to
+  their goal): R1 sets M down with g1 at a placement in Re where R2 picks it up with g2
+  (:mod:`mrgc.geometry.relays`);
 
 and ``in-region M Re`` from the initial poses.  Everything is deterministic for a seed.
 """
@@ -33,6 +36,8 @@ from mrgc.geometry.facts import FactsResult, HandoverConfig, RobotFacts
 from mrgc.geometry.grasps import finger_opening, fits, grasp_transform, pregrasp_transform
 from mrgc.geometry.ik import solve_ik_many
 from mrgc.geometry.kinematics import model_for_kind
+from mrgc.geometry.relays import Asks, Spots, relay_facts, stranded
+from mrgc.geometry.relays import asks as relay_asks
 from mrgc.geometry.scene import SceneSpec, half_extents, inside
 from mrgc.geometry.transforms import translation
 from mrgc.language.model import Box, Fact
@@ -248,6 +253,20 @@ class RobotEvaluator:
         self._handover_configs()
         return self.out
 
+    def spots(self, asks: Asks) -> Spots:
+        """The relay spots this arm reaches (:mod:`mrgc.geometry.relays`): for each (object, grasp, region)
+        asked, the indices of the region's placement lattice where the arm holds the object with the grasp,
+        grasp and pre-grasp free of the fixed objects (movable objects ignored)."""
+        queries, keys = [], []
+        for obj, grasp, region in asks:
+            if not self.usable(obj, grasp):
+                continue
+            for k, pose in enumerate(self.placements(obj, region)):
+                if self.arm.in_reach(pose[:3, 3], margin=0.3):
+                    queries.append((obj, grasp, pose, True, "relay"))
+                    keys.append((obj, grasp, region, k))
+        return {keys[i] for i in self._solve(queries, want_free=False)}
+
     def _handover_configs(self) -> None:
         """Up to HANDOVER_CONFIGS distinct configurations per (goal object, handover point, grasp), from
         HANDOVER_STARTS IK solves (the first from home, the others from seeded random starts): one solution
@@ -300,6 +319,26 @@ def _robot_worker(args: tuple[SceneSpec, str, int]) -> RobotFacts:
     return RobotEvaluator(scene, robot, seed).run()
 
 
+def _spots_worker(args: tuple[SceneSpec, str, int, Asks]) -> tuple[Spots, int, int]:
+    scene, robot, seed, asked = args
+    ev = RobotEvaluator(scene, robot, seed)
+    return ev.spots(asked), ev.out.ik_solves, ev.out.collision_checks
+
+
+def _relays(scene: SceneSpec, facts: set[Fact], seed: int, n: int) -> tuple[set[Fact], int, int]:
+    """``enable-relay`` facts for the goal objects that need them (:mod:`mrgc.geometry.relays`), with the
+    IK solves and collision checks they took."""
+    arms = {r.name for r in scene.robots if r.kind.base != "planar"}
+    stuck = stranded(scene, facts)
+    asked = {r: a for r, a in relay_asks(scene, facts, stuck).items() if r in arms} if stuck else {}
+    if not asked:
+        return set(), 0, 0
+    jobs = [(scene, r, seed, a) for r, a in sorted(asked.items())]
+    answers = map_in_workers(_spots_worker, jobs, min(n, len(jobs)))
+    spots = {job[1]: ans[0] for job, ans in zip(jobs, answers)}
+    return relay_facts(scene, facts, spots), sum(a[1] for a in answers), sum(a[2] for a in answers)
+
+
 def compute_facts(scene: SceneSpec, seed: int = 0, workers: int | None = None) -> FactsResult:
     """Every fact of ``scene`` (see the module docstring); ``workers`` processes (default: one per robot;
     capped at one per robot and one per usable core; 1 runs everything in this process; see
@@ -317,6 +356,8 @@ def compute_facts(scene: SceneSpec, seed: int = 0, workers: int | None = None) -
     for rf in per_robot:
         facts.update(rf.facts)
     facts.update(_handovers(scene, dict(zip(robots, per_robot))))
+    relays, relay_ik, relay_checks = _relays(scene, facts, seed, n)
+    facts.update(relays)
     for m in scene.movable:
         for reg in scene.regions:
             if inside(reg, m.shape, m.pose):
@@ -328,13 +369,14 @@ def compute_facts(scene: SceneSpec, seed: int = 0, workers: int | None = None) -
         "occludes-pick": 3,
         "occludes-goal-place": 4,
         "enable-goal-handover": 5,
+        "enable-relay": 6,
     }
     stats = {
         "seconds": time.perf_counter() - t0,
         "robot_seconds": t_robots,
         "workers": n,
-        "ik_solves": sum(rf.ik_solves for rf in per_robot),
-        "collision_checks": sum(rf.collision_checks for rf in per_robot),
+        "ik_solves": sum(rf.ik_solves for rf in per_robot) + relay_ik,
+        "collision_checks": sum(rf.collision_checks for rf in per_robot) + relay_checks,
         "facts": len(facts),
     }
     return FactsResult(sorted(facts, key=lambda f: (order[f.predicate], f.args)), stats)

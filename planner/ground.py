@@ -33,6 +33,7 @@ PLACEMENT_TRIES = 6  # placements sampled per place before the step gives up
 #: more placements an arm may try when they are out of its reach (a bin at the edge of the arm's reach:
 #: the corners come first when packing, and many are unreachable)
 OUT_OF_REACH_TRIES = 30
+RELAY_TRIES = 3  # spots tried per relay (the k-th spot both of its robots reach at the k-th try)
 #: paths replayed in another path's phase (the validator's execution model): name -> phase
 PATH_PHASE = {"taker-to-handover": "to-handover", "giver-home": "home"}
 #: each robot's volume at every sample of every phase of its motions: robot -> phase -> volumes
@@ -95,6 +96,8 @@ class ReverseGrounder:
         self.deadline = deadline
         #: the objects the steps grounded so far move (later in the plan than the step being grounded)
         self.grounded: set[str] = set()
+        #: where the relays being grounded set their objects down (see :meth:`_relay_steps`)
+        self._forced: dict[str, np.ndarray] = {}
 
     def ground(self, skeleton: Skeleton, suffix: list[GroundedStep], key: str = "") -> Grounding:
         """Ground ``skeleton``'s steps, last first, before the already grounded ``suffix`` (see the module
@@ -144,6 +147,8 @@ class ReverseGrounder:
         later, or else one step earlier, than the others (each part split again as needed).  The skeleton's
         action set and order constraints are kept (actions of one step constrain each other in neither
         direction); only the plan's makespan grows."""
+        if any(a.via is not None for a in step):
+            return self._relay_steps(step, avoid, v_fut, key, index)
         same = {a.obj for a in step}
         done = self._step(step, avoid, same, v_fut, key, index)
         if not isinstance(done, Failure):
@@ -173,6 +178,82 @@ class ReverseGrounder:
             if not isinstance(head, Failure):
                 return head + tail
         return done
+
+    def _relay_steps(
+        self, step: tuple[Action, ...], avoid: set[str], v_fut: Volume, key: str, index: int
+    ) -> list[GroundedStep] | Failure:
+        """A skeleton step holding relays (beyond the paper) as two plan steps: the step's other actions with
+        each relay setting its object down at a spot of its ``via`` region, then the relays' onward moves
+        (picked up at the spot, placed in the goal).  The reverse search grounds the onward moves first, at
+        spots both robots of the relay reach (:meth:`_spots`); the first step then sets each object down at
+        its spot.  The k-th try uses each relay's k-th such spot."""
+        relays = [a for a in step if a.via is not None]
+        onward = tuple(a.halves[1] for a in relays)
+        first = tuple(a.halves[0] if a.via is not None else a for a in step)
+        last: Failure = Failure(index, label(relays[0]), f"relay: no spot in {relays[0].via} both robots reach")
+        for k in range(RELAY_TRIES):
+            spots = self._spots(relays, avoid | {a.obj for a in step}, v_fut, f"{key}:relay", k)
+            if isinstance(spots, Failure):
+                return last if k else replace(spots, step=index)
+            initial = {o: self.g.poses[o] for o in spots}
+            try:
+                for o, pose in spots.items():
+                    self.g.move(o, pose)
+                tail = self._steps(onward, avoid, v_fut, f"{key}:onward:{k}", index)
+            finally:
+                for o, pose in initial.items():
+                    self.g.move(o, pose)
+            if isinstance(tail, Failure):
+                last = tail
+                continue
+            before, self.grounded = self.grounded, self.grounded | set(spots)
+            self._forced = spots
+            try:
+                head = self._steps(first, avoid, v_fut + [p for s in tail for p in s.volume], f"{key}:down:{k}", index)
+            finally:
+                self.grounded, self._forced = before, {}
+            if isinstance(head, Failure):
+                last = head
+                continue
+            for s in head:
+                for planned in s.actions:
+                    planned.relay = planned.object in spots
+            return head + tail
+        return last
+
+    def _spots(
+        self, relays: list[Action], avoid: set[str], v_fut: Volume, key: str, k: int
+    ) -> dict[str, np.ndarray] | Failure:
+        """For each relay, its k-th free spot in its ``via`` region (clear of ``avoid`` at their poses, of
+        ``v_fut`` and of the spots chosen before) where its first robot sets the object down with its grasp
+        and its second one picks it up with its own (both approaches free; the robots' paths are grounded
+        afterwards)."""
+        g, out = self.g, {}
+        taken: Volume = []
+        for a in relays:
+            assert a.via is not None
+            others = sorted(avoid - {a.obj})
+            found, tried = 0, 0
+            for pose in g.placements(a.obj, a.via, avoid=others, volume=v_fut + taken, key=key):
+                tried += 1
+                if tried > PLACEMENT_TRIES + OUT_OF_REACH_TRIES:
+                    break
+                if not g.place(a.pick_robot, a.obj, a.pick_grasp, pose, avoid=others).ok:
+                    continue
+                initial = g.poses[a.obj]
+                g.move(a.obj, pose)
+                try:
+                    ok = g.pick(a.place_robot, a.obj, a.place_grasp, avoid=others).ok
+                finally:
+                    g.move(a.obj, initial)
+                if ok and found == k:
+                    out[a.obj] = pose
+                    taken.append((g.shape(a.obj), pose))
+                    break
+                found += ok
+            if a.obj not in out:
+                return Failure(0, label(a), f"relay: no spot in {a.via} where both robots reach {a.obj}")
+        return out
 
     def _step(
         self, step: tuple[Action, ...], avoid: set[str], same: set[str], v_fut: Volume, key: str, index: int = 0
@@ -294,14 +375,19 @@ class ReverseGrounder:
         tried = 0  # placements that failed for another reason than being out of the arm's reach
         # goal bins are shared by several objects: packed from the corners; elsewhere (moving an obstacle
         # aside) the middle of the region first, nearest the arms that reach it
-        spots = g.placements(
-            a.obj,
-            a.region,
-            avoid=avoid,
-            volume=v_fut,
-            key=key,
-            packed=self.goal.get(a.obj) == a.region,
-            prefer=g.comfortable(a.place_robot, a.obj, a.place_grasp),
+        forced = self._forced.get(a.obj)
+        spots = (
+            iter([forced])
+            if forced is not None  # a relay sets its object down where its onward move picks it up
+            else g.placements(
+                a.obj,
+                a.region,
+                avoid=avoid,
+                volume=v_fut,
+                key=key,
+                packed=self.goal.get(a.obj) == a.region,
+                prefer=g.comfortable(a.place_robot, a.obj, a.place_grasp),
+            )
         )
         for _ in range(PLACEMENT_TRIES + OUT_OF_REACH_TRIES):
             if tried >= PLACEMENT_TRIES:
@@ -533,7 +619,12 @@ class ReverseGrounder:
 
 
 def label(a: Action) -> str:
-    """An action as a failure line names it: ``r1 moves o3 to bin-a (top)``, ``r1->r2 hands o3 to bin-a ...``."""
+    """An action as a failure line names it: ``r1 moves o3 to bin-a (top)``, ``r1->r2 hands o3 to bin-a ...``,
+    ``r1->r2 relay o3 to bin-a via start (top->top)``."""
+    if a.via is not None:
+        return (
+            f"{a.pick_robot}->{a.place_robot} relay {a.obj} to {a.region} via {a.via} ({a.pick_grasp}->{a.place_grasp})"
+        )
     if a.pick_robot == a.place_robot:
         return f"{a.pick_robot} moves {a.obj} to {a.region} ({a.pick_grasp})"
     return f"{a.pick_robot}->{a.place_robot} hand {a.obj} over to {a.region} ({a.pick_grasp}->{a.place_grasp})"

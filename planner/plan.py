@@ -173,7 +173,7 @@ class Plan:
 
     @property
     def motion_cost(self) -> int:
-        """The number of objects moved (the paper's cost)."""
+        """The number of moves (the paper's cost, objects moved; an object a relay sets down moves twice)."""
         return sum(len(step) for step in self.steps)
 
     def candidate(self, steps: list[list[PlannedAction]], robots: list[str], symbolic: bool = False) -> "Plan":
@@ -224,11 +224,16 @@ class Plan:
         """The plan file's text."""
         return json.dumps(self.to_json(), indent=1, sort_keys=False) + "\n"
 
+    def _moved_text(self) -> str:
+        """``5 objects moved`` (and ``in 6 moves`` when relays move some twice)."""
+        objects = len({a.object for step in self.steps for a in step})
+        return f"{objects} objects moved" + (f" in {self.motion_cost} moves" if objects != self.motion_cost else "")
+
     def summary(self) -> list[str]:
         """The plan in a few lines, as ``mrgc plan`` prints it."""
         lines = [
             f"plan for {self.problem}: {self.status}"
-            + (f", makespan {self.makespan}, {self.motion_cost} objects moved" if self.steps else "")
+            + (f", makespan {self.makespan}, {self._moved_text()}" if self.steps else "")
         ]
         for i, step in enumerate(self.steps, 1):
             parts = []

@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Any, Callable
 from mrgc.compiler.enumerate import BatchOutcome
 from mrgc.compiler.facts import FactBase
 from mrgc.compiler.skeleton import Skeleton
+from mrgc.compiler.task_graph import Action
 from mrgc.language.model import Problem
 from mrgc.planner.outcome import BlockingCycle, Failure, PlanStatus, Why
 from mrgc.planner.plan import Plan, PlannedAction, planner_motion_model
@@ -201,7 +202,7 @@ def _conclude_symbolic(plan: Plan, why: Why, more: _Skeletons, time_limit: float
     first = more(1)
     if first:
         plan.status = PlanStatus.SOLVED
-        plan.steps = [[_planned(a) for a in step] for step in first[0].steps]
+        plan.steps = [planned for step in first[0].steps for planned in planned_steps(step)]
     elif more.infeasible:
         plan.status = PlanStatus.INFEASIBLE
         why.facts = more.reasons()
@@ -325,8 +326,22 @@ def _log_line(elapsed: float, n: int, skel: Skeleton, suffix: list[GroundedStep]
     return f"{head}: fails at {f.line() if f else result.reason}"
 
 
-def _planned(a: Any) -> PlannedAction:
-    return PlannedAction(a.obj, a.region, a.pick_robot, a.place_robot, a.pick_grasp, a.place_grasp)
+def planned_steps(step: tuple[Action, ...]) -> list[list[PlannedAction]]:
+    """A skeleton step as the plan's steps, without geometry: the step itself, and when it holds relays, a
+    second step with their onward moves (the first step sets their objects down)."""
+    first, onward = [], []
+    for a in step:
+        if a.via is None:
+            first.append(PlannedAction(a.obj, a.region, a.pick_robot, a.place_robot, a.pick_grasp, a.place_grasp))
+            continue
+        down, on = a.halves
+        first.append(
+            PlannedAction(
+                down.obj, down.region, down.pick_robot, down.place_robot, down.pick_grasp, down.place_grasp, relay=True
+            )
+        )
+        onward.append(PlannedAction(on.obj, on.region, on.pick_robot, on.place_robot, on.pick_grasp, on.place_grasp))
+    return [first, onward] if onward else [first]
 
 
 def _order(problem: Problem) -> Callable[[str], int]:

@@ -291,14 +291,17 @@ def reference_task_graph(
     Target region: the goal region of a goal object, else the object's current region.  Direct actions need
     ReachablePick and ReachablePlace(target) with the same robot and grasp; handovers (goal objects only)
     need ReachablePick(g1, R1), EnableGoalHandover(g1, g2, R1, R2) with R1 != R2 and
-    ReachablePlace(target, g2, R2).  Pick obstacles: OccludesPick(Mj, M, g_pick, R_pick); place obstacles
-    (goal objects only): OccludesGoalPlace(Mj, M, target, g_place, R_place).  Obstacles join the graph
-    recursively.  Edges and actions are compared as sets by the tests, so order is not meaningful here.
+    ReachablePlace(target, g2, R2); relays (goal objects only, beyond the paper) need ReachablePick(g1, R1),
+    EnableRelay(Re, g1, g2, R1, R2) with Re not the target and ReachablePlace(target, g2, R2).  Pick
+    obstacles: OccludesPick(Mj, M, g_pick, R_pick); place obstacles (goal objects only):
+    OccludesGoalPlace(Mj, M, target, g_place, R_place).  Obstacles join the graph recursively.  Edges and
+    actions are compared as sets by the tests, so order is not meaningful here.
     """
     facts = {tuple(f) for f in facts}
     pick = {f[1:] for f in facts if f[0] == "reachable-pick"}
     place = {f[1:] for f in facts if f[0] == "reachable-place"}
     hand = {f[1:] for f in facts if f[0] == "enable-goal-handover"}
+    relay = {f[1:] for f in facts if f[0] == "enable-relay"}
     occ_pick = {f[1:] for f in facts if f[0] == "occludes-pick" and f[1] != f[2]}
     occ_place = {f[1:] for f in facts if f[0] == "occludes-goal-place" and f[1] != f[2]}
     done = set(moved)
@@ -316,7 +319,14 @@ def reference_task_graph(
         target = goal.get(m, region.get(m))
         if target is None:
             return
-        for a in _actions_of(m, target, m in goal, robots, grasps.get(m, ()), pick, place, hand):
+        acts = _actions_of(m, target, m in goal, robots, grasps.get(m, ()), pick, place, hand)
+        if m in goal:
+            acts += [
+                Action(m, target, r1, r2, g1, g2, via)
+                for (o, via, g1, g2, r1, r2) in sorted(relay)
+                if o == m and via != target and (m, g1, r1) in pick and (m, target, g2, r2) in place
+            ]
+        for a in acts:
             p = tuple(mj for mj in movable if (mj, m, a.pick_grasp, a.pick_robot) in occ_pick)
             q = tuple(mj for mj in movable if m in goal and (mj, m, target, a.place_grasp, a.place_robot) in occ_place)
             if done & set(p + q):

@@ -68,7 +68,7 @@ def test_a_handover_with_the_wrong_grasps_names_pickers_placers_and_grasp_pairs(
     data = json.loads(capsys.readouterr().out)
     assert data["status"] == "infeasible"
     assert data["why"]["facts"] == [
-        "no robot that can pick o1 can also place it in goal, and no handover of it is enabled (picked by r1 "
+        "no robot that can pick o1 can also place it in goal, and no handover or relay of it is enabled (picked by r1 "
         "with top; placed in goal by r2 with top; handovers of it only between grasps side->side)"
     ]
 

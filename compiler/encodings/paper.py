@@ -18,9 +18,10 @@ from mrgc.compiler.task_graph import TaskGraph
 
 
 def action_label(graph: TaskGraph, i: int) -> str:
-    """The action's label in model names: object, region, robots and grasps."""
+    """The action's label in model names: object, region, robots and grasps (and a relay's region)."""
     a = graph.actions[i]
-    return f"{a.obj},{a.region},{a.pick_robot},{a.place_robot},{a.pick_grasp},{a.place_grasp}"
+    via = f",via {a.via}" if a.via is not None else ""
+    return f"{a.obj},{a.region},{a.pick_robot},{a.place_robot},{a.pick_grasp},{a.place_grasp}{via}"
 
 
 class PaperEncoding(Encoding):

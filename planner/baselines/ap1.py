@@ -167,9 +167,10 @@ class Ap1Search:
 
     def actions(self, obj: str) -> list[Action]:
         """The composite robot's actions moving ``obj`` (to its goal region, or within its region): the
-        single-robot ones first, then the handovers, each in the facts' order."""
+        single-robot ones first, then the handovers, each in the facts' order (no relays: Ap1 keeps the
+        paper's model, each object moved once by one action)."""
         if obj not in self._actions:
-            acts = facts_actions(self.facts, obj)
+            acts = [a for a in facts_actions(self.facts, obj) if a.via is None]
             self._actions[obj] = [a for a in acts if not a.handover] + [a for a in acts if a.handover]
         return self._actions[obj]
 

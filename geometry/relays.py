@@ -1,0 +1,91 @@
+"""Relays in phase 1 (beyond the paper): ``enable-relay M Re g1 g2 R1 R2``.
+
+A goal object that no single action can take to its goal region (no robot both picks it and places it
+there with one grasp, and no handover links a robot that picks it to one that places it) may still be
+moved by setting it down on the way: R1 picks it with g1 and sets it down in another region Re, where R2
+(another robot, or R1 with another grasp) picks it up with g2 and places it in its goal.  On generated
+packaging tables this is a low box that only top grasps hold (two hands cannot both hold it from above,
+so no handover exists), picked by an arm that cannot reach its bin.
+
+The fact needs one placement of M in Re (a pose of :meth:`RobotEvaluator.placements
+<mrgc.geometry.predicates.RobotEvaluator.placements>`' lattice) that R1 reaches holding M with g1 and R2
+reaches with g2: grasp and pre-grasp by inverse kinematics, the arm, its fingers at the grasp's opening
+and M along the approach free of the fixed objects (movable objects ignored, as for ``reachable-place``:
+grounding looks for a free spot).  R1 must also pick M (``reachable-pick M g1 R1``) and R2 place it in its
+goal (``reachable-place M goal g2 R2``).  Relays are looked for only for the goal objects that need them,
+so a problem every goal of which has a pick-and-place or a handover gets the paper's facts unchanged.
+
+This module decides which spots to ask for and combines the answers; the per-robot inverse kinematics run
+in :mod:`mrgc.geometry.predicates` (one worker per robot, like the rest of phase 1).
+"""
+
+from __future__ import annotations
+
+from typing import Iterable
+
+from mrgc.geometry.scene import SceneSpec
+from mrgc.language.model import Box, Fact
+
+#: what one robot is asked: (object, grasp, region) triples whose spots it should try
+Asks = list[tuple[str, str, str]]
+#: what one robot answers: (object, grasp, region, lattice index) of the spots it reaches
+Spots = set[tuple[str, str, str, int]]
+
+
+def stranded(scene: SceneSpec, facts: Iterable[Fact]) -> list[str]:
+    """The goal objects no pick-and-place and no handover takes to their goal region (in goal order)."""
+    by: dict[str, set[tuple[str, ...]]] = {}
+    for f in facts:
+        by.setdefault(f.predicate, set()).add(f.args)
+    pick, place = by.get("reachable-pick", set()), by.get("reachable-place", set())
+    hand = by.get("enable-goal-handover", set())
+    out = []
+    for obj, goal in scene.goal.items():
+        picks = {(g, r) for o, g, r in pick if o == obj}
+        places = {(g, r) for o, re, g, r in place if o == obj and re == goal}
+        if picks & places:
+            continue
+        if any(o == obj and (g1, r1) in picks and (g2, r2) in places for o, g1, g2, r1, r2 in hand):
+            continue
+        if picks and places:
+            out.append(obj)
+    return out
+
+
+def asks(scene: SceneSpec, facts: Iterable[Fact], objects: list[str]) -> dict[str, Asks]:
+    """Per robot, the spots to try for ``objects``: a robot that picks an object tries setting it down with
+    that grasp, a robot that places it in its goal tries picking it up with that grasp, in every box region
+    but the goal (sorted, so the answers are deterministic)."""
+    wanted = set(objects)
+    out: dict[str, set[tuple[str, str, str]]] = {}
+    regions = sorted(r.name for r in scene.regions if isinstance(r.shape, Box))
+    for f in facts:
+        a = f.args
+        if f.predicate == "reachable-pick" and a[0] in wanted:
+            obj, grasp, robot = a
+        elif f.predicate == "reachable-place" and a[0] in wanted and a[1] == scene.goal[a[0]]:
+            obj, _, grasp, robot = a
+        else:
+            continue
+        out.setdefault(robot, set()).update((obj, grasp, re) for re in regions if re != scene.goal[obj])
+    return {r: sorted(v) for r, v in out.items()}
+
+
+def relay_facts(scene: SceneSpec, facts: Iterable[Fact], spots: dict[str, Spots]) -> set[Fact]:
+    """``enable-relay`` facts from each robot's reached spots (see the module docstring)."""
+    facts = list(facts)
+    pick = {f.args for f in facts if f.predicate == "reachable-pick"}
+    place = {f.args for f in facts if f.predicate == "reachable-place"}
+    out: set[Fact] = set()
+    for r1, mine in sorted(spots.items()):
+        for r2, theirs in sorted(spots.items()):
+            for obj, g1, region, k in sorted(mine):
+                if (obj, g1, r1) not in pick:
+                    continue
+                goal = scene.goal[obj]
+                for o2, g2, region2, k2 in sorted(theirs):
+                    if (o2, region2, k2) != (obj, region, k) or (r1, g1) == (r2, g2):
+                        continue
+                    if (obj, goal, g2, r2) in place:
+                        out.add(Fact("enable-relay", (obj, region, g1, g2, r1, r2)))
+    return out

@@ -46,6 +46,16 @@ class Arm:
             index.append(link.index)
         return shapes, index
 
+    @cached_property
+    def base_hull(self) -> tuple[CollisionShape, np.ndarray] | None:
+        """The base link's hull and world pose: left out of :attr:`probes` (it cannot move, and this arm's
+        own links start on it), it is an obstacle to every other arm (None: the link has no geometry)."""
+        link = next((k for k in self.model.links if k.index == 0), None)
+        if link is None or len(link.points) < 4:
+            return None
+        pose: np.ndarray = fk_world(self.model, self.home[None], self.base)[0, 0]
+        return collision_shape(ConvexHull(np.asarray(link.points, dtype=float))), pose
+
     def ee_target(self, tool_world: np.ndarray) -> np.ndarray:
         """The end-effector pose (base frame) that puts the tool centre point at ``tool_world``."""
         target: np.ndarray = self.base_inv @ tool_world @ self.tcp_inv

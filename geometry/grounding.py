@@ -145,6 +145,8 @@ class Grounder:
         #: arms wait at home while others move (the validator's rule): each arm's links at home, group
         #: ``home:<arm>``, an obstacle to the other arms' motions
         self.homes: tuple[str, ...] = ()
+        #: each arm's base link, group ``base:<arm>``: an obstacle to the other arms, home or not
+        self._bases: tuple[str, ...] = ()
         #: the arms of the step being grounded that are *not* at home, by phase (see :meth:`step`)
         self._away: dict[str, frozenset[str]] = {}
 
@@ -156,6 +158,9 @@ class Grounder:
                     arm = self.arm(spec.name)
                     for i, (shape, t) in enumerate(self.arm_volume(spec.name, arm.home[None])):
                         self.world.add(f"@{spec.name}:{i}", shape, t, f"home:{spec.name}")
+                    if arm.base_hull is not None:  # bolted in place: there whether the arm is home or not
+                        self.world.add(f"@{spec.name}:base", *arm.base_hull, f"base:{spec.name}")
+                        self._bases += (f"base:{spec.name}",)
             self.homes = tuple(f"home:{s.name}" for s in self.scene.robots if not is_planar(s))
         return self.homes
 
@@ -173,9 +178,10 @@ class Grounder:
         arms but ``robot``, ``partner`` (which moves with ``robot``: the other arm of a handover, at the
         exchange or in transit) and the step's arms away from home then."""
         away = self._away.get(phase, self._away.get("*", frozenset()))
-        return tuple(
+        homes = tuple(
             h for h in self._arm_homes() if h not in (f"home:{robot}", f"home:{partner}") and h[5:] not in away
         )
+        return homes + tuple(b for b in self._bases if b != f"base:{robot}")
 
     # ------------------------------------------------------------ state
     def arm(self, robot: str) -> Arm:

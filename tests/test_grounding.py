@@ -276,3 +276,17 @@ def test_a_carry_crosses_the_table_above_what_may_stand_there() -> None:
     assert np.allclose(over[0], a) and np.allclose(over[-1], b)
     assert np.abs(np.diff(over, axis=0)).max() <= PATH_RESOLUTION + 1e-9
     assert g._held_bottom("r4", held, over).min() >= top  # raised: above whatever may stand there
+
+
+def test_other_arms_bases_are_obstacles_home_or_not(pa3: Grounder) -> None:
+    """An arm's base link (left out of its probes: its own links start on it) is an obstacle to every other
+    arm, also while that arm is away from home in the step (generated i67/i69: the validator rejected
+    grounded plans whose arm grazed another arm's base by 1.1-21.7 mm)."""
+    hull = pa3.arm("r2").base_hull
+    assert hull is not None
+    probe = [hull]
+    for pickers in ((), ("r2",)):  # r2 at home, then r2 picking in the step (its home links gone)
+        pa3.step(pickers, pickers)
+        assert pa3.world.probe_hits(probe, against=pa3._others_home("r1", phase="pick")) >= {"@r2:base"}
+        assert "@r2:base" not in pa3.world.probe_hits(probe, against=pa3._others_home("r2", phase="pick"))
+    pa3.step((), ())

@@ -26,6 +26,7 @@ from mrgc.compiler.task_graph import Action
 from mrgc.geometry.collision import CollisionWorld
 from mrgc.geometry.conventions import refine, to_se2
 from mrgc.geometry.grounding import BUSY, Answer, Grounder, GroundStatus, Volume
+from mrgc.language.model import Box
 from mrgc.planner.outcome import DeadlineReached, Failure
 from mrgc.planner.plan import PlannedAction
 
@@ -33,6 +34,8 @@ PLACEMENT_TRIES = 6  # placements sampled per place before the step gives up
 #: more placements an arm may try when they are out of its reach (a bin at the edge of the arm's reach:
 #: the corners come first when packing, and many are unreachable)
 OUT_OF_REACH_TRIES = 30
+#: other regions an obstacle with no reachable place in its own may be parked in, nearest first
+PARKING_REGIONS = 2
 RELAY_TRIES = 3  # spots tried per relay (the k-th spot both of its robots reach at the k-th try)
 #: paths replayed in another path's phase (the validator's execution model): name -> phase
 PATH_PHASE = {"taker-to-handover": "to-handover", "giver-home": "home"}
@@ -371,21 +374,60 @@ class ReverseGrounder:
             if isinstance(exchange, Failure):
                 return exchange
             start, lift = exchange, False  # the taker's transfer starts at the exchange
+        done = self._place(a, planned, a.region, start, lift, avoid, v_fut, key, placed, busy)
+        if not isinstance(done, Failure) or a.obj in self.goal or a.obj in self._forced:
+            return done
+        # beyond the paper: an obstacle with no place in its own region that its arm reaches (a crowded start
+        # region, the later steps' sweeps kept clear) is parked in another region the arm reaches
+        for region in self._parking(a):
+            parked = self._place(a, planned, region, start, lift, avoid, v_fut, f"{key}:park", placed, busy)
+            if not isinstance(parked, Failure):
+                return parked
+        return done
+
+    def _parking(self, a: Action) -> list[str]:
+        """The regions an obstacle ``a`` moves may be parked in when its own has no place for it: the other
+        box regions whose centre the placing arm reaches, regions nobody's goal first, then nearest the arm."""
+        g = self.g
+        arm = g.arm(a.place_robot)
+        goals = set(self.goal.values())
+        out = []
+        for r in g.scene.regions:
+            if r.name != a.region and isinstance(r.shape, Box) and arm.in_reach(r.pose[:3, 3], margin=0.1):
+                out.append((r.name in goals, float(np.linalg.norm(r.pose[:2, 3] - arm.base[:2, 3])), r.name))
+        return [name for _, _, name in sorted(out)][:PARKING_REGIONS]
+
+    def _place(
+        self,
+        a: Action,
+        planned: PlannedAction,
+        region: str,
+        start: np.ndarray,
+        lift: bool,
+        avoid: list[str],
+        v_fut: Volume,
+        key: str,
+        placed: dict[str, np.ndarray] | None,
+        busy: dict[str, Volume],
+    ) -> PlannedAction | Failure:
+        """Put ``a``'s object into ``region``: a placement, the place approach and the carry there from
+        ``start``, into ``planned`` (its region too); the failure of the last placement tried otherwise."""
+        g = self.g
         last: Failure | None = None
         tried = 0  # placements that failed for another reason than being out of the arm's reach
+        forced = self._forced.get(a.obj)
         # goal bins are shared by several objects: packed from the corners; elsewhere (moving an obstacle
         # aside) the middle of the region first, nearest the arms that reach it
-        forced = self._forced.get(a.obj)
         spots = (
             iter([forced])
             if forced is not None  # a relay sets its object down where its onward move picks it up
             else g.placements(
                 a.obj,
-                a.region,
+                region,
                 avoid=avoid,
                 volume=v_fut,
                 key=key,
-                packed=self.goal.get(a.obj) == a.region,
+                packed=self.goal.get(a.obj) == region,
                 prefer=g.comfortable(a.place_robot, a.obj, a.place_grasp),
             )
         )
@@ -394,7 +436,7 @@ class ReverseGrounder:
                 break
             pose = next(spots, None)
             if pose is None:
-                return last or Failure(0, "", f"placement: no free pose of {a.obj} in {a.region}")
+                return last or Failure(0, "", f"placement: no free pose of {a.obj} in {region}")
             place = g.place(a.place_robot, a.obj, a.place_grasp, pose, avoid=avoid, busy=busy.get("place", []))
             if not place.ok:
                 last = _failed(f"place by {a.place_robot}", place)
@@ -417,6 +459,7 @@ class ReverseGrounder:
             if not carry.ok:
                 last = _failed(f"carry to the placement by {a.place_robot}", carry)
                 continue
+            planned.region = region
             planned.place_pose = _matrix(pose)
             planned.configs["place"] = _configs(place.configs)
             planned.paths["to-place"] = _configs(np.array(carry.path))
@@ -443,14 +486,14 @@ class ReverseGrounder:
         the goal objects that the earlier steps still have to put into the same bin no free pose there
         (see :meth:`Grounder.crowded_out`); None when each still has one, or none is left to come."""
         later = {a.obj, *placed, *self.grounded}
-        still = [o for o in sorted(self.goal) if self.goal[o] == a.region and o not in later]
+        still = [o for o in sorted(self.goal) if self.goal[o] == planned.region and o not in later]
         if not still:
             return None
         mine = [p for phases in self._motions(planned).values() for vols in phases.values() for v in vols for p in v]
-        crowded = self.g.crowded_out(still, a.region, avoid, v_fut + mine, key)
+        crowded = self.g.crowded_out(still, planned.region, avoid, v_fut + mine, key)
         if crowded is None:
             return None
-        return Failure(0, "", f"placement: leaves no free pose of {crowded} in {a.region}")
+        return Failure(0, "", f"placement: leaves no free pose of {crowded} in {planned.region}")
 
     def _hand_over(
         self, a: Action, planned: PlannedAction, grasped: np.ndarray, avoid: list[str], busy: dict[str, Volume]

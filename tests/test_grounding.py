@@ -290,3 +290,21 @@ def test_other_arms_bases_are_obstacles_home_or_not(pa3: Grounder) -> None:
         assert pa3.world.probe_hits(probe, against=pa3._others_home("r1", phase="pick")) >= {"@r2:base"}
         assert "@r2:base" not in pa3.world.probe_hits(probe, against=pa3._others_home("r2", phase="pick"))
     pa3.step((), ())
+
+
+def test_an_obstacle_with_no_reachable_place_in_its_region_is_parked_in_another() -> None:
+    """Generated packaging i51 (seed 1051): r2 must clear obstacles from the crowded start region, and once
+    the later steps' sweeps are kept clear no free place there is within its reach (~100 skeletons failed
+    with "place by r2: no inverse kinematics" before).  Obstacles are parked in bin-b, a region nobody's
+    goal that r2 reaches (then goal bins with room left for their goals); the plan is valid."""
+    from mrgc.planner.plan import file_sha256
+    from mrgc.planner.search import plan_problem
+    from mrgc.planner.validate import validate
+
+    path = ROOT / "tests" / "data" / "park-packaging.mrg"
+    problem = parse_file(path).problem()
+    plan = plan_problem(problem, str(path), file_sha256(str(path)), mrgc.__version__, seed=0, time_limit=600)
+    assert plan.status == "solved", plan.summary()
+    parked = {a.region for step in plan.steps for a in step if a.object not in problem.goal_regions} - {"start"}
+    assert "bin-b" in parked  # nobody's goal, tried first; goal bins after it, keeping room for their goals
+    assert validate(problem, plan, str(path)).ok

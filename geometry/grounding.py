@@ -109,6 +109,9 @@ class Answer:
     #: what else was in the way when the status is COLLISION: fixed bodies, another arm at home, or what
     #: another robot of the step sweeps meanwhile (a line for the failure report)
     detail: str = ""
+    #: a failure that only what never moves explains (no IK, fixed bodies, other arms' base links): the same
+    #: query fails again in any state of the movable objects and the other robots
+    static: bool = False
 
     @property
     def ok(self) -> bool:
@@ -410,6 +413,7 @@ class Grounder:
         moving = self._busy_world(busy) if busy else None
         clash: tuple[str, Volume] | None = None  # the last attempt's collision not with ``avoid``: told at the end
         phase = key.split(":")[0]  # "pick", "place" or "handover"
+        static = True  # every attempt so far failed on what never moves (IK, fixed bodies, bases)
         for attempt in range(attempts):
             seed = seed_for(robot, obj, grasp, key, str(attempt), seed=self.seed)
             # the first attempt starts from home (the solution nearest it); the others from a start drawn from
@@ -422,9 +426,9 @@ class Grounder:
             q = solve_ik_many(arm.model, arm.ee_target(pose @ g_t)[None], seed, q_init=start)[0]
             if not q.solved or q.q is None:  # (q is None exactly when the solve failed)
                 if q.status.value == "unreachable":
-                    return Answer(GroundStatus.NO_IK)  # provably out of reach: no other seed helps
+                    return Answer(GroundStatus.NO_IK, static=True)  # provably out of reach: no other seed helps
                 if attempt + 1 >= IK_GIVE_UP and status is GroundStatus.NO_IK:
-                    return Answer(GroundStatus.NO_IK)  # no start converged (phase 1 gives up after as many)
+                    return Answer(GroundStatus.NO_IK, static=True)  # no start converged (phase 1 gives up too)
                 continue
             configs = self._approach_configs(arm, pose @ g_t, q.q, seed) if approach else np.asarray(q.q)[None]
             if configs is None:
@@ -437,7 +441,9 @@ class Grounder:
             self.queries += 1
             if self._fixed_clash(robot, obj, grasp, configs, volume, held, self._others_home(robot, partner, phase)):
                 status, clash = GroundStatus.COLLISION, ("fixed", volume)
+                static = static and self._static_clash(robot, obj, volume, held)
                 continue
+            static = False  # this attempt failed (if it did) on what moves
             hit = self.world.probe_hits(volume, against=avoid) if avoid else set()
             if hit:
                 blockers |= hit
@@ -451,7 +457,12 @@ class Grounder:
         detail = ""
         if clash is not None and not blockers:
             detail = self._clash_detail(robot, partner, phase, clash, ignore=() if held else (obj,))
-        return Answer(status, blockers=blockers, detail=detail)
+        return Answer(status, blockers=blockers, detail=detail, static=static)
+
+    def _static_clash(self, robot: str, obj: str, volume: Volume, held: bool) -> bool:
+        """Whether an approach volume hits what never moves: a fixed body or another arm's base link."""
+        bases = tuple(b for b in self._bases if b != f"base:{robot}")
+        return self.world.probe_collides(volume, against=("fixed", *bases), ignore=() if held else (obj,))
 
     def _fixed_clash(
         self, robot: str, obj: str, grasp: str, configs: np.ndarray, volume: Volume, held: bool, homes: tuple[str, ...]

@@ -101,6 +101,9 @@ class ReverseGrounder:
         self.grounded: set[str] = set()
         #: where the relays being grounded set their objects down (see :meth:`_relay_steps`)
         self._forced: dict[str, np.ndarray] = {}
+        #: (robot, object, grasp, placement) whose place failed on what never moves (no IK, fixed bodies):
+        #: later groundings pass over them without spending one of their tries
+        self._dead_spots: set[tuple[str, str, str, tuple[float, ...]]] = set()
 
     def ground(self, skeleton: Skeleton, suffix: list[GroundedStep], key: str = "") -> Grounding:
         """Ground ``skeleton``'s steps, last first, before the already grounded ``suffix`` (see the module
@@ -431,16 +434,21 @@ class ReverseGrounder:
                 prefer=g.comfortable(a.place_robot, a.obj, a.place_grasp),
             )
         )
-        for _ in range(PLACEMENT_TRIES + OUT_OF_REACH_TRIES):
-            if tried >= PLACEMENT_TRIES:
-                break
+        looked = 0
+        while looked < PLACEMENT_TRIES + OUT_OF_REACH_TRIES and tried < PLACEMENT_TRIES:
             pose = next(spots, None)
             if pose is None:
                 return last or Failure(0, "", f"placement: no free pose of {a.obj} in {region}")
+            spot = (a.place_robot, a.obj, a.place_grasp, _spot_key(pose))
+            if spot in self._dead_spots:
+                continue  # failed before on what never moves: fails again, and costs no try
+            looked += 1
             place = g.place(a.place_robot, a.obj, a.place_grasp, pose, avoid=avoid, busy=busy.get("place", []))
             if not place.ok:
                 last = _failed(f"place by {a.place_robot}", place)
                 tried += place.status is not GroundStatus.NO_IK
+                if place.static:
+                    self._dead_spots.add(spot)
                 continue
             tried += 1
             assert place.configs is not None
@@ -671,6 +679,12 @@ def label(a: Action) -> str:
     if a.pick_robot == a.place_robot:
         return f"{a.pick_robot} moves {a.obj} to {a.region} ({a.pick_grasp})"
     return f"{a.pick_robot}->{a.place_robot} hand {a.obj} over to {a.region} ({a.pick_grasp}->{a.place_grasp})"
+
+
+def _spot_key(pose: np.ndarray) -> tuple[float, ...]:
+    """A placement as a set key: its rotation and position rounded to 1e-6 (the same candidate drawn again by
+    another grounding is the same key)."""
+    return tuple(float(v) + 0.0 for v in np.round(pose[:3], 6).ravel())
 
 
 def _failed(what: str, answer: Answer) -> Failure:

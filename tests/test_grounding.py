@@ -308,3 +308,16 @@ def test_an_obstacle_with_no_reachable_place_in_its_region_is_parked_in_another(
     parked = {a.region for step in plan.steps for a in step if a.object not in problem.goal_regions} - {"start"}
     assert "bin-b" in parked  # nobody's goal, tried first; goal bins after it, keeping room for their goals
     assert validate(problem, plan, str(path)).ok
+
+
+def test_failures_say_whether_only_what_never_moves_explains_them(pa3: Grounder) -> None:
+    """A place that fails on the table or on IK fails again whatever moves (``static``: grounding passes over
+    that placement later without spending a try; generated i20, a side grasp whose place hits the table at
+    most placements of its bin, was a time limit with both seeds and is solved); one blocked by a movable
+    object is not static."""
+    sunk = pa3.poses["o1"] @ translation(0, 0, -0.03)  # 3 cm into the table: the held object hits it
+    into_table = pa3.place("r1", "o1", "top", sunk)
+    assert into_table.status is GroundStatus.COLLISION and into_table.static
+    assert pa3.place("r2", "o1", "top", pa3.poses["o1"]).static  # out of r2's reach: no IK
+    blocked = pa3.place("r1", "o1", "side-x+", pa3.poses["o1"], avoid=["o2"])
+    assert blocked.status is GroundStatus.COLLISION and "o2" in blocked.blockers and not blocked.static

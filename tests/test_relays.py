@@ -95,3 +95,15 @@ def test_a_generated_table_without_a_one_move_plan_is_planned_with_a_relay(seed:
     assert plan.validation is not None and plan.validation["valid"] is True
     report = validate(problem, plan, str(GENERATED))  # the referee again, outside the search
     assert report.ok, [str(v) for v in report.violations]
+
+
+def test_compile_json_names_the_relay_region(capsys: pytest.CaptureFixture[str]) -> None:
+    import json
+
+    from mrgc import cli
+
+    assert cli.main(["compile", str(SYMBOLIC), "--format", "json"]) == 0
+    (skeleton,) = json.loads(capsys.readouterr().out)["skeletons"]
+    acts = [a for step in skeleton["steps"] for a in step]
+    assert [a.get("via") for a in acts if a["object"] == "o1"] == ["mid"]
+    assert all("via" not in a for a in acts if a["object"] != "o1")

@@ -32,6 +32,7 @@ from typing import Any, Iterable, Mapping
 import numpy as np
 
 from mrgc.errors import Diagnostic, InputError
+from mrgc.render.palette import moved_text
 from mrgc.render.world import World
 
 #: the phases of a step, in order
@@ -171,6 +172,7 @@ class _Act:
     configs: dict[str, np.ndarray]
     paths: dict[str, np.ndarray]
     point: str | None
+    relay: bool = False  # the object is only set down in ``region`` on its way (a relay move)
 
     @property
     def handover(self) -> bool:
@@ -180,7 +182,8 @@ class _Act:
         who = self.giver if not self.handover else f"{self.giver}->{self.taker}"
         grasp = self.g1 if not self.handover else f"{self.g1}->{self.g2}"
         at = f" at {self.point}" if self.handover and self.point else ""
-        return f"{who}: {self.obj} -> {self.region} ({grasp}){at}"
+        where = f"set down in {self.region}" if self.relay else f"-> {self.region}"
+        return f"{who}: {self.obj} {where} ({grasp}){at}"
 
 
 def build_timeline(world: World, plan: Mapping[str, Any], source: str = "plan") -> Timeline:
@@ -195,9 +198,8 @@ def build_timeline(world: World, plan: Mapping[str, Any], source: str = "plan") 
     n = len(steps)
     for t, acts in enumerate(steps, 1):
         phases += _step_phases(world, t, n, acts, home)
-    moved = sum(len(a) for a in steps)
     title = (
-        f"{world.problem.name}: {n} step{'s' * (n != 1)}, {moved} object{'s' * (moved != 1)} moved"
+        f"{world.problem.name}: {n} step{'s' * (n != 1)}, {moved_text([[a.obj for a in acts] for acts in steps])}"
         if n
         else f"{world.problem.name}: the plan has no steps"
     )
@@ -371,6 +373,7 @@ def _parse(world: World, a: Mapping[str, Any], t: int, source: str) -> _Act:
         configs,
         paths,
         a.get("handover_point"),
+        bool(a.get("relay", False)),
     )
 
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 from typing import Any, Mapping
 
 from mrgc.language.model import Problem
-from mrgc.render.palette import ROLE_COLOURS, Role, moved_objects, robot_colours, roles
+from mrgc.render.palette import ROLE_COLOURS, Role, moved_objects, moved_text, robot_colours, roles
 
 BAR = 0.74  # bar width (steps) and height (rows)
 
@@ -73,7 +73,8 @@ def write(problem: Problem, plan: Mapping[str, Any], path: str) -> None:
         ax.grid(which="minor", axis="x", color="0.85")
         ax.tick_params(which="minor", length=0)
         ax.set_title(
-            f"{problem.name}: {len(steps)} steps, {sum(len(s.get('actions', [])) for s in steps)} objects moved"
+            f"{problem.name}: {len(steps)} steps, "
+            + moved_text([[a["object"] for a in s.get("actions", [])] for s in steps])
         )
         ax.legend(
             handles=[

@@ -107,3 +107,15 @@ def test_compile_json_names_the_relay_region(capsys: pytest.CaptureFixture[str])
     acts = [a for step in skeleton["steps"] for a in step]
     assert [a.get("via") for a in acts if a["object"] == "o1"] == ["mid"]
     assert all("via" not in a for a in acts if a["object"] != "o1")
+
+
+def test_pictures_of_a_relay_plan_say_set_down_and_count_objects_and_moves() -> None:
+    from mrgc.render.frames import build_timeline
+    from mrgc.render.world import World
+
+    problem = _problem(GENERATED)
+    plan = _plan(problem, GENERATED).to_json()
+    timeline = build_timeline(World(problem, plan), plan)
+    assert timeline.title.endswith("3 objects moved in 4 moves")
+    labels = {p.caption for p in timeline.phases if p.step == 3}
+    assert any("o3 set down in start" in label for label in labels), labels

@@ -20,8 +20,10 @@ from __future__ import annotations
 
 import enum
 import hashlib
+from contextlib import contextmanager
 from dataclasses import dataclass, field
-from typing import Callable, Hashable, Iterable, Iterator, Sequence
+from functools import cached_property
+from typing import Callable, Hashable, Iterable, Iterator, Mapping, Sequence
 
 import numpy as np
 
@@ -207,6 +209,19 @@ class Grounder:
         """Put ``obj`` at ``pose`` (world) for all later queries."""
         self.poses[obj] = pose.copy()
         self.world.set_transform(obj, pose)
+
+    @contextmanager
+    def moved(self, poses: Mapping[str, np.ndarray]) -> Iterator[None]:
+        """The objects at ``poses`` for the queries inside the ``with`` block, back where they were after it
+        (also when it raises)."""
+        before = {o: self.poses[o] for o in poses}
+        try:
+            for o, pose in poses.items():
+                self.move(o, pose)
+            yield
+        finally:
+            for o, pose in before.items():
+                self.move(o, pose)
 
     def shape(self, obj: str) -> CollisionShape:
         """The collision shape of body ``obj``."""
@@ -832,7 +847,7 @@ class Grounder:
         start grid) a lift of a few centimetres leaves the object boxed in, and every carry from there has
         to find the way up by sampling.  With ``start`` (lifting it where it rests now) or ``goal`` (the
         robot, grasp and configuration holding it above its placement), at least until its bottom clears
-        :meth:`standing_top` by 1 cm: a carry crosses the table above anything that may stand there."""
+        :attr:`standing_top` by 1 cm: a carry crosses the table above anything that may stand there."""
         pose, h = self.poses[obj], half_extents(self.scene.body(obj).shape)
         bottom, reach = pose[2, 3] - h[2], float(np.hypot(h[0], h[1])) + NEIGHBOURHOOD
         top = bottom
@@ -847,9 +862,10 @@ class Grounder:
             if goal is not None:
                 robot, grasp, q = goal
                 bottom = self._held_bottom(robot, (obj, grasp), np.asarray(q)[None])[0]
-            lift = max(lift, self.standing_top() - bottom + 0.01)
+            lift = max(lift, self.standing_top - bottom + 0.01)
         return float(np.clip(lift, TRANSFER_LIFT, MAX_LIFT))
 
+    @cached_property
     def standing_top(self) -> float:
         """The highest top of a movable object standing on the lowest region floor (the top of the tallest
         object wherever it is placed), world z."""
@@ -872,7 +888,7 @@ class Grounder:
     def _over(self, robot: str, held: tuple[str, str], a: np.ndarray, b: np.ndarray) -> np.ndarray | None:
         """The joint-space line from ``a`` to ``b`` (both holding ``held``) with its points every
         :data:`CARRY_STEP` of the tool's horizontal travel raised (the tool straight up, by IK from the
-        line's configuration) where the held object's bottom dips below :meth:`standing_top` + 1 cm or
+        line's configuration) where the held object's bottom dips below :attr:`standing_top` + 1 cm or
         below both ends, whichever is lower; at :data:`PATH_RESOLUTION`.  None when the line does not dip
         or a raised point has no IK solution near the line."""
         arm = self.arm(robot)
@@ -883,7 +899,7 @@ class Grounder:
         s = np.linspace(0.0, 1.0, n + 1)[:, None]
         configs = a[None] * (1 - s) + b[None] * s
         bottoms = self._held_bottom(robot, held, configs)
-        floor = min(self.standing_top() + 0.01, max(bottoms[0], bottoms[-1]))
+        floor = min(self.standing_top + 0.01, max(bottoms[0], bottoms[-1]))
         low = [k for k in range(1, n) if bottoms[k] < floor - 0.005]
         if not low:
             return None

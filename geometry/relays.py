@@ -76,16 +76,18 @@ def relay_facts(scene: SceneSpec, facts: Iterable[Fact], spots: dict[str, Spots]
     facts = list(facts)
     pick = {f.args for f in facts if f.predicate == "reachable-pick"}
     place = {f.args for f in facts if f.predicate == "reachable-place"}
+    # robot -> (object, region, lattice index) -> the grasps it holds the object with there
+    grasps: dict[str, dict[tuple[str, str, int], set[str]]] = {}
+    for robot, reached in spots.items():
+        for obj, grasp, region, k in reached:
+            grasps.setdefault(robot, {}).setdefault((obj, region, k), set()).add(grasp)
     out: set[Fact] = set()
-    for r1, mine in sorted(spots.items()):
-        for r2, theirs in sorted(spots.items()):
-            for obj, g1, region, k in sorted(mine):
-                if (obj, g1, r1) not in pick:
-                    continue
+    for r1, mine in grasps.items():
+        for r2, theirs in grasps.items():
+            for (obj, region, k), g1s in mine.items():
                 goal = scene.goal[obj]
-                for o2, g2, region2, k2 in sorted(theirs):
-                    if (o2, region2, k2) != (obj, region, k) or (r1, g1) == (r2, g2):
-                        continue
-                    if (obj, goal, g2, r2) in place:
-                        out.add(Fact("enable-relay", (obj, region, g1, g2, r1, r2)))
+                for g1 in g1s:
+                    for g2 in theirs.get((obj, region, k), ()):
+                        if (r1, g1) != (r2, g2) and (obj, g1, r1) in pick and (obj, goal, g2, r2) in place:
+                            out.add(Fact("enable-relay", (obj, region, g1, g2, r1, r2)))
     return out

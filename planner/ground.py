@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import enum
 import time
+from contextlib import ExitStack
 from dataclasses import dataclass, field, replace
 from typing import Iterable
 
@@ -201,14 +202,8 @@ class ReverseGrounder:
             spots = self._spots(relays, avoid | {a.obj for a in step}, v_fut, f"{key}:relay", k)
             if isinstance(spots, Failure):
                 return last if k else replace(spots, step=index)
-            initial = {o: self.g.poses[o] for o in spots}
-            try:
-                for o, pose in spots.items():
-                    self.g.move(o, pose)
+            with self.g.moved(spots):
                 tail = self._steps(onward, avoid, v_fut, f"{key}:onward:{k}", index)
-            finally:
-                for o, pose in initial.items():
-                    self.g.move(o, pose)
             if isinstance(tail, Failure):
                 last = tail
                 continue
@@ -246,12 +241,8 @@ class ReverseGrounder:
                     break
                 if not g.place(a.pick_robot, a.obj, a.pick_grasp, pose, avoid=others).ok:
                     continue
-                initial = g.poses[a.obj]
-                g.move(a.obj, pose)
-                try:
+                with g.moved({a.obj: pose}):
                     ok = g.pick(a.place_robot, a.obj, a.place_grasp, avoid=others).ok
-                finally:
-                    g.move(a.obj, initial)
                 if ok and found == k:
                     out[a.obj] = pose
                     taken.append((g.shape(a.obj), pose))
@@ -557,13 +548,13 @@ class ReverseGrounder:
             mine["to-handover"] = g.arm_volume(
                 a.pick_robot, np.array(planned.paths["to-handover"]), holding=(a.obj, a.pick_grasp)
             )
-        initial = {o: g.poses[o] for o in new}
-        try:
+        home = False
+        with ExitStack() as stack:
             for name, robot, start, goal, obstacles, via in asks:
                 phase = PATH_PHASE.get(name, name)
-                if phase == "home":
-                    for o, pose in new.items():
-                        g.move(o, pose)
+                if phase == "home" and not home:  # the home phases come last: the step's objects placed
+                    stack.enter_context(g.moved(new))
+                    home = True
                 other = ({a.pick_robot, a.place_robot} - {robot}) if phase != "to-pick" else set()
                 ans = g.transit(
                     robot,
@@ -579,9 +570,6 @@ class ReverseGrounder:
                     return _failed(f"{name} of {robot}", ans)
                 planned.paths[name] = _configs(np.array(ans.path))
                 mine.setdefault(phase, []).extend(g.arm_volume(robot, np.array(ans.path)))
-        finally:
-            for o, pose in initial.items():
-                g.move(o, pose)
         return None
 
     def _drive(
@@ -625,14 +613,8 @@ class ReverseGrounder:
                 last = _failed("carry to the placement", carry)
                 continue
             new = {**placed, a.obj: spot.pose}
-            initial = {o: g.poses[o] for o in new}
-            for o, pose in new.items():
-                g.move(o, pose)
-            try:
+            with g.moved(new):
                 back = g.base_path(robot, q_place, home, avoid=sorted({*avoid, *new}), busy=busy.get("home", []))
-            finally:
-                for o, pose in initial.items():
-                    g.move(o, pose)
             if not back.ok:
                 last = _failed("drive home", back)
                 continue

@@ -224,16 +224,15 @@ class Plan:
         """The plan file's text."""
         return json.dumps(self.to_json(), indent=1, sort_keys=False) + "\n"
 
-    def _moved_text(self) -> str:
-        """``5 objects moved`` (and ``in 6 moves`` when relays move some twice)."""
-        objects = len({a.object for step in self.steps for a in step})
-        return f"{objects} objects moved" + (f" in {self.motion_cost} moves" if objects != self.motion_cost else "")
-
     def summary(self) -> list[str]:
         """The plan in a few lines, as ``mrgc plan`` prints it."""
         lines = [
             f"plan for {self.problem}: {self.status}"
-            + (f", makespan {self.makespan}, {self._moved_text()}" if self.steps else "")
+            + (
+                f", makespan {self.makespan}, {moved_text([[a.object for a in step] for step in self.steps])}"
+                if self.steps
+                else ""
+            )
         ]
         for i, step in enumerate(self.steps, 1):
             parts = []
@@ -246,6 +245,13 @@ class Plan:
         if self.why is not None and self.status is not PlanStatus.SOLVED:
             lines += self.why.lines()
         return lines
+
+
+def moved_text(steps: list[list[str]]) -> str:
+    """``3 objects moved`` (``in 4 moves`` when a relay moves one twice) for the objects each step moves."""
+    objects, moves = len({o for step in steps for o in step}), sum(len(step) for step in steps)
+    text = f"{objects} object{'s' * (objects != 1)} moved"
+    return text + (f" in {moves} moves" if moves != objects else "")
 
 
 def file_sha256(path: str) -> str:

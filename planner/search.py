@@ -326,21 +326,22 @@ def _log_line(elapsed: float, n: int, skel: Skeleton, suffix: list[GroundedStep]
     return f"{head}: fails at {f.line() if f else result.reason}"
 
 
+def planned_action(a: Action, relay: bool = False) -> PlannedAction:
+    """A skeleton's (relay-free) action as the plan's action, without geometry."""
+    return PlannedAction(a.obj, a.region, a.pick_robot, a.place_robot, a.pick_grasp, a.place_grasp, relay=relay)
+
+
 def planned_steps(step: tuple[Action, ...]) -> list[list[PlannedAction]]:
     """A skeleton step as the plan's steps, without geometry: the step itself, and when it holds relays, a
     second step with their onward moves (the first step sets their objects down)."""
     first, onward = [], []
     for a in step:
         if a.via is None:
-            first.append(PlannedAction(a.obj, a.region, a.pick_robot, a.place_robot, a.pick_grasp, a.place_grasp))
+            first.append(planned_action(a))
             continue
         down, on = a.halves
-        first.append(
-            PlannedAction(
-                down.obj, down.region, down.pick_robot, down.place_robot, down.pick_grasp, down.place_grasp, relay=True
-            )
-        )
-        onward.append(PlannedAction(on.obj, on.region, on.pick_robot, on.place_robot, on.pick_grasp, on.place_grasp))
+        first.append(planned_action(down, relay=True))
+        onward.append(planned_action(on))
     return [first, onward] if onward else [first]
 
 

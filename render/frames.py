@@ -32,7 +32,7 @@ from typing import Any, Iterable, Mapping
 import numpy as np
 
 from mrgc.errors import Diagnostic, InputError
-from mrgc.render.palette import moved_text
+from mrgc.planner.plan import moved_text
 from mrgc.render.world import World
 
 #: the phases of a step, in order

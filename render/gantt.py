@@ -13,7 +13,8 @@ from __future__ import annotations
 from typing import Any, Mapping
 
 from mrgc.language.model import Problem
-from mrgc.render.palette import ROLE_COLOURS, Role, moved_objects, moved_text, robot_colours, roles
+from mrgc.planner.plan import moved_text
+from mrgc.render.palette import ROLE_COLOURS, Role, moved_objects, robot_colours, roles
 
 BAR = 0.74  # bar width (steps) and height (rows)
 

@@ -70,10 +70,3 @@ def byte_colour(rgb: RGB) -> tuple[int, int, int]:
     """An RGB colour in [0, 1] as bytes (0-255)."""
     r, g, b = (round(max(0.0, min(1.0, c)) * 255) for c in rgb)
     return r, g, b
-
-
-def moved_text(steps: list[list[str]]) -> str:
-    """``3 objects moved`` (``in 4 moves`` when a relay moves one twice) for the objects each step moves."""
-    objects, moves = len({o for step in steps for o in step}), sum(len(step) for step in steps)
-    text = f"{objects} object{'s' * (objects != 1)} moved"
-    return text + (f" in {moves} moves" if moves != objects else "")

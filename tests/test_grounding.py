@@ -262,7 +262,7 @@ def test_a_carry_crosses_the_table_above_what_may_stand_there() -> None:
     assert pick.ok and pick.configs is not None
     place = next(a for pose in g.placements("o1", "start", packed=True) if (a := g.place("r4", *held, pose)).ok)
     assert place.configs is not None
-    top = g.standing_top()
+    top = g.standing_top
     assert top == pytest.approx(0.12)  # the tallest movable object, on the table
     up = g._lift("r4", pick.configs[-1], g.lift_height("o1", start=True))
     down = g._lift("r4", place.configs[0], g.lift_height("o1", goal=("r4", "top", place.configs[0])))

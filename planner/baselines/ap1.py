@@ -44,8 +44,8 @@ from mrgc.compiler.task_graph import _actions_for as facts_actions
 from mrgc.language.model import Problem
 from mrgc.planner.ground import GroundedStep, label, moved_objects
 from mrgc.planner.outcome import Failure, PlanStatus, Why
-from mrgc.planner.plan import Plan, PlannedAction, planner_motion_model
-from mrgc.planner.search import MOTIONS
+from mrgc.planner.plan import Plan, planner_motion_model
+from mrgc.planner.search import MOTIONS, planned_action
 from mrgc.planner.skeletons import must_move, problem_facts
 
 #: joint-action groundings the first depth-first run may make; every restart doubles it
@@ -141,9 +141,7 @@ class SymbolicSteps:
                     hits.add(b)
         if strict and hits:
             return Failure(index, " + ".join(label(a) for a in actions), "obstructed", tuple(sorted(hits)))
-        planned = [
-            PlannedAction(a.obj, a.region, a.pick_robot, a.place_robot, a.pick_grasp, a.place_grasp) for a in actions
-        ]
+        planned = [planned_action(a) for a in actions]
         return Attempt(GroundedStep(planned, [], tuple(a.obj for a in actions)), hits)
 
 

@@ -30,6 +30,9 @@ RANGES = {"--robots": (2, 6), "--goals": (1, 12), "--others": (0, 30)}
 
 SHOULDER = 0.333  # height of the Panda's shoulder (first joint) above its base (m)
 REACH = 0.8  # the reach sphere around the shoulder that bins and the start region are kept in (Panda: 0.855)
+#: no grasp of an object whose centre is farther than this from an arm's shoulder is within that arm's
+#: reach: the Panda's 0.855 m to the flange, its 0.105 m tool, and 4 cm from an object's centre to a grasp
+GOAL_REACH = 1.0
 ARM_SPACING = 0.35  # least distance between two arm bases
 BASE_CLEARANCE = 0.15  # regions keep this far (horizontally) from every arm base
 EDGE_OFFSET = (-0.12, 0.10)  # base distance outside the table edge (negative: on the table)
@@ -94,7 +97,7 @@ def packaging(robots: int = 2, goals: int = 3, others: int = 2, seed: int = 0) -
     counts = {"--robots": robots, "--goals": goals, "--others": others}
     rng, layout = draw_layout("packaging", RANGES, counts, seed, lambda rng: _layout(rng, robots, goals, others))
     table, arms, start, objects, bins, handovers, pitch = layout
-    goal_idx = sorted(int(i) for i in rng.choice(len(objects), goals, replace=False))
+    goal_idx = _within_reach(arms, objects, [int(i) for i in rng.choice(len(objects), goals, replace=False)])
     goal_bin = {i: bins[int(rng.integers(len(bins)))].name for i in goal_idx}
     # a stream of its own, so that a layout that needs no repair stays exactly as drawn
     handovers = _connect(np.random.default_rng([seed, 1]), arms, table, objects, bins, goal_bin, handovers)
@@ -119,6 +122,26 @@ def packaging(robots: int = 2, goals: int = 3, others: int = 2, seed: int = 0) -
         [f"({h} :position ({num(x)} {num(y)} {num(z)}))" for h, (x, y, z) in handovers],
     )
     return document("packaging", command, summary, body)
+
+
+def _within_reach(arms: list[Arm], objects: list[Item], drawn: list[int]) -> list[int]:
+    """The goal objects, sorted: the drawn ones, except that a drawn object whose centre lies farther than
+    GOAL_REACH from every arm's shoulder (no arm can grasp it at all) is swapped for the nearest object
+    within GOAL_REACH of some shoulder that is not a goal yet (ties: the lower index), while there is one.
+    No random number is drawn, so a draw whose goals are all within reach is kept as it is."""
+
+    def graspable(item: Item) -> bool:
+        return any(a.shoulder_distance(item.foot.x, item.foot.y, item.height / 2) <= GOAL_REACH for a in arms)
+
+    goals = list(drawn)
+    for k, i in enumerate(drawn):
+        if graspable(objects[i]):
+            continue
+        spare = [j for j in range(len(objects)) if j not in goals and graspable(objects[j])]
+        if spare:
+            here = objects[i].foot
+            goals[k] = min(spare, key=lambda j: (math.hypot(objects[j].foot.x - here.x, objects[j].foot.y - here.y), j))
+    return sorted(goals)
 
 
 def _layout(rng: np.random.Generator, robots: int, goals: int, others: int):  # type: ignore[no-untyped-def]

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 from support import ROOT
 
@@ -322,6 +322,23 @@ def test_phase1_yields_facts(text: str) -> None:
     predicates = {f.predicate for f in facts}
     assert {"in-region", "reachable-pick"} <= predicates, predicates
     assert sum(f.predicate == "in-region" for f in facts) == len(problem.movable)
+
+
+@SETTINGS
+@given(st.integers(2, 6), st.integers(1, 12), st.integers(0, 30), st.integers(0, 10_000))
+@example(2, 5, 5, 1033)  # benchmarks/generated.py's i33: two goal objects 1.02 and 1.30 m from the shoulders as drawn
+def test_packaging_goal_objects_are_within_an_arms_reach(robots: int, goals: int, others: int, seed: int) -> None:
+    """A goal object's centre lies within 1 m of some arm's shoulder (farther, the Panda cannot grasp it at
+    all) whenever enough objects are: otherwise every object that is within it is a goal."""
+    problem = parse(packaging(robots=robots, goals=goals, others=others, seed=seed))
+    shoulders = [(r.base.x, r.base.y, SHOULDER) for r in problem.robots]
+    near = set()
+    for o in problem.movable:
+        assert o.pose is not None
+        if min(math.dist(s, (o.pose.x, o.pose.y, o.pose.z)) for s in shoulders) <= 1.0 + 1e-6:
+            near.add(o.name)
+    goal = set(problem.goal_regions)
+    assert goal <= near if len(near) >= len(goal) else near <= goal, (sorted(goal - near), sorted(near - goal))
 
 
 @SETTINGS

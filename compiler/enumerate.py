@@ -6,6 +6,11 @@ encodings the horizon grows T = T0, T0+1, ... up to the limit, carrying the cuts
 model of horizon T yields skeletons with exactly T non-empty steps, cheapest first.  For time-of-move one
 model covers every makespan up to the limit.  ``next(k)`` returns the next k skeletons and keeps the solver,
 the horizon and the cuts, so asking again continues where it stopped.
+
+Beyond the paper, actions may be *deferred* (:meth:`SkeletonGenerator.defer`; the planner defers an action
+whose grounding keeps failing): the skeletons that hold none of them come first, and when those are used
+up the deferral is lifted once and enumeration goes on from the first horizon with every cut kept, so no
+skeleton is lost, only later (the (makespan, moved) order then holds within each of the two parts).
 """
 
 from __future__ import annotations
@@ -14,13 +19,13 @@ import enum
 import math
 import time
 from dataclasses import dataclass, field
-from typing import Callable
+from typing import Callable, Iterable
 
 from mrgc.compiler.diagnose import prune
 from mrgc.compiler.encodings.base import Encoded, Encoding
 from mrgc.compiler.ir import Row, Solver, SolveStatus
 from mrgc.compiler.skeleton import Skeleton
-from mrgc.compiler.task_graph import TaskGraph
+from mrgc.compiler.task_graph import Action, TaskGraph
 
 
 class BatchOutcome(enum.StrEnum):
@@ -60,7 +65,11 @@ class SkeletonGenerator:
         self.limit = min(max_makespan, complete) if max_makespan is not None else complete
         robots = max(1, len(graph.robots))
         self.horizon = max(1, math.ceil(len(graph.must_move) / robots))  # each step moves <= |R| objects
+        self.first_horizon = self.horizon
         self.found: list[frozenset[int]] = []
+        #: actions (indices) kept out of the skeletons until the others are used up; then ``lifted``
+        self.deferred: set[int] = set()
+        self.lifted = False
         self.solver: Solver | None = None
         self.encoded: Encoded | None = None
         self.done = False
@@ -68,7 +77,28 @@ class SkeletonGenerator:
         self.stats: dict[str, float] = {"solves": 0, "solve_seconds": 0.0, "build_seconds": 0.0, "models": 0}
 
     def _cuts(self, enc: Encoded) -> list[Row]:
-        return [enc.cut(s, name=f"cut{i}") for i, s in enumerate(self.found)]
+        cuts = [enc.cut(s, name=f"cut{i}") for i, s in enumerate(self.found)]
+        return cuts + (_out(enc, self.deferred) if not self.lifted else [])
+
+    def defer(self, actions: Iterable[Action]) -> None:
+        """Keep ``actions`` (those of this graph; others are ignored) out of the skeletons given next, until
+        no other skeleton is left; no effect once the deferral has been lifted."""
+        index = {a: i for i, a in enumerate(self.graph.actions)}
+        new = {index[a] for a in actions if a in index} - self.deferred
+        if self.lifted or not new:
+            return
+        self.deferred |= new
+        if self.solver is not None and self.encoded is not None:
+            self.solver.add_rows(_out(self.encoded, new))
+
+    def _used_up(self) -> bool:
+        """Whether enumeration is over; when only the deferred actions' skeletons are left, the deferral
+        is lifted (once) and enumeration starts again at the first horizon, with the cuts."""
+        if not self.deferred or self.lifted:
+            return True
+        self.lifted = True
+        self.horizon, self.solver, self.done = self.first_horizon, None, False
+        return False
 
     def _load(self) -> None:
         t0 = time.perf_counter()
@@ -89,7 +119,7 @@ class SkeletonGenerator:
             self.done = True
             return Batch([Skeleton(())] if k > 0 else [], BatchOutcome.EXHAUSTED, stats=dict(self.stats))
         while len(out) < k:
-            if self.done or self.horizon > self.limit:
+            if (self.done or self.horizon > self.limit) and self._used_up():
                 self.done = True
                 return Batch(out, BatchOutcome.EXHAUSTED, stats=dict(self.stats))
             if self.solver is None:
@@ -118,3 +148,8 @@ class SkeletonGenerator:
             else:
                 return Batch(out, BatchOutcome.ERROR, sol.message, stats=dict(self.stats))
         return Batch(out, BatchOutcome.ENOUGH, stats=dict(self.stats))
+
+
+def _out(enc: Encoded, actions: Iterable[int]) -> list[Row]:
+    """Rows keeping each of ``actions`` out of the skeleton (its selection literal 0)."""
+    return [Row(((enc.select[i], 1),), hi=0, name=f"defer{i}") for i in sorted(actions)]

@@ -37,6 +37,10 @@ Log = Callable[[str], None]
 #: the arms' motion models ``plan_problem`` can plan (docs/validator.md)
 MOTIONS = ("configurations", "full")
 
+#: an action whose grounding failed this many times is deferred: skeletons without it come first
+#: (beyond the paper; docs/planner.md, "Deferred actions")
+DEFER_AFTER = 3
+
 
 def plan_problem(
     problem: Problem,
@@ -111,7 +115,10 @@ def plan_problem(
                 result = _referee(problem, problem_file, plan, result, why, validation)
             for f in result.failures:
                 why.add(f)
+            deferred = sources.failed(skel, result.failures) if result.outcome is Outcome.FAIL else None
             say(_log_line(time.perf_counter() - t0, count[0], skel, suffix, result))
+            if deferred is not None:
+                say(f"  deferred after {DEFER_AFTER} failures: {deferred} (skeletons without it come first)")
             return result
 
         search = MCTS(ground, sources, set(start), c=c, alpha=alpha, k=skeletons)
@@ -120,6 +127,7 @@ def plan_problem(
         stats.update({k: (round(v, 4) if isinstance(v, float) else v) for k, v in result.stats.items()})
         stats["iterations"] = result.iterations
         stats["geometric_queries"] = grounder.queries
+        stats["deferred_actions"] = len(sources.deferred)
         stats["validation_seconds"] = round(validation.get("seconds", 0.0), 4)
         why.summary = _summary(plan.status, result.ended, time_limit, max_iterations, why)
     stats["seconds"] = round(time.perf_counter() - t0, 4)
@@ -132,14 +140,17 @@ class _Skeletons:
     ``k``, the next ``k`` skeletons within the time left; it counts the skeletons it gave and keeps why its
     last batch stopped."""
 
-    def __init__(self, source: SkeletonSource, deadline: float) -> None:
+    def __init__(self, source: SkeletonSource, deadline: float, deferred: set[Action]) -> None:
         self.source = source
         self.deadline = deadline
+        #: the search's deferred actions (shared by every source; read at each call)
+        self.deferred = deferred
         self.count = 0
         self.outcome: BatchOutcome | None = None
 
     def __call__(self, k: int) -> list[Skeleton]:
         left = max(0.01, self.deadline - time.perf_counter())
+        self.source.generator.defer(self.deferred)
         batch = self.source.next(k, time_limit=left)
         self.count += len(batch.skeletons)
         self.outcome = batch.outcome
@@ -175,6 +186,9 @@ class _Sources:
         self.backend, self.encoding, self.max_makespan, self.seed = backend, encoding, max_makespan, seed
         self.deadline = deadline
         self.roots: list[_Skeletons] = []
+        #: how often each skeleton action was the one a grounding failed at, and those deferred
+        self.failures: dict[Action, int] = {}
+        self.deferred: set[Action] = set()
 
     def __call__(self, need: set[str], moved: set[str]) -> _Skeletons:
         src = SkeletonSource(
@@ -186,7 +200,7 @@ class _Sources:
             self.max_makespan,
             self.seed,
         )
-        more = _Skeletons(src, self.deadline)
+        more = _Skeletons(src, self.deadline, self.deferred)
         if not self.roots:
             self.roots.append(more)
         return more
@@ -195,6 +209,21 @@ class _Sources:
     def root(self) -> _Skeletons:
         """The first source made: the root's."""
         return self.roots[0]
+
+    def failed(self, skeleton: Skeleton, failures: list[Failure]) -> Action | None:
+        """Count the action of ``skeleton`` a failed grounding names (its first failure's step and action);
+        at DEFER_AFTER failures the action is deferred by every source (returned when that happens now)."""
+        from mrgc.planner.ground import label
+
+        if not failures or not 1 <= failures[0].step <= skeleton.makespan:
+            return None
+        for a in skeleton.steps[failures[0].step - 1]:
+            if label(a) == failures[0].action:
+                self.failures[a] = self.failures.get(a, 0) + 1
+                if self.failures[a] == DEFER_AFTER:
+                    self.deferred.add(a)
+                    return a
+        return None
 
 
 def _conclude_symbolic(plan: Plan, why: Why, more: _Skeletons, time_limit: float) -> None:

@@ -18,11 +18,12 @@ from pathlib import Path
 from typing import Any, Sequence
 
 import pytest
-from hypothesis import HealthCheck, event, given, settings
+from hypothesis import HealthCheck, assume, event, given, settings
 from hypothesis import strategies as st
 
 from mrgc import cli, parse_file, parse_string
 from mrgc.compiler.diagnose import explain_infeasible, explain_waits, orderable
+from mrgc.compiler.enumerate import BatchOutcome
 from mrgc.compiler.facts import FactBase
 from mrgc.compiler.task_graph import Action, build_task_graph
 from mrgc.language.model import Problem
@@ -130,6 +131,38 @@ def test_resumed_requests_with_moved_objects_and_a_horizon_limit(case: SymbolicC
                 if bad or any(a.obj in moved for a in sk.actions):
                     failures.append(f"{backend}/{encoding}: {sk.describe()} violates {bad} (moved: {moved})")
     assert not failures, "\n".join(failures) + f"\n\nM* {must}, moved {moved}, limit {limit}\n" + text
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@given(problems(), st.data())
+def test_deferred_actions_come_last_and_no_skeleton_is_lost(case: SymbolicCase, data: Any) -> None:
+    """Actions deferred after the first skeleton (what the planner does with an action whose grounding
+    keeps failing): the skeletons without them come first, in (makespan, moved) order, then the deferral
+    is lifted and the others follow, so that enumeration to the end still returns every feasible action
+    set of the oracle exactly once, each at its minimum makespan."""
+    problem, text = case.problem(), case.text
+    sets = oracle.feasible_action_sets(reference_graph(problem))
+    assume(0 < len(sets) <= 40)
+    encoding = data.draw(st.sampled_from(ENCODINGS), label="encoding")
+    source = SkeletonSource(FactBase.from_problem(problem), must_move(problem), (), "cpsat", encoding)
+    got = source.next(1).skeletons
+    actions = sorted(source.generator.graph.actions, key=str)
+    deferred = set(data.draw(st.lists(st.sampled_from(actions), max_size=3), label="deferred"))
+    source.generator.defer(deferred)
+    while True:
+        batch = source.next(3)
+        got += batch.skeletons
+        if batch.outcome is BatchOutcome.EXHAUSTED:
+            break
+    where = f"{encoding}, deferred {sorted(map(str, deferred))}\n{text}"
+    assert {s.actions for s in got} == set(sets), where
+    assert len({s.actions for s in got}) == len(got), where
+    assert all(sets[s.actions] == s.makespan for s in got), where
+    late = [bool(s.actions & deferred) for s in got[1:]]
+    assert late == sorted(late), where  # every skeleton without a deferred action before any with one
+    first = [s.key for s, d in zip(got[1:], late) if not d]
+    last = [s.key for s, d in zip(got[1:], late) if d]
+    assert first == sorted(first) and last == sorted(last), where
 
 
 # ---------------------------------------------------------------- the oracle is not vacuous

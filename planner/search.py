@@ -21,6 +21,7 @@ from mrgc.compiler.facts import FactBase
 from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action
 from mrgc.language.model import Problem
+from mrgc.planner.deferral import DEFER_AFTER, Deferrals, describe
 from mrgc.planner.outcome import BlockingCycle, Failure, PlanStatus, Why
 from mrgc.planner.plan import Plan, PlannedAction, planner_motion_model
 from mrgc.planner.skeletons import DEFAULT_BACKEND, DEFAULT_ENCODING, SkeletonSource, must_move, problem_facts
@@ -36,10 +37,6 @@ Log = Callable[[str], None]
 
 #: the arms' motion models ``plan_problem`` can plan (docs/validator.md)
 MOTIONS = ("configurations", "full")
-
-#: an action whose grounding failed this many times is deferred: skeletons without it come first
-#: (beyond the paper; docs/planner.md, "Deferred actions")
-DEFER_AFTER = 3
 
 
 def plan_problem(
@@ -115,10 +112,11 @@ def plan_problem(
                 result = _referee(problem, problem_file, plan, result, why, validation)
             for f in result.failures:
                 why.add(f)
-            deferred = sources.failed(skel, result.failures) if result.outcome is Outcome.FAIL else None
+            failed = result.outcome is Outcome.FAIL and result.failures
+            deferred = sources.deferrals.failed(skel, result.failures[0]) if failed else None
             say(_log_line(time.perf_counter() - t0, count[0], skel, suffix, result))
             if deferred is not None:
-                say(f"  deferred after {DEFER_AFTER} failures: {deferred} (skeletons without it come first)")
+                say(f"  deferred after {DEFER_AFTER} failures: {describe(deferred)} (skeletons without it first)")
             return result
 
         search = MCTS(ground, sources, set(start), c=c, alpha=alpha, k=skeletons)
@@ -127,7 +125,7 @@ def plan_problem(
         stats.update({k: (round(v, 4) if isinstance(v, float) else v) for k, v in result.stats.items()})
         stats["iterations"] = result.iterations
         stats["geometric_queries"] = grounder.queries
-        stats["deferred_actions"] = len(sources.deferred)
+        stats["deferred"] = sorted(describe(p) for p in sources.deferrals.deferred)
         stats["validation_seconds"] = round(validation.get("seconds", 0.0), 4)
         why.summary = _summary(plan.status, result.ended, time_limit, max_iterations, why)
     stats["seconds"] = round(time.perf_counter() - t0, 4)
@@ -140,17 +138,18 @@ class _Skeletons:
     ``k``, the next ``k`` skeletons within the time left; it counts the skeletons it gave and keeps why its
     last batch stopped."""
 
-    def __init__(self, source: SkeletonSource, deadline: float, deferred: set[Action]) -> None:
+    def __init__(self, source: SkeletonSource, deadline: float, deferrals: Deferrals) -> None:
         self.source = source
         self.deadline = deadline
         #: the search's deferred actions (shared by every source; read at each call)
-        self.deferred = deferred
+        self.deferrals = deferrals
         self.count = 0
         self.outcome: BatchOutcome | None = None
 
     def __call__(self, k: int) -> list[Skeleton]:
         left = max(0.01, self.deadline - time.perf_counter())
-        self.source.generator.defer(self.deferred)
+        gen = self.source.generator
+        gen.defer(self.deferrals.among(gen.graph.actions))
         batch = self.source.next(k, time_limit=left)
         self.count += len(batch.skeletons)
         self.outcome = batch.outcome
@@ -186,9 +185,8 @@ class _Sources:
         self.backend, self.encoding, self.max_makespan, self.seed = backend, encoding, max_makespan, seed
         self.deadline = deadline
         self.roots: list[_Skeletons] = []
-        #: how often each skeleton action was the one a grounding failed at, and those deferred
-        self.failures: dict[Action, int] = {}
-        self.deferred: set[Action] = set()
+        #: what failed groundings failed at, and what is deferred (docs/planner.md, "Deferred actions")
+        self.deferrals = Deferrals()
 
     def __call__(self, need: set[str], moved: set[str]) -> _Skeletons:
         src = SkeletonSource(
@@ -200,7 +198,7 @@ class _Sources:
             self.max_makespan,
             self.seed,
         )
-        more = _Skeletons(src, self.deadline, self.deferred)
+        more = _Skeletons(src, self.deadline, self.deferrals)
         if not self.roots:
             self.roots.append(more)
         return more
@@ -209,21 +207,6 @@ class _Sources:
     def root(self) -> _Skeletons:
         """The first source made: the root's."""
         return self.roots[0]
-
-    def failed(self, skeleton: Skeleton, failures: list[Failure]) -> Action | None:
-        """Count the action of ``skeleton`` a failed grounding names (its first failure's step and action);
-        at DEFER_AFTER failures the action is deferred by every source (returned when that happens now)."""
-        from mrgc.planner.ground import label
-
-        if not failures or not 1 <= failures[0].step <= skeleton.makespan:
-            return None
-        for a in skeleton.steps[failures[0].step - 1]:
-            if label(a) == failures[0].action:
-                self.failures[a] = self.failures.get(a, 0) + 1
-                if self.failures[a] == DEFER_AFTER:
-                    self.deferred.add(a)
-                    return a
-        return None
 
 
 def _conclude_symbolic(plan: Plan, why: Why, more: _Skeletons, time_limit: float) -> None:

@@ -1,0 +1,101 @@
+"""Deferred actions (beyond the paper): what keeps failing in grounding comes last in the skeletons.
+
+Skeletons come in (makespan, objects moved) order, and many share an action: when that action cannot be
+grounded (a bin at the edge of the arm's reach, an obstacle with no free place the arm reaches), the
+search fails on it skeleton after skeleton while the skeletons without it, one step longer, never come.
+:class:`Deferrals` counts, for each failed grounding, the *part* of the skeleton action it failed at:
+
+- a place out of the arm's reach (``place by r1: no inverse kinematics``, ``carry to the placement by
+  r1: no inverse kinematics``): the object, the region and the placing robot, whatever the grasps
+  (``r1 places o6 in bin-b``): where the hand must go is out of reach with most grasps alike;
+- a pick out of reach (``pick by r1: no inverse kinematics``): the object and the picking robot
+  (``r1 picks o6``);
+- anything else (collisions, crowded regions, handovers, relays, robots of a step colliding): the action
+  itself, grasps included: those depend on the grasp and on what else the skeleton moves.
+
+On nine generated runs that hit the time limit before deferral, this split solved 7, counting every
+failure by the action 6, and every place and pick failure by its part 5 (docs/planner.md, "Deferred
+actions").
+
+At :data:`DEFER_AFTER` failures of one part every skeleton action with that part is deferred: the skeleton
+sources give the skeletons without such actions first (:meth:`mrgc.compiler.enumerate.SkeletonGenerator.defer`),
+and the rest once those are used up, so no skeleton is lost.  The counts depend only on what the
+groundings found, never on time.
+"""
+
+from __future__ import annotations
+
+from typing import Iterable
+
+from mrgc.compiler.skeleton import Skeleton
+from mrgc.compiler.task_graph import Action
+from mrgc.planner.outcome import Failure
+
+#: failures of one part (see the module docstring) before the actions with it are deferred
+DEFER_AFTER = 3
+
+#: a part of an action: ("place", object, region, robot), ("pick", object, robot) or ("action", action)
+Part = tuple[object, ...]
+
+
+def parts(a: Action) -> list[Part]:
+    """The parts of ``a`` a failure may be counted against (a relay only as itself)."""
+    whole: Part = ("action", a)
+    if a.via is not None:
+        return [whole]
+    return [("place", a.obj, a.region, a.place_robot), ("pick", a.obj, a.pick_robot), whole]
+
+
+def describe(part: Part) -> str:
+    """A part in words: ``r1 places o6 in bin-b``, ``r1 picks o6``, or the action."""
+    if part[0] == "place":
+        return f"{part[3]} places {part[1]} in {part[2]}"
+    if part[0] == "pick":
+        return f"{part[2]} picks {part[1]}"
+    return str(part[1])
+
+
+class Deferrals:
+    """The search's failure counts and deferred parts, shared by every skeleton source."""
+
+    def __init__(self, after: int = DEFER_AFTER) -> None:
+        self.after = after
+        self.counts: dict[Part, int] = {}
+        self.deferred: set[Part] = set()
+
+    def failed(self, skeleton: Skeleton, failure: Failure) -> Part | None:
+        """Count the part of ``skeleton``'s action that ``failure`` (the first failure of a failed
+        grounding) names; returns the part when this failure defers it."""
+        from mrgc.planner.ground import label
+
+        if not 1 <= failure.step <= skeleton.makespan:
+            return None  # the validator's verdict on a whole plan, or no step
+        for a in skeleton.steps[failure.step - 1]:
+            names = (label(a), *(label(h) for h in (a.halves if a.via is not None else ())))
+            if failure.action in names:
+                part = _part(a, failure.check)
+                self.counts[part] = self.counts.get(part, 0) + 1
+                if self.counts[part] == self.after:
+                    self.deferred.add(part)
+                    return part
+                return None
+        return None
+
+    def covers(self, a: Action) -> bool:
+        """Whether ``a`` has a deferred part."""
+        return any(p in self.deferred for p in parts(a))
+
+    def among(self, actions: Iterable[Action]) -> list[Action]:
+        """The deferred ones of ``actions``."""
+        return [a for a in actions if self.covers(a)] if self.deferred else []
+
+
+def _part(a: Action, check: str) -> Part:
+    """The part of ``a`` a failure with ``check`` is counted against."""
+    if a.via is not None or not check.endswith("no inverse kinematics"):
+        return ("action", a)
+    if check.startswith(("place", "carry to the placement")):
+        return ("place", a.obj, a.region, a.place_robot)
+    if check.startswith("pick"):
+        return ("pick", a.obj, a.pick_robot)
+    return ("action", a)

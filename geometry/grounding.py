@@ -35,6 +35,7 @@ from mrgc.geometry.ik import solve_ik_many
 from mrgc.geometry.lattice import Body, LatticePlanner, box_corners
 from mrgc.geometry.motion import MAX_CHECKS, plan_joint_path
 from mrgc.geometry.planar import DiscGrid, PlanarRobot, is_planar, scene_bounds
+from mrgc.geometry.scene import Body as SceneBody
 from mrgc.geometry.scene import SceneSpec, half_extents, inside
 from mrgc.geometry.transforms import rot_z, translation
 from mrgc.language.model import Box, Shape
@@ -279,7 +280,7 @@ class Grounder:
     def placement(
         self,
         obj: str,
-        region: str,
+        region: str | SceneBody,
         avoid: Iterable[str] = (),
         volume: Volume | None = None,
         samples: int = 200,
@@ -304,7 +305,7 @@ class Grounder:
     def placements(
         self,
         obj: str,
-        region: str,
+        region: str | SceneBody,
         avoid: Iterable[str] = (),
         volume: Volume | None = None,
         samples: int = 200,
@@ -315,11 +316,13 @@ class Grounder:
         """The poses :meth:`placement` would return with ``skip`` 0, 1, 2 ..., in that order, each checked
         once (asking :meth:`placement` for the k-th checks the first k again).  ``prefer`` (a rank of a pose,
         e.g. :meth:`comfortable`'s) orders the grid and lattice candidates by rank, keeping their order
-        among equal ranks."""
-        body, reg = self.scene.body(obj), self.scene.body(region)
+        among equal ranks.  ``region`` is a region's name or a region body (a relay's spot on a fixed object's
+        top: :func:`mrgc.geometry.relays.spot_region`)."""
+        body = self.scene.body(obj)
+        reg = region if isinstance(region, SceneBody) else self.scene.body(region)
         if not isinstance(reg.shape, Box):
             return
-        rng = np.random.default_rng(seed_for("placement", obj, region, key, seed=self.seed))
+        rng = np.random.default_rng(seed_for("placement", obj, reg.name, key, seed=self.seed))
         h_o, h_r = half_extents(body.shape), half_extents(reg.shape)
         vol_world = self._volume_world(volume) if volume else None
         avoid = tuple(a for a in avoid if a != obj)

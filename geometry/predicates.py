@@ -36,9 +36,9 @@ from mrgc.geometry.facts import FactsResult, HandoverConfig, RobotFacts
 from mrgc.geometry.grasps import finger_opening, fits, grasp_transform, pregrasp_transform
 from mrgc.geometry.ik import solve_ik_many
 from mrgc.geometry.kinematics import model_for_kind
-from mrgc.geometry.relays import Asks, Spots, relay_facts, stranded
+from mrgc.geometry.relays import Asks, Spots, relay_facts, spot_region, stranded
 from mrgc.geometry.relays import asks as relay_asks
-from mrgc.geometry.scene import SceneSpec, half_extents, inside
+from mrgc.geometry.scene import Body, SceneSpec, half_extents, inside
 from mrgc.geometry.transforms import translation
 from mrgc.language.model import Box, Fact
 from mrgc.workers import map_in_workers, worker_count
@@ -191,9 +191,10 @@ class RobotEvaluator:
             todo = [i for i in todo if i not in unsolvable and (i not in found or (want_free and found[i][1]))]
         return found
 
-    def placements(self, obj: str, region: str) -> list[np.ndarray]:
-        """Candidate poses of ``obj`` resting inside ``region``: a lattice, centre first."""
-        body, reg = self.scene.body(obj), self.scene.body(region)
+    def placements(self, obj: str, region: str | Body) -> list[np.ndarray]:
+        """Candidate poses of ``obj`` resting inside ``region`` (a name or a region body): a lattice, centre
+        first."""
+        body, reg = self.scene.body(obj), region if isinstance(region, Body) else self.scene.body(region)
         if not isinstance(reg.shape, Box):
             return []
         h_o, h_r = half_extents(body.shape), half_extents(reg.shape)
@@ -263,7 +264,7 @@ class RobotEvaluator:
         for obj, grasp, region in asks:
             if not self.usable(obj, grasp):
                 continue
-            for k, pose in enumerate(self.placements(obj, region)):
+            for k, pose in enumerate(self.placements(obj, spot_region(self.scene, region))):
                 if self.arm.in_reach(pose[:3, 3], margin=0.3):
                     queries.append((obj, grasp, pose, True, "relay"))
                     keys.append((obj, grasp, region, k))
@@ -331,14 +332,20 @@ def _relays(scene: SceneSpec, facts: set[Fact], seed: int, n: int) -> tuple[set[
     """``enable-relay`` facts for the goal objects that need them (:mod:`mrgc.geometry.relays`), with the
     IK solves and collision checks they took."""
     arms = {r.name for r in scene.robots if r.kind.base != "planar"}
+    out: set[Fact] = set()
+    ik = checks = 0
     stuck = stranded(scene, facts)
-    asked = {r: a for r, a in relay_asks(scene, facts, stuck).items() if r in arms} if stuck else {}
-    if not asked:
-        return set(), 0, 0
-    jobs = [(scene, r, seed, a) for r, a in sorted(asked.items())]
-    answers = map_in_workers(_spots_worker, jobs, min(n, len(jobs)))
-    spots = {job[1]: ans[0] for job, ans in zip(jobs, answers)}
-    return relay_facts(scene, facts, spots), sum(a[1] for a in answers), sum(a[2] for a in answers)
+    for surfaces in (False, True):  # the regions first; fixed objects' tops for the objects still stuck
+        stuck = [o for o in stuck if not any(f.args[0] == o for f in out)]
+        asked = {r: a for r, a in relay_asks(scene, facts, stuck, surfaces).items() if r in arms} if stuck else {}
+        if not asked:
+            continue
+        jobs = [(scene, r, seed, a) for r, a in sorted(asked.items())]
+        answers = map_in_workers(_spots_worker, jobs, min(n, len(jobs)))
+        spots = {job[1]: ans[0] for job, ans in zip(jobs, answers)}
+        out |= relay_facts(scene, facts, spots)
+        ik, checks = ik + sum(a[1] for a in answers), checks + sum(a[2] for a in answers)
+    return out, ik, checks
 
 
 def compute_facts(scene: SceneSpec, seed: int = 0, workers: int | None = None) -> FactsResult:

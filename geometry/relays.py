@@ -15,6 +15,13 @@ grounding looks for a free spot).  R1 must also pick M (``reachable-pick M g1 R1
 goal (``reachable-place M goal g2 R2``).  Relays are looked for only for the goal objects that need them,
 so a problem every goal of which has a pick-and-place or a handover gets the paper's facts unchanged.
 
+**Surfaces.**  When no region gives an object a relay (a table whose regions are each out of one arm's
+reach), the top of a fixed object may: ``enable-relay M table g1 g2 R1 R2`` sets M down on the table.
+Spots are looked for in a STAGING square of the top (:func:`mrgc.geometry.scene.surface`) centred between
+the two robots' bases (:func:`staging`), only for two different robots, and only for the objects the
+regions gave no relay (so problems whose regions serve get the same facts as before).  Grounding looks in
+the same square (:func:`spot_region`); the validator accepts any spot on the top.
+
 This module decides which spots to ask for and combines the answers; the per-robot inverse kinematics run
 in :mod:`mrgc.geometry.predicates` (one worker per robot, like the rest of phase 1).
 """
@@ -23,8 +30,17 @@ from __future__ import annotations
 
 from typing import Iterable
 
-from mrgc.geometry.scene import SceneSpec
+import numpy as np
+
+from mrgc.geometry.scene import SURFACE_HEIGHT, Body, SceneSpec
+from mrgc.geometry.transforms import translation
 from mrgc.language.model import Box, Fact
+
+#: side of the square of a fixed object's top where a relay between two robots looks for its spot (m)
+STAGING = 0.3
+#: joins a surface and a pair of robots into the name of their staging square in phase 1's asks (no
+#: name of the language holds it)
+PAIR = "@"
 
 #: what one robot is asked: (object, grasp, region) triples whose spots it should try
 Asks = list[tuple[str, str, str]]
@@ -52,23 +68,66 @@ def stranded(scene: SceneSpec, facts: Iterable[Fact]) -> list[str]:
     return out
 
 
-def asks(scene: SceneSpec, facts: Iterable[Fact], objects: list[str]) -> dict[str, Asks]:
+def asks(scene: SceneSpec, facts: Iterable[Fact], objects: list[str], surfaces: bool = False) -> dict[str, Asks]:
     """Per robot, the spots to try for ``objects``: a robot that picks an object tries setting it down with
     that grasp, a robot that places it in its goal tries picking it up with that grasp, in every box region
-    but the goal (sorted, so the answers are deterministic)."""
+    but the goal, or with ``surfaces`` in the staging square of every fixed box's top for each pair of it
+    and another robot of the other role (sorted, so the answers are deterministic)."""
     wanted = set(objects)
-    out: dict[str, set[tuple[str, str, str]]] = {}
-    regions = sorted(r.name for r in scene.regions if isinstance(r.shape, Box))
+    facts = list(facts)
+    pickers: dict[str, set[str]] = {}
+    placers: dict[str, set[str]] = {}
+    roles = []
     for f in facts:
         a = f.args
         if f.predicate == "reachable-pick" and a[0] in wanted:
-            obj, grasp, robot = a
+            roles.append((a[0], a[1], a[2], True))
+            pickers.setdefault(a[0], set()).add(a[2])
         elif f.predicate == "reachable-place" and a[0] in wanted and a[1] == scene.goal[a[0]]:
-            obj, _, grasp, robot = a
+            roles.append((a[0], a[2], a[3], False))
+            placers.setdefault(a[0], set()).add(a[3])
+    regions = sorted(r.name for r in scene.regions if isinstance(r.shape, Box))
+    tops = sorted(b.name for b in scene.fixed if isinstance(b.shape, Box))
+    out: dict[str, set[tuple[str, str, str]]] = {}
+    for obj, grasp, robot, picks in roles:
+        if surfaces:
+            partners = (placers if picks else pickers).get(obj, set()) - {robot}
+            where = [pair_name(top, robot, other) for top in tops for other in partners]
         else:
-            continue
-        out.setdefault(robot, set()).update((obj, grasp, re) for re in regions if re != scene.goal[obj])
-    return {r: sorted(v) for r, v in out.items()}
+            where = [re for re in regions if re != scene.goal[obj]]
+        out.setdefault(robot, set()).update((obj, grasp, w) for w in where)
+    return {r: sorted(v) for r, v in out.items() if v}
+
+
+def pair_name(surface: str, ra: str, rb: str) -> str:
+    """The name phase 1 gives the staging square of ``surface`` between robots ``ra`` and ``rb``."""
+    return PAIR.join((surface, *sorted((ra, rb))))
+
+
+def staging(scene: SceneSpec, surface: str, ra: str, rb: str) -> Body:
+    """The STAGING square of ``surface``'s top (a fixed object's, :func:`mrgc.geometry.scene.surface`)
+    centred between the bases of ``ra`` and ``rb``, moved onto the top where it would overhang."""
+    top = scene.region(surface)
+    if not isinstance(top.shape, Box) or top.shape.sx <= 0:
+        return top
+    mid = (scene.robot(ra).base[:3, 3] + scene.robot(rb).base[:3, 3]) / 2
+    inv = np.linalg.inv(top.pose)
+    local = inv[:3, :3] @ mid + inv[:3, 3]
+    half = np.minimum([STAGING / 2, STAGING / 2], [top.shape.sx / 2, top.shape.sy / 2])
+    lim = np.array([top.shape.sx / 2, top.shape.sy / 2]) - half
+    x, y = np.clip(local[:2], -lim, lim)
+    return Body(surface, Box(2 * half[0], 2 * half[1], SURFACE_HEIGHT), top.pose @ translation(x, y, 0.0))
+
+
+def spot_region(scene: SceneSpec, name: str, r1: str = "", r2: str = "") -> Body:
+    """Where a relay through ``name`` by ``r1`` and ``r2`` looks for its spot: the region ``name``, the
+    staging square of a fixed object's top between the two robots, or a :func:`pair_name` of one."""
+    if PAIR in name:
+        surface, ra, rb = name.split(PAIR)
+        return staging(scene, surface, ra, rb)
+    if any(r.name == name for r in scene.regions):
+        return scene.body(name)
+    return staging(scene, name, r1, r2)
 
 
 def relay_facts(scene: SceneSpec, facts: Iterable[Fact], spots: dict[str, Spots]) -> set[Fact]:
@@ -86,8 +145,11 @@ def relay_facts(scene: SceneSpec, facts: Iterable[Fact], spots: dict[str, Spots]
         for r2, theirs in grasps.items():
             for (obj, region, k), g1s in mine.items():
                 goal = scene.goal[obj]
+                where, *pair = region.split(PAIR)
+                if pair and sorted((r1, r2)) != pair:
+                    continue  # a staging square is the one between r1 and r2
                 for g1 in g1s:
                     for g2 in theirs.get((obj, region, k), ()):
                         if (r1, g1) != (r2, g2) and (obj, g1, r1) in pick and (obj, goal, g2, r2) in place:
-                            out.add(Fact("enable-relay", (obj, region, g1, g2, r1, r2)))
+                            out.add(Fact("enable-relay", (obj, where, g1, g2, r1, r2)))
     return out

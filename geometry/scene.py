@@ -62,6 +62,17 @@ class SceneSpec:
                 return b
         raise KeyError(name)
 
+    def region(self, name: str) -> Body:
+        """The region called ``name``, or, for a fixed object, its :func:`surface` (where a relay may set an
+        object down on it: ``enable-relay M table ...``)."""
+        for b in self.regions:
+            if b.name == name:
+                return b
+        for b in self.fixed:
+            if b.name == name:
+                return surface(b)
+        raise KeyError(name)
+
     def robot(self, name: str) -> RobotSpec:
         """The robot called ``name``."""
         return next(r for r in self.robots if r.name == name)
@@ -93,6 +104,22 @@ def scene_from_problem(problem: Problem) -> SceneSpec:
         goal=problem.goal_regions,
         grasp_specs=problem.grasp_specs,
     )
+
+
+#: how high the region standing on a fixed object's top reaches (as tall as the shipped regions)
+SURFACE_HEIGHT = 0.3
+
+
+def surface(body: Body) -> Body:
+    """The top of a fixed object as a region (named as the object): a box of its footprint and
+    SURFACE_HEIGHT standing on its top face, for a box whose z axis is vertical; a body of no volume
+    (nothing lies inside it) for any other fixed object."""
+    if not isinstance(body.shape, Box) or abs(body.pose[2, 2]) < 1 - 1e-9:
+        return Body(body.name, Box(0.0, 0.0, 0.0), body.pose)
+    up = (body.shape.sz + SURFACE_HEIGHT) / 2  # world z: the box's z axis is vertical, up or down
+    pose = body.pose.copy()
+    pose[:3, 3] = body.pose[:3, 3] + np.array([0.0, 0.0, up])
+    return Body(body.name, Box(body.shape.sx, body.shape.sy, SURFACE_HEIGHT), pose)
 
 
 def _mesh_shapes(problem: Problem) -> list[Mesh]:

@@ -40,7 +40,12 @@ SORTS: dict[str, tuple[str, str]] = {
     "kind": ("E214", "robot kind"),
     "handover-point": ("E215", "handover point"),
     "fixed": ("E211", "fixed object"),
+    # where a relay sets its object down: a region, or the top of a fixed object
+    "surface": ("E212", "region or fixed object"),
 }
+
+#: sort a predicate asks for -> the sorts of names it accepts there
+ACCEPTS = {"surface": ("region", "fixed")}
 
 #: problem section keyword -> sort of the names it declares
 SECTION_SORT = {
@@ -360,15 +365,16 @@ class Checker:
                 self.err(code, f"undeclared grasp '{name}'{did_you_mean(name, grasps)}", span)
                 return False
             return True
+        accepted = ACCEPTS.get(want, (want,))
         if name not in sort_of:
             cached = self._sorted_names.get(want)
             if cached is None or cached[0] is not sort_of:
-                cached = (sort_of, frozenset(n for n, (s, _) in sort_of.items() if s == want))
+                cached = (sort_of, frozenset(n for n, (s, _) in sort_of.items() if s in accepted))
                 self._sorted_names[want] = cached
             self.err(code, f"undeclared {noun} '{name}'{did_you_mean(name, cached[1])}", span)
             return False
         have = sort_of[name][0]
-        if have != want:
+        if have not in accepted:
             self.err(
                 "E216", f"'{name}' is {_article(SORTS[have][1])}, but '{predicate}' expects {_article(noun)} here", span
             )

@@ -16,7 +16,8 @@ from mrgc.errors import Span
 from mrgc.language.ast import NOWHERE
 
 # The predicates: name -> sorts of the arguments, in order.  The paper's six, and ``enable-relay`` (beyond
-# the paper: a goal object set down on its way and picked up again; docs/language.md).
+# the paper: a goal object set down on its way and picked up again, in a region or on the top of a fixed
+# object, a "surface"; docs/language.md).
 PREDICATES: dict[str, tuple[str, ...]] = {
     "in-region": ("movable", "region"),
     "reachable-pick": ("movable", "grasp", "robot"),
@@ -24,7 +25,7 @@ PREDICATES: dict[str, tuple[str, ...]] = {
     "occludes-pick": ("movable", "movable", "grasp", "robot"),
     "occludes-goal-place": ("movable", "movable", "region", "grasp", "robot"),
     "enable-goal-handover": ("movable", "grasp", "grasp", "robot", "robot"),
-    "enable-relay": ("movable", "region", "grasp", "grasp", "robot", "robot"),
+    "enable-relay": ("movable", "surface", "grasp", "grasp", "robot", "robot"),
 }
 
 #: words users write for a predicate -> the predicates they mean (E220's "did you mean"; a word that is a

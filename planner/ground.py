@@ -27,6 +27,7 @@ from mrgc.compiler.task_graph import Action
 from mrgc.geometry.collision import CollisionWorld
 from mrgc.geometry.conventions import refine, to_se2
 from mrgc.geometry.grounding import BUSY, Answer, Grounder, GroundStatus, Volume
+from mrgc.geometry.relays import spot_region
 from mrgc.language.model import Box
 from mrgc.planner.outcome import DeadlineReached, Failure
 from mrgc.planner.plan import PlannedAction
@@ -235,7 +236,8 @@ class ReverseGrounder:
             assert a.via is not None
             others = sorted(avoid - {a.obj})
             found, tried = 0, 0
-            for pose in g.placements(a.obj, a.via, avoid=others, volume=v_fut + taken, key=key):
+            where = spot_region(g.scene, a.via, a.pick_robot, a.place_robot)
+            for pose in g.placements(a.obj, where, avoid=others, volume=v_fut + taken, key=key):
                 tried += 1
                 if tried > PLACEMENT_TRIES + OUT_OF_REACH_TRIES:
                     break

@@ -248,7 +248,7 @@ class _Replayer(ActionReader):
             if a.place_pose is None:
                 continue
             self.poses[a.obj] = a.place_pose
-            if not inside(self.scene.body(a.action.region), self.shapes[a.obj], a.place_pose):
+            if not inside(self.scene.region(a.action.region), self.shapes[a.obj], a.place_pose):
                 p = a.place_pose[:3, 3]
                 self._v(
                     t,

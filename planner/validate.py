@@ -272,8 +272,8 @@ def _unknown_names(problem: Problem, names: _Names, a: Action) -> list[str]:
         bad.append(
             f"{obj!r} is a fixed object, which never moves" if obj in names.fixed else f"no movable object {obj!r}"
         )
-    if a.region not in names.regions:
-        bad.append(f"no region {a.region!r}")
+    if a.region not in names.regions and not (a.relay and a.region in names.fixed):
+        bad.append(f"no region {a.region!r}" + (" or fixed object" if a.relay else ""))
     for role, robot in (("pick robot", a.pick_robot), ("place robot", a.place_robot)):
         if robot not in names.robots:
             bad.append(f"no robot {robot!r} ({role})")

@@ -165,12 +165,17 @@ def _relay_diagnostics(facts: str) -> list[Diagnostic]:
 
 def test_relay_facts_are_read_with_their_argument_sorts() -> None:
     problem = mrgc.parse_file(str(RELAY)).problem(None)
-    assert PREDICATES["enable-relay"] == ("movable", "region", "grasp", "grasp", "robot", "robot")
+    assert PREDICATES["enable-relay"] == ("movable", "surface", "grasp", "grasp", "robot", "robot")
     relays = sorted(f.args for f in problem.init if f.predicate == "enable-relay")
     assert relays == [("o1", "mid", "top", "side", "r1", "r1"), ("o1", "mid", "top", "side", "r1", "r2")]
     # a regrasp (one robot, two grasps) and an object without a goal are accepted
     text = RELAY_FACTS.replace("FACTS", "(enable-relay o1 mid top side r1 r1) (enable-relay o2 goal top top r1 r2)")
     assert len(mrgc.parse_string(text).problem(None).init) == 4
+    # a relay on the top of a fixed object (a table between the arms, no region there)
+    text = RELAY_FACTS.replace("(:regions", "(:fixed table) (:regions").replace(
+        "FACTS", "(enable-relay o1 table top side r1 r2)"
+    )
+    assert ("o1", "table", "top", "side", "r1", "r2") in [f.args for f in mrgc.parse_string(text).problem(None).init]
 
 
 @pytest.mark.parametrize(
@@ -190,8 +195,13 @@ def test_relay_facts_are_read_with_their_argument_sorts() -> None:
             "'enable-relay' sets 'o1' down in its goal region 'goal': a relay is a stop on the way to the goal, "
             "in another region",
         ),
-        ("(enable-relay o1 r1 top side r1 r2)", "E216", 22, "'r1' is a robot, but 'enable-relay' expects a region"),
-        ("(enable-relay o1 nowhere top side r1 r2)", "E212", 22, "undeclared region 'nowhere'"),
+        (
+            "(enable-relay o1 r1 top side r1 r2)",
+            "E216",
+            22,
+            "'r1' is a robot, but 'enable-relay' expects a region or fixed object",
+        ),
+        ("(enable-relay o1 nowhere top side r1 r2)", "E212", 22, "undeclared region or fixed object 'nowhere'"),
         ("(enable-relay o1 mid top grip r1 r2)", "E213", 30, "undeclared grasp 'grip'"),
         ("(enable-relay o1 mid top side r1)", "E221", 5, "'enable-relay' takes 6 arguments"),
     ],

@@ -5,15 +5,18 @@ generated packaging table that had no plan before relays, planned and validated.
 
 from __future__ import annotations
 
+import copy
+import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 from support import ROOT
 
 from mrgc import __version__
 from mrgc.compiler.facts import FactBase
 from mrgc.compiler.task_graph import Action, build_task_graph
-from mrgc.geometry.relays import stranded
+from mrgc.geometry.relays import STAGING, staging, stranded
 from mrgc.geometry.scene import scene_from_problem
 from mrgc.language.loader import parse_file
 from mrgc.language.model import Problem
@@ -26,6 +29,9 @@ from mrgc.testing.oracle import graph_signature, reference_task_graph
 
 SYMBOLIC = ROOT / "tests" / "data" / "relay.mrg"
 GENERATED = ROOT / "tests" / "data" / "relay-packaging.mrg"
+TABLE = ROOT / "tests" / "data" / "relay-table.mrg"
+#: ``mrgc plan tests/data/relay-table.mrg --seed 0`` (relays on the table at steps 4 and 6)
+TABLE_PLAN = ROOT / "tests" / "data" / "relay-table-plan.json"
 
 
 def _problem(path: Path) -> Problem:
@@ -119,3 +125,46 @@ def test_pictures_of_a_relay_plan_say_set_down_and_count_objects_and_moves() -> 
     assert timeline.title.endswith("3 objects moved in 4 moves")
     labels = {p.caption for p in timeline.phases if p.step == 3}
     assert any("o3 set down in start" in label for label in labels), labels
+
+
+def test_phase1_finds_relays_on_the_table_between_two_arms_when_no_region_serves() -> None:
+    problem = _problem(TABLE)
+    facts = compute_problem_facts(problem, seed=0).facts
+    relays = sorted(f.args for f in facts if f.predicate == "enable-relay")
+    assert {r[0] for r in relays} == {"o5", "o9"} and {r[1] for r in relays} == {"table"}, relays
+    assert all((r[4], r[5]) == ("r1", "r2") for r in relays)  # r1 picks them in start, r2 places in bin-a
+    scene = scene_from_problem(problem)
+    square = staging(scene, "table", "r1", "r2")  # where both look: between their bases, on the top
+    mid = (scene.robot("r1").base[:3, 3] + scene.robot("r2").base[:3, 3]) / 2
+    assert np.allclose(square.pose[:2, 3], mid[:2]) and abs(square.pose[2, 3] - 0.15) < 1e-9
+    assert (square.shape.sx, square.shape.sy) == (STAGING, STAGING)
+
+
+def test_the_validator_accepts_a_relay_on_the_table_and_rejects_edits_of_it() -> None:
+    problem = _problem(TABLE)
+    plan = json.loads(TABLE_PLAN.read_text())
+    report = validate(problem, plan, str(TABLE))
+    assert report.ok, [str(v) for v in report.violations]
+    moves = [(s["index"], a) for s in plan["steps"] for a in s["actions"]]
+    assert [(t, a["object"], a["region"]) for t, a in moves if a.get("relay")] == [
+        (4, "o9", "table"),
+        (6, "o5", "table"),
+    ]
+
+    def codes(edit) -> set[str]:  # type: ignore[no-untyped-def]
+        bad = copy.deepcopy(plan)
+        edit([a for s in bad["steps"] for a in s["actions"]])
+        return {v.code for v in validate(problem, bad, str(TABLE)).violations}
+
+    def off_the_table(acts) -> None:  # type: ignore[no-untyped-def]
+        next(a for a in acts if a.get("relay"))["place_pose"][0][3] += 1.0  # 1 m along x: beyond the edge
+
+    def onward_to_the_table(acts) -> None:  # type: ignore[no-untyped-def]
+        next(a for a in acts if a["object"] == "o9" and not a.get("relay"))["region"] = "table"
+
+    def on_a_shelf(acts) -> None:  # type: ignore[no-untyped-def]
+        next(a for a in acts if a.get("relay"))["region"] = "shelf"
+
+    assert "outside-region" in codes(off_the_table)
+    assert "unknown-name" in codes(onward_to_the_table)  # only a relay move sets an object down on a top
+    assert "unknown-name" in codes(on_a_shelf)

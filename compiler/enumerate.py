@@ -82,10 +82,12 @@ class SkeletonGenerator:
 
     def defer(self, actions: Iterable[Action]) -> None:
         """Keep ``actions`` (those of this graph; others are ignored) out of the skeletons given next, until
-        no other skeleton is left; no effect once the deferral has been lifted."""
+        no other skeleton is left; no effect once the deferral has been lifted or enumeration is over."""
+        if self.done or self.lifted:  # between calls ``done`` means enumeration is over: nothing to reorder
+            return
         index = {a: i for i, a in enumerate(self.graph.actions)}
         new = {index[a] for a in actions if a in index} - self.deferred
-        if self.lifted or not new:
+        if not new:
             return
         self.deferred |= new
         if self.solver is not None and self.encoded is not None:
@@ -112,7 +114,8 @@ class SkeletonGenerator:
         self.stats["models"] += 1
 
     def next(self, k: int, time_limit: float | None = None) -> Batch:
-        """Up to ``k`` further skeletons, in (makespan, moved) order."""
+        """Up to ``k`` further skeletons, in (makespan, moved) order (after a :meth:`defer`, within the
+        skeletons without the deferred actions, then within the others)."""
         deadline = None if time_limit is None else time.perf_counter() + time_limit
         out: list[Skeleton] = []
         if self.trivial and not self.done:

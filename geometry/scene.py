@@ -106,17 +106,17 @@ def scene_from_problem(problem: Problem) -> SceneSpec:
     )
 
 
-#: how high the region standing on a fixed object's top reaches (as tall as the shipped regions)
-SURFACE_HEIGHT = 0.3
+#: how high the region standing on a fixed object's top reaches: anything a robot sets down there fits
+SURFACE_HEIGHT = 1.0
 
 
 def surface(body: Body) -> Body:
     """The top of a fixed object as a region (named as the object): a box of its footprint and
-    SURFACE_HEIGHT standing on its top face, for a box whose z axis is vertical; a body of no volume
-    (nothing lies inside it) for any other fixed object."""
+    SURFACE_HEIGHT standing on its top face, for a box (the language's poses turn bodies about z only); a
+    body of no volume (nothing lies inside it) for any other fixed object."""
     if not isinstance(body.shape, Box) or abs(body.pose[2, 2]) < 1 - 1e-9:
         return Body(body.name, Box(0.0, 0.0, 0.0), body.pose)
-    up = (body.shape.sz + SURFACE_HEIGHT) / 2  # world z: the box's z axis is vertical, up or down
+    up = (body.shape.sz + SURFACE_HEIGHT) / 2
     pose = body.pose.copy()
     pose[:3, 3] = body.pose[:3, 3] + np.array([0.0, 0.0, up])
     return Body(body.name, Box(body.shape.sx, body.shape.sy, SURFACE_HEIGHT), pose)

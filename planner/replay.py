@@ -261,6 +261,7 @@ class _Replayer(ActionReader):
         placed = [a for a in acts if a.place_pose is not None]
         self._placements(t, placed)
         self._rests(t, placed)
+        self._on_tops(t, placed)
         self.flush()
 
     # ------------------------------------------------------------------ sweeping a phase
@@ -507,6 +508,16 @@ class _Replayer(ActionReader):
             if d0 - d1 >= SUPPORT_TOL / 2:
                 out.add(b)
         return out
+
+    def _on_tops(self, t: int, acts: list[ActionGeometry]) -> None:
+        """A relay move onto a fixed object's top sets its object down resting on that object
+        ``[outside-region]`` (inside its :func:`~mrgc.geometry.scene.surface` box is not enough: a slab under
+        the table has one too)."""
+        fixed = set(self.fixed)
+        for a in acts:
+            top = a.action.region
+            if a.action.relay and top in fixed and top not in self._supports(a.obj):
+                self._v(t, a.obj, "outside-region", f"{a.obj} is set down on {top} but does not rest on it")
 
     def _rests(self, t: int, acts: list[ActionGeometry]) -> None:
         """Every placement rests on something, and so does every object whose support the step moved away

@@ -21,7 +21,7 @@ from mrgc.compiler.facts import FactBase
 from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action
 from mrgc.language.model import Problem
-from mrgc.planner.deferral import DEFER_AFTER, Deferrals, describe
+from mrgc.planner.deferral import Deferrals, describe
 from mrgc.planner.outcome import BlockingCycle, Failure, PlanStatus, Why
 from mrgc.planner.plan import Plan, PlannedAction, planner_motion_model
 from mrgc.planner.skeletons import DEFAULT_BACKEND, DEFAULT_ENCODING, SkeletonSource, must_move, problem_facts
@@ -112,11 +112,12 @@ def plan_problem(
                 result = _referee(problem, problem_file, plan, result, why, validation)
             for f in result.failures:
                 why.add(f)
-            failed = result.outcome is Outcome.FAIL and result.failures
+            failed = result.outcome is Outcome.FAIL and bool(result.failures)
             deferred = sources.deferrals.failed(skel, result.failures[0]) if failed else None
             say(_log_line(time.perf_counter() - t0, count[0], skel, suffix, result))
             if deferred is not None:
-                say(f"  deferred after {DEFER_AFTER} failures: {describe(deferred)} (skeletons without it first)")
+                after = sources.deferrals.after
+                say(f"  deferred after {after} failures: {describe(deferred)} (skeletons without it first)")
             return result
 
         search = MCTS(ground, sources, set(start), c=c, alpha=alpha, k=skeletons)

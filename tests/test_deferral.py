@@ -6,6 +6,7 @@ against the oracle in tests/test_skeletons_property.py."""
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 from pathlib import Path
 
 from mrgc import parse_file
@@ -72,3 +73,32 @@ def test_reach_failures_count_by_part_other_failures_by_action() -> None:
     assert d.failed(rskel, Failure(1, label(onward), "place by r2: no inverse kinematics")) is None
     assert d.failed(rskel, Failure(1, label(down), "place by r1: collision")) == ("action", relay)
     assert d.covers(relay) and d.among([A2, relay, C]) == [relay]
+
+
+def test_the_checks_grounding_writes_are_the_ones_counted_by_part() -> None:
+    """The part of a failure is read from the check text that planner/ground.py writes: built here by its own
+    formatter, so a reworded message fails this test instead of quietly deferring whole actions."""
+    from mrgc.geometry.grounding import Answer, GroundStatus
+    from mrgc.planner.ground import _failed
+
+    skel = Skeleton(((A3,),))
+    for what, part in (
+        ("place by r2", ("place", "o1", "goal", "r2")),
+        ("carry to the placement by r2", ("place", "o1", "goal", "r2")),
+        ("pick by r1", ("pick", "o1", "r1")),
+    ):
+        d = Deferrals(after=1)
+        failure = replace(_failed(what, Answer(GroundStatus.NO_IK)), step=1, action=label(A3))
+        assert d.failed(skel, failure) == part, what
+        collided = replace(_failed(what, Answer(GroundStatus.COLLISION)), step=1, action=label(A3))
+        assert Deferrals(after=1).failed(skel, collided) == ("action", A3), what
+
+
+def test_a_finished_source_is_not_reopened_by_a_deferral() -> None:
+    src = sources()
+    more = src({"o1"}, set())
+    assert len(more(10)) == 3 and more(10) == []
+    gen = more.source.generator
+    solves = gen.stats["solves"]
+    gen.defer([A2, B])
+    assert more(10) == [] and gen.stats["solves"] == solves and not gen.deferred

@@ -18,7 +18,7 @@ from mrgc.compiler.facts import FactBase
 from mrgc.compiler.task_graph import Action, build_task_graph
 from mrgc.geometry.relays import STAGING, staging, stranded
 from mrgc.geometry.scene import scene_from_problem
-from mrgc.language.loader import parse_file
+from mrgc.language.loader import parse_file, parse_string
 from mrgc.language.model import Problem
 from mrgc.planner.outcome import PlanStatus
 from mrgc.planner.phase1 import compute_problem_facts
@@ -136,7 +136,7 @@ def test_phase1_finds_relays_on_the_table_between_two_arms_when_no_region_serves
     scene = scene_from_problem(problem)
     square = staging(scene, "table", "r1", "r2")  # where both look: between their bases, on the top
     mid = (scene.robot("r1").base[:3, 3] + scene.robot("r2").base[:3, 3]) / 2
-    assert np.allclose(square.pose[:2, 3], mid[:2]) and abs(square.pose[2, 3] - 0.15) < 1e-9
+    assert np.allclose(square.pose[:2, 3], mid[:2]) and abs(square.pose[2, 3] - 0.5) < 1e-9
     assert (square.shape.sx, square.shape.sy) == (STAGING, STAGING)
 
 
@@ -168,3 +168,16 @@ def test_the_validator_accepts_a_relay_on_the_table_and_rejects_edits_of_it() ->
     assert "outside-region" in codes(off_the_table)
     assert "unknown-name" in codes(onward_to_the_table)  # only a relay move sets an object down on a top
     assert "unknown-name" in codes(on_a_shelf)
+    # a slab under the table: the spots lie inside its top's box, but the objects rest on the table
+    text = TABLE.read_text().replace(
+        "(table :shape (box 1.41 1.34 0.05) :pose (0 0 -0.025 0))",
+        "(table :shape (box 1.41 1.34 0.05) :pose (0 0 -0.025 0)) (floor :shape (box 2 2 0.02) :pose (0 0 -0.07 0))",
+    )
+    slab = parse_string(text, str(TABLE)).problems[0]
+    # the slab changes nothing for the plan as it is, but the problem's digest
+    assert {v.code for v in validate(slab, plan).violations} == {"problem-changed"}
+    on_the_floor = copy.deepcopy(plan)
+    for a in (a for s in on_the_floor["steps"] for a in s["actions"] if a.get("relay")):
+        a["region"] = "floor"
+    said = [(v.code, v.message) for v in validate(slab, on_the_floor).violations]
+    assert ("outside-region", "o9 is set down on floor but does not rest on it") in said, said

@@ -125,9 +125,9 @@ def spot_region(scene: SceneSpec, name: str, r1: str = "", r2: str = "") -> Body
     if PAIR in name:
         surface, ra, rb = name.split(PAIR)
         return staging(scene, surface, ra, rb)
-    if any(r.name == name for r in scene.regions):
-        return scene.body(name)
-    return staging(scene, name, r1, r2)
+    if any(f.name == name for f in scene.fixed):
+        return staging(scene, name, r1, r2)
+    return scene.region(name)
 
 
 def relay_facts(scene: SceneSpec, facts: Iterable[Fact], spots: dict[str, Spots]) -> set[Fact]:

@@ -114,7 +114,7 @@ def surface(body: Body) -> Body:
     """The top of a fixed object as a region (named as the object): a box of its footprint and
     SURFACE_HEIGHT standing on its top face, for a box (the language's poses turn bodies about z only); a
     body of no volume (nothing lies inside it) for any other fixed object."""
-    if not isinstance(body.shape, Box) or abs(body.pose[2, 2]) < 1 - 1e-9:
+    if not isinstance(body.shape, Box):
         return Body(body.name, Box(0.0, 0.0, 0.0), body.pose)
     up = (body.shape.sz + SURFACE_HEIGHT) / 2
     pose = body.pose.copy()

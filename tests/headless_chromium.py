@@ -1,6 +1,6 @@
 """A real headless Chromium driven over the DevTools protocol, for tests of HTML output.
 
-Debian's ``chromium`` package (``.ci/run`` installs it) is started with a private profile and
+Debian's ``chromium`` package (``tests/system-packages.sh`` installs it) is started with a private profile and
 ``--remote-debugging-port=0``; the page's DevTools WebSocket (the ``websockets`` package, a dependency of
 viser) takes screenshots until a condition on the picture holds or time runs out.  WebGL runs on
 SwiftShader (software), as on a machine without a GPU.  Nothing here skips: a missing browser is an error
@@ -33,7 +33,7 @@ def browser() -> str:
             return path
     raise AssertionError(
         "headless Chromium is needed for the HTML replay test and is not on PATH: "
-        "apt-get install -y chromium (.ci/run installs it)"
+        "apt-get install -y chromium (tests/system-packages.sh installs it)"
     )
 
 

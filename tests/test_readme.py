@@ -29,6 +29,16 @@ def test_ci_runs_exactly_the_readme_test_command() -> None:
     assert lines[-1] == quick_start()[1]
 
 
+def test_the_test_command_installs_the_system_packages_the_tests_need() -> None:
+    """A fresh machine has neither Chromium nor Graphviz: the test command itself installs them (one script,
+    called by the README and so by .ci/run), before pytest runs."""
+    command = quick_start()[1]
+    assert "sh tests/system-packages.sh && " in command
+    assert command.index("tests/system-packages.sh") < command.index("pytest")
+    script = (ROOT / "tests" / "system-packages.sh").read_text(encoding="utf-8")
+    assert "chromium" in script and "graphviz" in script and "apt-get install" in script
+
+
 def test_quick_start_paths_exist() -> None:
     first = quick_start()[0]
     for path in re.findall(r"domains/[\w/*.-]+", first):

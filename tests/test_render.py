@@ -287,7 +287,9 @@ def test_graph_svg_through_dot_and_a_clear_message_without_it(
 
     from mrgc.render import graph
 
-    assert shutil.which("dot"), "Graphviz's dot is needed: apt-get install -y graphviz (.ci/run installs it)"
+    assert shutil.which("dot"), (
+        "Graphviz's dot is needed: apt-get install -y graphviz (tests/system-packages.sh installs it)"
+    )
     svg = tmp_path / "g.svg"
     code, _, err = run(["graph", ROOT / "domains/symbolic/handover.mrg", "-o", svg, "--skeleton", 1], capsys)
     assert code == 0, err

@@ -314,6 +314,39 @@ class ReplayScene:
                 best = Closest(d, self._link(a, int(p[3])), self._link(b, int(p[4])))
         return best
 
+    def link_distances(
+        self, a: str, b: str, max_distance: float, links_a: tuple[int, ...] | None = None
+    ) -> dict[tuple[int, int], float]:
+        """Signed distances (margin-corrected) between the links of bodies ``a`` and ``b`` closer than
+        ``max_distance``: (link of a, link of b) -> the least distance (-1 for a rigid object), after the
+        base-link rule; with ``a == b`` (a robot against itself) ``links_a`` names the two links to ask."""
+        ba = self.robots[a].body if a in self.robots else self.bodies[a]
+        bb = self.robots[b].body if b in self.robots else self.bodies[b]
+        extra = float(max_distance) + 2 * MESH_MARGIN
+        if links_a is not None:
+            pts = self.pb.getClosestPoints(
+                ba, bb, extra, linkIndexA=links_a[0], linkIndexB=links_a[1], physicsClientId=self.cid
+            )
+        else:
+            pts = self.pb.getClosestPoints(ba, bb, extra, physicsClientId=self.cid)
+        self.queries += 1
+        skip_a = a in self.robots and not self.robots[a].planar and b in self.fixed
+        skip_b = b in self.robots and not self.robots[b].planar and a in self.fixed
+        out: dict[tuple[int, int], float] = {}
+        margin = self._margin
+        for p in pts:
+            la, lb = int(p[3]), int(p[4])
+            if (skip_a and la == -1) or (skip_b and lb == -1):
+                continue
+            d = float(p[8]) + margin.get((ba, la), 0.0) + margin.get((bb, lb), 0.0)
+            if d < max_distance and d < out.get((la, lb), np.inf):
+                out[(la, lb)] = d
+        return out
+
+    def link_name(self, name: str, index: int) -> str | None:
+        """The name of link ``index`` of robot ``name`` (None for a rigid object)."""
+        return self._link(name, index)
+
     def _link(self, name: str, index: int) -> str | None:
         r = self.robots.get(name)
         return None if r is None else r.links.get(index, str(index))

@@ -1,50 +1,64 @@
-"""Geometric plan replay for the validator: every step re-run in pybullet, finer than the planner checks.
+"""Geometric plan replay for the validator: every step re-run in pybullet, checked continuously.
 
 Nothing here comes from the planner's search or grounding: configurations are read from the plan, forward
 kinematics and signed distances are pybullet's (:class:`mrgc.geometry.replay_world.ReplayScene`: the robots'
-URDF collision meshes, the objects as pybullet shapes), grasp frames come from their specification
-(:mod:`mrgc.geometry.grasps`), the planar-robot model from :mod:`mrgc.geometry.planar`'s docstring.  Each
-action's geometry is read and checked by :mod:`mrgc.planner.replay_actions`; this module sweeps it.
+URDF collision meshes, the objects as pybullet shapes), motion bounds and self-collision pairs are derived
+from the URDFs as pybullet loads them (:mod:`mrgc.geometry.replay_bounds`), grasp frames come from their
+specification (:mod:`mrgc.geometry.grasps`), the planar-robot model from :mod:`mrgc.geometry.planar`'s
+docstring.  Each action's geometry is read and checked by :mod:`mrgc.planner.replay_actions`; this module
+sweeps it (:mod:`mrgc.planner.sweep`).
 
-**Execution model** (what a plan means; the checks follow it).  Robots start each step at home (their
-kind's ``:home``; a planar robot at its ``:base`` pose) and robots that wait stay there.  A step runs in
-synchronised phases:
+**Execution model** (what a plan means; the checks follow it).  Every robot starts each step at home (its
+kind's ``:home``; a planar robot at its ``:base`` pose).  Between its own motions a robot stands where its
+last motion left it, holding what it holds, its fingers as they were: it is never "in transit".  A step
+runs in synchronised phases:
 
 1. *to-pick* (paths ``to-pick``): pick robots move from home to their first pick configuration;
 2. *pick*: every pick robot follows its ``configs.pick`` (pre-grasp first, grasp last) and grasps its object
-   at the last one; the other robots are at home; every object is where the earlier steps left it;
+   at the last one; every object is where the earlier steps left it;
 3. *to-handover* (holding: ``to-handover``; empty-handed: ``taker-to-handover``);
 4. *handover*: each giver at ``configs.handover[0]``, each taker at ``configs.handover[1]``, both holding
-   the object;
-5. *to-place* (paths ``to-place``, holding): from the grasp (or a taker's exchange) to the pre-place;
-6. *place*: every place robot follows its ``configs.place`` (pre-place first) holding its object and
-   releases it at ``place_pose``; the other robots are at home;
-7. *home* (paths ``home``, ``giver-home``): back home, every object at its new pose.
+   the object; then the taker holds it;
+5. *giver-home* (paths ``giver-home``): each giver lets go (its fingers stay at the grasp's opening) and
+   withdraws home while its taker stands at the exchange holding the object;
+6. *to-place* (paths ``to-place``, holding): from the grasp (or a taker's exchange) to the pre-place;
+7. *place*: every place robot follows its ``configs.place`` (pre-place first) holding its object and
+   releases it at ``place_pose``;
+8. *home* (paths ``home``): back home, every object at its new pose.
+
+So a pick-and-place arm in a step with a handover stands at its last pick configuration, holding its
+object, through phases 3-5; a taker stands at home until phase 3; robots that wait stand at home.
 
 **The motion model** (the plan's ``motion_model``) says which motions the plan holds.  Planar robots
 (``paths``): ``to-pick``, ``to-place`` and ``home`` are required of every action.  Arms, ``full``: every
 path of the action's kind is required.  Arms, ``configurations`` (the paper's packaging model): no path is
 required; a *holding* transfer without a path (``to-handover``, ``to-place``) is the straight joint-space
-move between the configurations it connects, checked like a path; empty-handed transit is not modelled.
-
-In phases 3-6 the step's own objects are held or in transit, the other objects in place.  In phases 1, 2
-and 6 a robot without a motion in the phase is at home; in phases 3, 4, 5 and 7 only the waiting robots
-are, and a robot of the step without a motion in the phase is in transit and not checked (the plan says
-nothing about where it is).  Motions of different robots in one phase are paired by index and sampled at
-the union of their sample times (:mod:`mrgc.planner.sampling`): between two samples no joint moves more
-than the resolution (:data:`RESOLUTION`, or the plan's finer one, never below :data:`MIN_RESOLUTION`).
+move between the configurations it connects, checked like a path; an empty-handed transit without a path is
+not modelled: the robot stands where it was until the end of the transit's phase and is at its destination
+from then on (a giver is home after phase 5, a placer after phase 8).  Motions of different robots in one
+phase are paired by index: they share the phase's time ``s`` in [0, 1], each linear between its
+configurations (:mod:`mrgc.planner.sampling`).
 
 **Checks** (codes in brackets; tolerances as module constants here and in :mod:`~mrgc.planner.replay_actions`):
 
 - what :mod:`~mrgc.planner.replay_actions` checks per action: ``[motion-model]``, ``[missing]``,
-  ``[config]``, ``[joint-limits]``, ``[pose]``, ``[grasp]``, ``[approach]``, ``[handover]``, ``[path]``;
-- no collision (penetration deeper than :data:`CONTACT_TOL`) robot-robot, robot-object, robot-fixed
-  (except an arm's base link, see :class:`~mrgc.geometry.replay_world.ReplayScene`), held object-object and held
-  object-fixed, at every sample of every phase ``[collision-...]``; a robot is exempt from the object it
-  holds, and from the object it picks only in the *contact segment* of its pick approach (between its last
-  two configurations); a collision is reported once per step, phase and pair, at its deepest;
-- a motion longer than :data:`MAX_SAMPLES` samples, or a plan whose motions need more than
-  :data:`MAX_PLAN_SAMPLES` robot samples in all, is not checked and so not valid ``[too-long]``;
+  ``[config]``, ``[joint-limits]``, ``[pose]``, ``[grasp]``, ``[approach]`` (including the tool's pose along
+  the pick's and place's contact segment), ``[handover]``, ``[path]``;
+- **continuously** through every phase (:mod:`mrgc.planner.sweep`: conservative advancement on bounds of
+  how far any point of a link, footprint or held object can move; nothing passes between two checked
+  samples), no overlap deeper than :data:`CONTACT_TOL` of: a moving robot with the fixed objects (except an
+  arm's base link, see :class:`~mrgc.geometry.replay_world.ReplayScene`), the objects present, the other
+  robots moving or standing and what they hold ``[collision-robot-fixed]``, ``[collision-robot-robot]``,
+  ``[collision-robot-object]``; an arm with itself, every pair of links more than one chain joint apart
+  (:mod:`mrgc.geometry.replay_bounds`) ``[collision-self]``; a held object with the fixed objects, the
+  other objects and robots, and every link of the arm or arms holding it but their fingers
+  ``[collision-object-fixed]``, ``[collision-object-object]``, ``[collision-self-held]``.  The object a robot
+  picks is exempt only from its gripper (hand and fingers) and only in the *contact segment* of its pick
+  approach (between its last two configurations); its other links may not touch it.  A collision is
+  reported once per step, phase and pair (link pair, for a self-collision), at its deepest;
+- a motion longer than :data:`MAX_SAMPLES` samples at the resolution (:data:`RESOLUTION`), or a plan whose
+  motions need more than :data:`MAX_PLAN_SAMPLES` robot samples at the resolution in all, or a phase that
+  needs more than :data:`MAX_SAMPLES` checked times, is not checked and so not valid ``[too-long]``;
 - every placement lies inside its action's region ``[outside-region]``, is free of fixed objects, other
   objects and the robots at home, to :data:`CONTACT_TOL` ``[collision-...]``, and rests on something
   ``[floating]``: its lowest point at most :data:`SUPPORT_TOL` above the floor of a region under it, or
@@ -56,11 +70,12 @@ than the resolution (:data:`RESOLUTION`, or the plan's finer one, never below :d
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Sequence
 
 import numpy as np
 
+from mrgc.geometry.replay_bounds import arm_bounds, planar_radius
 from mrgc.geometry.replay_world import ReplayScene
 from mrgc.geometry.scene import SceneSpec, inside, outline, scene_from_problem
 from mrgc.geometry.transforms import translation
@@ -68,7 +83,8 @@ from mrgc.language.model import Problem
 from mrgc.planner.plan import MotionModel
 from mrgc.planner.plan_reader import Action
 from mrgc.planner.replay_actions import PATH_PHASES, ActionGeometry, ActionReader
-from mrgc.planner.sampling import config_at, sample_count, sample_times, where
+from mrgc.planner.sampling import config_at, deltas, sample_count, where
+from mrgc.planner.sweep import CAP, Pair, Sweep
 from mrgc.planner.violation import Violation
 
 RESOLUTION = 0.01  # largest joint (rad) or planar base (m, rad) motion between samples
@@ -82,9 +98,10 @@ BOX_PAD = 1e-3  # m: bounding boxes closer than this are handed to pybullet's di
 
 @dataclass
 class _Track:
-    """A robot moving through configurations during a phase, maybe holding an object.  ``carries``: the
-    track puts the held object where its tool holds it (a taker at a handover does not: the giver does);
-    ``exempt``: an object the robot may touch from time ``exempt_from`` on (the pick's contact segment)."""
+    """A robot during a phase: moving through ``configs`` (one row: standing), maybe holding an object.
+    ``carries``: the track puts the held object where its tool holds it (a taker at a handover does not:
+    the giver does); ``exempt``: the object the robot picks, which its gripper links may touch from time
+    ``exempt_from`` on (the pick's contact segment)."""
 
     robot: str
     configs: np.ndarray  # (m, dof)
@@ -95,6 +112,167 @@ class _Track:
     carries: bool = True
     exempt: str | None = None
     exempt_from: float = 2.0
+
+
+@dataclass(frozen=True)
+class _Part:
+    """One side of a checked pair: a robot (``link`` -1 .. its links) or an object, with the columns of the
+    phase's speeds that move it and how (``rows``: link -> rate coefficients over all columns)."""
+
+    name: str
+    label: tuple[str, str]  # (what, where) for messages
+    rows: dict[int, np.ndarray]
+    track: int  # index of the track whose columns move it; -1: it stands
+    robot: bool
+    holder: str | None = None  # an object held: the robot that carries it
+
+
+@dataclass
+class _StepState:
+    """Where each robot is during a step: its configuration (every robot starts the step at home), what it
+    holds (object, grasp) and its finger opening since its last motion (absent: fully open)."""
+
+    cur: dict[str, np.ndarray]
+    hold: dict[str, tuple[str, str]] = field(default_factory=dict)
+    opening: dict[str, float | None] = field(default_factory=dict)
+
+
+class _PairList:
+    """The pairs of a phase as they are added: :class:`~mrgc.planner.sweep.Pair` (sub-pairs and rates) and
+    their sides (parts, the link indices of a self pair, the collision kind)."""
+
+    def __init__(self) -> None:
+        self.pairs: list[Pair] = []
+        self.sides: list[tuple[_Part, _Part, tuple[int, int] | None, str]] = []
+
+    def add(
+        self,
+        a: _Part,
+        b: _Part,
+        kind: str,
+        links: tuple[int, int] | None = None,
+        skip: frozenset[int] = frozenset(),
+        until: dict[int, float] | None = None,
+    ) -> None:
+        """Pair ``a`` with ``b`` (not when neither moves): every link of a robot side (only ``links`` for a
+        self pair; robot links in ``skip`` left out), each sub-pair's rate the sum of its sides' rates, or for
+        two parts moved by one track only what moves one and not the other; ``until``: link -> the time from
+        which that link of the robot side is no longer checked."""
+        if a.track < 0 and b.track < 0:
+            return
+        a_rows = {links[0]: a.rows[links[0]]} if links else a.rows
+        b_rows = {links[1]: b.rows[links[1]]} if links else b.rows
+        same = a.track >= 0 and a.track == b.track
+        subs, rows, ends = [], [], []
+        for la, ra in a_rows.items():
+            if a.robot and la in skip:
+                continue
+            for lb, rb in b_rows.items():
+                if b.robot and lb in skip:
+                    continue
+                rows.append(ra * (rb == 0) + rb * (ra == 0) if same else ra + rb)
+                subs.append((la, lb))
+                ends.append((until or {}).get(la if a.robot else lb, np.inf))
+        if subs:
+            self.pairs.append(Pair(subs, np.array(rows), np.array(ends)))
+            self.sides.append((a, b, links, kind))
+
+
+class _PhaseWorld:
+    """The pybullet world set up for one phase, and what the sweep needs of it: the moving ``tracks`` (each
+    owns columns of the phase's speed vector: an arm's joints, a planar robot's (|d(x, y)|, |d yaw|)), the
+    ``standing`` robots, the objects present (not held), and every robot and object as a :class:`_Part`."""
+
+    def __init__(self, rp: _Replayer, tracks: list[_Track], standing: list[_Track]) -> None:
+        self.rp, self.tracks, self.standing = rp, tracks, standing
+        self.everyone = [*tracks, *standing]
+        held = {tr.holding for tr in self.everyone if tr.holding}
+        self.present = [o for o in rp.movable if o not in held]
+        rs = rp.rs
+        for tr in self.everyone:
+            rs.set_fingers(tr.robot, tr.fingers)
+            rs.set_config(tr.robot, tr.configs[0])
+            if tr.holding and tr.grasp and tr.carries:
+                rs.set_pose(tr.holding, rp.held_pose(tr.robot, tr.configs[0], tr.holding, tr.grasp))
+        for o in rp.movable:
+            if o not in held:
+                rs.set_pose(o, rp.poses[o])
+        self.offset: list[int] = []
+        self.columns = 0
+        for tr in tracks:
+            self.offset.append(self.columns)
+            self.columns += 2 if rp.planar[tr.robot] else len(tr.configs[0])
+        self.parts = {tr.robot: self._robot(i, tr) for i, tr in enumerate(self.everyone)}
+        carrier = {tr.holding: (i, tr) for i, tr in enumerate(self.everyone) if tr.holding and tr.carries}
+        self.objects = {o: self._object(o, carrier.get(o)) for o in (*self.present, *carrier)}
+        for f in rp.fixed:
+            self.objects[f] = _Part(f, (f, ""), {-1: np.zeros(self.columns)}, -1, False)
+
+    def _robot(self, i: int, tr: _Track) -> _Part:
+        """Track ``i``'s robot: each link's rate coefficients (zero when it stands)."""
+        rp, r = self.rp, tr.robot
+        moving = i < len(self.tracks)
+        rows: dict[int, np.ndarray] = {}
+        if rp.planar[r]:
+            rows[-1] = np.zeros(self.columns)
+            if moving:
+                rows[-1][self.offset[i] : self.offset[i] + 2] = (1.0, rp.footprint.get(r, 0.0))
+        else:
+            b = rp.bounds[r]
+            for col, link in enumerate(b.links):
+                rows[link] = np.zeros(self.columns)
+                if moving:
+                    rows[link][self.offset[i] : self.offset[i] + len(b.reach)] = b.reach[:, col]
+        return _Part(r, (r, tr.label), rows, i if moving else -1, True)
+
+    def _object(self, o: str, carried: tuple[int, _Track] | None) -> _Part:
+        """Object ``o``: standing, or held by the track that carries it (its rate: the end effector's plus its
+        radius about the end-effector frame per unit turn; planar: about the base's yaw axis)."""
+        rp = self.rp
+        row = np.zeros(self.columns)
+        if carried is None:
+            return _Part(o, (o, ""), {-1: row}, -1, False)
+        i, tr = carried
+        if i < len(self.tracks) and tr.grasp:
+            at = self.offset[i]
+            if rp.planar[tr.robot]:
+                rel = rp.grasp_frame(tr.robot, o, tr.grasp)
+                row[at : at + 2] = (1.0, float(np.hypot(rel[0, 3], rel[1, 3])) + rp.radius[o])
+            else:
+                b = rp.bounds[tr.robot]
+                held = rp.held_pose(tr.robot, tr.configs[0], o, tr.grasp)
+                rho = float(np.linalg.norm(held[:3, 3] - rp.rs.ee_pose(tr.robot)[:3, 3])) + rp.radius[o]
+                row[at : at + len(b.ee_chain)] = b.ee_chain + rho * b.turns
+        return _Part(o, (f"{o} held by {tr.robot}", ""), {-1: row}, i if i < len(self.tracks) else -1, False, tr.robot)
+
+    def breakpoints(self) -> np.ndarray:
+        """The times between which every motion's speed is constant: each track's configurations, and the
+        start of each pick's contact segment."""
+        times = [np.zeros(1), np.ones(1)]
+        for tr in self.tracks:
+            times.append(np.linspace(0.0, 1.0, len(tr.configs)) if len(tr.configs) > 1 else np.zeros(1))
+            if tr.exempt and 0.0 < tr.exempt_from < 1.0:
+                times.append(np.array([tr.exempt_from]))
+        self._bp: np.ndarray = np.unique(np.concatenate(times))
+        return self._bp
+
+    def speeds(self, k: int) -> np.ndarray:
+        """The absolute speeds (per unit of phase time) on ``[breakpoints[k], breakpoints[k + 1]]``."""
+        mid = 0.5 * (self._bp[k] + self._bp[k + 1])
+        w = np.zeros(self.columns)
+        for i, tr in enumerate(self.tracks):
+            m = len(tr.configs)
+            if m < 2:
+                continue
+            j = min(int(mid * (m - 1)), m - 2)
+            planar = self.rp.planar[tr.robot]
+            d = deltas(tr.configs[j : j + 2], planar)[0] * (m - 1)
+            at = self.offset[i]
+            if planar:
+                w[at : at + 2] = (float(np.hypot(d[0], d[1])), abs(float(d[2])))
+            else:
+                w[at : at + len(d)] = np.abs(d)
+        return w
 
 
 class _Stop(Exception):
@@ -158,92 +336,99 @@ class _Replayer(ActionReader):
         self.movable = [b.name for b in scene.movable]
         self.resolution = max(MIN_RESOLUTION, min(RESOLUTION, model.resolution))
         self.samples = 0
+        self.plan_samples = 0  # robot samples at the resolution of the motions checked so far (the cap's measure)
         self.budget_spent = False
         self._worst: dict[tuple[Any, ...], tuple[float, str, str]] = {}
         self.first_only = False
-        #: bounding boxes (min x y z, max x y z) of the bodies of the phase being swept
-        self._boxes: dict[str, tuple[float, ...]] = {}
+        self.bounds = {r: arm_bounds(rs, r, self.home[r]) for r, planar in self.planar.items() if not planar}
+        self.footprint = {
+            r.name: planar_radius(outline(r.kind.footprint))
+            for r in scene.robots
+            if self.planar[r.name] and r.kind.footprint
+        }
+        self.radius = {b.name: float(np.linalg.norm(outline(b.shape), axis=1).max()) for b in scene.movable}
         self._placements_state()
         self.support = {o: self._supports(o) for o in self.movable}  # what each object rests on
 
     # ------------------------------------------------------------------ one step
     def run_step(self, t: int, acts: list[ActionGeometry]) -> None:
-        """Replay step ``t``: the phases of the module docstring."""
+        """Replay step ``t``: the phases of the module docstring, every robot at its true configuration."""
         geo = [a for a in acts if a.geometry]
-        robots = list(self.planar)
-        in_step = {a.obj for a in acts}
-        busy = {r for a in acts for r in a.action.robots()}
-        waiting = [r for r in robots if r not in busy]
-        everything = list(self.movable)
-        present = [o for o in self.movable if o not in in_step]
-
-        def paths(*names: str) -> list[_Track]:
-            out = []
-            for a in geo:  # an action with broken geometry is reported, its motions are not replayed
-                for name in names:
-                    if name in a.paths:
-                        role, grasp_role = PATH_PHASES[name][:2]
-                        robot, grasp = a.robot(role), a.grasp(grasp_role)
-                        label = f"straight {name} transfer" if name in a.straight else f"{name} path"
-                        out.append(
-                            _Track(
-                                robot,
-                                a.paths[name],
-                                label,
-                                a.obj if grasp else None,
-                                grasp,
-                                self.fingers(robot, a.obj, grasp),
-                            )
-                        )
-            return out
-
-        def others(tracks: list[_Track]) -> list[str]:
-            return [r for r in robots if r not in {tr.robot for tr in tracks}]
-
-        tracks = paths("to-pick")
-        self._sweep(t, "to-pick", tracks, others(tracks), everything)
-        tracks = []
+        st = _StepState(dict(self.home))
+        self._phase(t, "to-pick", st, [self._path(a, "to-pick") for a in geo])
+        self._phase(t, "pick", st, [self._pick(a, st) for a in geo])
         for a in geo:
-            qs, robot = a.configs["pick"], a.action.pick_robot
-            contact = max(0.0, (len(qs) - 2) / (len(qs) - 1)) if len(qs) > 1 else 0.0
-            tracks.append(
-                _Track(
-                    robot,
-                    qs,
-                    "pick",
-                    fingers=self.fingers(robot, a.obj, a.action.pick_grasp),
-                    exempt=None if self.planar[robot] else a.obj,
-                    exempt_from=contact,
-                )
-            )
-        self._sweep(t, "pick", tracks, others(tracks), everything)
-        self._sweep(t, "to-handover", paths("to-handover", "taker-to-handover"), waiting, present)
-        tracks = []
+            st.hold[a.action.pick_robot] = (a.obj, a.action.pick_grasp)
+        self._phase(t, "to-handover", st, [self._path(a, n) for a in geo for n in ("to-handover", "taker-to-handover")])
+        self._phase(t, "handover", st, [tr for a in geo if a.handover for tr in self._exchange(a, st)])
         for a in geo:
             if a.handover:
-                h, (giver, taker), (g1, g2) = (
-                    a.configs["handover"],
-                    a.action.robots(),
-                    (a.action.pick_grasp, a.action.place_grasp),
-                )
-                tracks.append(_Track(giver, h[:1], "handover (giver)", a.obj, g1, self.fingers(giver, a.obj, g1)))
-                tracks.append(
-                    _Track(taker, h[1:], "handover (taker)", a.obj, g2, self.fingers(taker, a.obj, g2), carries=False)
-                )
-        self._sweep(t, "handover", tracks, waiting, present)
-        self._sweep(t, "to-place", paths("to-place"), waiting, present)
-        tracks = [
-            _Track(
-                a.action.place_robot,
-                a.configs["place"],
-                "place",
-                a.obj,
-                a.action.place_grasp,
-                self.fingers(a.action.place_robot, a.obj, a.action.place_grasp),
-            )
-            for a in geo
+                del st.hold[a.action.pick_robot]
+                st.hold[a.action.place_robot] = (a.obj, a.action.place_grasp)
+        self._phase(t, "giver-home", st, [self._withdraw(a) for a in geo if a.handover])
+        for a in geo:
+            if a.handover:  # without a giver-home path (configurations model) the giver is home now
+                st.cur[a.action.pick_robot] = self.home[a.action.pick_robot]
+                st.opening.pop(a.action.pick_robot, None)
+        self._phase(t, "to-place", st, [self._path(a, "to-place") for a in geo])
+        self._phase(t, "place", st, [self._place(a, st) for a in geo])
+        for a in geo:
+            st.hold.pop(a.action.place_robot, None)
+        self._release(t, acts)
+        self._phase(t, "home", st, [self._path(a, "home") for a in geo])
+        placed = [a for a in acts if a.place_pose is not None]
+        self._placements(t, placed)
+        self._rests(t, placed)
+        self._on_tops(t, placed)
+        self.flush()
+
+    def _path(self, a: ActionGeometry, name: str) -> _Track | None:
+        """The track of ``a``'s path ``name`` (given, or the model's straight transfer); None without one."""
+        if name not in a.paths:
+            return None
+        role, grasp_role = PATH_PHASES[name][:2]
+        robot, grasp = a.robot(role), a.grasp(grasp_role)
+        label = f"straight {name} transfer" if name in a.straight else f"{name} path"
+        return _Track(robot, a.paths[name], label, a.obj if grasp else None, grasp, self.fingers(robot, a.obj, grasp))
+
+    def _pick(self, a: ActionGeometry, st: _StepState) -> _Track:
+        """The pick approach of ``a``; its arm may touch the object with its gripper in the contact segment (a
+        planar robot stops in front of what it picks).  Without a to-pick path the robot is at its first
+        pick configuration now."""
+        qs, robot = a.configs["pick"], a.action.pick_robot
+        st.cur[robot] = qs[0]
+        contact = max(0.0, (len(qs) - 2) / (len(qs) - 1)) if len(qs) > 1 else 0.0
+        fingers = self.fingers(robot, a.obj, a.action.pick_grasp)
+        exempt = None if self.planar[robot] else a.obj
+        return _Track(robot, qs, "pick", fingers=fingers, exempt=exempt, exempt_from=contact)
+
+    def _exchange(self, a: ActionGeometry, st: _StepState) -> list[_Track]:
+        """A handover's giver and taker at their exchange configurations, both holding the object (where
+        the giver holds it); without paths to it the robots are there now."""
+        h, (giver, taker) = a.configs["handover"], a.action.robots()
+        g1, g2 = a.action.pick_grasp, a.action.place_grasp
+        st.cur[giver], st.cur[taker] = h[0], h[1]
+        return [
+            _Track(giver, h[:1], "handover (giver)", a.obj, g1, self.fingers(giver, a.obj, g1)),
+            _Track(taker, h[1:], "handover (taker)", a.obj, g2, self.fingers(taker, a.obj, g2), carries=False),
         ]
-        self._sweep(t, "place", tracks, others(tracks), present)
+
+    def _withdraw(self, a: ActionGeometry) -> _Track | None:
+        """The giver's way home from the exchange, its fingers as they let the object go (the grasp's
+        opening); None without a giver-home path."""
+        tr = self._path(a, "giver-home")
+        if tr is not None:
+            tr.fingers = self.fingers(a.action.pick_robot, a.obj, a.action.pick_grasp)
+        return tr
+
+    def _place(self, a: ActionGeometry, st: _StepState) -> _Track:
+        """The place approach of ``a``, holding the object; without a path to it the robot is there now."""
+        robot, grasp = a.action.place_robot, a.action.place_grasp
+        st.cur[robot] = a.configs["place"][0]
+        return _Track(robot, a.configs["place"], "place", a.obj, grasp, self.fingers(robot, a.obj, grasp))
+
+    def _release(self, t: int, acts: list[ActionGeometry]) -> None:
+        """The step's objects at their placements, each inside its action's region ``[outside-region]``."""
         for a in acts:
             if a.place_pose is None:
                 continue
@@ -257,31 +442,108 @@ class _Replayer(ActionReader):
                     f"the placement of {a.obj} at ({p[0]:.3f}, {p[1]:.3f}, {p[2]:.3f}) "
                     f"is not entirely inside region {a.action.region}",
                 )
-        self._sweep(t, "home", paths("home", "giver-home"), waiting, everything)
-        placed = [a for a in acts if a.place_pose is not None]
-        self._placements(t, placed)
-        self._rests(t, placed)
-        self._on_tops(t, placed)
-        self.flush()
+
+    def _phase(self, t: int, phase: str, st: _StepState, tracks: list[_Track | None]) -> None:
+        """Sweep phase ``phase`` with the ``tracks`` that move in it; then each robot that moved stands at
+        its last configuration with its fingers as they were."""
+        moving = [tr for tr in tracks if tr is not None]
+        if moving and not self.budget_spent and self._within_budget(t, phase, moving):
+            self._sweep(t, phase, moving, self._standing(moving, st))
+        for tr in moving:
+            st.cur[tr.robot], st.opening[tr.robot] = tr.configs[-1], tr.fingers
+
+    def _standing(self, tracks: list[_Track], st: _StepState) -> list[_Track]:
+        """Every robot without a track in a phase, standing where ``st`` says, holding what it holds."""
+        moving = {tr.robot for tr in tracks}
+        out = []
+        for r in self.planar:
+            if r in moving:
+                continue
+            home = np.array_equal(st.cur[r], self.home[r])
+            obj, grasp = st.hold.get(r, (None, None))
+            out.append(_Track(r, np.asarray(st.cur[r])[None], "home" if home else "standing", obj, grasp))
+            out[-1].fingers = st.opening.get(r)
+        return out
 
     # ------------------------------------------------------------------ sweeping a phase
-    def _sweep(self, t: int, phase: str, tracks: list[_Track], static: list[str], present: list[str]) -> None:
-        if not tracks or self.budget_spent or not self._within_budget(t, phase, tracks):
-            return
-        others = self._stage(tracks, static, present)
-        times = np.unique(
-            np.concatenate([sample_times(tr.configs, self.planar[tr.robot], self.resolution) for tr in tracks])
-        )
-        for s in times:
-            self._sample(t, phase, tracks, static, others, float(s))
-            if self.first_only and self._worst:
-                break
+    def _sweep(self, t: int, phase: str, tracks: list[_Track], standing: list[_Track]) -> None:
+        """Check phase ``phase`` of step ``t`` continuously (:mod:`mrgc.planner.sweep`): the ``tracks`` move,
+        the ``standing`` robots stand (with what they hold)."""
+        ph = _PhaseWorld(self, tracks, standing)
+        pairs, sides = self._pairs(ph)
+        rs = self.rs
+
+        def set_state(s: float) -> None:
+            for tr in tracks:
+                q = config_at(tr.configs, s, self.planar[tr.robot])
+                rs.set_config(tr.robot, q)
+                if tr.holding and tr.grasp and tr.carries:
+                    rs.set_pose(tr.holding, self.held_pose(tr.robot, q, tr.holding, tr.grasp))
+            self.samples += len(tracks)
+
+        def query(p: int, s: float) -> dict[tuple[int, int], float]:
+            a, b, links, _ = sides[p]
+            return rs.link_distances(a.name, b.name, CAP, links)
+
+        def report(p: int, sub: tuple[int, int], d: float, s: float) -> None:
+            a, b, _, kind = sides[p]
+            self._hit_at(t, phase, kind, (a, sub[0]), (b, sub[1]), d, ph.everyone, s)
+
+        sweep = Sweep(ph.breakpoints(), ph.speeds, pairs, set_state, query, report, CONTACT_TOL, MAX_SAMPLES)
+        if self.first_only:
+            sweep.stop = lambda: bool(self._worst)
+        sweep.run()
+        if sweep.exhausted:
+            self._v(
+                t, None, "too-long", f"{phase}: the motions need more than {MAX_SAMPLES} checked samples; not checked"
+            )
         self.stop_if_found()
 
+    def _pairs(self, ph: _PhaseWorld) -> tuple[list[Pair], list[tuple[_Part, _Part, tuple[int, int] | None, str]]]:
+        """The pairs a phase checks, with their two sides, link indices (self pairs) and collision kind:
+        each moving robot and what it carries against the fixed objects, the objects present, itself, the
+        other moving robots and the standing ones with what they hold."""
+        out = _PairList()
+        for i, tr in enumerate(ph.tracks):
+            me, b, h = ph.parts[tr.robot], self.bounds.get(tr.robot), tr.holding
+            for f in self.fixed:
+                out.add(me, ph.objects[f], "robot-fixed")
+            for o in ph.present:
+                exempt = dict.fromkeys(b.gripper if b else (-1,), tr.exempt_from) if o == tr.exempt else None
+                out.add(me, ph.objects[o], "robot-object", until=exempt)
+            for la, lb in b.self_pairs if b is not None else ():
+                out.add(me, me, "self", (la, lb))
+            if h and h in ph.objects:
+                for o in (*self.fixed, *ph.present):
+                    out.add(ph.objects[h], ph.objects[o], "object-fixed" if o in self.fixed else "object-object")
+                if b is not None:  # the held object against its own arm, the fingers (which hold it) excepted
+                    out.add(ph.objects[h], me, "self-held", skip=b.fingers)
+            for other in [*ph.tracks[i + 1 :], *ph.standing]:
+                self._between(ph, out, tr, other)
+        return out.pairs, out.sides
+
+    def _between(self, ph: _PhaseWorld, out: _PairList, tr: _Track, other: _Track) -> None:
+        """The pairs of two robots of a phase (``tr`` moves) and what they hold: robot-robot, each robot
+        against the other's object, object-object; the object two robots hold at a handover is checked
+        against both arms but their fingers."""
+        me, them, h, oh = ph.parts[tr.robot], ph.parts[other.robot], tr.holding, other.holding
+        out.add(me, them, "robot-robot")
+        if oh and oh != h and oh in ph.objects:
+            out.add(me, ph.objects[oh], "robot-object")
+        if not (h and h in ph.objects):
+            return
+        if oh == h:
+            ob = self.bounds.get(other.robot)
+            out.add(ph.objects[h], them, "self-held", skip=ob.fingers if ob else frozenset())
+            return
+        out.add(ph.objects[h], them, "robot-object")
+        if oh and oh in ph.objects:
+            out.add(ph.objects[h], ph.objects[oh], "object-object")
+
     def _within_budget(self, t: int, phase: str, tracks: list[_Track]) -> bool:
-        """Whether the phase's motions can be checked: no motion longer than :data:`MAX_SAMPLES` samples,
-        the plan's samples in all at most :data:`MAX_PLAN_SAMPLES` ``[too-long]`` (then the rest of the
-        plan's motions are not checked)."""
+        """Whether the phase's motions can be checked: no motion longer than :data:`MAX_SAMPLES` samples at
+        the resolution, the plan's samples in all at most :data:`MAX_PLAN_SAMPLES` ``[too-long]`` (then the
+        rest of the plan's motions are not checked)."""
         counts = [sample_count(tr.configs, self.planar[tr.robot], self.resolution) for tr in tracks]
         n = max(counts)
         if n > MAX_SAMPLES:
@@ -294,7 +556,8 @@ class _Replayer(ActionReader):
                 f"({n} samples at {self.resolution:g} rad or m each; at most {MAX_SAMPLES})",
             )
             return False
-        if self.samples + sum(counts) * len(tracks) > MAX_PLAN_SAMPLES:
+        self.plan_samples += sum(counts) * len(tracks)
+        if self.plan_samples > MAX_PLAN_SAMPLES:
             self._v(
                 t,
                 None,
@@ -306,120 +569,58 @@ class _Replayer(ActionReader):
             return False
         return True
 
-    def _stage(self, tracks: list[_Track], static: list[str], present: list[str]) -> list[str]:
-        """Set the world up for a phase: robots not moving at home with open fingers, moving robots' fingers
-        at their opening, objects present where they are (the others and none held parked), bounding boxes
-        of what does not move; the objects present and not held."""
-        rs = self.rs
-        for r in static:
-            rs.set_config(r, self.home[r])
-            rs.set_fingers(r, None)
-        for tr in tracks:  # fingers: at the grasp's opening while approaching or holding, else fully open
-            rs.set_fingers(tr.robot, tr.fingers)
-        held = {tr.holding for tr in tracks if tr.holding}
-        for o in self.movable:
-            if o in present:
-                rs.set_pose(o, self.poses[o])
-            elif o not in held:
-                rs.set_pose(o, None)
-        others = [o for o in present if o not in held]
-        # bounding boxes: a pair whose boxes are apart cannot overlap, and is not asked of pybullet
-        self._boxes = {b: self.rs.aabb(b) for b in (*self.fixed, *others, *static)}
-        return others
-
-    def _sample(self, t: int, phase: str, tracks: list[_Track], static: list[str], others: list[str], s: float) -> None:
-        """Every moving robot (and what it holds) at time ``s`` of the phase, checked against the scene, the
-        other moving robots and the robots at home."""
-        rs = self.rs
-        states = []
-        for tr in tracks:
-            q = config_at(tr.configs, s, self.planar[tr.robot])
-            rs.set_config(tr.robot, q)
-            self._boxes[tr.robot] = self.rs.aabb(tr.robot)
-            if tr.holding and tr.grasp and tr.carries:  # a handed-over object is where the giver holds it
-                rs.set_pose(tr.holding, self.held_pose(tr.robot, q, tr.holding, tr.grasp))
-                self._boxes[tr.holding] = self.rs.aabb(tr.holding)
-            states.append(where(tr.label, len(tr.configs), s))
-        self.samples += len(tracks)
-        for tr, at in zip(tracks, states):
-            self._robot_scene(t, phase, tr, at, others, s)
-        for i, tr in enumerate(tracks):
-            for j in range(i + 1, len(tracks)):
-                self._pair(t, phase, tr, states[i], tracks[j], states[j])
-            for r in static:
-                self._pair(t, phase, tr, states[i], _Track(r, np.zeros((1, 1)), "home"), "at home")
-
     def stop_if_found(self) -> None:
         """With ``first_only``, end the replay once a violation is known."""
         if self.first_only and (self.out or self._worst):
             raise _Stop
 
-    def _closest(self, a: str, b: str) -> Any:
-        """pybullet's deepest overlap of ``a`` and ``b``, None when they do not overlap (at once when their
-        bounding boxes, grown by 1 mm, are apart)."""
-        a0, a1, a2, a3, a4, a5 = self._boxes[a]
-        b0, b1, b2, b3, b4, b5 = self._boxes[b]
-        if (
-            a0 > b3 + BOX_PAD
-            or a1 > b4 + BOX_PAD
-            or a2 > b5 + BOX_PAD
-            or b0 > a3 + BOX_PAD
-            or b1 > a4 + BOX_PAD
-            or b2 > a5 + BOX_PAD
-        ):
-            return None
-        return self.rs.closest(a, b)
+    def _hit_at(
+        self,
+        t: int,
+        phase: str,
+        kind: str,
+        a: tuple[_Part, int],
+        b: tuple[_Part, int],
+        d: float,
+        everyone: list[_Track],
+        s: float,
+    ) -> None:
+        """Record an overlap of ``d`` (< -CONTACT_TOL) between (part, link) ``a`` and ``b`` at time ``s`` of
+        the phase, keeping the deepest per (step, phase, pair; link pair of a self-collision)."""
+        (pa, la), (pb, lb) = a, b
+        links = (la, lb) if kind == "self" else None
+        key = (t, phase, f"collision-{kind}", pa.name, pb.name, links)
+        if key in self._worst and self._worst[key][0] <= d:
+            return
+        by = {tr.robot: tr for tr in everyone}
 
-    def _robot_scene(self, t: int, phase: str, tr: _Track, at: str, others: list[str], s: float) -> None:
-        me = (tr.robot, at)
-        for f in self.fixed:
-            self._hit(t, phase, tr.robot, f, self._closest(tr.robot, f), me, (f, ""), "robot-fixed")
-        for o in others:
-            if o == tr.holding or (o == tr.exempt and s >= tr.exempt_from - 1e-12):
-                continue
-            self._hit(t, phase, tr.robot, o, self._closest(tr.robot, o), me, (o, ""), "robot-object")
-        if tr.holding and tr.carries:
-            h = tr.holding
-            held = (f"{h} held by {tr.robot}", at)
-            for f in self.fixed:
-                self._hit(t, phase, h, f, self._closest(h, f), held, (f, ""), "object-fixed")
-            for o in others:
-                if o != h:
-                    self._hit(t, phase, h, o, self._closest(h, o), held, (o, ""), "object-object")
+        def at(robot: str) -> str:
+            tr = by[robot]
+            return {"home": "at home", "standing": "standing still"}.get(tr.label) or where(
+                tr.label, len(tr.configs), s
+            )
 
-    def _pair(self, t: int, phase: str, a: _Track, wa: str, b: _Track, wb: str) -> None:
-        da, db = (a.robot, wa), (b.robot, wb)
-        self._hit(t, phase, a.robot, b.robot, self._closest(a.robot, b.robot), da, db, "robot-robot")
-        ha = a.holding if a.holding and a.carries else None
-        hb = b.holding if b.holding and b.carries else None
-        if hb and hb != a.holding:
-            self._hit(
-                t, phase, a.robot, hb, self._closest(a.robot, hb), da, (f"{hb} held by {b.robot}", wb), "robot-object"
-            )
-        if ha and ha != b.holding:
-            self._hit(
-                t, phase, b.robot, ha, self._closest(b.robot, ha), db, (f"{ha} held by {a.robot}", wa), "robot-object"
-            )
-        if ha and hb and ha != hb:
-            self._hit(
-                t,
-                phase,
-                ha,
-                hb,
-                self._closest(ha, hb),
-                (f"{ha} held by {a.robot}", wa),
-                (f"{hb} held by {b.robot}", wb),
-                "object-object",
-            )
+        def side(p: _Part, link: int) -> str:
+            if not p.robot:
+                return p.label[0] + (f" ({at(p.holder)})" if p.holder else "")
+            return f"{self.rs.link_name(p.name, link)} of {p.name} ({at(p.name)})"
+
+        msg = f"{phase}: {side(pa, la)} and {side(pb, lb)} overlap by {-d * 1e3:.1f} mm"
+        self._worst[key] = (d, pa.name, msg)
+
+    def flush(self) -> None:
+        for (t, _, code, *_), (_, subject, msg) in self._worst.items():
+            self._v(t, subject, code, msg)
+        self._worst.clear()
 
     def _hit(
         self, t: int, phase: str, a: str, b: str, c: Any, da: tuple[str, str], db: tuple[str, str], kind: str
     ) -> None:
         """Record a penetration deeper than CONTACT_TOL between ``a`` and ``b`` (described by (label, when)),
-        keeping the deepest per (step, phase, pair)."""
+        keeping the deepest per (step, phase, pair): the placement checks."""
         if c is None or c.distance >= -CONTACT_TOL:
             return
-        key = (t, phase, kind, a, b)
+        key = (t, phase, f"collision-{kind}", a, b)
         if key in self._worst and self._worst[key][0] <= c.distance:
             return
 
@@ -428,11 +629,6 @@ class _Replayer(ActionReader):
 
         msg = f"{phase}: {side(da, c.link_a)} and {side(db, c.link_b)} overlap by {-c.distance * 1e3:.1f} mm"
         self._worst[key] = (c.distance, a, msg)
-
-    def flush(self) -> None:
-        for (t, _, kind, _, _), (_, subject, msg) in self._worst.items():
-            self._v(t, subject, f"collision-{kind}", msg)
-        self._worst.clear()
 
     # ------------------------------------------------------------------ after the step
     def _placements_state(self) -> None:

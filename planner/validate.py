@@ -15,9 +15,10 @@ reader's limits, not JSON, not following ``docs/plan.schema.json``, another sche
 Checks on every plan (codes in brackets):
 
 - the plan is for this problem: same name ``[problem]``, same contents ``[problem-changed]`` (the plan's
-  ``problem_digest``, the checked problem's content digest of :mod:`mrgc.language.digest`, matches: the
-  file the plan was made from and its facts file both qualify; a plan without a digest compares the
-  sha256 of the problem file's bytes), symbolic flag as the problem's ``[plan-kind]``; status ``solved``
+  ``problem_digest`` must equal the checked problem's content digest of :mod:`mrgc.language.digest`, its
+  ``problem_sha256`` then only records the file's bytes: the file the plan was made from and its facts
+  file both qualify; a plan without a digest compares its sha256 with the problem file's bytes), symbolic
+  flag as the problem's ``[plan-kind]``; status ``solved``
   ``[status]``; ``makespan``/``motion_cost``/step
   indices agree with the steps ``[summary]``;
 - every name is declared (objects, regions, robots of actions and of ``waiting``, handover points), every
@@ -195,30 +196,29 @@ def _header(problem: Problem, plan: PlanFile, problem_path: str | None, out: lis
 
 
 def _changed(problem: Problem, plan: PlanFile, problem_path: str | None) -> str:
-    """Why the plan is not for this problem's content ("" when it is): the plan's ``problem_digest`` (or a
-    ``problem_sha256`` that is a content digest) matches the checked problem's, or its ``problem_sha256``
-    matches the bytes of ``problem_path``; a plan without a digest and no path to compare is accepted."""
+    """Why the plan is not for this problem's content ("" when it is).  A plan with a ``problem_digest``
+    is for the problem whose content digest (:mod:`mrgc.language.digest`) that is, whatever its
+    ``problem_sha256`` says (the file it was made from and that file's facts file both qualify); a plan
+    without one (an older plan) is for the problem file whose bytes its ``problem_sha256`` hashes, or whose
+    content digest it is; a plan with neither, or without a digest and no file to compare, is accepted."""
     from mrgc.language.digest import problem_digest
 
-    recorded = {plan.problem_sha256, plan.problem_digest} - {None}
-    file_digest = "(no file given)"
-    if problem_path is not None:
-        try:
-            file_digest = file_sha256(problem_path)
-        except OSError as exc:
-            file_digest = f"unreadable ({exc.strerror})"
-        if file_digest in recorded:
-            return ""
-    elif plan.problem_digest is None:
-        return ""
-    content = problem_digest(problem)
-    if content in recorded:
-        return ""
     if plan.problem_digest is not None:
+        content = problem_digest(problem)
+        if plan.problem_digest == content:
+            return ""
         return (
             f"the plan was made for other problem contents: problem digest {plan.problem_digest[:12]}... in "
             f"the plan, {content[:12]}... now"
         )
+    if plan.problem_sha256 is None or problem_path is None:
+        return ""
+    try:
+        file_digest = file_sha256(problem_path)
+    except OSError as exc:
+        file_digest = f"unreadable ({exc.strerror})"
+    if plan.problem_sha256 in (file_digest, problem_digest(problem)):
+        return ""
     return (
         f"the problem file changed since the plan was made: sha256 {plan.problem_sha256[:12]}... in the plan, "
         f"{file_digest[:12]}... now"

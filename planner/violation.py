@@ -26,3 +26,11 @@ class Violation:
     def to_json(self) -> dict[str, Any]:
         """The violation as a JSON object (the keys of the dataclass)."""
         return {"step": self.step, "subject": self.subject, "code": self.code, "message": self.message}
+
+
+def number(x: float, places: int = 4) -> str:
+    """A plan's number as a violation message shows it: ``places`` decimals, or, beyond 1e4 or non-finite,
+    five significant digits in exponent form (a joint value of 1e308 is ``1e+308``, never 309 digits)."""
+    if not abs(x) < 1e4:
+        return f"{x:.5g}"
+    return f"{x:.{places}f}"

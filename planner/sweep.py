@@ -1,0 +1,158 @@
+"""Continuous collision checking of one phase of a replay: nothing passes between two checked samples.
+
+A phase is a set of motions that share the time ``s`` in [0, 1], each linear between its configurations
+(:mod:`mrgc.planner.sampling`).  The bodies it moves are checked pairwise; each *pair* (a robot against an
+object, a robot against itself at two links, a held object against another robot ...) is made of
+*sub-pairs*, one for each two links whose distance pybullet reports.  Between two breakpoints (where some
+motion passes one of its configurations) every joint moves at a constant speed, so every point of a link
+moves at most at a constant *rate* (:mod:`mrgc.geometry.replay_bounds`): the rate of a sub-pair is the sum
+of its two sides' rates (for two links of one arm, only the joints that move one of them and not the
+other count).
+
+**Conservative advancement.**  When a sub-pair is checked at time ``s`` and found ``d`` apart, it cannot
+overlap by more than the collision tolerance ``tol`` before its two sides together may have moved
+``d + tol``: its *budget*.  The sweep checks every pair at ``s = 0``, then moves time on to the first
+moment a budget runs out, checks the pairs whose budget ran out there (and only them) at that time, and so
+on to ``s = 1``.  So every sub-pair's distance is known, with a bound, at every time of the phase, and an
+overlap deeper than ``tol`` between two checked samples is impossible: the check is continuous, not
+sampled.  A pair farther apart than :data:`CAP` is checked as if it were :data:`CAP` away (pybullet is not
+asked about more distant points).  A pair already overlapping, or within :data:`MIN_BUDGET` of the
+tolerance, is given a budget of :data:`MIN_BUDGET`, and one deeper than ``tol`` one of :data:`FLOOR`
+(to find how deep it goes): there, and only there, an overlap between samples may exceed the tolerance
+by at most that budget.
+
+Everything the sweep needs from the world comes through callables: ``set_state(s)`` (put every moving body
+where it is at time ``s``), ``query(p, s)`` (the distances of pair ``p``'s links now) and ``report(p, sub, d,
+s)`` (a sub-pair of ``p`` that is checked then overlaps by more than the tolerance: ``d`` < -tol; links the
+pair does not list, and sub-pairs past their ``until``, are never reported).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable, Sequence
+
+import numpy as np
+
+CAP = 0.50  # m: pybullet is asked for distances up to this; a pair farther away counts as this far
+BATCH = 0.5  # when the world is set for a pair that is due, the pairs due within this share of the last step join it
+MIN_BUDGET = 1e-4  # m: the smallest budget of a pair at or near the tolerance
+FLOOR = 2e-3  # m: the budget of a pair overlapping deeper than the tolerance (its deepest point is sought)
+
+
+@dataclass
+class Pair:
+    """One pair of bodies to keep apart during a phase.  ``subs``: the (link of a, link of b) keys of its
+    sub-pairs as the query reports them; ``coeffs`` (len(subs), columns): each sub-pair's rate is
+    ``coeffs @ speeds`` (the phase's joint speeds, see :class:`Sweep`); ``until`` (len(subs),): the time
+    from which a sub-pair is no longer checked (inf: never; a gripper in its pick's contact segment)."""
+
+    subs: list[tuple[int, int]]
+    coeffs: np.ndarray
+    until: np.ndarray = field(default_factory=lambda: np.zeros(0))
+
+
+class Sweep:
+    """The conservative-advancement sweep of one phase (module docstring).
+
+    ``breakpoints``: sorted times from 0 to 1 between which speeds are constant (every configuration of
+    every motion, and every ``until``); ``speeds(k)``: the absolute speeds (columns of the pairs'
+    ``coeffs``) on ``[breakpoints[k], breakpoints[k + 1]]``; ``tol``: the collision tolerance (m);
+    ``max_events``: a sweep needing more checked times stops (``exhausted``)."""
+
+    def __init__(
+        self,
+        breakpoints: np.ndarray,
+        speeds: Callable[[int], np.ndarray],
+        pairs: Sequence[Pair],
+        set_state: Callable[[float], None],
+        query: Callable[[int, float], dict[tuple[int, int], float]],
+        report: Callable[[int, tuple[int, int], float, float], None],
+        tol: float,
+        max_events: int,
+    ) -> None:
+        self.breakpoints = breakpoints
+        self.speeds = speeds
+        self.pairs = pairs
+        self.set_state = set_state
+        self.query = query
+        self.report = report
+        self.tol = tol
+        self.max_events = max_events
+        #: times at which the world was set and pairs were asked
+        self.events = 0
+        #: pybullet queries made (pairs asked)
+        self.queries = 0
+        #: whether the sweep stopped at max_events before s = 1
+        self.exhausted = False
+        self.stop: Callable[[], bool] = lambda: False
+
+    def run(self) -> None:
+        """Sweep the phase from s = 0 to 1."""
+        if not self.pairs:
+            return
+        pair_of = np.concatenate([np.full(len(p.subs), i) for i, p in enumerate(self.pairs)])
+        index = {(i, sub): k for k, (i, sub) in enumerate((i, s) for i, p in enumerate(self.pairs) for s in p.subs)}
+        coeffs = np.concatenate([p.coeffs for p in self.pairs], axis=0)
+        until = np.concatenate([p.until if len(p.until) else np.full(len(p.subs), np.inf) for p in self.pairs])
+        budget = np.zeros(len(pair_of))
+        need: Sequence[int] = range(len(self.pairs))
+        bp = self.breakpoints
+        for k in range(len(bp) - 1):
+            a, b = float(bp[k]), float(bp[k + 1])
+            rate = coeffs @ self.speeds(k)
+            off = until <= a + 1e-12
+            rate[off] = 0.0
+            budget[off] = np.inf
+            s = a
+            while True:
+                if len(need):
+                    if self.events >= self.max_events:
+                        self.exhausted = True
+                        return
+                    self._check(s, need, pair_of, index, budget, off)
+                    if self.stop():
+                        return
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    dt = np.where(rate > 0, budget / rate, np.inf)
+                step = float(dt.min()) if len(dt) else np.inf
+                if s + step >= b:
+                    budget -= rate * (b - s)
+                    break
+                step = max(step, 1e-12)
+                budget -= rate * step
+                s += step
+                # the pairs due now, and those due within BATCH of the step just taken: asked together
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    soon = budget <= np.maximum(rate * step * BATCH, 1e-12)
+                need = np.unique(pair_of[soon]).tolist()
+            need = np.unique(pair_of[budget <= 1e-12]).tolist()
+        if len(need):
+            self._check(1.0, need, pair_of, index, budget, np.zeros(len(budget), dtype=bool))
+
+    def _check(
+        self,
+        s: float,
+        need: Sequence[int],
+        pair_of: np.ndarray,
+        index: dict[tuple[int, tuple[int, int]], int],
+        budget: np.ndarray,
+        off: np.ndarray,
+    ) -> None:
+        """Set the world at time ``s``, ask the pairs ``need`` and renew their sub-pairs' budgets."""
+        self.set_state(s)
+        self.events += 1
+        for i in need:
+            found = self.query(int(i), s)
+            self.queries += 1
+            mine = pair_of == i
+            budget[mine & ~off] = CAP + self.tol
+            for sub, d in found.items():
+                k = index.get((int(i), sub))
+                if k is None or off[k]:
+                    continue
+                if d < -self.tol:
+                    budget[k] = FLOOR
+                    self.report(int(i), sub, d, s)
+                else:
+                    budget[k] = max(min(d, CAP) + self.tol, MIN_BUDGET)

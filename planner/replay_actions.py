@@ -385,6 +385,14 @@ class ActionReader:
                         f"{dr:.3f} rad from where grasp {grasp!r} of {obj} puts it (at "
                         f"{what}; tolerance {POS_TOL * 1e3:g} mm, {ROT_TOL} rad)",
                     )
+                from mrgc.planner.stability import cart_set_down
+
+                # a cart lowers its box, upright, onto the floor it drives on (a pick takes the object as it is)
+                placing = (
+                    cart_set_down(obj, self.shapes[obj], pose, robot, ROT_TOL, POS_TOL) if phase == "place" else []
+                )
+                for message in placing:
+                    self._v(t, robot, "placement", message)
                 continue
             dp, dr = _pose_error(self.tool(robot, q), pose @ grasp_transform(self.scene.grasp(grasp), self.shapes[obj]))
             if dp > POS_TOL or dr > ROT_TOL:

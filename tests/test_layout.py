@@ -54,6 +54,7 @@ VALIDATOR = [
     "planner/replay.py",
     "planner/replay_actions.py",
     "planner/sampling.py",
+    "planner/stability.py",
     "geometry/replay_world.py",
 ]
 NOT_FOR_THE_VALIDATOR = {

@@ -38,6 +38,7 @@ if TYPE_CHECKING:
 #: configurations (home and these many more, drawn with a fixed seed within the limits) whose bounding boxes
 #: bound each link's radius: the smallest bound is kept (each is a true upper bound)
 RADIUS_CONFIGS = 6
+RADIUS_PAD = 1e-3  # m added to a bound from collision vertices (pybullet's hull of them, numerical noise)
 
 
 @dataclass(frozen=True)
@@ -66,76 +67,115 @@ class ArmBounds:
         return self.links.index(link)
 
 
+class _Tree:
+    """An arm's pybullet joint tree: link ``j`` hangs on joint ``j`` from link ``parent[j]`` (-1: the base
+    link); ``chain``: the joints the configuration drives."""
+
+    def __init__(self, rs: ReplayScene, robot: str) -> None:
+        pb, cid = rs.pb, rs.cid
+        self.r = r = rs.robots[robot]
+        self.n = n = pb.getNumJoints(r.body, physicsClientId=cid)
+        self.parent, self.kind, self.span, self.axis = {-1: -2}, {}, {}, {}
+        self.names = {-1: pb.getBodyInfo(r.body, physicsClientId=cid)[0].decode()}
+        for j in range(n):
+            ji = pb.getJointInfo(r.body, j, physicsClientId=cid)
+            self.parent[j], self.kind[j], self.names[j] = int(ji[16]), int(ji[2]), ji[12].decode()
+            lo, hi = float(ji[8]), float(ji[9])
+            self.span[j] = hi - lo if self.kind[j] == pb.JOINT_PRISMATIC and lo <= hi else 0.0
+            axis = np.asarray(ji[13], dtype=float)
+            self.axis[j] = axis / max(float(np.linalg.norm(axis)), 1e-12)
+        self.prismatic = pb.JOINT_PRISMATIC
+        self.chain = set(r.joints)
+        self.shaped = tuple(
+            link for link in range(-1, n) if pb.getCollisionShapeData(r.body, link, physicsClientId=cid)
+        )
+
+    def up(self, link: int) -> list[int]:
+        """``link``, its parent, ... up to the base link -1."""
+        out = [link]
+        while out[-1] != -1:
+            out.append(self.parent[out[-1]])
+        return out
+
+    def chain_joints_between(self, a: int, b: int) -> int:
+        """How many chain joints the tree path between links ``a`` and ``b`` crosses."""
+        up_a, up_b = self.up(a), self.up(b)
+        common = next(x for x in up_a if x in set(up_b))
+        path = up_a[: up_a.index(common)] + up_b[: up_b.index(common)]
+        return sum(1 for link in path if link in self.chain)  # link j hangs on joint j
+
+    def fingers(self) -> frozenset[int]:
+        """The links below an off-chain prismatic joint between them and the end effector."""
+        return frozenset(
+            link
+            for link in range(self.n)
+            if any(self.kind.get(x) == self.prismatic and x not in self.chain for x in _up_to(self.up(link), self.r.ee))
+        )
+
+    def gripper(self) -> frozenset[int]:
+        """The end-effector link and the links below it across joints outside the chain."""
+        ee = self.r.ee
+        return frozenset(
+            link
+            for link in range(-1, self.n)
+            if ee in self.up(link) and not (set(_up_to(self.up(link), ee)) - {ee}) & self.chain
+        )
+
+    def rigid_with(self, link: int, j: int) -> bool:
+        """Whether ``link`` hangs below link ``j`` across no chain joint."""
+        return j in self.up(link) and not set(_up_to(self.up(link), j)) & self.chain
+
+
 def arm_bounds(rs: ReplayScene, robot: str, home: np.ndarray) -> ArmBounds:
     """The :class:`ArmBounds` of arm ``robot`` of ``rs`` (its configuration is changed and put back at
     ``home``)."""
-    pb, cid = rs.pb, rs.cid
-    r = rs.robots[robot]
-    body = r.body
-    n = pb.getNumJoints(body, physicsClientId=cid)
-    parent = {-1: -2}
-    kind: dict[int, int] = {}
-    span: dict[int, float] = {}
-    for j in range(n):
-        ji = pb.getJointInfo(body, j, physicsClientId=cid)
-        parent[j], kind[j] = int(ji[16]), int(ji[2])
-        lo, hi = float(ji[8]), float(ji[9])
-        span[j] = hi - lo if kind[j] == pb.JOINT_PRISMATIC and lo <= hi else 0.0
-    chain = list(r.joints)
-    chain_set = set(chain)
-    shaped = tuple(link for link in range(-1, n) if pb.getCollisionShapeData(body, link, physicsClientId=cid))
-
-    def ancestors(link: int) -> list[int]:  # link, its parent, ... up to -1
-        out = [link]
-        while out[-1] != -1:
-            out.append(parent[out[-1]])
-        return out
-
-    def chain_joints_between(a: int, b: int) -> int:
-        up_a, up_b = ancestors(a), ancestors(b)
-        common = next(x for x in up_a if x in set(up_b))
-        path = up_a[: up_a.index(common)] + up_b[: up_b.index(common)]
-        return sum(1 for link in path if link in chain_set)  # link j hangs on joint j
-
-    pairs = tuple((a, b) for i, a in enumerate(shaped) for b in shaped[i + 1 :] if chain_joints_between(a, b) > 1)
-    fingers = frozenset(
-        link
-        for link in range(n)
-        if any(kind.get(x) == pb.JOINT_PRISMATIC and x not in chain_set for x in _up_to(ancestors(link), r.ee))
-    )
-    gripper = frozenset(
-        link
-        for link in range(-1, n)
-        if r.ee in ancestors(link) and not (set(_up_to(ancestors(link), r.ee)) - {r.ee}) & chain_set
-    )
-
+    tree = _Tree(rs, robot)
+    r, shaped = tree.r, tree.shaped
+    pairs = tuple((a, b) for i, a in enumerate(shaped) for b in shaped[i + 1 :] if tree.chain_joints_between(a, b) > 1)
+    fingers = tree.fingers()
     rs.set_config(robot, home)
-    origin = {link: np.array(pb.getLinkState(body, link, physicsClientId=cid)[4]) for link in range(n)}
-    edge = {
-        link: float(np.linalg.norm(origin[link] - origin[parent[link]])) + span[link]
-        if parent[link] >= 0
-        else span[link]
-        for link in range(n)
+    frames = {link: _frame(rs, r, link) for link in range(-1, tree.n)}
+    edge = {  # constant distance between a link's frame origin and its parent's (plus a prismatic range)
+        link: tree.span[link]
+        + (
+            float(np.linalg.norm(frames[link][:3, 3] - frames[tree.parent[link]][:3, 3]))
+            if tree.parent[link] >= 0
+            else 0
+        )
+        for link in range(tree.n)
     }
+    model = rs.models.get(robot)
+    points = {link.name: np.asarray(link.points, dtype=float) for link in model.links} if model else {}
+    verts = {link: points.get(tree.names[link]) for link in shaped if link not in fingers}
+    verts = {link: v for link, v in verts.items() if v is not None and len(v)}
     radius = _radii(rs, robot, shaped, home)
+    for link, v in verts.items():  # the link's own collision vertices, where the model has them, bound it tighter
+        radius[link] = min(radius[link], float(np.linalg.norm(v, axis=1).max()) + RADIUS_PAD)
 
     def chain_length(j: int, link: int) -> float:  # from joint j's axis (link j's origin) to link's origin
-        total, x = 0.0, link
-        while x != j:
-            total += edge[x]
-            x = parent[x]
-        return total
+        return sum(edge[x] for x in _up_to(tree.up(link), j))
 
-    reach = np.zeros((len(chain), len(shaped)))
-    ee_chain = np.zeros(len(chain))
-    for row, j in enumerate(chain):
-        for col, link in enumerate(shaped):
-            if j in ancestors(link):
-                reach[row, col] = 1.0 if kind[j] == pb.JOINT_PRISMATIC else chain_length(j, link) + radius[link]
-        if j in ancestors(r.ee):
-            ee_chain[row] = 1.0 if kind[j] == pb.JOINT_PRISMATIC else chain_length(j, r.ee)
-    turns = np.array([kind[j] != pb.JOINT_PRISMATIC for j in chain], dtype=float)
-    return ArmBounds(shaped, reach, ee_chain, pairs, fingers, gripper, turns)
+    def bound(j: int, link: int) -> float:
+        if tree.kind[j] == tree.prismatic:
+            return 1.0
+        out = chain_length(j, link) + radius[link]
+        if link in verts and tree.rigid_with(link, j):  # its points' distance from joint j's axis
+            rel = np.linalg.inv(frames[j]) @ frames[link]
+            local = verts[link] @ rel[:3, :3].T + rel[:3, 3]
+            off_axis = local - np.outer(local @ tree.axis[j], tree.axis[j])
+            out = min(out, float(np.linalg.norm(off_axis, axis=1).max()) + RADIUS_PAD)
+        return out
+
+    chain = list(r.joints)
+    reach = np.array([[bound(j, link) if j in tree.up(link) else 0.0 for link in shaped] for j in chain])
+    ee_chain = np.array(
+        [
+            (1.0 if tree.kind[j] == tree.prismatic else chain_length(j, r.ee)) if j in tree.up(r.ee) else 0.0
+            for j in chain
+        ]
+    )
+    turns = np.array([tree.kind[j] != tree.prismatic for j in chain], dtype=float)
+    return ArmBounds(shaped, reach.reshape(len(chain), len(shaped)), ee_chain, pairs, fingers, tree.gripper(), turns)
 
 
 def _up_to(path: list[int], stop: int) -> list[int]:
@@ -161,6 +201,16 @@ def _radii(rs: ReplayScene, robot: str, links: tuple[int, ...], home: np.ndarray
             best[link] = min(best[link], float(np.linalg.norm(corners - frame, axis=1).max()))
     rs.set_config(robot, home)
     return best
+
+
+def _frame(rs: ReplayScene, r: Any, link: int) -> np.ndarray:
+    """The world pose of a link's frame (the base link's: the robot's base pose)."""
+    if link == -1:
+        return np.asarray(r.base, dtype=float)
+    st = rs.pb.getLinkState(r.body, link, physicsClientId=rs.cid)
+    from mrgc.geometry.bullet import pose_of
+
+    return pose_of(st[4], st[5])
 
 
 def _link_frame(rs: ReplayScene, r: Any, link: int) -> np.ndarray:

@@ -102,6 +102,8 @@ class ReplayScene:
         self.bodies: dict[str, int] = {}
         self.fixed: set[str] = set()
         self.robots: dict[str, ReplayRobot] = {}
+        #: each arm's kinematic model as read from its URDF (link names, collision vertices, finger values)
+        self.models: dict[str, RobotModel] = {}
         self._owner: dict[int, str] = {}
         self._margin: dict[tuple[int, int], float] = {}  # (body, link) -> MESH_MARGIN for mesh shapes
         self._shaped: dict[int, tuple[int, ...]] = {}  # body -> its links with collision shapes
@@ -120,6 +122,7 @@ class ReplayScene:
                     if model is None:
                         model = model_for_kind(r.kind, r.base_dir)  # InputError E400/E401 for a bad URDF
                     self._add_arm(r.name, model, r.base)
+                    self.models[r.name] = model
         except BaseException:
             self.close()
             raise

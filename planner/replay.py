@@ -84,6 +84,7 @@ from mrgc.planner.plan import MotionModel
 from mrgc.planner.plan_reader import Action
 from mrgc.planner.replay_actions import PATH_PHASES, ActionGeometry, ActionReader
 from mrgc.planner.sampling import config_at, deltas, sample_count, where
+from mrgc.planner.stability import stability
 from mrgc.planner.sweep import CAP, Pair, Sweep
 from mrgc.planner.violation import Violation
 
@@ -478,7 +479,7 @@ class _Replayer(ActionReader):
                 q = config_at(tr.configs, s, self.planar[tr.robot])
                 rs.set_config(tr.robot, q)
                 if tr.holding and tr.grasp and tr.carries:
-                    rs.set_pose(tr.holding, self.held_pose(tr.robot, q, tr.holding, tr.grasp))
+                    rs.set_pose(tr.holding, self.held_pose_now(tr.robot, tr.holding, tr.grasp))
             self.samples += len(tracks)
 
         def query(p: int, s: float) -> dict[tuple[int, int], float]:
@@ -738,6 +739,8 @@ class _Replayer(ActionReader):
                     f"{o} is released at ({p[0]:.3f}, {p[1]:.3f}, {p[2]:.3f}) resting on "
                     f"nothing: {above}, and nothing is within {SUPPORT_TOL * 1e3:g} mm under it",
                 )
+            else:
+                self._stable(t, o)
         for o in self.movable:
             lost = self.support[o] & moved
             if o in moved or not lost:
@@ -750,6 +753,19 @@ class _Replayer(ActionReader):
                     "floating",
                     f"{o} rested on {', '.join(sorted(lost))}, which the step moves away: nothing holds it up now",
                 )
+            else:
+                self._stable(t, o)
+
+    def _stable(self, t: int, o: str) -> None:
+        """An object that rests on something rests stably: its centre of mass over the support polygon of
+        its contacts, with a margin, flat on its lowest face (:mod:`mrgc.planner.stability`) ``[unstable]``."""
+        bodies = {
+            b: (self.shapes[b], self.poses[b] if b in self.poses else self.scene.body(b).pose) for b in self.shapes
+        }
+        floors = [(r.name, r.shape, r.pose) for r in self.scene.regions]
+        verdict = stability(o, self.shapes[o], self.poses[o], bodies, floors)
+        if not verdict.stable:
+            self._v(t, o, "unstable", verdict.message())
 
     def goals(self) -> None:
         for obj, region in sorted(self.scene.goal.items()):

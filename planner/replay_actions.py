@@ -23,7 +23,7 @@ from mrgc.geometry.scene import SceneSpec
 from mrgc.geometry.transforms import from_pose, inverse
 from mrgc.planner.plan import MotionModel
 from mrgc.planner.plan_reader import Action
-from mrgc.planner.violation import Violation
+from mrgc.planner.violation import Violation, number
 
 POS_TOL = 1e-3  # m: tool vs grasp, handover position, path continuity of planar bases
 ROT_TOL = 0.01  # rad
@@ -31,6 +31,13 @@ LIMIT_TOL = 1e-6  # rad or m beyond a joint limit
 JOINT_TOL = 1e-3  # rad: path ends vs the configurations they connect
 WORLD = 1e4  # m: planar base coordinates beyond this are outside the world
 MIN_APPROACH_CONFIGURATIONS = 5  # an approach of fewer would make its contact segment longer than a quarter
+#: the tool in the contact segment: off the approach line at most this (m) and turned at most this (rad), so
+#: that fingers opened FINGER_CLEARANCE (1 cm) wider than the object cannot cut into it (4 mm sideways plus
+#: 0.01 rad at a 5 cm half-diagonal is 4.5 mm, under the 5 mm each finger stands off); measured on the
+#: planner's plans of pa5 and pa3-handover: at most 2.7 mm and 0.003 rad
+CONTACT_POS_TOL = 4e-3
+CONTACT_ROT_TOL = 0.01
+CONTACT_SAMPLES = 17  # configurations of the contact segment where the tool's pose is checked
 CONTACT_SLACK = 2.0  # the contact segment may start this much farther than its equal share of the back-off
 
 #: path name -> (robot role, grasp role held on the way or None, where it starts, where it ends); a place is
@@ -148,11 +155,16 @@ class ActionReader:
 
     def held_pose(self, robot: str, q: np.ndarray, obj: str, grasp: str) -> np.ndarray:
         """Where ``robot`` at ``q`` holds ``obj`` grasped with ``grasp`` (world frame)."""
+        self.rs.set_config(robot, q)
+        return self.held_pose_now(robot, obj, grasp)
+
+    def held_pose_now(self, robot: str, obj: str, grasp: str) -> np.ndarray:
+        """Where ``robot``, at the configuration it was last set to, holds ``obj`` grasped with ``grasp``."""
         key = (robot, obj, grasp)
         if key not in self._held:
             g = self.grasp_frame(robot, obj, grasp)
             self._held[key] = g if self.planar[robot] else inverse(g)
-        return self.tool(robot, q) @ self._held[key]  # type: ignore[no-any-return]
+        return self.rs.ee_pose(robot) @ self.tcp[robot] @ self._held[key]  # type: ignore[no-any-return]
 
     def _grasp_base(self, robot: str, obj: str, grasp: str, pose: np.ndarray) -> np.ndarray:
         """The planar model's base pose (x, y, yaw) for grasping ``obj`` at ``pose`` with ``grasp``: facing
@@ -348,8 +360,8 @@ class ActionReader:
                     robot,
                     "joint-limits",
                     f"{what} configuration {i} of {len(qs)} (moving {obj}): "
-                    f"{rr.joint_names[j]} = {v[j]:.4f} is outside "
-                    f"[{rr.lower[j]:.4f}, {rr.upper[j]:.4f}]",
+                    f"{rr.joint_names[j]} = {number(v[j])} is outside "
+                    f"[{number(rr.lower[j])}, {number(rr.upper[j])}]",
                 )
                 ok = False
         return ok
@@ -471,6 +483,8 @@ class ActionReader:
                     f"{dp * 1e3:.1f} mm, {dr:.3f} rad from the {word} of {obj} ({APPROACH:g} m "
                     f"back from grasp {grasp!r}; tolerance {POS_TOL * 1e3:g} mm, {ROT_TOL} rad)",
                 )
+            if len(qs) > 1:
+                self._contact_line(act, phase, robot, grasp, qs[-2], qs[-1], g)
             d = float(np.linalg.norm(self.tool(robot, qs[-2])[:3, 3] - g[:3, 3])) if len(qs) > 1 else 0.0
             if d > share + POS_TOL:
                 self._v(
@@ -481,6 +495,35 @@ class ActionReader:
                     f"starts with the tool {d * 1e3:.1f} mm from the grasp; at most "
                     f"{share * 1e3:.1f} mm ({CONTACT_SLACK:g} x the back-off / {n - 1})",
                 )
+
+    def _contact_line(
+        self, act: ActionGeometry, phase: str, robot: str, grasp: str, q0: np.ndarray, q1: np.ndarray, g: np.ndarray
+    ) -> None:
+        """In the contact segment (``q0`` to ``q1``, where the gripper may touch the object) the tool keeps
+        the grasp's orientation and stays on its approach line (the grasp's z axis through its position), to
+        :data:`CONTACT_ROT_TOL` and :data:`CONTACT_POS_TOL`, at :data:`CONTACT_SAMPLES` equally spaced
+        configurations of the segment (both ends included) ``[approach]``."""
+        z, worst = g[:3, 2], (0.0, 0.0, 0.0)
+        for u in np.linspace(0.0, 1.0, CONTACT_SAMPLES):
+            tool = self.tool(robot, q0 + u * (q1 - q0))
+            d = tool[:3, 3] - g[:3, 3]
+            off = float(np.linalg.norm(d - float(d @ z) * z))
+            rot = _pose_error(tool, g)[1]
+            if max(off / CONTACT_POS_TOL, rot / CONTACT_ROT_TOL) > max(
+                worst[0] / CONTACT_POS_TOL, worst[1] / CONTACT_ROT_TOL
+            ):
+                worst = (off, rot, float(u))
+        if worst[0] > CONTACT_POS_TOL or worst[1] > CONTACT_ROT_TOL:
+            n = len(act.configs[phase])
+            self._v(
+                act.step,
+                robot,
+                "approach",
+                f"in the contact segment of {robot}'s {phase} approach (moving {act.obj}; configurations {n - 1} "
+                f"to {n} of {n}, at {worst[2]:.2f} of the way) the tool is {worst[0] * 1e3:.1f} mm off grasp "
+                f"{grasp!r}'s approach line and turned {worst[1]:.3f} rad from it (tolerance "
+                f"{CONTACT_POS_TOL * 1e3:g} mm, {CONTACT_ROT_TOL} rad)",
+            )
 
     def _straight_transfers(self, act: ActionGeometry) -> None:
         """Arms under the configurations model: a holding transfer the plan gives no path for is the
@@ -525,7 +568,7 @@ class ActionReader:
                 bad, gap = dp > POS_TOL or dr > ROT_TOL, f"{dp * 1e3:.1f} mm, {dr:.3f} rad"
             else:
                 d = float(np.abs(q - want).max())
-                bad, gap = d > JOINT_TOL, f"{d:.4f} rad"
+                bad, gap = d > JOINT_TOL, f"{number(d)} rad"
             if bad:
                 self._v(
                     act.step,

@@ -88,71 +88,92 @@ class Sweep:
         self.stop: Callable[[], bool] = lambda: False
 
     def run(self) -> None:
-        """Sweep the phase from s = 0 to 1."""
+        """Sweep the phase from s = 0 to 1.  Each sub-pair keeps the time its budget runs out at the
+        current rates (``due``), each pair the earliest of its sub-pairs'; at a breakpoint the budgets left
+        are carried over to the next interval's rates."""
         if not self.pairs:
             return
-        pair_of = np.concatenate([np.full(len(p.subs), i) for i, p in enumerate(self.pairs)])
-        index = {(i, sub): k for k, (i, sub) in enumerate((i, s) for i, p in enumerate(self.pairs) for s in p.subs)}
+        sizes = [len(p.subs) for p in self.pairs]
+        self._start = np.concatenate([[0], np.cumsum(sizes)]).astype(int)
+        self._local = [{sub: k for k, sub in enumerate(p.subs)} for p in self.pairs]
         coeffs = np.concatenate([p.coeffs for p in self.pairs], axis=0)
         until = np.concatenate([p.until if len(p.until) else np.full(len(p.subs), np.inf) for p in self.pairs])
-        budget = np.zeros(len(pair_of))
-        need: Sequence[int] = range(len(self.pairs))
+        pair_of = np.repeat(np.arange(len(self.pairs)), sizes)
+        self._due = np.zeros(len(pair_of))  # when each sub-pair's budget runs out
+        self._budget = np.zeros(len(pair_of))  # its budget when it was last checked or carried over
+        self._since = np.zeros(len(pair_of))  # ... and the time of that
+        self._pdue = np.zeros(len(self.pairs))
         bp = self.breakpoints
+        need: list[int] = list(range(len(self.pairs)))
+        s = 0.0
         for k in range(len(bp) - 1):
             a, b = float(bp[k]), float(bp[k + 1])
-            rate = coeffs @ self.speeds(k)
-            off = until <= a + 1e-12
-            rate[off] = 0.0
-            budget[off] = np.inf
-            s = a
+            self._rate = coeffs @ self.speeds(k)
+            self._off = until <= a + 1e-12
+            self._rate[self._off] = 0.0
+            if k:  # carry the budgets left over into this interval's rates
+                self._budget = np.where(self._off, np.inf, self._left(a))
+                self._since[:] = a
+                self._renew(np.arange(len(pair_of)), pair_of)
+            s, last = a, a
             while True:
-                if len(need):
+                if need:
                     if self.events >= self.max_events:
                         self.exhausted = True
                         return
-                    self._check(s, need, pair_of, index, budget, off)
+                    self._check(s, need)
                     if self.stop():
                         return
-                with np.errstate(divide="ignore", invalid="ignore"):
-                    dt = np.where(rate > 0, budget / rate, np.inf)
-                step = float(dt.min()) if len(dt) else np.inf
-                if s + step >= b:
-                    budget -= rate * (b - s)
+                nxt = float(self._pdue.min())
+                if nxt >= b:
                     break
-                step = max(step, 1e-12)
-                budget -= rate * step
-                s += step
-                # the pairs due now, and those due within BATCH of the step just taken: asked together
-                with np.errstate(divide="ignore", invalid="ignore"):
-                    soon = budget <= np.maximum(rate * step * BATCH, 1e-12)
-                need = np.unique(pair_of[soon]).tolist()
-            need = np.unique(pair_of[budget <= 1e-12]).tolist()
-        if len(need):
-            self._check(1.0, need, pair_of, index, budget, np.zeros(len(budget), dtype=bool))
+                nxt = max(nxt, s + 1e-12)
+                window = nxt + BATCH * (nxt - last)
+                last, s = nxt, nxt
+                need = np.flatnonzero(self._pdue <= window).tolist()
+            need = []
+            self._budget = self._left(b)
+            self._since[:] = b
+        done = self._budget <= 1e-12
+        if done.any():
+            self._check(1.0, np.unique(pair_of[done]).tolist())
 
-    def _check(
-        self,
-        s: float,
-        need: Sequence[int],
-        pair_of: np.ndarray,
-        index: dict[tuple[int, tuple[int, int]], int],
-        budget: np.ndarray,
-        off: np.ndarray,
-    ) -> None:
+    def _left(self, at: float) -> np.ndarray:
+        """Each sub-pair's budget left at time ``at`` of the current interval."""
+        return np.maximum(self._budget - self._rate * (at - self._since), 0.0)
+
+    def _renew(self, subs: np.ndarray, pair_of: np.ndarray) -> None:
+        """Recompute the due times of ``subs`` and of their pairs."""
+        with np.errstate(divide="ignore", invalid="ignore"):
+            due = np.where(self._rate[subs] > 0, self._since[subs] + self._budget[subs] / self._rate[subs], np.inf)
+        self._due[subs] = due
+        for i in np.unique(pair_of[subs]):
+            lo, hi = int(self._start[i]), int(self._start[i + 1])
+            self._pdue[i] = float(self._due[lo:hi].min())
+
+    def _check(self, s: float, need: Sequence[int]) -> None:
         """Set the world at time ``s``, ask the pairs ``need`` and renew their sub-pairs' budgets."""
         self.set_state(s)
         self.events += 1
+        off, budget = self._off, self._budget
         for i in need:
             found = self.query(int(i), s)
             self.queries += 1
-            mine = pair_of == i
-            budget[mine & ~off] = CAP + self.tol
+            lo, hi = int(self._start[i]), int(self._start[i + 1])
+            budget[lo:hi] = np.where(off[lo:hi], np.inf, CAP + self.tol)
+            local = self._local[i]
             for sub, d in found.items():
-                k = index.get((int(i), sub))
-                if k is None or off[k]:
+                j = local.get(sub)
+                if j is None or off[lo + j]:
                     continue
                 if d < -self.tol:
-                    budget[k] = FLOOR
+                    budget[lo + j] = FLOOR
                     self.report(int(i), sub, d, s)
                 else:
-                    budget[k] = max(min(d, CAP) + self.tol, MIN_BUDGET)
+                    budget[lo + j] = max(min(d, CAP) + self.tol, MIN_BUDGET)
+            self._since[lo:hi] = s
+            rate = self._rate[lo:hi]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                due = np.where(rate > 0, s + budget[lo:hi] / rate, np.inf)
+            self._due[lo:hi] = due
+            self._pdue[i] = float(due.min()) if hi > lo else np.inf

@@ -55,7 +55,9 @@ VALIDATOR = [
     "planner/replay_actions.py",
     "planner/sampling.py",
     "planner/stability.py",
+    "planner/sweep.py",
     "geometry/replay_world.py",
+    "geometry/replay_bounds.py",
 ]
 NOT_FOR_THE_VALIDATOR = {
     "mrgc.planner.ground",

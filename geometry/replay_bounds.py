@@ -146,8 +146,11 @@ def arm_bounds(rs: ReplayScene, robot: str, home: np.ndarray) -> ArmBounds:
     }
     model = rs.models.get(robot)
     points = {link.name: np.asarray(link.points, dtype=float) for link in model.links} if model else {}
-    verts = {link: points.get(tree.names[link]) for link in shaped if link not in fingers}
-    verts = {link: v for link, v in verts.items() if v is not None and len(v)}
+    verts: dict[int, np.ndarray] = {
+        link: points[tree.names[link]]
+        for link in shaped
+        if link not in fingers and len(points.get(tree.names[link], ()))
+    }
     radius = _radii(rs, robot, shaped, home)
     for link, v in verts.items():  # the link's own collision vertices, where the model has them, bound it tighter
         radius[link] = min(radius[link], float(np.linalg.norm(v, axis=1).max()) + RADIUS_PAD)

@@ -140,7 +140,8 @@ class Sweep:
 
     def _left(self, at: float) -> np.ndarray:
         """Each sub-pair's budget left at time ``at`` of the current interval."""
-        return np.maximum(self._budget - self._rate * (at - self._since), 0.0)
+        left: np.ndarray = np.maximum(self._budget - self._rate * (at - self._since), 0.0)
+        return left
 
     def _renew(self, subs: np.ndarray, pair_of: np.ndarray) -> None:
         """Recompute the due times of ``subs`` and of their pairs."""

@@ -307,6 +307,7 @@ def replay(
     except _Stop:
         r.flush()
     stats["configurations"] = r.samples
+    stats["resolution_samples"] = r.plan_samples
     stats["distance_queries"] = rs.queries - queries
     return r.out
 

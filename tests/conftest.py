@@ -3,8 +3,8 @@
 Tests run with ``--import-mode=importlib`` and no ``tests/__init__.py``, so sibling helper modules are not
 on the import path; conftest runs first and registers them once for every test module: ``support`` (the
 repository root ``ROOT``, the Panda model, ``mrgc`` run in this process), the validator's valid plans
-(``validator_plans``) and a headless Chromium driver (``headless_chromium``).  (The independent skeleton
-oracle is installed with the package: ``mrgc.testing.oracle``.)
+(``validator_plans``), a headless Chromium driver (``headless_chromium``) and issue 21's doctored plans
+(``doctor``).  (The independent skeleton oracle is installed with the package: ``mrgc.testing.oracle``.)
 
 Fixture: ``panda``, the Franka Panda's model, loaded once.
 """
@@ -17,7 +17,7 @@ from pathlib import Path
 
 import pytest
 
-for _name in ("support", "validator_plans", "headless_chromium"):
+for _name in ("support", "validator_plans", "headless_chromium", "doctor"):
     if _name not in sys.modules:
         _spec = importlib.util.spec_from_file_location(_name, Path(__file__).with_name(f"{_name}.py"))
         assert _spec is not None and _spec.loader is not None

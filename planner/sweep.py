@@ -37,7 +37,7 @@ import numpy as np
 CAP = 0.5  # m: pybullet is asked for distances up to this; a pair farther away counts as this far
 BATCH = 1.0  # when the world is set for a pair that is due, the pairs due within this share of the last step join it
 MIN_BUDGET = 1e-4  # m: the smallest budget of a pair at or near the tolerance
-FLOOR = 2e-3  # m: the budget of a pair overlapping deeper than the tolerance (its deepest point is sought)
+FLOOR = 5e-4  # m: the budget of a pair overlapping deeper than the tolerance (its deepest point is sought)
 
 
 @dataclass

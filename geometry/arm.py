@@ -1,7 +1,9 @@
 """A robot arm placed in a scene: its kinematic model, base pose, tool centre point and link hulls.
 
 Everything the predicates and grounding ask of a robot goes through here: where the end effector must be
-for a tool pose, where the links are at a configuration (as collision probes), and where a held object is.
+for a tool pose, where the links are at a configuration (as collision probes), where a held object is, and
+whether the arm collides with itself (:meth:`Arm.self_collides`: the link pairs of
+:attr:`RobotModel.self_collision_pairs` kept :data:`SELF_CLEARANCE` apart; docs/geometry.md).
 """
 
 from __future__ import annotations
@@ -10,11 +12,17 @@ from functools import cached_property
 
 import numpy as np
 
-from mrgc.geometry.collision import CollisionShape, ConvexHull, collision_shape
+from mrgc.geometry.collision import CollisionShape, ConvexHull, PairCheck, collision_shape
 from mrgc.geometry.fk import ee_pose, fk_world
 from mrgc.geometry.kinematics import RobotModel, model_for_kind
 from mrgc.geometry.scene import RobotSpec
 from mrgc.geometry.transforms import from_pose, inverse
+
+#: how far apart (m) the planner keeps two links of one arm that the self-collision rule does not exempt
+#: (:attr:`RobotModel.self_collision_pairs`).  The validator calls a self-collision a penetration deeper than
+#: 1 mm in pybullet, whose link meshes (convex hulls, their 1 mm margin removed) agree with these hulls to
+#: about 0.05 mm; the clearance covers that and what moves between two configurations the planner checks
+SELF_CLEARANCE = 0.003
 
 
 class Arm:
@@ -36,25 +44,61 @@ class Arm:
         )
 
     @cached_property
+    def hulls(self) -> dict[int, CollisionShape]:
+        """The collision hull of every :attr:`~mrgc.geometry.kinematics.Link.solid` link, by link index."""
+        return {
+            link.index: collision_shape(ConvexHull(np.asarray(link.points, dtype=float)))
+            for link in self.model.links
+            if link.solid
+        }
+
+    @cached_property
     def probes(self) -> tuple[list[CollisionShape], list[int]]:
         """Collision hulls of the links that can hit anything (the base link, bolted in place, is left out)."""
-        shapes, index = [], []
-        for link in self.model.links:
-            if link.index == 0 or len(link.points) < 4:
-                continue
-            shapes.append(collision_shape(ConvexHull(np.asarray(link.points, dtype=float))))
-            index.append(link.index)
-        return shapes, index
+        index = [k for k in self.hulls if k != 0]
+        return [self.hulls[k] for k in index], index
 
     @cached_property
     def base_hull(self) -> tuple[CollisionShape, np.ndarray] | None:
         """The base link's hull and world pose: left out of :attr:`probes` (it cannot move, and this arm's
         own links start on it), it is an obstacle to every other arm (None: the link has no geometry)."""
-        link = next((k for k in self.model.links if k.index == 0), None)
-        if link is None or len(link.points) < 4:
+        if 0 not in self.hulls:
             return None
         pose: np.ndarray = fk_world(self.model, self.home[None], self.base)[0, 0]
-        return collision_shape(ConvexHull(np.asarray(link.points, dtype=float))), pose
+        return self.hulls[0], pose
+
+    @cached_property
+    def _self_check(self) -> PairCheck:
+        """The self-collision check over the solid links: the base link (when solid) first, then the
+        :attr:`probes` in their order."""
+        index = ([0] if 0 in self.hulls else []) + self.probes[1]
+        at = {k: i for i, k in enumerate(index)}
+        pairs = [(at[a], at[b]) for a, b in self.model.self_collision_pairs]
+        return PairCheck([self.hulls[k] for k in index], pairs, SELF_CLEARANCE)
+
+    def self_colliding(self, q: np.ndarray, opening: float | None = None) -> np.ndarray:
+        """Whether the arm collides with itself at each configuration of ``q`` (C, dof): two links of
+        :attr:`RobotModel.self_collision_pairs` within :data:`SELF_CLEARANCE`, the fingers ``opening`` apart
+        (None: fully open).  A (C,) bool array."""
+        return self._self_check.colliding(self._with_base(self.link_transforms(np.atleast_2d(q), opening)))
+
+    def self_collides(self, q: np.ndarray, opening: float | None = None) -> bool:
+        """Whether the arm collides with itself at some configuration of ``q`` ((C, dof) or (dof,)); stops at
+        the first that does."""
+        return self.self_collides_at(self.link_transforms(np.atleast_2d(q), opening))
+
+    def self_collides_at(self, transforms: np.ndarray) -> bool:
+        """:meth:`self_collides` for the probed links' world transforms as :meth:`link_transforms` gives them
+        ((C, L, 4, 4)): a caller that has them already (collision probes) saves the forward kinematics."""
+        return self._self_check.collides(self._with_base(transforms))
+
+    def _with_base(self, transforms: np.ndarray) -> np.ndarray:
+        """The probed links' transforms (C, L, 4, 4) with the base link's (fixed) in front when it is solid."""
+        t = np.asarray(transforms, dtype=float).reshape(-1, len(self.probes[1]), 4, 4)
+        if self.base_hull is None:
+            return t
+        base = np.broadcast_to(self.base_hull[1], (len(t), 1, 4, 4))
+        return np.concatenate([base, t], axis=1)
 
     def ee_target(self, tool_world: np.ndarray) -> np.ndarray:
         """The end-effector pose (base frame) that puts the tool centre point at ``tool_world``."""

@@ -87,6 +87,10 @@ CONTACT_START = 1.5
 #: the detail of a failed query whose motion collided with what another robot of the step sweeps in the same
 #: phase (the skeleton step may be split: planner/ground.py)
 BUSY = "another robot of the step moves there in the same phase"
+#: the detail of a failed query whose every answer put the arm in collision with itself (two links that
+#: :attr:`~mrgc.geometry.kinematics.RobotModel.self_collision_pairs` keeps apart closer than
+#: :data:`~mrgc.geometry.arm.SELF_CLEARANCE`)
+SELF = "the arm collides with itself"
 
 
 class GroundStatus(str, enum.Enum):
@@ -238,6 +242,25 @@ class Grounder:
     ) -> Volume:
         """Link hulls (and the held object) at each of ``configs`` (C, dof); the fingers stand at the opening
         of the (object, grasp) held, or of ``grasp`` (approaching it), else fully open."""
+        return self._arm_volume(robot, configs, holding, grasp)[0]
+
+    def free_volume(
+        self,
+        robot: str,
+        configs: np.ndarray,
+        holding: tuple[str, str] | None = None,
+        grasp: tuple[str, str] | None = None,
+    ) -> Volume | None:
+        """:meth:`arm_volume`, or None when the arm collides with itself at one of ``configs``
+        (:meth:`~mrgc.geometry.arm.Arm.self_collides`, on the same link transforms): every configuration the
+        grounding answers with (approaches, exchanges, transfers, transits, paths) is checked through here."""
+        volume, transforms = self._arm_volume(robot, configs, holding, grasp)
+        return None if self.arm(robot).self_collides_at(transforms) else volume
+
+    def _arm_volume(
+        self, robot: str, configs: np.ndarray, holding: tuple[str, str] | None, grasp: tuple[str, str] | None
+    ) -> tuple[Volume, np.ndarray]:
+        """:meth:`arm_volume` and the probed links' transforms it was made of."""
         arm = self.arm(robot)
         shapes, _ = arm.probes
         out: Volume = []
@@ -251,7 +274,7 @@ class Grounder:
             g_inv = self._grip(obj, held_grasp)[1]
             for tool in arm.tool_world(np.atleast_2d(configs)):
                 out.append((self.shape(obj), tool @ g_inv))
-        return out
+        return out, transforms
 
     def _grip(self, obj: str, grasp: str) -> tuple[float, np.ndarray]:
         """The finger opening holding ``obj`` with ``grasp`` and the object's pose in the tool frame (the
@@ -453,9 +476,11 @@ class Grounder:
                 continue
             # checked at every APPROACH_CHECK of joint motion (finer than the validator samples), with the
             # object in hand when placing
-            volume = self.arm_volume(
-                robot, joint_line(configs, APPROACH_CHECK), holding=(obj, grasp) if held else None, grasp=(obj, grasp)
-            )
+            dense = joint_line(configs, APPROACH_CHECK)
+            volume = self.free_volume(robot, dense, holding=(obj, grasp) if held else None, grasp=(obj, grasp))
+            if volume is None:  # the arm collides with itself: another branch may not (what never moves)
+                status, clash = GroundStatus.COLLISION, ("self", [])
+                continue
             self.queries += 1
             if self._fixed_clash(robot, obj, grasp, configs, volume, held, self._others_home(robot, partner, phase)):
                 status, clash = GroundStatus.COLLISION, ("fixed", volume)
@@ -521,6 +546,8 @@ class Grounder:
         kind, volume = clash
         if kind == "moving":
             return BUSY
+        if kind == "self":
+            return SELF
         hit = self.world.probe_hits(volume, against=("fixed", *self._others_home(robot, partner, phase)), ignore=ignore)
         named = sorted({f"{h[1:].split(':')[0]} at home" if h.startswith("@") else h for h in hit})
         return "hits " + ", ".join(named) if named else ""
@@ -620,7 +647,9 @@ class Grounder:
 
         def free(configs: np.ndarray) -> bool:
             self.queries += 1
-            volume = self.arm_volume(robot, configs, holding)
+            volume = self.free_volume(robot, configs, holding)
+            if volume is None:
+                return False
             if moving is not None and moving.probe_collides(volume, against="volume"):
                 return False
             return not self.world.probe_collides(volume, against=against, ignore=ignore)
@@ -725,11 +754,12 @@ class Grounder:
         crossed = [False]  # did the last blocked motion cross what another robot of the step sweeps?
 
         def hits(configs: np.ndarray, holding: tuple[str, str] | None = held) -> set[str] | None:
-            """None when free, else the avoided objects hit (empty: a fixed one or a moving robot)."""
+            """None when free, else the avoided objects hit (empty: a fixed one, a moving robot or the arm
+            itself)."""
             self.queries += 1
-            volume = self.arm_volume(robot, configs, holding=holding, grasp=held)
-            crossed[0] = moving is not None and moving.probe_collides(volume, against="volume")
-            if crossed[0]:
+            volume = self.free_volume(robot, configs, holding=holding, grasp=held)
+            crossed[0] = volume is not None and moving is not None and moving.probe_collides(volume, against="volume")
+            if crossed[0] or volume is None:
                 return set()
             if not self.world.probe_collides(volume, against=against, ignore=(obj,)):
                 return None
@@ -817,7 +847,9 @@ class Grounder:
 
         def free(configs: np.ndarray) -> bool:
             self.queries += 1
-            volume = self.arm_volume(robot, configs)
+            volume = self.free_volume(robot, configs)
+            if volume is None:
+                return False
             if moving is not None and moving.probe_collides(volume, against="volume"):
                 return False
             return not self.world.probe_collides(volume, against=against)

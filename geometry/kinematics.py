@@ -109,6 +109,11 @@ class Link:
         """An off-chain prismatic joint: a gripper finger."""
         return self.chain_index < 0 and self.joint_kind == "prismatic"
 
+    @property
+    def solid(self) -> bool:
+        """The link has collision geometry (at least 4 points: a volume, whose hull the collision checks use)."""
+        return len(self.points) >= 4
+
 
 @dataclass(frozen=True, eq=False)
 class Joint:
@@ -166,6 +171,39 @@ class RobotModel:
     def joint_names(self) -> tuple[str, ...]:
         """The chain's joints' names, in configuration order."""
         return tuple(j.name for j in self.joints)
+
+    @functools.cached_property
+    def self_collision_pairs(self) -> tuple[tuple[int, int], ...]:
+        """The pairs of links (indices ``a < b``) an arm must keep apart from each other: both links
+        :attr:`~Link.solid`, and the path between them in the URDF's tree passes through more than one joint
+        of the configuration chain (:attr:`Link.chain_index` >= 0).  Fixed joints and off-chain joints (a
+        Panda's fingers) do not count, so links bolted together (link7, link8, hand), the gripper (hand and
+        both fingers) and a link and its neighbours across one chain joint (link6 and link7, the hand and the
+        fingers; link0 and link1) are exempt: they touch by construction.  Derived once per model
+        (docs/geometry.md, "Self-collision"); the validator derives the same rule from the URDF in pybullet."""
+        solid = [link.index for link in self.links if link.solid]
+        pairs = []
+        for i, a in enumerate(solid):
+            for b in solid[i + 1 :]:
+                if self.chain_joints_between(a, b) > 1:
+                    pairs.append((a, b))
+        return tuple(pairs)
+
+    def chain_joints_between(self, a: int, b: int) -> int:
+        """How many joints of the configuration chain the tree path between links ``a`` and ``b`` passes
+        through (the joints attaching the links of the path, below their common ancestor, to their parents)."""
+        up_a, up_b = self._ancestry(a), self._ancestry(b)
+        common = next(k for k in up_a if k in up_b)
+        path = up_a[: up_a.index(common)] + up_b[: up_b.index(common)]
+        return sum(1 for k in path if self.links[k].chain_index >= 0)
+
+    def _ancestry(self, k: int) -> list[int]:
+        """Link ``k`` and its ancestors up to the base link, ``k`` first."""
+        out = [k]
+        while self.links[k].parent >= 0:
+            k = self.links[k].parent
+            out.append(k)
+        return out
 
     def link_index(self, name: str) -> int:
         """The index of the link called ``name``."""

@@ -108,11 +108,15 @@ class RobotEvaluator:
         return finger_opening(self.scene.grasp(grasp), self.scene.body(obj).shape)
 
     def _free(self, qs: np.ndarray, ignore: tuple[str, ...], opening: float | None, against: str = "fixed") -> bool:
+        """Whether the arm at configurations ``qs`` (fingers ``opening`` apart) is free of itself (the link
+        pairs :attr:`~mrgc.geometry.kinematics.RobotModel.self_collision_pairs` keeps apart) and of the
+        ``against`` objects but ``ignore``."""
         shapes, _ = self.arm.probes
         self.out.collision_checks += 1
-        return not self.world.batch_collides(
-            shapes, self.arm.link_transforms(qs, opening), against=against, ignore=ignore
-        )
+        transforms = self.arm.link_transforms(qs, opening)
+        if self.arm.self_collides_at(transforms):
+            return False
+        return not self.world.batch_collides(shapes, transforms, against=against, ignore=ignore)
 
     def _swept_hits(self, qs: np.ndarray, ignore: tuple[str, ...], opening: float | None) -> set[str]:
         shapes, _ = self.arm.probes
@@ -299,16 +303,17 @@ class RobotEvaluator:
                     self._keep_handover(keys[i], q)
 
     def _keep_handover(self, key: tuple[str, str, str], q: np.ndarray) -> None:
-        """Keep ``q`` as a handover configuration of ``key`` if it is free of the fixed objects (arms at
-        home aside) and differs from those kept."""
+        """Keep ``q`` as a handover configuration of ``key`` if it is free of itself and of the fixed objects
+        (arms at home aside) and differs from those kept."""
         kept = self.out.handover.setdefault(key, [])
         if any(np.max(np.abs(c.q - q)) < DISTINCT_CONFIG for c in kept):
             return
         shapes, _ = self.arm.probes
         self.out.collision_checks += 1
-        hits = self.world.batch_hits(
-            shapes, self.arm.link_transforms(q[None], self.opening(key[0], key[2])), against="fixed", ignore=(key[0],)
-        )
+        transforms = self.arm.link_transforms(q[None], self.opening(key[0], key[2]))
+        if self.arm.self_collides_at(transforms):
+            return
+        hits = self.world.batch_hits(shapes, transforms, against="fixed", ignore=(key[0],))
         if all(h.startswith("@") for h in hits):  # only arms at home: fine if the partner is the one hit
             kept.append(HandoverConfig(q, frozenset(h[1:].split(":")[0] for h in hits)))
 

@@ -26,7 +26,7 @@ from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action
 from mrgc.geometry.collision import CollisionWorld
 from mrgc.geometry.conventions import refine, to_se2
-from mrgc.geometry.grounding import BUSY, Answer, Grounder, GroundStatus, Volume
+from mrgc.geometry.grounding import BUSY, SELF, Answer, Grounder, GroundStatus, Volume
 from mrgc.geometry.relays import spot_region
 from mrgc.language.model import Box
 from mrgc.planner.outcome import DeadlineReached, Failure
@@ -644,7 +644,11 @@ class ReverseGrounder:
             if ans.ok:
                 return point, ans
             failure = _failed(f"handover at {point}", ans)
-            if ans.status is GroundStatus.COLLISION and not ans.blockers and not ans.detail.startswith(("hits", BUSY)):
+            if (
+                ans.status is GroundStatus.COLLISION
+                and not ans.blockers
+                and not ans.detail.startswith(("hits", BUSY, SELF))
+            ):
                 failure = replace(
                     failure,
                     check=f"handover at {point}: the two arms collide",

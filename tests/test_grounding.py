@@ -231,15 +231,17 @@ def test_crowded_out_names_an_object_left_no_free_pose(pa3: Grounder) -> None:
 
 
 def test_a_placement_that_leaves_no_room_for_an_earlier_object_is_passed_over(tmp_path: Path) -> None:
-    """Grounding o2, o10, o13 into the bin in that order: before, the first placement of the last object swept
+    """Grounding o2, o13, o10 into the bin in that order: before, the first placement of the last object swept
     the whole bin and o2 had no free pose ("placement: no free pose of o2 in bin-a" on every skeleton, the
     search exhausted); now a placement that leaves an object still to come no free pose is not taken, and
-    the plan is found and valid."""
+    the plan is found and valid.  (The order was o2, o10, o13 until the arm kept clear of itself: that
+    grounding placed o13 with link6 24.5 mm inside link0 and carried o2 with link5 6.2 mm inside link2;
+    free of that, o10 leaves o2 no room in that order, and the planner's own plan takes this one.)"""
     path = tmp_path / "packed-bin.mrg"
     path.write_text(PACKED_BIN, encoding="utf-8")
     problem = parse_file(path).problem()
     g = Grounder(scene_from_problem(problem), seed=0)
-    steps = tuple((Action(o, "bin-a", "r2", "r2", "side-y+", "side-y+"),) for o in ("o2", "o10", "o13"))
+    steps = tuple((Action(o, "bin-a", "r2", "r2", "side-y+", "side-y+"),) for o in ("o2", "o13", "o10"))
     grounding = ReverseGrounder(g, {"o2": "bin-a", "o10": "bin-a", "o13": "bin-a"}).ground(Skeleton(steps), [])
     assert grounding.outcome is Outcome.SUCCESS, grounding.reason
     bin_a = g.scene.body("bin-a")

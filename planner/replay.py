@@ -359,6 +359,7 @@ class _Replayer(ActionReader):
         st = _StepState(dict(self.home))
         self._phase(t, "to-pick", st, [self._path(a, "to-pick") for a in geo])
         self._phase(t, "pick", st, [self._pick(a, st) for a in geo])
+        self._picked_from_under(t, [a.obj for a in geo])
         for a in geo:
             st.hold[a.action.pick_robot] = (a.obj, a.action.pick_grasp)
         self._phase(t, "to-handover", st, [self._path(a, n) for a in geo for n in ("to-handover", "taker-to-handover")])
@@ -757,16 +758,63 @@ class _Replayer(ActionReader):
             else:
                 self._stable(t, o)
 
-    def _stable(self, t: int, o: str) -> None:
-        """An object that rests on something rests stably: its centre of mass over the support polygon of
-        its contacts, with a margin, flat on its lowest face (:mod:`mrgc.planner.stability`) ``[unstable]``."""
-        bodies = {
-            b: (self.shapes[b], self.poses[b] if b in self.poses else self.scene.body(b).pose) for b in self.shapes
-        }
+    def _stable(self, t: int, o: str, gone: frozenset[str] = frozenset()) -> None:
+        """An object that rests on something rests stably, with the objects that stand on it alone (their
+        weight is its weight), and so does every object under it that holds it up alone, down to what
+        stands on several supports or on something fixed: the centre of mass over the support polygon of the
+        contacts, with a margin, flat on its lowest face (:mod:`mrgc.planner.stability`) ``[unstable]``;
+        ``gone``: objects not in the scene now (picked up)."""
         floors = [(r.name, r.shape, r.pose) for r in self.scene.regions]
-        verdict = stability(o, self.shapes[o], self.poses[o], bodies, floors)
-        if not verdict.stable:
-            self._v(t, o, "unstable", verdict.message())
+        bodies = {
+            b: (s, self.poses[b] if b in self.poses else self.scene.body(b).pose)
+            for b, s in self.shapes.items()
+            if b not in gone
+        }
+        seen: set[str] = set()
+        while o not in seen:
+            seen.add(o)
+            load = {x: bodies[x] for x in self._load(o, gone)}
+            verdict = stability(o, self.shapes[o], self.poses[o], bodies, floors, load)
+            if not verdict.stable:
+                self._v(t, o, "unstable", verdict.message())
+                return
+            under = [s for s in self.support.get(o, set()) if s in self.poses and s not in gone]
+            if len(self.support.get(o, set())) != 1 or len(under) != 1:
+                return
+            o = under[0]
+
+    def _load(self, o: str, gone: frozenset[str]) -> set[str]:
+        """The objects that stand on ``o`` alone, directly or through each other."""
+        out: set[str] = set()
+        todo = [o]
+        while todo:
+            x = todo.pop()
+            for y, under in self.support.items():
+                if y not in out and y != o and y not in gone and under == {x}:
+                    out.add(y)
+                    todo.append(y)
+        return out
+
+    def _picked_from_under(self, t: int, picked: list[str]) -> None:
+        """When a step picks objects up, what rested on them must rest on something else at once, and
+        stand (``[floating]``, ``[unstable]``): a support is not there while it is held, even if it is put
+        back by the end of the step."""
+        gone = frozenset(picked)
+        hit = [o for o in self.movable if o not in gone and self.support.get(o, set()) & gone]
+        if not hit:
+            return
+        for p in picked:
+            self.rs.set_pose(p, None)
+        for o in hit:
+            self.rs.set_pose(o, self.poses[o])
+            left = self._supports(o) - gone
+            if not left:
+                lost = ", ".join(sorted(self.support[o] & gone))
+                self._v(t, o, "floating", f"{o} rested on {lost}, which step {t} picks up: nothing holds it up then")
+            else:
+                self._stable(t, o, gone)
+        for p in picked:
+            self.rs.set_pose(p, self.poses[p])
 
     def goals(self) -> None:
         for obj, region in sorted(self.scene.goal.items()):

@@ -82,7 +82,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from mrgc.geometry.meshes import read_mesh
-from mrgc.geometry.scene import outline
+from mrgc.geometry.scene import half_extents, outline
 from mrgc.language.model import Box, Cylinder, Mesh, Shape, Sphere
 
 Array = NDArray[np.float64]
@@ -127,6 +127,7 @@ class Stability:
     supporters: tuple[str, ...]
     polygon: tuple[tuple[float, float], ...]
     com: tuple[float, float]
+    load: tuple[str, ...] = ()
 
     def message(self) -> str:
         """The verdict in one line (the formats of the module docstring)."""
@@ -148,8 +149,9 @@ class Stability:
             where = f"lies {-self.margin * 1e3:.1f} mm outside"
         else:
             where = "lies on the edge of"
+        whose = "its centre of mass" if not self.load else f"the centre of mass of it and {', '.join(self.load)} on it"
         return (
-            f"{self.obj} would topple: its centre of mass {where} the support polygon of its contacts with "
+            f"{self.obj} would topple: {whose} {where} the support polygon of its contacts with "
             f"{on} (it must lie at least {self.required * 1e3:.1f} mm inside)"
         )
 
@@ -160,18 +162,26 @@ def stability(
     pose: Array,
     bodies: Mapping[str, tuple[Shape, Array]],
     floors: Sequence[tuple[str, Shape, Array]] = (),
+    load: Mapping[str, tuple[Shape, Array]] | None = None,
 ) -> Stability:
     """Whether ``obj`` (of ``shape`` at world ``pose``, 4×4) stands on what is under it: ``bodies`` (name ->
-    shape and world pose of every fixed and movable object it may rest on; ``obj`` itself is skipped) and
-    the floors of ``floors`` (regions: name, shape, world pose).  A value for every geometric outcome
-    (tilted, unsupported, toppling); never raises for one."""
+    shape and world pose of every fixed and movable object it may rest on; ``obj`` itself and the ``load``
+    are skipped) and the floors of ``floors`` (regions: name, shape, world pose).  ``load``: the objects
+    that stand on ``obj`` alone (directly or through each other): their weight is its weight, so the centre
+    of mass judged is that of ``obj`` and its load together (uniform density, each weighted by its volume).
+    A value for every geometric outcome (tilted, unsupported, toppling); never raises for one."""
     pose = np.asarray(pose, dtype=float)
     tilt = 0.0 if isinstance(shape, Sphere) else _tilt(pose)
     flat = tilt <= FLAT_TOL
     bottom, low = _face(shape, pose, top=False)
     names: list[str] = []
     patches: list[Array] = []
-    faces = [(name, *_face(s, np.asarray(p, dtype=float), top=True)) for name, (s, p) in bodies.items() if name != obj]
+    load = load or {}
+    faces = [
+        (name, *_face(s, np.asarray(p, dtype=float), top=True))
+        for name, (s, p) in bodies.items()
+        if name != obj and name not in load
+    ]
     faces += [(f"floor of {name}", *_face(s, np.asarray(p, dtype=float), top=False)) for name, s, p in floors]
     for name, face, height in faces:
         if abs(low - height) > SUPPORT_TOL or not _boxes_meet(bottom, face):
@@ -181,7 +191,10 @@ def stability(
             names.append(name)
             patches.append(patch)
     polygon = _hull(np.vstack(patches)) if patches else np.zeros((0, 2))
-    com = (pose @ np.append(_centroid(shape), 1.0))[:2]
+    parts = [(shape, pose), *((s, np.asarray(p, dtype=float)) for s, p in load.values())]
+    weights = np.array([_volume(s) for s, _ in parts])
+    centres = np.array([(p @ np.append(_centroid(s), 1.0))[:2] for s, p in parts])
+    com = weights @ centres / weights.sum() if weights.sum() > 0 else centres[0]
     margin = _signed_distance(com, polygon)
     required = _required(shape)
     return Stability(
@@ -194,6 +207,7 @@ def stability(
         supporters=tuple(sorted(names)),
         polygon=tuple((float(x), float(y)) for x, y in polygon),
         com=(float(com[0]), float(com[1])),
+        load=tuple(sorted(load)),
     )
 
 
@@ -290,6 +304,17 @@ def _mesh_centroid(mesh: Mesh) -> tuple[float, float, float]:
         return (float(mean[0]), float(mean[1]), float(mean[2]))
     centre = (vol[:, None] * (a + b + c)).sum(axis=0) / (4.0 * total)
     return (float(centre[0]), float(centre[1]), float(centre[2]))
+
+
+def _volume(shape: Shape) -> float:
+    """The shape's volume (a mesh: its bounding box's, a documented approximation of its weight)."""
+    if isinstance(shape, Box):
+        return float(shape.sx * shape.sy * shape.sz)
+    if isinstance(shape, Cylinder):
+        return float(math.pi * shape.radius**2 * shape.height)
+    if isinstance(shape, Sphere):
+        return float(4.0 / 3.0 * math.pi * shape.radius**3)
+    return float(np.prod(2 * half_extents(shape)))
 
 
 def _centroid(shape: Shape) -> Array:

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import pytest
 
-for _name in ("support", "validator_plans", "headless_chromium", "doctor"):
+for _name in ("support", "validator_plans", "headless_chromium", "doctor", "adversarial_round2"):
     if _name not in sys.modules:
         _spec = importlib.util.spec_from_file_location(_name, Path(__file__).with_name(f"{_name}.py"))
         assert _spec is not None and _spec.loader is not None

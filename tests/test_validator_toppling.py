@@ -73,3 +73,23 @@ def test_the_same_box_centred_on_its_neighbour_is_not_unstable(
     report = json.loads(capsys.readouterr().out)
     assert rc == 1
     assert not [v for v in report["violations"] if v["code"] in ("unstable", "floating")], report["violations"]
+
+
+@pytest.mark.parametrize("case", ["A21", "H13", "A31", "A31-twin"])
+def test_the_adversarial_review_s_accepted_plans_are_now_rejected(case: str, tmp_path: Path) -> None:
+    """tests/adversarial_round2.py's plans (issue 21's second adversarial review): a tower whose combined
+    centre of mass overhangs the box under it (A21) and a support pulled out from under a box and put back
+    within one step (A31) are rejected; the centred tower and the same excursion with nothing on top pass."""
+    import adversarial_round2 as adv
+
+    name, wrong, _, build, _ = next(c for c in adv.CASES if c[0] == case)
+    plan = copy.deepcopy(d.load("pa5"))
+    build(plan)
+    path = tmp_path / f"{name}.json"
+    path.write_text(json.dumps(plan), encoding="utf-8")
+    rc, first = adv.validate(path)
+    assert rc == (1 if wrong else 0), first
+    if case == "A21":
+        assert "[unstable]" in first and "o3 on it" in first
+    if case == "A31":
+        assert "[floating]" in first and "picks up" in first

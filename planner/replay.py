@@ -53,8 +53,9 @@ configurations (:mod:`mrgc.planner.sampling`).
   (:mod:`mrgc.geometry.replay_bounds`) ``[collision-self]``; a held object with the fixed objects, the
   other objects and robots, and every link of the arm or arms holding it but their fingers
   ``[collision-object-fixed]``, ``[collision-object-object]``, ``[collision-self-held]``.  The object a robot
-  picks is exempt only from its gripper (hand and fingers) and only in the *contact segment* of its pick
-  approach (between its last two configurations); its other links may not touch it.  A collision is
+  picks may touch only its gripper (hand and fingers), only in the *contact segment* of its pick
+  approach (between its last two configurations) and no deeper than the gripper stands in it at the grasp;
+  its other links may not touch it.  A collision is
   reported once per step, phase and pair (link pair, for a self-collision), at its deepest;
 - a motion longer than :data:`MAX_SAMPLES` samples at the resolution (:data:`RESOLUTION`), or a plan whose
   motions need more than :data:`MAX_PLAN_SAMPLES` robot samples at the resolution in all, or a phase that
@@ -153,7 +154,7 @@ class _PairList:
         kind: str,
         links: tuple[int, int] | None = None,
         skip: frozenset[int] = frozenset(),
-        until: dict[int, float] | None = None,
+        until: dict[int, tuple[float, float]] | None = None,
     ) -> None:
         """Pair ``a`` with ``b`` (not when neither moves): every link of a robot side (only ``links`` for a
         self pair; robot links in ``skip`` left out), each sub-pair's rate the sum of its sides' rates, or for
@@ -173,9 +174,11 @@ class _PairList:
                     continue
                 rows.append(ra * (rb == 0) + rb * (ra == 0) if same else ra + rb)
                 subs.append((la, lb))
-                ends.append((until or {}).get(la if a.robot else lb, np.inf))
+                ends.append((until or {}).get(la if a.robot else lb, (np.inf, 0.0)))
         if subs:
-            self.pairs.append(Pair(subs, np.array(rows), np.array(ends)))
+            self.pairs.append(
+                Pair(subs, np.array(rows), np.array([e[0] for e in ends]), np.array([e[1] for e in ends]))
+            )
             self.sides.append((a, b, links, kind))
 
 
@@ -512,7 +515,7 @@ class _Replayer(ActionReader):
             for f in self.fixed:
                 out.add(me, ph.objects[f], "robot-fixed")
             for o in ph.present:
-                exempt = dict.fromkeys(b.gripper if b else (-1,), tr.exempt_from) if o == tr.exempt else None
+                exempt = self._grasp_depths(tr) if o == tr.exempt else None
                 out.add(me, ph.objects[o], "robot-object", until=exempt)
             for la, lb in b.self_pairs if b is not None else ():
                 out.add(me, me, "self", (la, lb))
@@ -524,6 +527,15 @@ class _Replayer(ActionReader):
             for other in [*ph.tracks[i + 1 :], *ph.standing]:
                 self._between(ph, out, tr, other)
         return out.pairs, out.sides
+
+    def _grasp_depths(self, tr: _Track) -> dict[int, tuple[float, float]]:
+        """A pick track's gripper links against the object it picks: from the contact segment on, each may
+        reach as deep into the object as it stands at the grasp (its last configuration), no deeper."""
+        b, obj = self.bounds[tr.robot], tr.exempt or ""
+        self.rs.set_config(tr.robot, tr.configs[-1])
+        depth = self.rs.link_distances(tr.robot, obj, 0.0)
+        self.rs.set_config(tr.robot, tr.configs[0])
+        return {link: (tr.exempt_from, max(0.0, -depth.get((link, -1), 0.0))) for link in b.gripper}
 
     def _between(self, ph: _PhaseWorld, out: _PairList, tr: _Track, other: _Track) -> None:
         """The pairs of two robots of a phase (``tr`` moves) and what they hold: robot-robot, each robot

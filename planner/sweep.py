@@ -24,7 +24,7 @@ by at most that budget.
 Everything the sweep needs from the world comes through callables: ``set_state(s)`` (put every moving body
 where it is at time ``s``), ``query(p, s)`` (the distances of pair ``p``'s links now) and ``report(p, sub, d,
 s)`` (a sub-pair of ``p`` that is checked then overlaps by more than the tolerance: ``d`` < -tol; links the
-pair does not list, and sub-pairs past their ``until``, are never reported).
+pair does not list are never reported; from its ``until`` on, a sub-pair may overlap ``slack`` more).
 """
 
 from __future__ import annotations
@@ -45,11 +45,14 @@ class Pair:
     """One pair of bodies to keep apart during a phase.  ``subs``: the (link of a, link of b) keys of its
     sub-pairs as the query reports them; ``coeffs`` (len(subs), columns): each sub-pair's rate is
     ``coeffs @ speeds`` (the phase's joint speeds, see :class:`Sweep`); ``until`` (len(subs),): the time
-    from which a sub-pair is no longer checked (inf: never; a gripper in its pick's contact segment)."""
+    from which a sub-pair may overlap ``slack`` (len(subs),, m) more than the tolerance (a gripper in its
+    pick's contact segment may reach as deep into the object as it stands at the grasp; inf: not checked
+    then at all)."""
 
     subs: list[tuple[int, int]]
     coeffs: np.ndarray
     until: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    slack: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
 
 class Sweep:
@@ -98,6 +101,7 @@ class Sweep:
         self._local = [{sub: k for k, sub in enumerate(p.subs)} for p in self.pairs]
         coeffs = np.concatenate([p.coeffs for p in self.pairs], axis=0)
         until = np.concatenate([p.until if len(p.until) else np.full(len(p.subs), np.inf) for p in self.pairs])
+        slack = np.concatenate([p.slack if len(p.slack) else np.zeros(len(p.subs)) for p in self.pairs])
         pair_of = np.repeat(np.arange(len(self.pairs)), sizes)
         self._due = np.zeros(len(pair_of))  # when each sub-pair's budget runs out
         self._budget = np.zeros(len(pair_of))  # its budget when it was last checked or carried over
@@ -109,7 +113,8 @@ class Sweep:
         for k in range(len(bp) - 1):
             a, b = float(bp[k]), float(bp[k + 1])
             self._rate = coeffs @ self.speeds(k)
-            self._off = until <= a + 1e-12
+            self._extra = np.where(until <= a + 1e-12, slack, 0.0)  # overlap allowed beyond the tolerance
+            self._off = np.isinf(self._extra)
             self._rate[self._off] = 0.0
             if k:  # carry the budgets left over into this interval's rates
                 self._budget = np.where(self._off, np.inf, self._left(a))
@@ -156,7 +161,7 @@ class Sweep:
         """Set the world at time ``s``, ask the pairs ``need`` and renew their sub-pairs' budgets."""
         self.set_state(s)
         self.events += 1
-        off, budget = self._off, self._budget
+        off, budget, extra = self._off, self._budget, self._extra
         for i in need:
             found = self.query(int(i), s)
             self.queries += 1
@@ -167,11 +172,12 @@ class Sweep:
                 j = local.get(sub)
                 if j is None or off[lo + j]:
                     continue
-                if d < -self.tol:
+                allowed = self.tol + float(extra[lo + j])
+                if d < -allowed:
                     budget[lo + j] = FLOOR
                     self.report(int(i), sub, d, s)
                 else:
-                    budget[lo + j] = max(min(d, CAP) + self.tol, MIN_BUDGET)
+                    budget[lo + j] = max(min(d, CAP) + allowed, MIN_BUDGET)
             self._since[lo:hi] = s
             rate = self._rate[lo:hi]
             with np.errstate(divide="ignore", invalid="ignore"):

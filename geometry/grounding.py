@@ -92,6 +92,82 @@ BUSY = "another robot of the step moves there in the same phase"
 #: :data:`~mrgc.geometry.arm.SELF_CLEARANCE`)
 SELF = "the arm collides with itself"
 
+#: the phases of a step, in the order they run (docs/validator.md, "What a plan means")
+PHASES = ("to-pick", "pick", "to-handover", "handover", "giver-home", "to-place", "place", "home")
+
+
+class Stance(str, enum.Enum):
+    """Where an arm of the step is during one of its :data:`PHASES` (:data:`STANCES`); the value names it in
+    a failure line (``hits r2 at its exchange, holding``)."""
+
+    HOME = "at home"
+    #: its own motion of the phase: a path, an approach, its exchange configuration in the handover phase
+    MOVES = "moving"
+    #: standing at its last pick configuration, holding its object (fingers at the grasp's opening)
+    PICKED = "at its grasp"
+    #: a giver standing at its exchange configuration, the object let go (fingers at the grasp's opening)
+    EXCHANGE = "at its exchange"
+    #: a taker standing at its exchange configuration, holding the object
+    RECEIVED = "at its exchange, holding"
+    #: standing at its last place configuration, the object released (fingers at the grasp's opening)
+    PLACED = "at its release"
+
+
+#: **The execution model a plan means** (docs/validator.md; planner/replay.py replays it), the one place
+#: the grounding reads it from: an arm's stance in each phase of :data:`PHASES`, by its role in its action,
+#: under the ``configurations`` motion model.  Every arm starts the step at home; between its own motions it
+#: stands where its last motion left it, its fingers as that motion left them; an arm in no action of the
+#: step stays at home.
+STANCES: dict[str, tuple[Stance, ...]] = {
+    # to-pick, pick, to-handover, handover, giver-home, to-place, place, home
+    "pick-place": (
+        Stance.HOME,  # no to-pick path: it is at its pre-grasp when the pick phase starts
+        Stance.MOVES,
+        Stance.PICKED,  # while the handovers of the step run
+        Stance.PICKED,
+        Stance.PICKED,
+        Stance.MOVES,
+        Stance.MOVES,
+        Stance.PLACED,  # no home path: at home when the next step starts
+    ),
+    "giver": (
+        Stance.HOME,
+        Stance.MOVES,
+        Stance.MOVES,  # its to-handover transfer
+        Stance.MOVES,  # at its exchange, holding
+        Stance.EXCHANGE,  # no giver-home path: it lets go, and is at home when the phase ends
+        Stance.HOME,
+        Stance.HOME,
+        Stance.HOME,
+    ),
+    "taker": (
+        Stance.HOME,
+        Stance.HOME,
+        Stance.HOME,  # no taker-to-handover path: at its exchange when the handover phase starts
+        Stance.MOVES,  # at its exchange, holding
+        Stance.RECEIVED,  # while the giver withdraws
+        Stance.MOVES,
+        Stance.MOVES,
+        Stance.PLACED,
+    ),
+}
+#: each role's empty-handed transits: without a path (``configurations``) the arm jumps at the end of the
+#: phase, so it stands where it was until then (:data:`STANCES`); with ``--motions full`` they are paths,
+#: and the arm moves then
+TRANSITS: dict[str, tuple[str, ...]] = {
+    "pick-place": ("to-pick", "home"),
+    "giver": ("to-pick", "giver-home"),
+    "taker": ("to-handover", "home"),
+}
+
+
+def stance(role: str, phase: str, full: bool = False) -> Stance:
+    """Where an arm of ``role`` (``pick-place``, ``giver``, ``taker``) is in ``phase``: :data:`STANCES`, or
+    moving on its :data:`TRANSITS` when they are paths (``full``)."""
+    if full and phase in TRANSITS[role]:
+        return Stance.MOVES
+    return STANCES[role][PHASES.index(phase)]
+
 
 class GroundStatus(str, enum.Enum):
     """How a geometric query of the grounding ended (its value is what a failure line says)."""
@@ -142,6 +218,7 @@ class Grounder:
         self._grips: dict[tuple[str, str], tuple[float, np.ndarray]] = {}
         self._vol_world = _PieceWorld()
         self._moving_world = _PieceWorld()
+        self._after_world = _PieceWorld()  # what an arm standing still afterwards keeps clear of (``after``)
         # planar robots wait at their start pose (as the validator assumes): obstacles for the others
         self.parked: dict[str, str] = {}
         for spec in scene.robots:
@@ -157,8 +234,12 @@ class Grounder:
         self.homes: tuple[str, ...] = ()
         #: each arm's base link, group ``base:<arm>``: an obstacle to the other arms, home or not
         self._bases: tuple[str, ...] = ()
-        #: the arms of the step being grounded that are *not* at home, by phase (see :meth:`step`)
-        self._away: dict[str, frozenset[str]] = {}
+        #: the step being grounded (see :meth:`step`): each of its robots' role, and the arms' motion model
+        self._roles: dict[str, str] = {}
+        self._full = False
+        #: arms of the step standing still away from home where they are known (:meth:`standing`): robot ->
+        #: stance -> (world group, digest of its transforms)
+        self._stands: dict[str, dict[Stance, tuple[str, bytes]]] = {}
 
     def _arm_homes(self) -> tuple[str, ...]:
         """Put every arm's links at home into the world (once) and name their groups."""
@@ -174,24 +255,84 @@ class Grounder:
             self.homes = tuple(f"home:{s.name}" for s in self.scene.robots if not is_planar(s))
         return self.homes
 
-    def step(self, pickers: Iterable[str], placers: Iterable[str]) -> None:
-        """Declare the step whose actions are grounded next: its arms that pick and that place.  The
-        validator's execution model says where the step's other arms are in each phase: in the to-pick and
-        pick phases the picking arms move and every other arm stands at home; in the place phase the placing
-        arms; in the phases between (to-handover, handover, to-place, home) the step's arms are in transit
-        (not at home) and only the waiting arms stand there.  ``step((), ())`` forgets it."""
-        pick, place = frozenset(pickers), frozenset(placers)
-        self._away = {"to-pick": pick, "pick": pick, "place": place, "*": pick | place} if pick | place else {}
+    def step(self, roles: Mapping[str, str], full: bool = False) -> None:
+        """Declare the step whose actions are grounded next: each of its robots' role in its action
+        (``pick-place``, ``giver`` or ``taker``) and whether arms' empty-handed transits are paths (``full``,
+        ``mrgc plan --motions full``).  The grounder then knows, per phase, where every arm is (the execution
+        model a plan means, :data:`STANCES`; docs/validator.md, docs/planner.md):
 
-    def _others_home(self, robot: str, partner: str | None = None, phase: str = "*") -> tuple[str, ...]:
-        """The groups of the other arms at home in ``phase`` of the current step (see :meth:`step`): all
-        arms but ``robot``, ``partner`` (which moves with ``robot``: the other arm of a handover, at the
-        exchange or in transit) and the step's arms away from home then."""
-        away = self._away.get(phase, self._away.get("*", frozenset()))
-        homes = tuple(
-            h for h in self._arm_homes() if h not in (f"home:{robot}", f"home:{partner}") and h[5:] not in away
-        )
-        return homes + tuple(b for b in self._bases if b != f"base:{robot}")
+        - every arm starts the step at home; an arm in no action of the step stays there;
+        - between its own motions an arm stands where its last motion left it, its fingers as that motion
+          left them: a pick-and-place arm at its last pick configuration holding its object while the step's
+          handovers run (to-handover, handover, giver-home), a taker at its exchange holding the object while
+          the giver withdraws (giver-home), an arm without a home path at its last place configuration in
+          the home phase;
+        - a missing transit (no path under ``configurations``) is a jump at the end of its phase: a taker is
+          at home until the handover phase (unless it has a ``taker-to-handover`` path), a giver at its
+          exchange until the end of the giver-home phase, then at home (to-place, place, home);
+        - planar robots always drive their paths (as ``full``).
+
+        Each query of a phase keeps clear of the other arms at home then and of those standing still where
+        :meth:`standing` has put them (:meth:`_others`); what the step's other robots do meanwhile, moving or
+        standing, comes as the query's ``busy``.  ``step({})`` forgets the step."""
+        self._roles, self._full = dict(roles), full
+
+    def stance(self, robot: str, phase: str) -> Stance:
+        """Where ``robot`` is during ``phase`` of the declared step (:meth:`step`); at home when it has no
+        action in it."""
+        role = self._roles.get(robot)
+        if role is None:
+            return Stance.HOME
+        return stance(role, phase, self._full or self.is_planar(robot))
+
+    @contextmanager
+    def standing(self, robot: str, where: Mapping[Stance, Volume]) -> Iterator[None]:
+        """``robot`` standing still at ``where`` (a volume per stance: its links, and the object it holds
+        there) for the queries inside the ``with`` block: an obstacle to the other arms in the phases the
+        execution model puts it there (:meth:`stance`); taken out again after the block."""
+        before = self._stands.get(robot, {})
+        added: list[str] = []
+        mine = dict(before)
+        try:
+            for where_, volume in where.items():
+                if where_ in before:
+                    continue
+                group = f"stand:{robot}:{where_.name}"
+                for i, (shape, t) in enumerate(volume):
+                    added.append(f"~{robot}:{where_.name}:{i}")
+                    self.world.add(added[-1], shape, t, group)
+                mine[where_] = (group, _fingerprint((), volume)[1])
+            self._stands[robot] = mine
+            yield
+        finally:
+            for name in added:
+                self.world.remove(name)
+            if before:
+                self._stands[robot] = before
+            else:
+                self._stands.pop(robot, None)
+
+    def _presence(self) -> tuple[object, ...]:
+        """What :meth:`_others` answers depend on (a path cache's key): the step's roles, its motion model
+        and where its arms stand."""
+        stands = sorted((r, s.name, d) for r, m in self._stands.items() for s, (_, d) in m.items())
+        return (tuple(sorted(self._roles.items())), self._full, tuple(stands))
+
+    def _others(self, robot: str, phase: str) -> tuple[str, ...]:
+        """The world groups of the other arms standing still in ``phase`` of the current step (:meth:`step`):
+        at home, or where :meth:`standing` put them (an arm that moves then is in the query's ``busy``; one
+        whose place is not known yet is left out), and every other arm's base link."""
+        out = []
+        for home in self._arm_homes():
+            other = home[5:]
+            if other == robot:
+                continue
+            where = self.stance(other, phase)
+            if where is Stance.HOME:
+                out.append(home)
+            elif where in self._stands.get(other, {}):
+                out.append(self._stands[other][where][0])
+        return tuple(out) + tuple(b for b in self._bases if b != f"base:{robot}")
 
     # ------------------------------------------------------------ state
     def arm(self, robot: str) -> Arm:
@@ -440,8 +581,8 @@ class Grounder:
         approach: bool = True,
         held: bool = False,
         busy: Pieces = (),
-        partner: str | None = None,
         from_home: bool = True,
+        after: Pieces = (),
     ) -> Answer:
         spec = self.scene.grasp_specs.get(grasp)
         arm = self.arm(robot)
@@ -482,7 +623,7 @@ class Grounder:
                 status, clash = GroundStatus.COLLISION, ("self", [])
                 continue
             self.queries += 1
-            if self._fixed_clash(robot, obj, grasp, configs, volume, held, self._others_home(robot, partner, phase)):
+            if self._fixed_clash(robot, obj, grasp, configs, volume, held, self._others(robot, phase)):
                 status, clash = GroundStatus.COLLISION, ("fixed", volume)
                 static = static and self._static_clash(robot, obj, volume, held)
                 continue
@@ -492,15 +633,25 @@ class Grounder:
                 blockers |= hit
                 status = GroundStatus.COLLISION
                 continue
-            if moving is not None and moving.probe_collides(volume, against="volume"):
-                # another robot of the step moves there meanwhile: another IK seed
+            if (moving is not None and moving.probe_collides(volume, against="volume")) or (
+                after and self._standing_clash(robot, obj, grasp, configs[-1], after)
+            ):
+                # another robot of the step moves there meanwhile, or moves (or stands) where the arm stands
+                # afterwards: another IK seed
                 status, clash = GroundStatus.COLLISION, ("moving", volume)
                 continue
             return Answer(GroundStatus.OK, pose=pose, configs=configs)
         detail = ""
         if clash is not None and not blockers:
-            detail = self._clash_detail(robot, partner, phase, clash, ignore=() if held else (obj,))
+            detail = self._clash_detail(robot, phase, clash, ignore=() if held else (obj,))
         return Answer(status, blockers=blockers, detail=detail, static=static)
+
+    def _standing_clash(self, robot: str, obj: str, grasp: str, q: np.ndarray, after: Pieces) -> bool:
+        """Whether ``robot`` standing at ``q`` holding ``obj`` hits ``after``: what the step's other robots do
+        in the later phases it stands there (:meth:`step`).  Held: where it has let the object go, the object
+        is there too then (placed, or held by the taker)."""
+        volume = self.arm_volume(robot, q[None], holding=(obj, grasp))
+        return self._after_world.holding(after).probe_collides(volume, against="volume")
 
     def _static_clash(self, robot: str, obj: str, volume: Volume, held: bool) -> bool:
         """Whether an approach volume hits what never moves: a fixed body or another arm's base link."""
@@ -538,31 +689,41 @@ class Grounder:
             return None
         return configs
 
-    def _clash_detail(
-        self, robot: str, partner: str | None, phase: str, clash: tuple[str, Volume], ignore: tuple[str, ...]
-    ) -> str:
+    def _clash_detail(self, robot: str, phase: str, clash: tuple[str, Volume], ignore: tuple[str, ...]) -> str:
         """Name what a volume collided with besides the avoided objects: fixed bodies, other arms at home
-        (their links are named ``@<arm>:<i>``), or the other robots of the step."""
+        (their links are named ``@<arm>:<i>``) or standing still (``~<arm>:<stance>:<i>``), or the other robots
+        of the step."""
         kind, volume = clash
         if kind == "moving":
             return BUSY
         if kind == "self":
             return SELF
-        hit = self.world.probe_hits(volume, against=("fixed", *self._others_home(robot, partner, phase)), ignore=ignore)
-        named = sorted({f"{h[1:].split(':')[0]} at home" if h.startswith("@") else h for h in hit})
+        hit = self.world.probe_hits(volume, against=("fixed", *self._others(robot, phase)), ignore=ignore)
+        named = sorted({_named(h) for h in hit})
         return "hits " + ", ".join(named) if named else ""
 
-    def pick(self, robot: str, obj: str, grasp: str, avoid: Iterable[str] = (), busy: Pieces = ()) -> Answer:
+    def pick(
+        self, robot: str, obj: str, grasp: str, avoid: Iterable[str] = (), busy: Pieces = (), after: Pieces = ()
+    ) -> Answer:
         """Approach configurations for ``robot`` to grasp ``obj`` (at its current pose) with ``grasp``,
-        free of fixed objects, of ``avoid`` and of ``busy`` (what other robots sweep meanwhile); ``blockers``
-        names the avoided objects that were in the way."""
-        return self._approach(robot, obj, grasp, self.poses[obj], "pick", avoid, busy=busy)
+        free of fixed objects, of ``avoid`` and of ``busy`` (what other robots sweep meanwhile), the last one
+        holding the object also free of ``after`` (what they do in the later phases the arm stands there,
+        :meth:`step`); ``blockers`` names the avoided objects that were in the way."""
+        return self._approach(robot, obj, grasp, self.poses[obj], "pick", avoid, busy=busy, after=after)
 
     def place(
-        self, robot: str, obj: str, grasp: str, pose: np.ndarray, avoid: Iterable[str] = (), busy: Pieces = ()
+        self,
+        robot: str,
+        obj: str,
+        grasp: str,
+        pose: np.ndarray,
+        avoid: Iterable[str] = (),
+        busy: Pieces = (),
+        after: Pieces = (),
     ) -> Answer:
-        """Approach configurations for ``robot`` holding ``obj`` with ``grasp`` to put it at ``pose``."""
-        return self._approach(robot, obj, grasp, pose, "place", avoid, held=True, busy=busy)
+        """Approach configurations for ``robot`` holding ``obj`` with ``grasp`` to put it at ``pose`` (``busy``
+        and ``after`` as for :meth:`pick`)."""
+        return self._approach(robot, obj, grasp, pose, "place", avoid, held=True, busy=busy, after=after)
 
     def handover(
         self,
@@ -574,8 +735,11 @@ class Grounder:
         g2: str,
         avoid: Iterable[str] = (),
         busy: Pieces = (),
+        after: Mapping[str, Pieces] | None = None,
     ) -> Answer:
-        """Both arms' configurations holding ``obj`` at handover point ``point`` (configs: giver, taker)."""
+        """Both arms' configurations holding ``obj`` at handover point ``point`` (configs: giver, taker), free
+        of ``busy`` (what the step's other robots do in the handover phase), each arm's also of ``after[arm]``
+        (what they do in the later phases it stands at its exchange: :meth:`step`)."""
         pose = translation(*self.scene.handover_points[point])
         # as in phase 1, a handover is checked at the exchange configurations (no approach).  Each round draws
         # one more free exchange configuration of each arm (the first from home, the others from seeded
@@ -584,14 +748,17 @@ class Grounder:
         found: dict[str, list[np.ndarray]] = {giver: [], taker: []}
         failed = Answer(GroundStatus.COLLISION)
         worlds: list[CollisionWorld] = []  # the taker's configurations, one world each
-        for attempt in range(HANDOVER_PAIRS):
+        later = after or {}
+
+        def exchange(arm: str, grasp: str, attempt: int) -> Answer:
             key = f"handover:{point}" + (f":{attempt}" if attempt else "")
-            a = self._approach(
-                giver, obj, g1, pose, key, avoid, approach=False, busy=busy, partner=taker, from_home=attempt == 0
+            first = attempt == 0
+            return self._approach(
+                arm, obj, grasp, pose, key, avoid, approach=False, busy=busy, from_home=first, after=later.get(arm, ())
             )
-            b = self._approach(
-                taker, obj, g2, pose, key, avoid, approach=False, busy=busy, partner=giver, from_home=attempt == 0
-            )
+
+        for attempt in range(HANDOVER_PAIRS):
+            a, b = exchange(giver, g1, attempt), exchange(taker, g2, attempt)
             if not b.ok:
                 failed = b
             else:
@@ -628,18 +795,19 @@ class Grounder:
         max_checks: int = MAX_CHECKS,
         resolution: float = 0.05,
         busy: Pieces = (),
-        partner: str | None = None,
-        phase: str = "*",
+        phase: str = "to-place",
+        fingers: tuple[str, str] | None = None,
     ) -> Answer:
         """A joint-space path (RRTConnect, at most ``max_checks`` validity checks: no clock decides) free of
-        fixed objects, ``avoid`` and ``busy`` (and of the held object's collisions with them), no two of its
+        fixed objects, of the other arms where they stand in ``phase`` (:meth:`step`), of ``avoid`` and of
+        ``busy`` (and of the held object's collisions with them), no two of its
         configurations more than ``resolution`` apart.  A ``resolution`` finer than
         :data:`COARSE_RESOLUTION` is searched coarsely first (:data:`COARSE_BUDGET` of the checks) and the
         result checked at ``resolution``."""
         arm = self.arm(robot)
         against = (
             "fixed",
-            *self._others_home(robot, partner, phase),
+            *self._others(robot, phase),
             *[a for a in avoid if not holding or a != holding[0]],
         )
         ignore = (holding[0],) if holding else ()
@@ -647,7 +815,7 @@ class Grounder:
 
         def free(configs: np.ndarray) -> bool:
             self.queries += 1
-            volume = self.free_volume(robot, configs, holding)
+            volume = self.free_volume(robot, configs, holding, fingers)
             if volume is None:
                 return False
             if moving is not None and moving.probe_collides(volume, against="volume"):
@@ -692,12 +860,12 @@ class Grounder:
         avoid: Iterable[str] = (),
         lift: bool = False,
         busy: Pieces = (),
-        partner: str | None = None,
         lower: bool = False,
+        phase: str = "to-place",
     ) -> Answer:
         """:meth:`_transfer`, remembered: the same question (same configurations, objects at the same poses,
-        the same moving robots and arms at home) gets the same answer without a second search (the reverse
-        search asks again when it splits a step or grounds a skeleton that shares a suffix)."""
+        the same moving robots and arms where they stand) gets the same answer without a second search (the
+        reverse search asks again when it splits a step or grounds a skeleton that shares a suffix)."""
         avoid = tuple(sorted(set(avoid)))
         poses = [self.poses[o] for o in sorted(self.poses)]  # lift_height reads every object's pose
         key = (
@@ -708,11 +876,11 @@ class Grounder:
             avoid,
             lift,
             lower,
-            partner,
-            tuple(sorted(self._away.items())),
+            phase,
+            self._presence(),
         ) + _fingerprint([start, goal, *poses], busy)
         if key not in self._paths:
-            self._remember(key, self._transfer(robot, obj, grasp, start, goal, avoid, lift, busy, partner, lower))
+            self._remember(key, self._transfer(robot, obj, grasp, start, goal, avoid, lift, busy, lower, phase))
         return self._paths[key]
 
     def _remember(self, key: tuple[object, ...], answer: Answer) -> None:
@@ -732,8 +900,8 @@ class Grounder:
         avoid: Iterable[str] = (),
         lift: bool = False,
         busy: Pieces = (),
-        partner: str | None = None,
         lower: bool = False,
+        phase: str = "to-place",
     ) -> Answer:
         """How ``robot`` carries ``obj`` (held with ``grasp``) from configuration ``start`` to ``goal``: when
         ``lift`` (``start`` grasps the object where it rests), first straight up by :meth:`lift_height`
@@ -742,13 +910,13 @@ class Grounder:
         collides, an RRTConnect path (a budget of checks, seeded from the query); with ``lower``, that
         motion ends as high above ``goal`` and the carry comes straight down onto it (so the arm crosses
         a bin above what will stand in it, not through it).  Free of fixed objects, of the other arms
-        at home, of ``avoid`` and of ``busy`` (what other robots sweep meanwhile).
+        where they stand in ``phase`` (:meth:`step`), of ``avoid`` and of ``busy`` (what the step's other
+        robots do meanwhile).
         ``path`` is every configuration, ``start`` first, no joint moving more than
         :data:`PATH_RESOLUTION` between two; ``blockers`` the avoided objects in the way."""
         held = (obj, grasp)
         others = tuple(a for a in avoid if a != obj)
-        against = ("fixed", *self._others_home(robot, partner), *others)
-        back = np.asarray(start, dtype=float)[None]
+        against = ("fixed", *self._others(robot, phase), *others)
         moving = self._busy_world(busy) if busy else None
 
         crossed = [False]  # did the last blocked motion cross what another robot of the step sweeps?
@@ -765,6 +933,7 @@ class Grounder:
                 return None
             return self.world.probe_hits(volume, against=others, ignore=(obj,)) if others else set()
 
+        back = np.asarray(start, dtype=float)[None]
         if lift:
             up = self._lift(robot, back[0], self.lift_height(obj, start=True))
             if up is None:
@@ -804,7 +973,7 @@ class Grounder:
             avoid=others,
             resolution=PATH_RESOLUTION,
             busy=busy,
-            partner=partner,
+            phase=phase,
             max_checks=TRANSFER_CHECKS,
         )
         if not planned.ok:
@@ -817,13 +986,26 @@ class Grounder:
         """Configurations coming straight down onto ``goal`` from up to ``height`` above it (the tool's pose
         at ``goal`` raised centimetre by centimetre, as far as IK follows and ``hits`` finds the way free),
         ``goal`` last, at :data:`PATH_RESOLUTION`; ``goal`` alone when not even one centimetre is free."""
-        up = self._lift(robot, goal, height)
+        return joint_line(self._straight(robot, goal, height, hits)[::-1], PATH_RESOLUTION)
+
+    def _straight(
+        self,
+        robot: str,
+        q: np.ndarray,
+        distance: float,
+        hits: Callable[[np.ndarray], set[str] | None],
+        direction: np.ndarray | None = None,
+    ) -> np.ndarray:
+        """Configurations moving the tool straight along ``direction`` (world; default up) from its pose at
+        ``q`` by up to ``distance``, ``q`` first, one per centimetre (:meth:`_lift`), as far as IK follows and
+        ``hits`` finds each motion between two free; ``q`` alone when not even one centimetre is."""
+        up = self._lift(robot, q, distance, direction)
         if up is None:
-            return goal[None]
+            return q[None]
         top = 0
         while top + 1 < len(up) and hits(joint_line(up[top : top + 2], PATH_RESOLUTION)) is None:
             top += 1
-        return joint_line(up[: top + 1][::-1], PATH_RESOLUTION)
+        return up[: top + 1]
 
     def transit(
         self,
@@ -833,27 +1015,34 @@ class Grounder:
         avoid: Iterable[str] = (),
         busy: Pieces = (),
         via: np.ndarray | None = None,
-        partner: str | None = None,
-        phase: str = "*",
+        phase: str = "home",
+        fingers: tuple[str, str] | None = None,
+        retreat: np.ndarray | None = None,
     ) -> Answer:
-        """An empty-handed motion of ``robot`` (fingers fully open, as the validator replays it) from
-        ``start`` to ``goal``: along ``via`` first when given (configurations, ``start`` first, joined by
-        straight joint-space lines: a release backing off along its approach), then the straight line or, when
-        that collides, an RRTConnect path.  Free of fixed objects, of the other arms at home, of ``avoid`` and
-        of ``busy``; ``path`` as for :meth:`transfer`.  ``phase`` (``to-pick``, ``home`` ...) says which arms
-        stand at home meanwhile (:meth:`step`)."""
-        against = ("fixed", *self._others_home(robot, partner, phase), *avoid)
+        """An empty-handed motion of ``robot`` from ``start`` to ``goal``, its fingers at the opening of
+        ``fingers`` (object, grasp: a giver letting go) or fully open, as the validator replays it: along ``via``
+        first when given (configurations, ``start`` first, joined by straight joint-space lines: a release
+        backing off along its approach), or with ``retreat`` (a world direction) first straight along it by
+        up to :data:`~mrgc.geometry.grasps.APPROACH` as far as the way is free (a giver backing its open
+        fingers off the object the taker holds, along its approach axis); then the straight line or, when that
+        collides, an RRTConnect path.  Free of fixed objects, of the other arms where they stand in ``phase``
+        (``to-pick``, ``giver-home`` ...: :meth:`step`), of ``avoid`` and of ``busy``; ``path`` as for
+        :meth:`transfer`."""
+        against = ("fixed", *self._others(robot, phase), *avoid)
         moving = self._busy_world(busy) if busy else None
 
         def free(configs: np.ndarray) -> bool:
             self.queries += 1
-            volume = self.free_volume(robot, configs)
+            volume = self.free_volume(robot, configs, grasp=fingers)
             if volume is None:
                 return False
             if moving is not None and moving.probe_collides(volume, against="volume"):
                 return False
             return not self.world.probe_collides(volume, against=against)
 
+        if retreat is not None:
+            start = np.asarray(start, dtype=float)
+            via = self._straight(robot, start, APPROACH, lambda c: None if free(c) else set(), retreat)
         back = joint_line(np.asarray(via if via is not None else [start], dtype=float), PATH_RESOLUTION)
         if not free(back):
             return Answer(GroundStatus.COLLISION)
@@ -867,9 +1056,9 @@ class Grounder:
             avoid=tuple(avoid),
             resolution=PATH_RESOLUTION,
             busy=busy,
-            partner=partner,
             max_checks=TRANSFER_CHECKS,
             phase=phase,
+            fingers=fingers,
         )
         if not planned.ok:
             return Answer(GroundStatus.NO_PATH)
@@ -947,15 +1136,18 @@ class Grounder:
             configs[k] = ik.q
         return joint_line(configs, PATH_RESOLUTION)
 
-    def _lift(self, robot: str, q: np.ndarray, height: float = TRANSFER_LIFT) -> np.ndarray | None:
-        """Configurations raising the tool straight up from its pose at ``q`` by up to :data:`TRANSFER_LIFT`
-        (one per centimetre, each solved from the one before, as far as none fails or jumps; None when not
-        even the first centimetre can be solved)."""
+    def _lift(
+        self, robot: str, q: np.ndarray, height: float = TRANSFER_LIFT, direction: np.ndarray | None = None
+    ) -> np.ndarray | None:
+        """Configurations moving the tool straight along ``direction`` (world, a unit vector; default up) from
+        its pose at ``q`` by up to ``height`` (one per centimetre, each solved from the one before, as far as
+        none fails or jumps; None when not even the first centimetre can be solved)."""
         arm = self.arm(robot)
         tool = arm.tool_world(q[None])[0]
+        way = (0.0, 0.0, 1.0) if direction is None else tuple(float(v) for v in direction)
         out = [q]
         for dz in np.arange(1, round(height / 0.01) + 1) * 0.01:
-            target = arm.ee_target(translation(0.0, 0.0, float(dz)) @ tool)
+            target = arm.ee_target(translation(way[0] * dz, way[1] * dz, way[2] * dz) @ tool)
             ik = solve_ik_many(arm.model, target[None], 0, q_init=out[-1], restarts=0)[0]
             if not ik.solved or ik.q is None or float(np.abs(ik.q - out[-1]).max()) > 0.2:
                 break  # as high as the arm goes straight up (at the edge of its reach: less)
@@ -1136,6 +1328,18 @@ def _swept_hulls(volume: Sequence[tuple[CollisionShape, np.ndarray]], chunk: int
             flushed.add(id(shape))
     out += [np.concatenate(run) for key, run in runs.items() if len(run) > 1 or key not in flushed]
     return out
+
+
+def _named(hit: str) -> str:
+    """A body of the grounder's world as a failure line names it: ``r2 at home`` for an arm's link at home
+    (``@r2:<i>``, its base link ``@r2:base``), ``r1 at its exchange`` for one standing still
+    (``~r1:EXCHANGE:<i>``, :meth:`Grounder.standing`), else its name."""
+    if hit.startswith("@"):
+        return f"{hit[1:].split(':')[0]} at home"
+    if hit.startswith("~"):
+        robot, where = hit[1:].split(":")[:2]
+        return f"{robot} {Stance[where].value}"
+    return hit
 
 
 def _against(among: Iterable[str] | str) -> str | tuple[str, ...]:

@@ -4,10 +4,12 @@ Steps are grounded from the last to the first.  At step t, placements avoid the 
 that are never moved (M_out), the objects moved later (M_fut, still at their initial poses at t), the
 objects moved in the same step, and the future volume V_fut (everything later grounded steps sweep,
 including objects at their final placements).  Pick, handover and place configurations avoid the same
-objects; robots of one step must not collide with each other: each action's motions (approaches,
-exchanges, transfers, base paths) keep clear of everything the step's actions grounded before it sweep in
-the same phase (conservative: it ignores when they pass), and the phases are then compared sample by
-sample as the validator replays them.  If step t fails, it is retried allowing
+objects; robots of one step must not collide with each other: the grounder knows where each robot of the
+step is in each phase (at home, moving, or standing still where its last motion left it: the execution
+model, :meth:`Grounder.step <mrgc.geometry.grounding.Grounder.step>`), each action's motions (approaches,
+exchanges, transfers, base paths) keep clear of everything the step's actions grounded before it sweep or
+occupy in the same phase (conservative: it ignores when they pass), and the phases are then compared
+sample by sample as the validator replays them.  If step t fails, it is retried allowing
 collisions with M_out: on success grounding stops and returns the grounded suffix S' and M* = the goal
 objects not moved in S' plus the M_out objects that obstruct S'; otherwise it fails.
 """
@@ -18,7 +20,7 @@ import enum
 import time
 from contextlib import ExitStack
 from dataclasses import dataclass, field, replace
-from typing import Iterable
+from typing import Any, Iterable
 
 import numpy as np
 
@@ -26,7 +28,7 @@ from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action
 from mrgc.geometry.collision import CollisionWorld
 from mrgc.geometry.conventions import refine, to_se2
-from mrgc.geometry.grounding import BUSY, SELF, Answer, Grounder, GroundStatus, Volume
+from mrgc.geometry.grounding import BUSY, PHASES, SELF, Answer, Grounder, GroundStatus, Stance, Volume
 from mrgc.geometry.relays import spot_region
 from mrgc.language.model import Box
 from mrgc.planner.outcome import DeadlineReached, Failure
@@ -40,8 +42,9 @@ OUT_OF_REACH_TRIES = 30
 PARKING_REGIONS = 2
 RELAY_TRIES = 3  # spots tried per relay (the k-th spot both of its robots reach at the k-th try)
 #: paths replayed in another path's phase (the validator's execution model): name -> phase
-PATH_PHASE = {"taker-to-handover": "to-handover", "giver-home": "home"}
-#: each robot's volume at every sample of every phase of its motions: robot -> phase -> volumes
+PATH_PHASE = {"taker-to-handover": "to-handover"}
+#: each robot's volume at every sample of every phase of its motions (one volume for a phase it stands still
+#: in, away from home): robot -> phase -> volumes
 Motions = dict[str, dict[str, list[Volume]]]
 
 
@@ -257,12 +260,18 @@ class ReverseGrounder:
     def _step(
         self, step: tuple[Action, ...], avoid: set[str], same: set[str], v_fut: Volume, key: str, index: int = 0
     ) -> GroundedStep | Failure:
-        # the step's arms are not at home while they pick, place or are in transit (the validator's model)
-        self.g.step([a.pick_robot for a in step], [a.place_robot for a in step])
+        # where each robot of the step is in each phase follows from its role (the execution model)
+        roles: dict[str, str] = {}
+        for a in step:
+            if a.pick_robot == a.place_robot:
+                roles[a.pick_robot] = "pick-place"
+            else:
+                roles[a.pick_robot], roles[a.place_robot] = "giver", "taker"
+        self.g.step(roles, self.full)
         try:
             return self._actions(step, avoid, same, v_fut, key, index)
         finally:
-            self.g.step((), ())
+            self.g.step({})
 
     def _actions(
         self, step: tuple[Action, ...], avoid: set[str], same: set[str], v_fut: Volume, key: str, index: int
@@ -274,19 +283,21 @@ class ReverseGrounder:
         for a in step:
             self._on_time()
             avoid_a = sorted((avoid | same) - {a.obj})
-            # what the other robots of the step sweep in each phase: this action's motions keep clear of it
+            # what the other robots of the step sweep or occupy in each phase: this action keeps clear of it
             busy = _swept_by_others(motions, (a.pick_robot, a.place_robot))
             action = self._action(a, avoid_a, v_fut + step_volume, f"{key}:{a.obj}", placed, busy)
             if isinstance(action, Failure):
                 return replace(action, step=index, action=label(a))
-            mine = self._motions(action)
+            moves = self._motions(action)
+            mine = _joined(moves, self._stood(action))
             clash = _robots_collide(mine, motions)
             if clash:
                 phase, robots = clash
                 return Failure(index, label(a), f"{phase}: robots of the step collide", robots)
             for robot, phases in mine.items():
                 motions.setdefault(robot, {}).update(phases)
-            for phases in mine.values():  # the step's volume is every sample of every motion
+            # the step's volume is every sample of every motion (where a robot stands still is the end of one)
+            for phases in moves.values():
                 for samples in phases.values():
                     for vol in samples:
                         step_volume.extend(vol)
@@ -321,25 +332,67 @@ class ReverseGrounder:
                 g.arm_volume(action.place_robot, taker[None], (obj, action.place_grasp))
             ]
         # the paths (every configuration: they are already at the validator's resolution); holding the
-        # object on the transfers, empty-handed (fingers fully open) otherwise
-        for phase, robot, grasp in (
-            ("to-handover", action.pick_robot, action.pick_grasp),
-            ("to-place", action.place_robot, action.place_grasp),
-            ("to-pick", action.pick_robot, None),
-            ("taker-to-handover", action.place_robot, None),
-            ("home", action.place_robot, None),
-            ("giver-home", action.pick_robot, None),
+        # object on the transfers, empty-handed otherwise (fingers fully open, a giver's as it let go)
+        for phase, robot, grasp, holds in (
+            ("to-handover", action.pick_robot, action.pick_grasp, True),
+            ("to-place", action.place_robot, action.place_grasp, True),
+            ("to-pick", action.pick_robot, None, False),
+            ("taker-to-handover", action.place_robot, None, False),
+            ("home", action.place_robot, None, False),
+            ("giver-home", action.pick_robot, action.pick_grasp, False),
         ):
             if phase in action.paths:
-                held = (obj, grasp) if grasp is not None else None
+                grip = (obj, grasp) if grasp is not None else None
                 out.setdefault(robot, {})[PATH_PHASE.get(phase, phase)] = [
-                    g.arm_volume(robot, np.array(q)[None], holding=held) for q in action.paths[phase]
+                    g.arm_volume(robot, np.array(q)[None], holding=grip if holds else None, grasp=grip)
+                    for q in action.paths[phase]
                 ]
         out.setdefault(action.place_robot, {})["place"] = [
             g.arm_volume(action.place_robot, q[None], (obj, action.place_grasp))
             for q in refine(np.array(action.configs["place"]))
         ]
         return out
+
+    def _standing(self, action: PlannedAction, robot: str) -> dict[Stance, Volume]:
+        """Where ``robot`` of ``action`` stands still away from home during the step (the stances
+        :meth:`Grounder.stance <mrgc.geometry.grounding.Grounder.stance>` gives it), as far as ``action`` is
+        grounded: at its last pick configuration holding the object, at its exchange (a giver having let go, a
+        taker holding the object), at its last place configuration with the object released; fingers at the
+        grasp's opening."""
+        c, obj = action.configs, action.object
+        takes = {self.g.stance(robot, phase) for phase in PHASES}
+        out: dict[Stance, Volume] = {}
+        if Stance.PICKED in takes and c.get("pick"):
+            out[Stance.PICKED] = self._volume_at(robot, c["pick"][-1], (obj, action.pick_grasp), True)
+        if Stance.EXCHANGE in takes and c.get("handover"):
+            out[Stance.EXCHANGE] = self._volume_at(robot, c["handover"][0], (obj, action.pick_grasp), False)
+        if Stance.RECEIVED in takes and c.get("handover"):
+            out[Stance.RECEIVED] = self._volume_at(robot, c["handover"][1], (obj, action.place_grasp), True)
+        if Stance.PLACED in takes and c.get("place"):
+            out[Stance.PLACED] = self._volume_at(robot, c["place"][-1], (obj, action.place_grasp), False)
+        return out
+
+    def _volume_at(self, robot: str, q: list[float], grip: tuple[str, str], held: bool) -> Volume:
+        """``robot`` at configuration (or base pose) ``q``, holding ``grip`` (object, grasp) or, with its
+        fingers at the grasp's opening, not."""
+        if self.g.is_planar(robot):
+            return self.g.base_volume(robot, [np.array(q)], grip if held else None)
+        return self.g.arm_volume(robot, np.array(q)[None], holding=grip if held else None, grasp=grip)
+
+    def _stood(self, action: PlannedAction) -> Motions:
+        """Each robot of a planned action standing still away from home: one volume per phase it stands in."""
+        out: Motions = {}
+        for robot in action.robots():
+            where = self._standing(action, robot)
+            for phase in PHASES:
+                if self.g.stance(robot, phase) in where:
+                    out.setdefault(robot, {})[phase] = [where[self.g.stance(robot, phase)]]
+        return out
+
+    def _after(self, busy: dict[str, Volume], robot: str, where: Stance) -> Volume:
+        """What the step's other robots do (``busy``) in the phases ``robot`` stands still ``where``: its
+        configuration there keeps clear of it."""
+        return [p for phase in PHASES if self.g.stance(robot, phase) is where for p in busy.get(phase, [])]
 
     def _on_time(self) -> None:
         """Raise :class:`DeadlineReached` when the search's time limit has passed."""
@@ -358,7 +411,8 @@ class ReverseGrounder:
         if self.g.is_planar(a.pick_robot):
             return self._drive(a, avoid, v_fut, key, placed or {}, busy or {})
         g, busy = self.g, busy or {}
-        pick = g.pick(a.pick_robot, a.obj, a.pick_grasp, avoid=avoid, busy=busy.get("pick", []))
+        after = self._after(busy, a.pick_robot, Stance.PICKED)
+        pick = g.pick(a.pick_robot, a.obj, a.pick_grasp, avoid=avoid, busy=busy.get("pick", []), after=after)
         if not pick.ok:
             return _failed(f"pick by {a.pick_robot}", pick)
         planned = PlannedAction(a.obj, a.region, a.pick_robot, a.place_robot, a.pick_grasp, a.place_grasp)
@@ -370,15 +424,20 @@ class ReverseGrounder:
             if isinstance(exchange, Failure):
                 return exchange
             start, lift = exchange, False  # the taker's transfer starts at the exchange
-        done = self._place(a, planned, a.region, start, lift, avoid, v_fut, key, placed, busy)
-        if not isinstance(done, Failure) or a.obj in self.goal or a.obj in self._forced:
-            return done
-        # beyond the paper: an obstacle with no place in its own region that its arm reaches (a crowded start
-        # region, the later steps' sweeps kept clear) is parked in another region the arm reaches
-        for region in self._parking(a):
-            parked = self._place(a, planned, region, start, lift, avoid, v_fut, f"{key}:park", placed, busy)
-            if not isinstance(parked, Failure):
-                return parked
+        with ExitStack() as stack:
+            # a handover's two arms stand where its grounded configurations put them, each an obstacle to the
+            # other (the taker at its exchange holding the object while the giver withdraws)
+            for robot in planned.robots() if a.handover else ():
+                stack.enter_context(g.standing(robot, self._standing(planned, robot)))
+            done = self._place(a, planned, a.region, start, lift, avoid, v_fut, key, placed, busy)
+            if not isinstance(done, Failure) or a.obj in self.goal or a.obj in self._forced:
+                return done
+            # beyond the paper: an obstacle with no place in its own region that its arm reaches (a crowded
+            # start region, the later steps' sweeps kept clear) is parked in another region the arm reaches
+            for region in self._parking(a):
+                parked = self._place(a, planned, region, start, lift, avoid, v_fut, f"{key}:park", placed, busy)
+                if not isinstance(parked, Failure):
+                    return parked
         return done
 
     def _parking(self, a: Action) -> list[str]:
@@ -436,7 +495,15 @@ class ReverseGrounder:
             if spot in self._dead_spots:
                 continue  # failed before on what never moves: fails again, and costs no try
             looked += 1
-            place = g.place(a.place_robot, a.obj, a.place_grasp, pose, avoid=avoid, busy=busy.get("place", []))
+            place = g.place(
+                a.place_robot,
+                a.obj,
+                a.place_grasp,
+                pose,
+                avoid=avoid,
+                busy=busy.get("place", []),
+                after=self._after(busy, a.place_robot, Stance.PLACED),
+            )
             if not place.ok:
                 last = _failed(f"place by {a.place_robot}", place)
                 tried += place.status is not GroundStatus.NO_IK
@@ -454,8 +521,8 @@ class ReverseGrounder:
                 avoid,
                 lift=lift,
                 busy=busy.get("to-place", []),
-                partner=a.pick_robot if a.pick_robot != a.place_robot else None,
                 lower=True,
+                phase="to-place",
             )
             if not carry.ok:
                 last = _failed(f"carry to the placement by {a.place_robot}", carry)
@@ -496,13 +563,26 @@ class ReverseGrounder:
             return None
         return Failure(0, "", f"placement: leaves no free pose of {crowded} in {planned.region}")
 
+    def _let_go(self, action: PlannedAction) -> np.ndarray:
+        """How a handover's giver backs off the object it lets go at the exchange (the taker holds it there,
+        between the giver's fingers at the grasp's opening): along its approach axis, back (world; the tool's
+        -z), as a home path backs off along the place approach."""
+        tool = self.g.arm(action.pick_robot).tool_world(np.array(action.configs["handover"][0])[None])[0]
+        back: np.ndarray = -tool[:3, 2]
+        return back
+
     def _hand_over(
         self, a: Action, planned: PlannedAction, grasped: np.ndarray, avoid: list[str], busy: dict[str, Volume]
     ) -> np.ndarray | Failure:
         """A handover action's exchange (both arms at a handover point) and the giver's carry there from
         ``grasped`` (its pick configuration), into ``planned``; the taker's configuration at the exchange."""
         g = self.g
-        hand = self._handover(a, avoid, busy.get("handover", []))
+        # each arm then stands at its exchange while the step's other robots do what ``after`` holds
+        after = {
+            a.pick_robot: self._after(busy, a.pick_robot, Stance.EXCHANGE),
+            a.place_robot: self._after(busy, a.place_robot, Stance.RECEIVED),
+        }
+        hand = self._handover(a, avoid, busy.get("handover", []), after)
         if isinstance(hand, Failure):
             return hand
         point, answer = hand
@@ -518,7 +598,7 @@ class ReverseGrounder:
             avoid,
             lift=True,
             busy=busy.get("to-handover", []),
-            partner=a.place_robot,
+            phase="to-handover",
         )
         if not giver.ok:
             return _failed(f"carry to the handover by {a.pick_robot}", giver)
@@ -530,20 +610,22 @@ class ReverseGrounder:
         self, a: Action, planned: PlannedAction, avoid: list[str], busy: dict[str, Volume], new: dict[str, np.ndarray]
     ) -> None | Failure:
         """An arm action's empty-handed motions (``full``), into ``planned.paths``: home to the pre-grasp
-        (the object to pick in the way too), the taker home to the exchange; then, with every object of the
-        step at its new pose (``new``, the validator's home phase), back off along the place approach and go
-        home, and the giver home from the exchange."""
+        (the object to pick in the way too), the taker home to the exchange, the giver home from the exchange
+        (letting go: its fingers at the grasp's opening back off along its approach axis first, the taker
+        standing there holding the object); then, with every object of the step at its new pose (``new``, the
+        validator's home phase), back off along the place approach and go home."""
         g = self.g
         pick, place = np.array(planned.configs["pick"]), np.array(planned.configs["place"])
-        asks: list[tuple[str, str, np.ndarray, np.ndarray, list[str], np.ndarray | None]] = [
-            ("to-pick", a.pick_robot, g.arm(a.pick_robot).home, pick[0], [*avoid, a.obj], None)
+        asks: list[tuple[str, str, np.ndarray, np.ndarray, list[str], dict[str, Any]]] = [
+            ("to-pick", a.pick_robot, g.arm(a.pick_robot).home, pick[0], [*avoid, a.obj], {})
         ]
-        after = sorted({*avoid, *new})
         if a.handover:
             giver, taker = np.array(planned.configs["handover"])
-            asks.append(("taker-to-handover", a.place_robot, g.arm(a.place_robot).home, taker, avoid, None))
-            asks.append(("giver-home", a.pick_robot, giver, g.arm(a.pick_robot).home, after, None))
-        asks.append(("home", a.place_robot, place[-1], g.arm(a.place_robot).home, after, place[::-1]))
+            asks.append(("taker-to-handover", a.place_robot, g.arm(a.place_robot).home, taker, avoid, {}))
+            let_go = {"fingers": (a.obj, a.pick_grasp), "retreat": self._let_go(planned)}
+            asks.append(("giver-home", a.pick_robot, giver, g.arm(a.pick_robot).home, avoid, let_go))
+        after = sorted({*avoid, *new})
+        asks.append(("home", a.place_robot, place[-1], g.arm(a.place_robot).home, after, {"via": place[::-1]}))
         # the giver's motions share the validator's phases with the taker's: each keeps clear of the other's
         mine: dict[str, Volume] = {}
         if "to-handover" in planned.paths:
@@ -552,26 +634,24 @@ class ReverseGrounder:
             )
         home = False
         with ExitStack() as stack:
-            for name, robot, start, goal, obstacles, via in asks:
+            for name, robot, start, goal, obstacles, how in asks:
                 phase = PATH_PHASE.get(name, name)
-                if phase == "home" and not home:  # the home phases come last: the step's objects placed
+                if phase == "home" and not home:  # the home phase comes last: the step's objects placed
                     stack.enter_context(g.moved(new))
                     home = True
-                other = ({a.pick_robot, a.place_robot} - {robot}) if phase != "to-pick" else set()
                 ans = g.transit(
                     robot,
                     start,
                     goal,
                     avoid=obstacles,
                     busy=busy.get(phase, []) + mine.get(phase, []),
-                    via=via,
-                    partner=next(iter(other), None),
                     phase=phase,
+                    **how,
                 )
                 if not ans.ok:
                     return _failed(f"{name} of {robot}", ans)
                 planned.paths[name] = _configs(np.array(ans.path))
-                mine.setdefault(phase, []).extend(g.arm_volume(robot, np.array(ans.path)))
+                mine.setdefault(phase, []).extend(g.arm_volume(robot, np.array(ans.path), grasp=how.get("fingers")))
         return None
 
     def _drive(
@@ -633,13 +713,23 @@ class ReverseGrounder:
         assert last is not None
         return last
 
-    def _handover(self, a: Action, avoid: list[str], busy: Volume) -> tuple[str, Answer] | Failure:
+    def _handover(
+        self, a: Action, avoid: list[str], busy: Volume, after: dict[str, Volume]
+    ) -> tuple[str, Answer] | Failure:
         failure = Failure(0, "", f"handover: no handover point usable for {a.obj}")
         for point in self.g.scene.handover_of.get(a.obj, ()):
             if point not in self.g.scene.handover_points:
                 continue
             ans = self.g.handover(
-                a.obj, point, a.pick_robot, a.pick_grasp, a.place_robot, a.place_grasp, avoid=avoid, busy=busy
+                a.obj,
+                point,
+                a.pick_robot,
+                a.pick_grasp,
+                a.place_robot,
+                a.place_grasp,
+                avoid=avoid,
+                busy=busy,
+                after=after,
             )
             if ans.ok:
                 return point, ans
@@ -690,6 +780,15 @@ def _swept_by_others(motions: Motions, robots: tuple[str, ...]) -> dict[str, Vol
     return busy
 
 
+def _joined(moves: Motions, stood: Motions) -> Motions:
+    """An action's motions with the phases its robots stand still in (where they make no motion)."""
+    out = {robot: dict(phases) for robot, phases in moves.items()}
+    for robot, phases in stood.items():
+        for phase, volumes in phases.items():
+            out.setdefault(robot, {}).setdefault(phase, volumes)
+    return out
+
+
 def _robots_collide(mine: Motions, motions: Motions) -> tuple[str, tuple[str, ...]] | None:
     """Robots of one step move at once: phase by phase (pick, handover, place; drives), samples paired by
     index as the validator replays them, they must not collide with each other.  The first phase where a
@@ -709,6 +808,11 @@ def _phases_collide(mine: dict[str, list[Volume]], theirs: dict[str, list[Volume
     for phase, samples in mine.items():
         other = theirs.get(phase)
         if not other:
+            continue
+        if len(samples) == 1 or len(other) == 1:  # one stands still: against every sample of the other at once
+            still, moves = (samples, other) if len(samples) == 1 else (other, samples)
+            if _volumes_collide([p for vol in moves for p in vol], still[0]):
+                return phase
             continue
         n = max(len(samples), len(other))
         for i in range(n):

@@ -12,9 +12,9 @@ import mrgc
 from mrgc import parse_file
 from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action
-from mrgc.geometry.collision import CollisionShape
+from mrgc.geometry.collision import CollisionShape, CollisionWorld
 from mrgc.geometry.conventions import to_se2
-from mrgc.geometry.grounding import PATH_RESOLUTION, Grounder, GroundStatus, joint_line
+from mrgc.geometry.grounding import PATH_RESOLUTION, PHASES, Grounder, GroundStatus, Stance, joint_line, stance
 from mrgc.geometry.scene import inside, scene_from_problem
 from mrgc.geometry.transforms import translation
 from mrgc.planner.ground import Outcome, ReverseGrounder
@@ -287,11 +287,11 @@ def test_other_arms_bases_are_obstacles_home_or_not(pa3: Grounder) -> None:
     hull = pa3.arm("r2").base_hull
     assert hull is not None
     probe = [hull]
-    for pickers in ((), ("r2",)):  # r2 at home, then r2 picking in the step (its home links gone)
-        pa3.step(pickers, pickers)
-        assert pa3.world.probe_hits(probe, against=pa3._others_home("r1", phase="pick")) >= {"@r2:base"}
-        assert "@r2:base" not in pa3.world.probe_hits(probe, against=pa3._others_home("r2", phase="pick"))
-    pa3.step((), ())
+    for roles in ({}, {"r2": "pick-place"}):  # r2 at home, then r2 picking in the step (its home links gone)
+        pa3.step(roles)
+        assert pa3.world.probe_hits(probe, against=pa3._others("r1", phase="pick")) >= {"@r2:base"}
+        assert "@r2:base" not in pa3.world.probe_hits(probe, against=pa3._others("r2", phase="pick"))
+    pa3.step({})
 
 
 def test_an_obstacle_with_no_reachable_place_in_its_region_is_parked_in_another() -> None:
@@ -323,3 +323,71 @@ def test_failures_say_whether_only_what_never_moves_explains_them(pa3: Grounder)
     assert pa3.place("r2", "o1", "top", pa3.poses["o1"]).static  # out of r2's reach: no IK
     blocked = pa3.place("r1", "o1", "side-x+", pa3.poses["o1"], avoid=["o2"])
     assert blocked.status is GroundStatus.COLLISION and "o2" in blocked.blockers and not blocked.static
+
+
+def test_the_grounder_knows_where_each_arm_of_the_step_is_in_each_phase(pa3: Grounder) -> None:
+    """The execution model a plan means (docs/validator.md, planner/replay.py), as the grounding reads it:
+    between its own motions an arm stands where its last motion left it; a missing transit (no path under
+    the ``configurations`` model) is a jump at the end of its phase."""
+    assert stance("pick-place", "to-handover") is stance("pick-place", "giver-home") is Stance.PICKED
+    assert stance("taker", "to-handover") is Stance.HOME and stance("taker", "to-handover", full=True) is Stance.MOVES
+    assert stance("taker", "giver-home") is Stance.RECEIVED and stance("giver", "giver-home") is Stance.EXCHANGE
+    assert stance("giver", "giver-home", full=True) is Stance.MOVES
+    assert [stance("giver", p) for p in PHASES[PHASES.index("to-place") :]] == [Stance.HOME] * 3
+    pa3.step({"r1": "giver", "r2": "taker"})
+    try:
+        # the taker waits at home while the giver picks and carries the object to the exchange; the giver is
+        # home again while the taker carries the object on and places it
+        assert "home:r2" in pa3._others("r1", "pick") and "home:r2" in pa3._others("r1", "to-handover")
+        assert "home:r1" in pa3._others("r2", "to-place") and "home:r1" in pa3._others("r2", "place")
+        # the taker stands at its exchange holding the object while the giver withdraws: an obstacle to it
+        # once the grounding knows that configuration, and not at home
+        assert "home:r2" not in pa3._others("r1", "giver-home")
+        hand = pa3.handover("o1", "h1", "r1", "top", "r2", "side-x+")
+        assert hand.ok and hand.configs is not None
+        taker = pa3.arm_volume("r2", hand.configs[1:], holding=("o1", "side-x+"))
+        with pa3.standing("r2", {Stance.RECEIVED: taker}):
+            assert "stand:r2:RECEIVED" in pa3._others("r1", "giver-home")
+            assert "stand:r2:RECEIVED" not in pa3._others("r1", "handover")  # it moves there then (busy)
+        assert "stand:r2:RECEIVED" not in pa3._others("r1", "giver-home")  # gone after the block
+        pa3.step({"r1": "giver", "r2": "taker"}, full=True)
+        assert "home:r2" not in pa3._others("r1", "to-handover")  # on its taker-to-handover path: busy
+    finally:
+        pa3.step({})
+    assert "home:r1" in pa3._others("r2", "handover")  # no step: every other arm at home
+
+
+def test_a_giver_lets_go_backing_its_fingers_off_the_object_the_taker_holds(pa3: Grounder) -> None:
+    """The taker stands at its exchange holding the object while the giver withdraws home, the giver's
+    fingers at the grasp's opening (the validator's giver-home phase): the giver's path first backs straight
+    off along its approach axis, and clear of the taker standing there and the object it holds, with the
+    fingers as the validator replays them (fully open fingers are another volume)."""
+    pa3.step({"r1": "giver", "r2": "taker"}, full=True)
+    try:
+        hand = pa3.handover("o1", "h1", "r1", "top", "r2", "side-x+")
+        assert hand.ok and hand.configs is not None
+        taker = pa3.arm_volume("r2", hand.configs[1:], holding=("o1", "side-x+"))
+        axis = pa3.arm("r1").tool_world(hand.configs[:1])[0][:3, 2]
+        with pa3.standing("r2", {Stance.RECEIVED: taker}):
+            home = pa3.transit(
+                "r1",
+                hand.configs[0],
+                pa3.arm("r1").home,
+                phase="giver-home",
+                fingers=("o1", "top"),
+                retreat=-axis,
+            )
+    finally:
+        pa3.step({})
+    assert home.ok
+    path = np.array(home.path)
+    assert np.allclose(path[0], hand.configs[0]) and np.allclose(path[-1], pa3.arm("r1").home)
+    tools = pa3.arm("r1").tool_world(path)[:, :3, 3]
+    back = (tools - tools[0]) @ -axis
+    out = next(i for i, d in enumerate(back) if d >= 0.05 - 1e-4)  # 5 cm back along its approach axis
+    sideways = (tools[: out + 1] - tools[0]) - back[: out + 1, None] * -axis
+    assert np.linalg.norm(sideways, axis=1).max() < 2e-3  # straight back
+    world = CollisionWorld()
+    for i, (shape, t) in enumerate(taker):
+        world.add(f"taker{i}", shape, t, "taker")
+    assert not world.probe_collides(pa3.arm_volume("r1", path, grasp=("o1", "top")), against="taker")

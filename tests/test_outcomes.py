@@ -8,9 +8,10 @@ import re
 import signal
 import subprocess
 import sys
+from contextlib import contextmanager
 from pathlib import Path
 from types import SimpleNamespace
-from typing import Any
+from typing import Any, Iterator
 
 import numpy as np
 import pytest
@@ -19,7 +20,7 @@ from support import ROOT, run_cli
 from mrgc import __version__, cli, parse_file
 from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action
-from mrgc.geometry.grounding import BUSY, Answer, GroundStatus
+from mrgc.geometry.grounding import BUSY, Answer, GroundStatus, Stance
 from mrgc.planner.ground import GroundedStep, Outcome, ReverseGrounder
 from mrgc.planner.outcome import EXIT_CODES, PlanStatus
 from mrgc.planner.plan import PlannedAction, file_sha256
@@ -222,15 +223,22 @@ class ScriptedGrounder:
         self.blocked_by, self.sweeps = blocked_by, sweeps
         self.crowded = crowded  # objects whose pick collides with whatever another robot of the step sweeps
         self.poses = {m: np.eye(4) for m in movable}
-        self.steps: list[tuple[list[str], list[str]]] = []
+        self.steps: list[list[str]] = []
 
     def is_planar(self, robot: str) -> bool:
         return False
 
-    def step(self, pickers: Any, placers: Any) -> None:
-        self.steps.append((list(pickers), list(placers)))  # the script has no arms at home: only recorded
+    def step(self, roles: Any, full: bool = False) -> None:
+        self.steps.append(sorted(roles))  # the script has no arms at home: only the step's robots are recorded
 
-    def pick(self, robot: str, obj: str, grasp: str, avoid: Any = (), busy: Any = ()) -> Answer:
+    def stance(self, robot: str, phase: str) -> Stance:
+        return Stance.HOME  # the script's arms never stand anywhere else (nothing to keep clear of)
+
+    @contextmanager
+    def standing(self, robot: str, where: Any) -> Iterator[None]:
+        yield
+
+    def pick(self, robot: str, obj: str, grasp: str, avoid: Any = (), busy: Any = (), after: Any = ()) -> Answer:
         hit = self.blocked_by.get(obj, set()) & set(avoid)
         if hit:
             return Answer(GroundStatus.COLLISION, blockers=hit)
@@ -238,7 +246,9 @@ class ScriptedGrounder:
             return Answer(GroundStatus.COLLISION, detail=BUSY)
         return Answer(GroundStatus.OK, configs=np.array([[0.0], [1.0]]))
 
-    def place(self, robot: str, obj: str, grasp: str, pose: np.ndarray, avoid: Any = (), busy: Any = ()) -> Answer:
+    def place(
+        self, robot: str, obj: str, grasp: str, pose: np.ndarray, avoid: Any = (), busy: Any = (), after: Any = ()
+    ) -> Answer:
         return Answer(GroundStatus.OK, configs=np.array([[1.0], [0.0]]))
 
     def transfer(
@@ -253,6 +263,7 @@ class ScriptedGrounder:
         busy: Any = (),
         partner: Any = None,
         lower: bool = False,
+        **where: Any,  # the phase and what stands in it: the script's paths are free anyway
     ) -> Answer:
         return Answer(GroundStatus.OK, path=[np.asarray(start), np.asarray(goal)])
 
@@ -331,9 +342,9 @@ def test_a_step_whose_robots_collide_is_split() -> None:
     assert result.outcome is Outcome.SUCCESS
     assert [s.moved for s in result.steps] == [("a",), ("b",)]
     assert [a.object for s in result.steps for a in s.actions] == ["a", "b"]
-    assert grounder.steps[0] == (["r1", "r2"], ["r1", "r2"])  # the whole step first
-    assert (["r2"], ["r2"]) in grounder.steps and (["r1"], ["r1"]) in grounder.steps
-    assert grounder.steps[-1] == ([], [])  # forgotten after each step
+    assert grounder.steps[0] == ["r1", "r2"]  # the whole step first
+    assert ["r2"] in grounder.steps and ["r1"] in grounder.steps
+    assert grounder.steps[-1] == []  # forgotten after each step
 
 
 def test_a_step_is_not_split_for_other_failures(monkeypatch: pytest.MonkeyPatch) -> None:

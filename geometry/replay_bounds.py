@@ -32,6 +32,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from mrgc.geometry.bullet import pose_of
+
 if TYPE_CHECKING:
     from mrgc.geometry.replay_world import ReplayScene
 
@@ -200,7 +202,7 @@ def _radii(rs: ReplayScene, robot: str, links: tuple[int, ...], home: np.ndarray
         for link in links:
             box = np.array(pb.getAABB(r.body, link, physicsClientId=cid))
             corners = np.array([[box[i][0], box[j][1], box[m][2]] for i in (0, 1) for j in (0, 1) for m in (0, 1)])
-            frame = _link_frame(rs, r, link)
+            frame = _frame(rs, r, link)[:3, 3]
             best[link] = min(best[link], float(np.linalg.norm(corners - frame, axis=1).max()))
     rs.set_config(robot, home)
     return best
@@ -211,16 +213,7 @@ def _frame(rs: ReplayScene, r: Any, link: int) -> np.ndarray:
     if link == -1:
         return np.asarray(r.base, dtype=float)
     st = rs.pb.getLinkState(r.body, link, physicsClientId=rs.cid)
-    from mrgc.geometry.bullet import pose_of
-
     return pose_of(st[4], st[5])
-
-
-def _link_frame(rs: ReplayScene, r: Any, link: int) -> np.ndarray:
-    """The world position of a link's frame origin (the base link's: the robot's base pose)."""
-    if link == -1:
-        return np.asarray(r.base[:3, 3], dtype=float)
-    return np.array(rs.pb.getLinkState(r.body, link, physicsClientId=rs.cid)[4])
 
 
 def planar_radius(points: np.ndarray) -> float:

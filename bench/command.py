@@ -56,6 +56,13 @@ def add_bench_parser(sub: Any) -> None:
         help="markdown (default): a row per instance set and method; wide: the paper's layout; "
         "csv: the same numbers; runs: every run as CSV",
     )
+    q.add_argument(
+        "--time",
+        choices=["wall", "cpu"],
+        default="wall",
+        help="wall (default): the planning time each plan reports; cpu: CPU seconds of the planner's process "
+        "and its workers (compare these on a shared machine)",
+    )
     q.add_argument("--figures", default=None, metavar="DIR", help="also write PNG figures here (matplotlib)")
     q.add_argument(
         "--planner-arena",
@@ -127,11 +134,11 @@ def cmd_report(args: argparse.Namespace) -> int:
                     )
                 ]
             )
-        sys.stdout.write(render(db, args.format, args.study))
+        sys.stdout.write(render(db, args.format, args.study, args.time))
         if args.figures:
             from mrgc.bench.figures import write_figures
 
-            for path in write_figures(db, args.figures, args.study):
+            for path in write_figures(db, args.figures, args.study, args.time):
                 print(f"figure written: {path}", file=sys.stderr)
         if args.planner_arena:
             from mrgc.bench.arena import export_planner_arena

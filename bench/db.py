@@ -1,6 +1,8 @@
 """The results database: SQLite, one row per finished run, committed per run (WAL journal).
 
-Tables (schema version :data:`SCHEMA_VERSION` in ``PRAGMA user_version``):
+Tables (schema version :data:`SCHEMA_VERSION` in ``PRAGMA user_version``; a database of an older schema is
+upgraded in place when ``bench run`` opens it — columns added since read as NULL — and read as it is by
+reports):
 
 - ``runs``: one row per finished run, the columns of :class:`~mrgc.bench.outcome.RunResult`; unique on
   the run key ``(study, instance_sha256, method, seed)``.  A run is written when it finishes, in its own
@@ -25,7 +27,8 @@ from typing import Any, Iterator
 from mrgc.bench.outcome import RunResult
 from mrgc.errors import Diagnostic, InputError
 
-SCHEMA_VERSION = 1
+#: 2 added ``cpu_seconds``
+SCHEMA_VERSION = 2
 #: diagnostic code: the results database cannot be used
 E_DB = "E603"
 
@@ -47,6 +50,7 @@ _COLUMNS: list[tuple[str, str]] = [
     ("planning_seconds", "REAL"),
     ("facts_seconds", "REAL"),
     ("wall_seconds", "REAL"),
+    ("cpu_seconds", "REAL"),
     ("validate_seconds", "REAL"),
     ("peak_mb", "REAL"),
     ("makespan", "INTEGER"),
@@ -112,11 +116,19 @@ class ResultsDB:
             self.conn.execute("PRAGMA journal_mode = WAL")
             self.conn.execute("PRAGMA synchronous = NORMAL")
             self.conn.executescript(_SCHEMA)
+            for name, kind in _COLUMNS:  # an older schema: add the columns it lacks
+                if name not in self._present():
+                    self.conn.execute(f"ALTER TABLE runs ADD COLUMN {name} {kind.replace(' NOT NULL', '')}")
             self.conn.execute(f"PRAGMA user_version = {SCHEMA_VERSION}")
             self.conn.commit()
         elif not tables:
             self.conn.close()
             raise InputError([Diagnostic(E_DB, f"'{path}' holds no results")])
+        self.present = self._present()
+
+    def _present(self) -> set[str]:
+        """The columns the ``runs`` table has."""
+        return {r[1] for r in self.conn.execute("PRAGMA table_info(runs)")}
 
     def close(self) -> None:
         """Close the connection."""
@@ -197,9 +209,9 @@ class ResultsDB:
     def runs(self, study: str | None = None) -> Iterator[dict[str, Any]]:
         """The recorded runs (all studies, or one) in a stable order."""
         where, args = ("WHERE study = ?", (study,)) if study is not None else ("", ())
+        columns = ", ".join(c if c in self.present else f"NULL AS {c}" for c in COLUMNS)
         for r in self.conn.execute(
-            f"SELECT {', '.join(COLUMNS)} FROM runs {where} ORDER BY study, set_index, "
-            "instance, method_index, method, seed",
+            f"SELECT {columns} FROM runs {where} ORDER BY study, set_index, instance, method_index, method, seed",
             args,
         ):
             yield dict(r)
@@ -215,7 +227,11 @@ class ResultsDB:
 
 
 class WriterLock:
-    """The one-writer lock of a database (``DB.lock``, an flock): E603 if another ``bench run`` holds it."""
+    """The one-writer lock of a database (``DB.lock``, an flock): E603 if another ``bench run`` holds it.
+
+    The lock file exists only while a writer holds it: the holder removes it before letting go.  A process
+    that opened the file just before it was removed would lock a file nobody else sees, so after locking it
+    checks that the path still names the file it locked, and starts again when it does not."""
 
     def __init__(self, db_path: str) -> None:
         self.path = db_path + ".lock"
@@ -224,21 +240,32 @@ class WriterLock:
     def __enter__(self) -> "WriterLock":
         import fcntl
 
-        try:
-            self.fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
-        except OSError as exc:
-            raise InputError(
-                [Diagnostic(E_DB, f"cannot write a results database at {self.path[:-5]}: {exc.strerror or exc}")]
-            ) from None
-        try:
-            fcntl.flock(self.fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            os.close(self.fd)
-            self.fd = None
-            raise InputError([Diagnostic(E_DB, f"another mrgc bench run is writing to {self.path[:-5]}")]) from None
-        return self
+        while True:
+            try:
+                fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
+            except OSError as exc:
+                raise InputError(
+                    [Diagnostic(E_DB, f"cannot write a results database at {self.path[:-5]}: {exc.strerror or exc}")]
+                ) from None
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                os.close(fd)
+                raise InputError([Diagnostic(E_DB, f"another mrgc bench run is writing to {self.path[:-5]}")]) from None
+            try:
+                same = os.stat(self.path).st_ino == os.fstat(fd).st_ino
+            except FileNotFoundError:
+                same = False
+            if same:
+                self.fd = fd
+                return self
+            os.close(fd)  # the holder before us removed the file we locked: lock the one the path names now
 
     def __exit__(self, *exc: object) -> None:
         if self.fd is not None:
+            try:
+                os.unlink(self.path)
+            except OSError:
+                pass
             os.close(self.fd)
             self.fd = None

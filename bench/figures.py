@@ -8,6 +8,8 @@ Per study, as PNG files in DIR:
   success rate, so a curve's end height is the method's success rate;
 - ``STUDY-cactus.png``: for each method, its solved runs' planning times in increasing order against
   how many runs are solved within that time (the SAT-competition "cactus" plot).
+
+Times are on the report's clock (``--time wall|cpu``, :data:`mrgc.bench.report.CLOCKS`).
 """
 
 from __future__ import annotations
@@ -16,11 +18,11 @@ import os
 from typing import Any
 
 from mrgc.bench.db import ResultsDB
-from mrgc.bench.report import aggregate
+from mrgc.bench.report import CLOCKS, aggregate
 
 
-def write_figures(db: ResultsDB, folder: str, study: str | None = None) -> list[str]:
-    """Write the figures of one study or of every study; the paths written."""
+def write_figures(db: ResultsDB, folder: str, study: str | None = None, clock: str = "wall") -> list[str]:
+    """Write the figures of one study or of every study, times on ``clock``; the paths written."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -32,21 +34,18 @@ def write_figures(db: ResultsDB, folder: str, study: str | None = None) -> list[
         runs = list(db.runs(name))
         if not runs:
             continue
-        rows = aggregate(runs)
+        rows = aggregate(runs, clock)
+        column, label = CLOCKS[clock]
         methods = list(dict.fromkeys(r.method for r in rows))
         sets = list(dict.fromkeys(r.instance_set for r in rows))
         written.append(_success(plt, name, rows, methods, sets, folder))
         times = {
-            m: sorted(
-                r["planning_seconds"]
-                for r in runs
-                if r["method"] == m and r["success"] and r["planning_seconds"] is not None
-            )
+            m: sorted(r[column] for r in runs if r["method"] == m and r["success"] and r[column] is not None)
             for m in methods
         }
         totals = {m: sum(1 for r in runs if r["method"] == m) for m in methods}
-        written.append(_ecdf(plt, name, times, totals, folder))
-        written.append(_cactus(plt, name, times, folder))
+        written.append(_ecdf(plt, name, times, totals, folder, label))
+        written.append(_cactus(plt, name, times, folder, label))
     return written
 
 
@@ -65,14 +64,14 @@ def _success(plt: Any, name: str, rows: list[Any], methods: list[str], sets: lis
     return _save(plt, fig, folder, f"{name}-success.png")
 
 
-def _ecdf(plt: Any, name: str, times: dict[str, list[float]], totals: dict[str, int], folder: str) -> str:
+def _ecdf(plt: Any, name: str, times: dict[str, list[float]], totals: dict[str, int], folder: str, label: str) -> str:
     fig, ax = plt.subplots(figsize=(5.5, 3.5))
     for m, ts in times.items():
         if ts:
             ys = [(i + 1) / totals[m] for i in range(len(ts))]
             ax.step([ts[0]] + ts, [0.0] + ys, where="post", label=m)
     ax.set_xscale("log")
-    ax.set_xlabel("planning time (s)")
+    ax.set_xlabel(label)
     ax.set_ylabel("fraction of runs solved")
     ax.set_ylim(0, 1.02)
     ax.set_title(f"{name}: solved within t")
@@ -80,14 +79,14 @@ def _ecdf(plt: Any, name: str, times: dict[str, list[float]], totals: dict[str, 
     return _save(plt, fig, folder, f"{name}-time-ecdf.png")
 
 
-def _cactus(plt: Any, name: str, times: dict[str, list[float]], folder: str) -> str:
+def _cactus(plt: Any, name: str, times: dict[str, list[float]], folder: str, label: str) -> str:
     fig, ax = plt.subplots(figsize=(5.5, 3.5))
     for m, ts in times.items():
         if ts:
             ax.plot(range(1, len(ts) + 1), ts, marker="o", markersize=3, label=m)
     ax.set_yscale("log")
     ax.set_xlabel("runs solved")
-    ax.set_ylabel("planning time (s)")
+    ax.set_ylabel(label)
     ax.set_title(f"{name}: cactus plot")
     ax.legend(fontsize="small")
     return _save(plt, fig, folder, f"{name}-cactus.png")

@@ -23,7 +23,9 @@ Measures (of the plan the planner returned; the report averages them over solved
 
 - **planning time**: the plan's ``stats.seconds`` (phase 1, skeletons, grounding and the planner's own
   validation: what ``mrgc plan`` reports); compile-only: ``stats.total_seconds`` (skeleton generation;
-  phase 1 is ``facts_seconds``, stored apart).  ``wall_seconds`` is the runner's clock for the process.
+  phase 1 is ``facts_seconds``, stored apart).  ``wall_seconds`` is the runner's clock for the process;
+  ``cpu_seconds`` the CPU time of the planner's process and its workers (start-up and the planner's own
+  validation included, the separate ``mrgc validate`` not): what ``bench report --time cpu`` shows.
 - **makespan**: the plan's number of steps; **objects moved**: its number of actions (the plan's
   ``motion_cost``, which is what the paper calls motion cost).
 - **path length**: the length of every motion the plan lists, summed over robots: each ``paths`` entry
@@ -94,6 +96,7 @@ class RunResult:
     facts_seconds: float | None
     wall_seconds: float
     validate_seconds: float | None
+    cpu_seconds: float | None
     peak_mb: float
     makespan: int | None
     objects_moved: int | None
@@ -168,6 +171,7 @@ def classify(raw: RawRun, method_index: int = 0, plan_file: str | None = None) -
         exit_code=proc.exit_code,
         signal=proc.signal,
         wall_seconds=round(proc.seconds, 3),
+        cpu_seconds=proc.cpu_seconds,
         validate_seconds=validate_seconds,
         peak_mb=round(max(proc.peak_mb, raw.validate.peak_mb if raw.validate else 0), 1),
         valid=valid,

@@ -7,6 +7,11 @@ mean (sample standard deviation / sqrt(n); no ± for a single run) of planning t
 (the paper's "motion cost") and path length (:mod:`mrgc.bench.outcome`).  A second table counts the
 outcomes, so that no failure is hidden behind a success rate; methods a study skipped are listed with
 their reason.  ``runs`` CSV gives every recorded run, every column.
+
+Time is one of two clocks (``--time``, :data:`CLOCKS`): ``wall`` (default), the planning time the plan
+reports (``planning_seconds``: wall-clock seconds of phase 1, search and the planner's own validation), or
+``cpu``, the CPU seconds of the planner's process and its workers (``cpu_seconds``: start-up included),
+which a study on a shared machine should compare, since others' load stretches wall time but not CPU time.
 """
 
 from __future__ import annotations
@@ -23,6 +28,8 @@ from mrgc.bench.outcome import RunStatus
 
 #: report formats of ``mrgc bench report --format``
 FORMATS = ("markdown", "wide", "csv", "runs")
+#: the clocks a report's time can be read on (module docstring): clock -> (runs column, table heading)
+CLOCKS = {"wall": ("planning_seconds", "planning time (s)"), "cpu": ("cpu_seconds", "CPU time (s)")}
 _DASH = "–"
 
 
@@ -81,8 +88,10 @@ class Row:
         return " + ".join(parts) if parts else _DASH
 
 
-def aggregate(runs: Iterable[dict[str, Any]]) -> list[Row]:
-    """Rows per (study, instance set, method) in the order of the runs (db.runs orders them)."""
+def aggregate(runs: Iterable[dict[str, Any]], clock: str = "wall") -> list[Row]:
+    """Rows per (study, instance set, method) in the order of the runs (db.runs orders them); time on
+    ``clock`` (:data:`CLOCKS`)."""
+    column = CLOCKS[clock][0]
     groups: dict[tuple[str, str, str], list[dict[str, Any]]] = {}
     order: dict[tuple[str, str, str], tuple[str, int, int]] = {}
     for r in runs:
@@ -99,7 +108,7 @@ def aggregate(runs: Iterable[dict[str, Any]]) -> list[Row]:
                 runs=len(rs),
                 solved=len(ok),
                 outcomes=Counter(r["status"] for r in rs),
-                time=Stat.of(r["planning_seconds"] for r in ok),
+                time=Stat.of(r[column] for r in ok),
                 makespan=Stat.of(r["makespan"] for r in ok),
                 moved=Stat.of(r["objects_moved"] for r in ok),
                 arm_path=Stat.of(r["arm_path"] for r in ok),
@@ -117,12 +126,12 @@ def _table(header: list[str], rows: list[list[str]], right: int) -> list[str]:
     return lines + ["| " + " | ".join(r) + " |" for r in rows]
 
 
-def markdown(db: ResultsDB, study: str | None = None) -> str:
+def markdown(db: ResultsDB, study: str | None = None, clock: str = "wall") -> str:
     """The Markdown report of one study or of every study in the database."""
     parts: list[str] = []
     for name in [study] if study is not None else db.studies():
         runs = list(db.runs(name))
-        rows = aggregate(runs)
+        rows = aggregate(runs, clock)
         parts.append(f"## Study {name}\n")
         if not runs:
             parts.append("No recorded runs.\n")
@@ -164,7 +173,7 @@ def markdown(db: ResultsDB, study: str | None = None) -> str:
                         "method",
                         "runs",
                         "success %",
-                        "planning time (s)",
+                        CLOCKS[clock][1],
                         "makespan",
                         "objects moved",
                         "path length",
@@ -184,18 +193,18 @@ def markdown(db: ResultsDB, study: str | None = None) -> str:
     return "\n".join(parts)
 
 
-def wide(db: ResultsDB, study: str | None = None) -> str:
+def wide(db: ResultsDB, study: str | None = None, clock: str = "wall") -> str:
     """The paper's layout (Table I): one row per instance set, each measure a group of columns with one
     column per method."""
     parts = []
     for name in [study] if study is not None else db.studies():
-        rows = aggregate(db.runs(name))
+        rows = aggregate(db.runs(name), clock)
         methods = list(dict.fromkeys(r.method for r in rows))
         sets = list(dict.fromkeys(r.instance_set for r in rows))
         cell = {(r.instance_set, r.method): r for r in rows}
         measures: list[tuple[str, Callable[[Row], str]]] = [
             ("success %", lambda r: f"{r.success:.1f}"),
-            ("time (s)", lambda r: r.time.text(2)),
+            ("time (s)" if clock == "wall" else "CPU (s)", lambda r: r.time.text(2)),
             ("makespan", lambda r: r.makespan.text(1)),
             ("moved", lambda r: r.moved.text(1)),
         ]
@@ -211,9 +220,9 @@ def _seeds(seeds: list[int]) -> str:
     return ", ".join(map(str, seeds))
 
 
-def csv_text(db: ResultsDB, study: str | None = None) -> str:
+def csv_text(db: ResultsDB, study: str | None = None, clock: str = "wall") -> str:
     """The aggregate table as CSV: one line per study, instance set and method; means and standard errors
-    in their own columns, then the count of each outcome."""
+    in their own columns (time on ``clock``), then the count of each outcome."""
     out = io.StringIO()
     w = csv.writer(out, lineterminator="\n")
     statuses = [s.value for s in RunStatus]
@@ -243,7 +252,7 @@ def csv_text(db: ResultsDB, study: str | None = None) -> str:
         return "" if x is None else f"{x:.6g}"
 
     for name in [study] if study is not None else db.studies():
-        for r in aggregate(db.runs(name)):
+        for r in aggregate(db.runs(name), clock):
             stats = [num(v) for s in (r.time, r.makespan, r.moved, r.arm_path, r.base_path) for v in (s.mean, s.se)]
             w.writerow(
                 [
@@ -260,8 +269,9 @@ def csv_text(db: ResultsDB, study: str | None = None) -> str:
     return out.getvalue()
 
 
-def runs_csv(db: ResultsDB, study: str | None = None) -> str:
-    """Every recorded run, every column (docs/bench.md), as CSV."""
+def runs_csv(db: ResultsDB, study: str | None = None, clock: str = "wall") -> str:
+    """Every recorded run, every column (docs/bench.md), as CSV (``clock`` changes nothing: both are
+    columns)."""
     out = io.StringIO()
     w = csv.writer(out, lineterminator="\n")
     w.writerow(COLUMNS)
@@ -270,6 +280,6 @@ def runs_csv(db: ResultsDB, study: str | None = None) -> str:
     return out.getvalue()
 
 
-def render(db: ResultsDB, fmt: str = "markdown", study: str | None = None) -> str:
-    """The report in format ``fmt`` (:data:`FORMATS`)."""
-    return {"markdown": markdown, "wide": wide, "csv": csv_text, "runs": runs_csv}[fmt](db, study)
+def render(db: ResultsDB, fmt: str = "markdown", study: str | None = None, clock: str = "wall") -> str:
+    """The report in format ``fmt`` (:data:`FORMATS`), time on ``clock`` (:data:`CLOCKS`)."""
+    return {"markdown": markdown, "wide": wide, "csv": csv_text, "runs": runs_csv}[fmt](db, study, clock)

@@ -43,7 +43,11 @@ TAIL_CHARS = 2000
 class ProcessResult:
     """How a limited process ended.  ``exit_code`` is its exit status, or None when a signal ended it
     (``signal``); ``killed`` says why the runner killed it (None: it ended by itself); ``seconds`` is the
-    wall-clock time from start to end; ``peak_mb`` the largest group memory sampled (MiB)."""
+    wall-clock time from start to end; ``peak_mb`` the largest group memory sampled (MiB); ``cpu_seconds`` the
+    CPU time (user + system) of the process and of every process it started and waited for (its worker
+    processes), from the kernel's accounting when the process is reaped — on a shared machine the measure
+    that does not grow with others' load.  A process killed at a limit counts what it had used; workers it
+    had not reaped by then are not counted."""
 
     argv: tuple[str, ...]
     exit_code: int | None
@@ -53,6 +57,7 @@ class ProcessResult:
     killed: str | None
     stdout_path: str
     stderr_path: str
+    cpu_seconds: float = 0.0
 
     def stderr_tail(self, chars: int = TAIL_CHARS) -> str:
         """The last ``chars`` characters of the process's standard error."""
@@ -191,10 +196,19 @@ def run_limited(
                 time.sleep(SAMPLE_SECONDS / 2)
     finally:  # also on KeyboardInterrupt (a cancelled Ray task): nothing of the run may outlive it
         _kill_group(pgid)
-        _, status = os.waitpid(proc.pid, 0)
+        _, status, usage = os.wait4(proc.pid, 0)
         proc.returncode = os.waitstatus_to_exitcode(status)
+        cpu = usage.ru_utime + usage.ru_stime
     seconds = time.monotonic() - start
     code = proc.returncode
     return ProcessResult(
-        tuple(argv), code if code >= 0 else None, -code if code < 0 else None, seconds, peak, killed, stdout, stderr
+        tuple(argv),
+        code if code >= 0 else None,
+        -code if code < 0 else None,
+        seconds,
+        peak,
+        killed,
+        stdout,
+        stderr,
+        round(cpu, 3),
     )

@@ -262,6 +262,66 @@ def test_a_run_past_its_wall_clock_limit_is_killed_as_a_group(tmp_path: Path) ->
     assert not leftover(str(folder))
 
 
+def test_cpu_seconds_count_the_process_and_the_workers_it_waited_for(tmp_path: Path) -> None:
+    """The runner's CPU time is the kernel's: a process that forks a worker, which spins for 0.6 s of CPU,
+    and waits for it, is charged at least that, and sleeping costs no CPU time."""
+    spin = (
+        "import os, time\n"
+        "pid = os.fork()\n"
+        "if pid == 0:\n"
+        "    t = time.process_time()\n"
+        "    while time.process_time() - t < 0.6: pass\n"
+        "    os._exit(0)\n"
+        "os.waitpid(pid, 0)\n"
+        "time.sleep(0.5)\n"
+    )
+    out = run_limited(
+        [sys.executable, "-c", spin],
+        wall=60,
+        memory_mb=4096,
+        stdout=str(tmp_path / "o"),
+        stderr=str(tmp_path / "e"),
+    )
+    assert out.exit_code == 0 and out.killed is None
+    assert 0.6 <= out.cpu_seconds < out.seconds, (out.cpu_seconds, out.seconds)
+
+
+def test_a_study_records_cpu_seconds_reports_either_clock_and_leaves_no_lock(tmp_path: Path) -> None:
+    symbolic_copy(tmp_path / "p", "chain-3")
+    study = write_study(
+        tmp_path / "s.yaml",
+        "study: clocks\nlimits: {time: 30}\ninstances: [{file: p/chain-3.mrg}]\nmethods: [{name: O}]\n",
+    )
+    db = tmp_path / "r.db"
+    run_study(str(study), str(db))
+    assert not (tmp_path / "r.db.lock").exists(), "bench run left its lock file behind"
+    (row,) = rows(db)
+    assert row["success"] and 0 < row["cpu_seconds"] < 60  # type: ignore[operator]
+    for clock, heading in (("wall", "planning time (s)"), ("cpu", "CPU time (s)")):
+        out = subprocess.run(
+            [*MRGC, "bench", "report", "--db", str(db), "--time", clock], capture_output=True, text=True, timeout=60
+        )
+        assert out.returncode == 0 and heading in out.stdout, out.stderr
+    cpu = subprocess.run(
+        [*MRGC, "bench", "report", "--db", str(db), "--time", "cpu", "--format", "csv"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    ).stdout.splitlines()
+    assert float(cpu[1].split(",")[6]) == pytest.approx(row["cpu_seconds"])
+
+
+def test_a_database_of_the_first_schema_is_read_and_upgraded_in_place(tmp_path: Path) -> None:
+    db = golden_db(tmp_path)
+    with ResultsDB(str(db), readonly=True) as old:
+        before = list(old.runs())
+        assert before and all(r["cpu_seconds"] is None for r in before)
+        assert "CPU time (s)" in render(old, "markdown", clock="cpu")
+    with ResultsDB(str(db)) as new:  # as bench run opens it
+        assert new.conn.execute("PRAGMA user_version").fetchone()[0] == 2
+        assert list(new.runs()) == before
+
+
 def test_a_run_over_its_memory_limit_is_recorded_as_memout(tmp_path: Path) -> None:
     """A packaging run passes 150 MiB for seconds (pybullet, coal, phase 1); a symbolic one, ending at about
     30 MiB within a second, made the outcome depend on where the samples fell."""

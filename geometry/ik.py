@@ -7,6 +7,14 @@ targets of :func:`solve_ik_many` — iterate as one numpy batch; a target stops 
 restarts meets the tolerances, and the lowest-numbered restart among those that met them first is the
 answer, so a target's result does not depend on the other targets of a batch.  Restarts come from
 ``numpy.random.default_rng(seed)``: the same (model, target, seed) always gives the same configuration.
+
+Arms with a Franka Panda's kinematics (recognised from their URDF chain, :func:`~mrgc.geometry.ik_analytic.
+panda_chain`) are solved analytically instead (:mod:`mrgc.geometry.ik_analytic`): the branch nearest
+``q_init`` (the middle of the limits when None), verified by forward kinematics to the same tolerances; it
+does not depend on ``seed``, ``restarts`` or ``max_iters``.  When no branch qualifies the result is
+NO_CONVERGENCE, without the numeric solver (docs/geometry.md, "Analytic IK", measures why), except for
+solves from ``q_init`` alone (``restarts`` 0), which also try it when the analytic answer jumps
+(:data:`LOCAL_JUMP`).
 """
 
 from __future__ import annotations
@@ -18,6 +26,7 @@ import numpy as np
 
 from mrgc.geometry.conventions import rotation_log
 from mrgc.geometry.fk import chain_frames, jacobian_t
+from mrgc.geometry.ik_analytic import PandaChain, panda_chain, solve_many
 from mrgc.geometry.kinematics import RobotModel
 
 #: weight of the orientation error (radians) against the position error (metres) in the least squares
@@ -32,6 +41,13 @@ STALL_RATIO = 0.9
 REDRAWS_PER_RESTART = 2
 #: targets per batch in :func:`solve_ik_many` (larger batches fall out of the CPU caches)
 CHUNK = 128
+#: solve Panda-kinematics arms analytically (:mod:`mrgc.geometry.ik_analytic`); False forces the numeric solver
+#: for every arm (benchmarks and tests compare the two)
+ANALYTIC = True
+#: a solve from ``q_init`` alone (``restarts`` 0: tracking a Cartesian line) whose analytic answer moves a joint
+#: farther than this (rad), or has none, also runs the numeric solver from ``q_init`` and keeps the nearer
+#: answer: near a wrist or shoulder singularity the analytic branches, q7 held near its start, jump
+LOCAL_JUMP = 0.1
 
 
 class IKStatus(str, enum.Enum):
@@ -49,7 +65,8 @@ class IKResult:
     """``q`` (within limits, read-only) when SOLVED, else None.  ``pos_error`` and ``rot_error`` (metres,
     radians) are those of ``q``, or of the closest configuration of the last iteration; for UNREACHABLE,
     ``pos_error`` is how far the target lies beyond the reach bound (a lower bound on any position error).
-    ``iterations``: solver iterations run (restarts tried, for pybullet's IK)."""
+    ``iterations``: solver iterations run (restarts tried, for pybullet's IK; q7 values tried, for the
+    analytic solver)."""
 
     status: IKStatus
     q: np.ndarray | None
@@ -136,7 +153,12 @@ def solve_ik_many(
     as M separate calls, at a fraction of the cost when M is large.  ``q_init`` may be one configuration for
     all targets or an (M, dof) array giving each target its own first start."""
     targets = np.asarray(targets, dtype=float).reshape(-1, 4, 4)
-    params = (restarts, tol_pos, tol_rot, max_iters)
+    chain = panda_chain(model) if ANALYTIC else None
+    params: tuple[object, ...]
+    if chain is not None:  # the analytic answer depends on neither the seed nor the numeric solver's budget
+        seed, params = 0, ("analytic", tol_pos, tol_rot, restarts <= 0 and max_iters)
+    else:
+        params = (restarts, tol_pos, tol_rot, max_iters)
     results: list[IKResult | None] = [None] * len(targets)
     per_target = q_init is not None and np.ndim(q_init) == 2  # one first start per target
     inits = np.asarray(q_init, dtype=float) if per_target else None
@@ -152,7 +174,16 @@ def solve_ik_many(
             _remember(key, miss)
         else:
             todo.append(i)
-    if todo:
+    if todo and chain is not None:
+        if inits is not None:
+            refs = model.clamp(inits[todo])
+        else:
+            refs = np.tile(restart_configurations(model, seed, 1, q_init)[0], (len(todo), 1))
+        local = (tol_pos, tol_rot, max_iters) if restarts <= 0 else None
+        for i, res in zip(todo, _analytic(model, chain, targets[todo], refs, tol_pos, tol_rot, local)):
+            results[i] = res
+            _remember(keys[i], res)
+    elif todo:
         starts = restart_configurations(model, seed, restarts, None if per_target else q_init)
         for lo in range(0, len(todo), CHUNK):
             part = todo[lo : lo + CHUNK]
@@ -165,6 +196,37 @@ def solve_ik_many(
                 results[i] = res
                 _remember(keys[i], res)
     return results  # type: ignore[return-value]
+
+
+def _analytic(
+    model: RobotModel,
+    chain: PandaChain,
+    targets: np.ndarray,
+    refs: np.ndarray,
+    tol_pos: float,
+    tol_rot: float,
+    local: tuple[float, float, int] | None,
+) -> list[IKResult]:
+    """The analytic results of ``targets`` from starts ``refs``; with ``local`` (the numeric solver's
+    tolerances and iterations), an answer that is missing or jumps (:data:`LOCAL_JUMP`) is compared with the
+    numeric solver's from the start alone."""
+    out = []
+    for target, ref, ans in zip(targets, refs, solve_many(model, chain, targets, refs, tol_pos, tol_rot)):
+        status = IKStatus.SOLVED if ans.q is not None else IKStatus.NO_CONVERGENCE
+        res = IKResult(status, ans.q, ans.pos_error, ans.rot_error, ans.calls)
+        if local is not None and (ans.q is None or float(np.abs(ans.q - ref).max()) > LOCAL_JUMP):
+            res = _nearer(res, _lm(model, target[None], ref[None], 0, *local)[0], ref)
+        out.append(res)
+    return out
+
+
+def _nearer(analytic: IKResult, local: IKResult, ref: np.ndarray) -> IKResult:
+    """Of an analytic answer and the numeric solver's from ``ref`` alone, the solved one nearer ``ref``."""
+    if not local.solved or local.q is None:
+        return analytic
+    if analytic.q is not None and np.linalg.norm(analytic.q - ref) <= np.linalg.norm(local.q - ref):
+        return analytic
+    return local
 
 
 # ------------------------------------------------------------------------------------------- the solver

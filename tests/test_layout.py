@@ -71,6 +71,7 @@ NOT_FOR_THE_VALIDATOR = {
     "mrgc.geometry.collision",
     "mrgc.geometry.fk",
     "mrgc.geometry.ik",
+    "mrgc.geometry.ik_analytic",
     "mrgc.geometry.arm",
     "mrgc.geometry.motion",
     "mrgc.geometry.lattice",
@@ -93,6 +94,7 @@ HEAVY = {
     "viser": "render/html.py",
     "ray": "bench/ray_executor.py",
     "jsonschema": "planner/plan_reader.py",
+    "geofikpy": "geometry/ik_analytic.py",
 }
 #: heavy libraries a second module may import too: pybullet's renderer draws the pictures
 ALSO_HEAVY = {"render/raster.py": {"pybullet"}, "bench/figures.py": {"matplotlib"}}

@@ -237,11 +237,14 @@ def plan(
     gets one line per grounded skeleton.  The plan records the problem's content digest, so it validates
     against any file holding the same problem (its facts file too).
     """
+    import time
+
     from mrgc import __version__
     from mrgc.language.digest import problem_digest
     from mrgc.planner.baselines import plan_with
     from mrgc.planner.plan import file_sha256
 
+    started = time.perf_counter()  # the time limit covers the layout checks, which load the robots' models
     problem, path = _resolve(source, name, allow_outside)
     _checked_layout(problem)
     digest = problem_digest(problem)
@@ -258,6 +261,7 @@ def plan(
         seed=seed,
         time_limit=time_limit,
         log=log,
+        started=started,
         **options,
     )
     result.problem_digest = digest

@@ -14,6 +14,10 @@ these guarantees, whatever ends the call (a result, an exception in a worker, Ct
   :class:`~mrgc.errors.InternalError` instead of a hang.
 
 The number of processes is capped by :func:`worker_count`: at most one per job and one per usable core.
+
+:func:`map_until` is the same with a time limit: when the limit passes before every job has finished, the
+workers are killed the same way and the call answers None (the planners' ``--time-limit`` covers phase 1
+this way, without a clock read inside the jobs).
 """
 
 from __future__ import annotations
@@ -22,7 +26,8 @@ import multiprocessing
 import os
 import signal
 import sys
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import FIRST_EXCEPTION, ProcessPoolExecutor
+from concurrent.futures import wait as wait_for
 from concurrent.futures.process import BrokenProcessPool
 from typing import Callable, Sequence, TypeVar
 
@@ -75,6 +80,20 @@ def map_in_workers(fn: Callable[[T], R], jobs: Sequence[T], workers: int) -> lis
     happens to the workers when the call ends."""
     if workers <= 1 or len(jobs) <= 1:
         return [fn(j) for j in jobs]
+    results = _pool(fn, jobs, workers, None)
+    assert results is not None  # no time limit: every job ends
+    return results
+
+
+def map_until(fn: Callable[[T], R], jobs: Sequence[T], workers: int, seconds: float) -> list[R] | None:
+    """:func:`map_in_workers` within ``seconds`` of wall-clock time, or None when they pass first (every
+    worker killed and reaped).  Always in worker processes, even one job, so that it can be cut."""
+    if not jobs:
+        return []
+    return _pool(fn, jobs, max(1, workers), max(0.0, seconds))
+
+
+def _pool(fn: Callable[[T], R], jobs: Sequence[T], workers: int, seconds: float | None) -> list[R] | None:
     before = {p.pid for p in multiprocessing.active_children()}
     pool = ProcessPoolExecutor(
         max_workers=workers,
@@ -93,6 +112,12 @@ def map_in_workers(fn: Callable[[T], R], jobs: Sequence[T], workers: int) -> lis
         finally:
             signal.pthread_sigmask(signal.SIG_SETMASK, old)
         try:
+            _, pending = wait_for(futures, timeout=seconds, return_when=FIRST_EXCEPTION)
+            if pending and not any(f.done() and f.exception() is not None for f in futures):
+                with signals.shielded():  # out of time: nothing of the jobs may run on
+                    _kill(mine or [p for p in multiprocessing.active_children() if p.pid not in before])
+                    pool.shutdown(wait=True, cancel_futures=True)
+                return None
             results = [f.result() for f in futures]
         except BrokenProcessPool as exc:
             codes = sorted({p.exitcode for p in mine if p.exitcode not in (None, 0)})

@@ -37,8 +37,11 @@ class RobotFacts:
 @dataclass
 class FactsResult:
     """All facts of a scene (sorted, deterministic) and statistics; ``warnings`` about the problem's layout
-    (W271, W272: docs/errors.md) when :func:`mrgc.compute_facts` ran the layout checks."""
+    (W271, W272: docs/errors.md) when :func:`mrgc.compute_facts` ran the layout checks.  ``complete`` is
+    False when a deadline cut phase 1 short: then there are no facts (none of a cut phase 1 is kept, so
+    that facts never depend on how fast the machine was)."""
 
     facts: list[Fact]
     stats: dict[str, float]
     warnings: tuple[Diagnostic, ...] = ()
+    complete: bool = True

@@ -26,6 +26,7 @@ and ``in-region M Re`` from the initial poses.  Everything is deterministic for 
 from __future__ import annotations
 
 import time
+from typing import Callable, TypeVar
 
 import numpy as np
 
@@ -41,7 +42,7 @@ from mrgc.geometry.relays import asks as relay_asks
 from mrgc.geometry.scene import Body, SceneSpec, half_extents, inside
 from mrgc.geometry.transforms import translation
 from mrgc.language.model import Box, Fact
-from mrgc.workers import map_in_workers, worker_count
+from mrgc.workers import map_in_workers, map_until, worker_count
 
 PLACEMENT_GRID = 3  # placements tried per region: a GRID × GRID lattice, centre first
 IK_SEEDS = 3  # IK solutions tried per target when looking for one free of movable objects
@@ -49,6 +50,9 @@ IK_ITERS = 100  # Levenberg-Marquardt iterations per solve (reachable targets co
 HANDOVER_STARTS = 4  # IK solves per handover target: from home, then from seeded random configurations
 HANDOVER_CONFIGS = 3  # distinct handover configurations kept per (object, point, grasp)
 DISTINCT_CONFIG = 0.1  # rad: configurations closer than this in every joint count as one
+
+J = TypeVar("J")
+R = TypeVar("R")
 
 
 class RobotEvaluator:
@@ -333,9 +337,11 @@ def _spots_worker(args: tuple[SceneSpec, str, int, Asks]) -> tuple[Spots, int, i
     return ev.spots(asked), ev.out.ik_solves, ev.out.collision_checks
 
 
-def _relays(scene: SceneSpec, facts: set[Fact], seed: int, n: int) -> tuple[set[Fact], int, int]:
+def _relays(
+    scene: SceneSpec, facts: set[Fact], seed: int, n: int, deadline: float | None
+) -> tuple[set[Fact], int, int] | None:
     """``enable-relay`` facts for the goal objects that need them (:mod:`mrgc.geometry.relays`), with the
-    IK solves and collision checks they took."""
+    IK solves and collision checks they took; None when ``deadline`` passed first."""
     arms = {r.name for r in scene.robots if r.kind.base != "planar"}
     out: set[Fact] = set()
     ik = checks = 0
@@ -346,17 +352,31 @@ def _relays(scene: SceneSpec, facts: set[Fact], seed: int, n: int) -> tuple[set[
         if not asked:
             continue
         jobs = [(scene, r, seed, a) for r, a in sorted(asked.items())]
-        answers = map_in_workers(_spots_worker, jobs, min(n, len(jobs)))
+        answers = _map(_spots_worker, jobs, min(n, len(jobs)), deadline)
+        if answers is None:
+            return None
         spots = {job[1]: ans[0] for job, ans in zip(jobs, answers)}
         out |= relay_facts(scene, facts, spots)
         ik, checks = ik + sum(a[1] for a in answers), checks + sum(a[2] for a in answers)
     return out, ik, checks
 
 
-def compute_facts(scene: SceneSpec, seed: int = 0, workers: int | None = None) -> FactsResult:
+def _map(fn: Callable[[J], R], jobs: list[J], workers: int, deadline: float | None) -> list[R] | None:
+    """The jobs in ``workers`` processes (:mod:`mrgc.workers`); with a ``deadline`` (a ``time.perf_counter``
+    value), None when it passes first."""
+    if deadline is None:
+        return map_in_workers(fn, jobs, workers)
+    return map_until(fn, jobs, workers, deadline - time.perf_counter())
+
+
+def compute_facts(
+    scene: SceneSpec, seed: int = 0, workers: int | None = None, deadline: float | None = None
+) -> FactsResult:
     """Every fact of ``scene`` (see the module docstring); ``workers`` processes (default: one per robot;
     capped at one per robot and one per usable core; 1 runs everything in this process; see
-    :mod:`mrgc.workers` for what happens to them on an error or a signal)."""
+    :mod:`mrgc.workers` for what happens to them on an error or a signal).  With a ``deadline`` (a
+    ``time.perf_counter`` value) the work always runs in worker processes and stops when it passes: the
+    result is then :attr:`~mrgc.geometry.facts.FactsResult.complete` False with no facts."""
     t0 = time.perf_counter()
     robots = [r.name for r in scene.robots]
     n = worker_count(workers, len(robots))
@@ -364,13 +384,20 @@ def compute_facts(scene: SceneSpec, seed: int = 0, workers: int | None = None) -
     for spec in scene.robots:  # load every arm model here: errors surface once, and forked workers share them
         if spec.kind.base != "planar":
             model_for_kind(spec.kind, spec.base_dir)
-    per_robot = map_in_workers(_robot_worker, jobs, n)
+    per_robot = _map(_robot_worker, jobs, n, deadline)
     t_robots = time.perf_counter() - t0
     facts: set[Fact] = set()
-    for rf in per_robot:
-        facts.update(rf.facts)
-    facts.update(_handovers(scene, dict(zip(robots, per_robot))))
-    relays, relay_ik, relay_checks = _relays(scene, facts, seed, n)
+    handovers = relayed = None
+    if per_robot is not None:
+        for rf in per_robot:
+            facts.update(rf.facts)
+        handovers = _handovers(scene, dict(zip(robots, per_robot)), deadline)
+    if handovers is not None:
+        facts.update(handovers)
+        relayed = _relays(scene, facts, seed, n, deadline)
+    if per_robot is None or relayed is None:
+        return FactsResult([], {"seconds": time.perf_counter() - t0, "workers": n, "facts": 0}, complete=False)
+    relays, relay_ik, relay_checks = relayed
     facts.update(relays)
     for m in scene.movable:
         for reg in scene.regions:
@@ -396,11 +423,14 @@ def compute_facts(scene: SceneSpec, seed: int = 0, workers: int | None = None) -
     return FactsResult(sorted(facts, key=lambda f: (order[f.predicate], f.args)), stats)
 
 
-def _handovers(scene: SceneSpec, per_robot: dict[str, RobotFacts]) -> set[Fact]:
-    """``enable-goal-handover`` from the robots' handover configurations, checking robot–robot collisions."""
+def _handovers(scene: SceneSpec, per_robot: dict[str, RobotFacts], deadline: float | None) -> set[Fact] | None:
+    """``enable-goal-handover`` from the robots' handover configurations, checking robot–robot collisions;
+    None when ``deadline`` passed first (it is read per goal object)."""
     out: set[Fact] = set()
     arms: dict[str, Arm] = {}
     for obj in scene.goal:
+        if deadline is not None and time.perf_counter() > deadline:
+            return None
         for r1 in per_robot:
             for r2 in per_robot:
                 if r1 == r2:

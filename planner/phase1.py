@@ -24,9 +24,12 @@ from mrgc.language.loader import MrgFile, inside, urdf_candidates
 from mrgc.language.model import Fact, Problem
 
 
-def compute_problem_facts(problem: Problem, seed: int = 0, workers: int | None = None) -> FactsResult:
-    """All facts of a geometric problem (InputError E402 for a symbolic one)."""
-    return compute_facts(scene_from_problem(problem), seed=seed, workers=workers)
+def compute_problem_facts(
+    problem: Problem, seed: int = 0, workers: int | None = None, deadline: float | None = None
+) -> FactsResult:
+    """All facts of a geometric problem (InputError E402 for a symbolic one); ``deadline`` (a
+    ``time.perf_counter`` value) cuts phase 1 short (``complete`` False, no facts)."""
+    return compute_facts(scene_from_problem(problem), seed=seed, workers=workers, deadline=deadline)
 
 
 @dataclass(frozen=True)

@@ -24,7 +24,7 @@ from mrgc.language.model import Problem
 from mrgc.planner.deferral import Deferrals, describe
 from mrgc.planner.outcome import BlockingCycle, Failure, PlanStatus, Why
 from mrgc.planner.plan import Plan, PlannedAction, planner_motion_model
-from mrgc.planner.skeletons import DEFAULT_BACKEND, DEFAULT_ENCODING, SkeletonSource, must_move, problem_facts
+from mrgc.planner.skeletons import DEFAULT_BACKEND, DEFAULT_ENCODING, SkeletonSource, facts_until, must_move
 
 if TYPE_CHECKING:  # the geometric modules load numpy and coal: a symbolic problem never imports them
     from mrgc.geometry.grounding import Grounder
@@ -56,19 +56,21 @@ def plan_problem(
     log: Log | None = None,
     max_iterations: int = 10_000,
     motions: str = "configurations",
+    started: float | None = None,
 ) -> Plan:
     """Plan ``problem`` (see the module docstring).  ``anytime`` keeps searching after the first plan until
     the time limit (or the end of the tree) and returns the best by (makespan, objects moved); ``log`` gets
     one line per grounded skeleton.  ``motions``: ``configurations`` (the paper's packaging model: arms'
     approaches, exchanges and the held object's transfers) or ``full`` (arms' empty-handed motions too, as
-    paths; docs/validator.md)."""
+    paths; docs/validator.md).  ``started``: the ``time.perf_counter`` value the time limit and the plan's
+    seconds count from (default: this call; :func:`mrgc.plan` passes its own start, before the layout checks
+    that load the robots' models)."""
     if motions not in MOTIONS:
         raise ValueError(f"motions is one of {', '.join(MOTIONS)}, not {motions!r}")
-    t0 = time.perf_counter()
+    t0 = time.perf_counter() if started is None else started
     deadline = t0 + time_limit
     say: Log = log or (lambda line: None)
-    facts, facts_seconds = problem_facts(problem, seed=seed)
-    base = FactBase.from_problem(problem, facts)
+    found, facts_seconds = facts_until(problem, None, seed, deadline)
     plan = Plan(
         problem.name,
         problem_file,
@@ -83,6 +85,10 @@ def plan_problem(
     plan.motion_model = None if problem.symbolic else planner_motion_model(motions)
     why = Why()
     plan.why = why
+    if found is None:
+        return phase1_cut(plan, problem, time_limit, t0, facts_seconds)
+    facts = found
+    base = FactBase.from_problem(problem, facts)
     stats: dict[str, Any] = {
         "robots": [r.name for r in problem.robots],
         "facts": len(facts),
@@ -131,6 +137,21 @@ def plan_problem(
         why.summary = _summary(plan.status, result.ended, time_limit, max_iterations, why)
     stats["seconds"] = round(time.perf_counter() - t0, 4)
     plan.stats = stats
+    return plan
+
+
+def phase1_cut(plan: Plan, problem: Problem, time_limit: float, t0: float, facts_seconds: float) -> Plan:
+    """``plan`` (of any planner) as the time limit leaves it when it cut phase 1 (the geometric facts) short:
+    status ``time limit``, no facts, no search."""
+    plan.status = PlanStatus.TIME_LIMIT
+    plan.why = plan.why or Why()
+    plan.why.summary = f"phase 1 (the geometric facts) did not finish within the time limit of {time_limit:g} s"
+    plan.stats = {
+        "robots": [r.name for r in problem.robots],
+        "facts": 0,
+        "facts_seconds": round(facts_seconds, 4),
+        "seconds": round(time.perf_counter() - t0, 4),
+    }
     return plan
 
 

@@ -87,13 +87,23 @@ def needs_facts(problem: Problem) -> bool:
 
 def problem_facts(problem: Problem, facts: Iterable[Fact] | None = None, seed: int = 0) -> tuple[list[Fact], float]:
     """The facts to compile with: given ones, the file's ``:init``, or phase 1 run now (and its seconds)."""
+    found, seconds = facts_until(problem, facts, seed, None)
+    assert found is not None  # no deadline: phase 1 runs to its end
+    return found, seconds
+
+
+def facts_until(
+    problem: Problem, facts: Iterable[Fact] | None, seed: int, deadline: float | None
+) -> tuple[list[Fact] | None, float]:
+    """:func:`problem_facts` for a planner with a ``deadline`` (a ``time.perf_counter`` value): None for the
+    facts when phase 1 had to run and the deadline cut it short."""
     if facts is not None:
         return list(facts), 0.0
     if needs_facts(problem):
         from mrgc.planner.phase1 import compute_problem_facts
 
-        result = compute_problem_facts(problem, seed=seed)
-        return list(result.facts), float(result.stats["seconds"])
+        result = compute_problem_facts(problem, seed=seed, deadline=deadline)
+        return (list(result.facts) if result.complete else None), float(result.stats["seconds"])
     return list(problem.init), 0.0
 
 

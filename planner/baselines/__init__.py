@@ -30,7 +30,8 @@ if TYPE_CHECKING:
 @dataclass(frozen=True)
 class Method:
     """A planning method: the module and function of its entry point, which takes ``(problem, problem_file,
-    sha256, version)`` and keyword options (every method takes ``seed``, ``time_limit`` and ``log``)."""
+    sha256, version)`` and keyword options (every method takes ``seed``, ``time_limit``, ``log`` and
+    ``started``, the ``time.perf_counter`` value the time limit counts from)."""
 
     module: str
     function: str

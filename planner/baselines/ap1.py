@@ -45,8 +45,8 @@ from mrgc.language.model import Problem
 from mrgc.planner.ground import GroundedStep, label, moved_objects
 from mrgc.planner.outcome import Failure, PlanStatus, Why
 from mrgc.planner.plan import Plan, planner_motion_model
-from mrgc.planner.search import MOTIONS, planned_action
-from mrgc.planner.skeletons import must_move, problem_facts
+from mrgc.planner.search import MOTIONS, phase1_cut, planned_action
+from mrgc.planner.skeletons import facts_until, must_move
 
 #: joint-action groundings the first depth-first run may make; every restart doubles it
 RESTART_BUDGET = 64
@@ -318,16 +318,16 @@ def plan_ap1(
     time_limit: float = 60.0,
     log: Log | None = None,
     motions: str = "configurations",
+    started: float | None = None,
 ) -> Plan:
     """Plan ``problem`` with Ap1 (see the module docstring); the same Plan, statuses and validation as
     :func:`mrgc.planner.search.plan_problem`, and the same ``motions`` (``full``: arms' empty-handed
-    motions planned too)."""
+    motions planned too); ``started`` as there."""
     if motions not in MOTIONS:
         raise ValueError(f"motions is one of {', '.join(MOTIONS)}, not {motions!r}")
-    t0 = time.perf_counter()
+    t0 = time.perf_counter() if started is None else started
     say: Log = log or (lambda line: None)
-    facts, facts_seconds = problem_facts(problem, seed=seed)
-    base = FactBase.from_problem(problem, facts)
+    known, facts_seconds = facts_until(problem, None, seed, t0 + time_limit)
     robots = [r.name for r in problem.robots]
     plan = Plan(
         problem.name,
@@ -342,6 +342,10 @@ def plan_ap1(
     )
     plan.motion_model = None if problem.symbolic else planner_motion_model(motions)
     why = plan.why = Why()
+    if known is None:
+        return phase1_cut(plan, problem, time_limit, t0, facts_seconds)
+    facts = known
+    base = FactBase.from_problem(problem, facts)
     stats: dict[str, Any] = {
         "planner": "ap1",
         "robots": robots,

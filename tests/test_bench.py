@@ -109,6 +109,12 @@ def test_a_study_file_is_checked_with_every_error_located() -> None:
     assert err.value.diagnostics[0].code == "E600" and err.value.diagnostics[0].span is not None
 
 
+@pytest.mark.parametrize("path", sorted((ROOT / "benchmarks").glob("*.yaml")), ids=lambda p: p.name)
+def test_every_shipped_study_file_is_a_valid_study(path: Path) -> None:
+    study = parse_study(path.read_text(encoding="utf-8"), str(path))
+    assert study.name and study.methods and study.instances
+
+
 def test_a_valid_study_and_its_methods_as_mrgc_command_lines() -> None:
     study = parse_study(
         "study: demo\nseeds: [0, 3..4]\nlimits: {time: 20, memory: 2GB}\n"

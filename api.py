@@ -24,7 +24,7 @@ if TYPE_CHECKING:
     from mrgc.backends.registry import BackendRecord
     from mrgc.geometry.facts import FactsResult
     from mrgc.language.loader import MrgFile
-    from mrgc.language.model import Fact, Problem
+    from mrgc.language.model import Fact, Problem, RobotKind
     from mrgc.planner.plan import Plan
     from mrgc.planner.skeletons import CompileResult
     from mrgc.planner.validate import ValidationReport
@@ -47,6 +47,9 @@ class CheckReport:
 
     file: "MrgFile"
     warnings: tuple[Diagnostic, ...] = ()
+    #: what was worked out for the user, one line each (``FILE:LINE:COL: note: ...``): the tool centre point
+    #: derived for a robot kind without ``:tcp`` (docs/language.md, "Robot kinds")
+    notes: tuple[str, ...] = ()
 
 
 def check(path: str | os.PathLike[str], *, allow_outside: Sequence[str] = ()) -> CheckReport:
@@ -64,7 +67,29 @@ def check(path: str | os.PathLike[str], *, allow_outside: Sequence[str] = ()) ->
             (warnings if d.severity == "warning" else errors).append(d)
     if errors:
         raise InputError(errors, {mf.path: mf.text})
-    return CheckReport(mf, tuple(warnings))
+    return CheckReport(mf, tuple(warnings), tuple(_tcp_notes(mf)))
+
+
+def _tcp_notes(mf: "MrgFile") -> list[str]:
+    """A note for each fixed-base robot kind of the file (its domains and its problems' domains) without
+    ``:tcp`` whose tool centre point is derived from its URDF."""
+    kinds: dict[tuple[str, object, str], "RobotKind"] = {}
+    for domain in [*mf.domains, *(p.domain for p in mf.problems)]:
+        for kind in domain.robot_kinds:
+            kinds.setdefault((kind.source, kind.span, kind.name), kind)
+    if not any(k.tcp is None and k.base == "fixed" for k in kinds.values()):
+        return []
+    from mrgc.geometry.tcp import derive_tcp
+
+    notes = []
+    for kind in kinds.values():
+        derived = derive_tcp(kind) if kind.tcp is None else None
+        if derived is not None:
+            notes.append(
+                f"{kind.span}: note: robot kind '{kind.name}' has no :tcp: using {derived.text()} from the "
+                f"{derived.source} of '{kind.urdf}'"
+            )
+    return notes
 
 
 def load_problem(source: ProblemSource, *, name: str | None = None, allow_outside: Sequence[str] = ()) -> "Problem":

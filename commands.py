@@ -71,7 +71,10 @@ def cmd_check(args: argparse.Namespace) -> int:
             continue
         mf = report.file
         _warn(mf.path, mf.text, report.warnings)
-        parts = [f"{len(mf.domains)} domain{'s' * (len(mf.domains) != 1)}"]
+        parts = [f"{len(mf.domains)} domain{'s' * (len(mf.domains) != 1)}"] if mf.domains or not mf.problems else []
+        own = {id(d) for d in mf.domains}
+        for d in {id(p.domain): p.domain for p in mf.problems if id(p.domain) not in own}.values():
+            parts.append(f"domain {d.name} from {_shown_path(d.source)}")  # the domain it used, from another file
         for p in mf.problems:
             kind = "symbolic" if p.symbolic else "geometric"
             parts.append(
@@ -79,8 +82,16 @@ def cmd_check(args: argparse.Namespace) -> int:
                 f"{len(p.regions)} regions, {len(p.goal)} goals, {len(p.init)} facts)"
             )
         if not args.quiet:
+            for note in report.notes:
+                print(note)
             print(f"{path}: ok: " + "; ".join(parts))
     return status
+
+
+def _shown_path(path: str) -> str:
+    """``path`` relative to the current folder when it lies below it, else as it is."""
+    rel = os.path.relpath(path) if path else path
+    return rel if path and not rel.startswith("..") else path
 
 
 def cmd_fmt(args: argparse.Namespace) -> int:

@@ -13,7 +13,8 @@ Each finding is a located :class:`~mrgc.errors.Diagnostic` (docs/errors.md).  Tw
   another robot's footprint;
 - ``W270`` (:func:`mrgc.geometry.grasps.grasp_warnings`) a grasp no gripper opens wide enough for;
 - ``W271`` a movable object lies in no region at its start pose (``in-region`` holds for none): unless it
-  is a goal object it can never move, so an obstacle in no region makes its goals unreachable.
+  is a goal object it can never move, so an obstacle in no region makes its goals unreachable;
+- ``W273`` an arm kind has no ``:tcp`` and none can be derived from its URDF (:mod:`mrgc.geometry.tcp`).
 
 **With robot models** (``mrgc facts`` and the commands that run phase 1, ``plan``):
 
@@ -60,6 +61,33 @@ def layout_diagnostics(problem: Problem) -> list[Diagnostic]:
     out += overlap_diagnostics(problem)
     out += grasp_warnings(problem)
     out += region_diagnostics(problem)
+    out += tcp_diagnostics(problem)
+    return out
+
+
+# ---------------------------------------------------------------------------------------------- :tcp
+def tcp_diagnostics(problem: Problem) -> list[Diagnostic]:
+    """W273 for each arm kind used by the problem that has no ``:tcp`` and none can be derived from its URDF
+    (:mod:`mrgc.geometry.tcp`); a URDF that cannot be found or read, or lacks the end-effector link, is left
+    to ``mrgc facts`` (E400/E401)."""
+    from mrgc.geometry.tcp import derive_tcp
+
+    used = {r.kind for r in problem.robots}
+    out = []
+    for kind in problem.domain.robot_kinds:
+        if kind.name not in used or kind.base != "fixed" or kind.tcp is not None or arm_joints(kind) is None:
+            continue
+        if derive_tcp(kind) is None:
+            out.append(
+                Diagnostic(
+                    "W273",
+                    f"robot kind '{kind.name}' has no :tcp and none can be derived from '{kind.urdf}' (no "
+                    f"grasp-target link, no fingers along the z axis of '{kind.end_effector}'): grasps put "
+                    f"the origin of '{kind.end_effector}' on the object; give :tcp (x y z yaw)",
+                    kind.span,
+                    severity="warning",
+                )
+            )
     return out
 
 

@@ -79,14 +79,18 @@ class SceneSpec:
 
 
 def scene_from_problem(problem: Problem) -> SceneSpec:
-    """The scene of a geometric problem (InputError E401 for a symbolic one)."""
+    """The scene of a geometric problem (InputError E402 for a symbolic one).  A fixed-base robot kind
+    without ``:tcp`` gets the one derived from its URDF (:mod:`mrgc.geometry.tcp`), so every user of the
+    scene (phase 1, grounding, the validator, the pictures) grasps at the same point."""
     if problem.symbolic:
         raise InputError(
             [Diagnostic("E402", f"problem '{problem.name}' is symbolic: it has no geometry", problem.span)]
         )
     for shape in _mesh_shapes(problem):  # bad mesh files fail here, located, before any worker starts
         mesh_vertices(shape)
-    kinds = {k.name: k for k in problem.domain.robot_kinds}
+    from mrgc.geometry.tcp import with_tcp
+
+    kinds = {k.name: with_tcp(k) for k in problem.domain.robot_kinds}  # a :tcp derived when not given
     robots = []
     for r in problem.robots:
         assert r.kind is not None and r.base is not None  # guaranteed by the checks of a geometric problem

@@ -78,6 +78,7 @@ CODES: dict[str, str] = {
     "W270": "grasp wider than the gripper",
     "W271": "object in no region",
     "W272": "region outside every robot's workspace",
+    "W273": "no tool centre point",
 }
 
 #: codes that are warnings: reported, but the input is accepted (exit code 0)
@@ -236,6 +237,11 @@ HELP: dict[str, str] = {
     "reach (the reach bound of its URDF), so nothing can be placed in it or picked from it. Reported by "
     "`mrgc facts` (and `mrgc plan`), which read the arms' models; problems with a planar robot never get it "
     "(planar robots drive).",
+    "W273": "A warning, not an error: a fixed-base robot kind has no `:tcp` and none can be derived from its "
+    "URDF (no grasp-target link fixed to the end-effector link, no gripper fingers along its z axis; "
+    "docs/language.md, 'Robot kinds'), so grasps put the end-effector link's origin on the object: the "
+    "fingers would reach past it into the object or the table. Give `:tcp (x y z yaw)`, the point between the "
+    "fingertips relative to the end-effector link.",
     "W270": "A warning, not an error: the object is wider along the grasp's finger axis (plus the 1 cm "
     "clearance) than a robot kind's `:gripper-opening`, so robots of that kind get no facts for this "
     "(object, grasp). `mrgc check` exits 0.",

@@ -10,7 +10,8 @@ the fraction solved to 1e-4 m / 1e-3 rad within the limits, the same through the
 (``solve_ik_many``, time per target), the cost of a failing solve (targets inside the reach bound with
 random orientations, mostly infeasible), and pybullet's ``calculateInverseKinematics`` with the same
 restarts (plain damped least squares, and the null-space variant with limits on a subset).
-Prints a Markdown table.
+Issue 22 adds, for a Panda chain: one GeoFIK call, and the analytic solve against the numeric one on the
+same targets (single solves and one batch, CPU µs by ``time.process_time``).  Prints a Markdown table.
 """
 
 from __future__ import annotations
@@ -49,6 +50,66 @@ def timed_solves(solve, targets) -> tuple[list[float], list]:
     return times, results
 
 
+def cpu_per_call(fn, items) -> float:
+    """Median CPU seconds per call over 5 rounds of calling ``fn`` on each of ``items``."""
+    rounds = []
+    for _ in range(5):
+        t = time.process_time()
+        for item in items:
+            fn(item)
+        rounds.append((time.process_time() - t) / len(items))
+    return statistics.median(rounds)
+
+
+def analytic_rows(model, qs, targets, restarts: int) -> list[tuple[str, str, str]]:
+    """Issue 22: GeoFIK's call alone, a verified analytic solve (single and batched, from home and from the
+    configuration itself) and the numeric solver on the same targets, in CPU µs (time.process_time)."""
+    from mrgc.geometry import ik_analytic as A
+
+    chain = A.panda_chain(model)
+    if chain is None:
+        return [("analytic IK", "not a Panda chain: numeric solver only", "")]
+    from geofikpy import franka_ik_q7
+
+    e = chain.base_inv @ targets @ chain.to_e
+    # q7 locked at the configuration's own value (the chain closes there; GeoFIK prints where it does not)
+    calls = [(t[:3, 3].tolist(), t[:3, :3].ravel().tolist(), float(q7)) for t, q7 in zip(e, qs[:, 6])]
+    rows = [
+        (
+            "GeoFIK franka_ik_q7, one call (q7 locked)",
+            f"{cpu_per_call(lambda c: franka_ik_q7(*c), calls) * 1e6:.1f} µs",
+            "",
+        )
+    ]
+    home = (model.lower + model.upper) / 2
+    for label, flag in (("analytic", True), ("numeric LM", False)):
+        I.ANALYTIC = flag
+        out = []
+
+        def one(t, out=out):
+            I.clear_ik_cache()
+            out.append(I.solve_ik(model, t, seed=0, q_init=home, restarts=restarts))
+
+        per = cpu_per_call(one, targets[: 100 if flag else 40])
+        ok = sum(r.solved for r in out[: 100 if flag else 40])
+        rows.append(
+            (f"solve_ik, {label}, from the middle of the limits", f"{per * 1e6:.0f} µs CPU", f"{ok}/{len(out) // 5}")
+        )
+        I.clear_ik_cache()
+        t = time.process_time()
+        res = I.solve_ik_many(model, targets, seed=0, q_init=home, restarts=restarts)
+        per = (time.process_time() - t) / len(targets)
+        rows.append(
+            (
+                f"solve_ik_many, {label}, batch of {len(targets)}",
+                f"{per * 1e6:.0f} µs CPU/target",
+                f"{sum(r.solved for r in res)}/{len(targets)}",
+            )
+        )
+    I.ANALYTIC = True
+    return rows
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--urdf", default="franka_panda/panda.urdf")
@@ -79,9 +140,12 @@ def main() -> None:
         )
     )
 
-    targets = F.ee_pose(model, rng.uniform(model.lower, model.upper, size=(args.poses, model.dof)))
+    qs = rng.uniform(model.lower, model.upper, size=(args.poses, model.dof))
+    targets = F.ee_pose(model, qs)
     n = len(targets)
 
+    rows += analytic_rows(model, qs, targets, args.restarts)
+    I.ANALYTIC = False  # the rows below are the numeric solver's (Levenberg-Marquardt), for every arm
     I.clear_ik_cache()
     times, res = timed_solves(lambda i, t: I.solve_ik(model, t, seed=i, restarts=args.restarts), targets)
     ok = sum(r.solved for r in res)

@@ -5,7 +5,8 @@ Public API (docs/api.md; everything the ``mrgc`` command does is a thin layer ov
 - :func:`parse_file`, :func:`parse_string`: read and check a ``.mrg`` file → :class:`MrgFile` holding checked
   :class:`Problem` objects (raises :class:`InputError` listing every diagnostic); :func:`check` adds the
   layout checks of ``mrgc check`` and returns the warnings; :func:`format_source`: canonical text.
-- :func:`compute_facts` (phase 1), :func:`compile` (task skeletons and statistics: a :class:`CompileResult`
+- :func:`compute_facts` (phase 1), :func:`facts_summary` (what the facts say, per robot and per goal),
+  :func:`compile` (task skeletons and statistics: a :class:`CompileResult`
   with a :class:`CompileStatus`), :func:`export_model` (the skeleton model as a solver file), :func:`plan`
   (a :class:`Plan` with a :class:`PlanStatus`, reasons and statistics),
   :func:`validate` (a :class:`ValidationReport`), :func:`backends` (the registered solver backends).
@@ -39,6 +40,8 @@ _LAZY: dict[str, str] = {
     "check": "mrgc.api:check",
     "load_problem": "mrgc.api:load_problem",
     "compute_facts": "mrgc.api:compute_facts",
+    "facts_summary": "mrgc.api:facts_summary",
+    "FactsSummary": "mrgc.planner.summary:FactsSummary",
     "compile": "mrgc.api:compile",
     "export_model": "mrgc.api:export_model",
     "plan": "mrgc.api:plan",
@@ -71,6 +74,7 @@ if TYPE_CHECKING:
         compile,
         compute_facts,
         export_model,
+        facts_summary,
         load_problem,
         plan,
         validate,
@@ -87,6 +91,7 @@ if TYPE_CHECKING:
     from mrgc.planner.outcome import PlanStatus
     from mrgc.planner.plan import Plan
     from mrgc.planner.skeletons import CompileResult, CompileStatus
+    from mrgc.planner.summary import FactsSummary
     from mrgc.planner.validate import ValidationReport
 
 
@@ -121,6 +126,7 @@ __all__ = [
     "ExitCode",
     "Fact",
     "FactsResult",
+    "FactsSummary",
     "Feature",
     "MrgFile",
     "Plan",
@@ -137,6 +143,7 @@ __all__ = [
     "compile",
     "compute_facts",
     "export_model",
+    "facts_summary",
     "format_source",
     "load_problem",
     "parse_file",

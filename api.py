@@ -27,6 +27,7 @@ if TYPE_CHECKING:
     from mrgc.language.model import Fact, Problem, RobotKind
     from mrgc.planner.plan import Plan
     from mrgc.planner.skeletons import CompileResult
+    from mrgc.planner.summary import FactsSummary
     from mrgc.planner.validate import ValidationReport
 
 #: a problem as the API takes it: checked, or the path of its ``.mrg`` file
@@ -151,6 +152,30 @@ def compute_facts(
     result = compute_problem_facts(problem, seed=seed, workers=workers)
     result.warnings = tuple(warnings)
     return result
+
+
+def facts_summary(
+    source: ProblemSource,
+    *,
+    name: str | None = None,
+    facts: Iterable["Fact"] | None = None,
+    seed: int = 0,
+    allow_outside: Sequence[str] = (),
+) -> "FactsSummary":
+    """What the facts of a problem say, for a person (``mrgc facts --summary``): per robot the objects it
+    can pick, the regions it can place in, its handover and relay partners; per goal how it can be
+    delivered (``direct``, ``handover``, ``relay``, ``none``); the objects and goals nobody reaches, each
+    with its nearest miss (:class:`~mrgc.planner.summary.FactsSummary`; ``.text()`` as the command prints
+    it, ``.to_json()``).  ``facts`` default to the problem's ``:init``, or phase 1 run now."""
+    from mrgc.planner.skeletons import needs_facts, problem_facts
+    from mrgc.planner.summary import summarize
+
+    problem = load_problem(source, name=name, allow_outside=allow_outside)
+    warnings = _checked_layout(problem, robots=facts is None and needs_facts(problem))
+    fact_list, _ = problem_facts(problem, facts, seed=seed)
+    summary = summarize(problem, fact_list)
+    summary.warnings = tuple(warnings)
+    return summary
 
 
 # ---------------------------------------------------------------- skeletons
@@ -352,6 +377,7 @@ __all__ = [
     "compile",
     "compute_facts",
     "export_model",
+    "facts_summary",
     "load_problem",
     "plan",
     "validate",

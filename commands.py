@@ -23,6 +23,7 @@ from mrgc.limits import count, number
 
 if TYPE_CHECKING:
     from mrgc.language.loader import MrgFile
+    from mrgc.planner.summary import FactsSummary
 
 
 class _Parser(argparse.ArgumentParser):
@@ -281,9 +282,21 @@ def cmd_facts(args: argparse.Namespace) -> int:
     mf = _load(args)
     problem = mf.problem(args.problem)
     check_output(args.output, inputs_of(mf))
+    if args.summary and not args.output:  # the file's own facts when it holds them, else phase 1
+        from mrgc.api import facts_summary
+
+        with signals.activity(f"summarizing the facts of {problem.name}"):
+            summary = facts_summary(problem, seed=args.seed)
+        _warn(mf.path, mf.text, summary.warnings)
+        _print_summary(summary, args.summary)
+        return ExitCode.OK
     with signals.activity(f"computing the facts of {problem.name} (phase 1)"):
         result = compute_facts(problem, seed=args.seed, workers=args.workers)
     _warn(mf.path, mf.text, result.warnings)
+    if args.summary:
+        from mrgc.planner.summary import summarize
+
+        _print_summary(summarize(problem, result.facts), args.summary)
     doc = facts_file(mf, problem, result.facts, args.seed, __version__, args.output)
     if args.output:
         for asset, data in doc.assets.items():  # local meshes and URDFs the output refers to, copied beside it
@@ -300,6 +313,13 @@ def cmd_facts(args: argparse.Namespace) -> int:
     if args.stats:
         print(json.dumps(result.stats, indent=2), file=sys.stdout if args.output else sys.stderr)
     return ExitCode.OK
+
+
+def _print_summary(summary: "FactsSummary", form: str) -> None:
+    """``mrgc facts --summary``: the summary as text or JSON on standard output."""
+    import json
+
+    sys.stdout.write(json.dumps(summary.to_json(), indent=2) + "\n" if form == "json" else summary.text())
 
 
 def _write_asset(path: str, data: bytes, inputs: Sequence[str]) -> None:
@@ -495,6 +515,15 @@ def build_parser() -> argparse.ArgumentParser:
         help="processes (default: one per robot; capped at one per robot and one per core)",
     )
     p.add_argument("--stats", action="store_true", help="also print timing statistics as JSON")
+    p.add_argument(
+        "--summary",
+        nargs="?",
+        const="text",
+        choices=("text", "json"),
+        help="print what the facts say instead (with -o: as well): per robot what it picks, where it places, "
+        "its handover and relay partners; how each goal can be delivered; what nobody reaches, with the "
+        "nearest miss",
+    )
     add_allow_outside(p)
     p.set_defaults(func=cmd_facts)
 

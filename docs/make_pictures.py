@@ -24,6 +24,9 @@ PICTURES: dict[str, list[list[str]]] = {
     "tutorial-scene.png": [
         ["render", "{tutorial}/two-arms.mrg", "-o", "{img}/tutorial-scene.png", "--size", "480x360"]
     ],
+    "tutorial-reach.png": [
+        ["render", "{tutorial}/two-arms.mrg", "--reach", "-o", "{img}/tutorial-reach.png", "--size", "760x560"]
+    ],
     "tutorial-cmtg.svg": [
         ["facts", "{tutorial}/two-arms.mrg", "-o", "{tmp}/two-arms.facts.mrg"],
         ["graph", "{tmp}/two-arms.facts.mrg", "-o", "{img}/tutorial-cmtg.svg", "--skeleton", "1"],

@@ -17,6 +17,7 @@ from mrgc.errors import Diagnostic, InputError
 from mrgc.exits import ExitCode
 
 MAX_SIDE = 4096  # pixels
+DEFAULT_SIZE = "400x300"
 MAX_FPS = 60.0
 #: the camera presets of :data:`mrgc.render.camera.PRESETS`, for --help without loading numpy (a test keeps
 #: the two in step)
@@ -42,10 +43,21 @@ def add_commands(sub: Any) -> None:
         ".svg or *gantt.png (Gantt chart)",
     )
     p.add_argument("--problem", help="which problem of the file (default: the one the plan names, else its only one)")
-    p.add_argument("--size", default="400x300", metavar="WxH", help="picture size in pixels (default 400x300)")
+    p.add_argument(
+        "--size",
+        default=DEFAULT_SIZE,
+        metavar="WxH",
+        help="picture size in pixels (default 400x300; 900x700 for --reach)",
+    )
     p.add_argument("--fps", type=float, default=10.0, help="frames per second of the replay (default 10)")
     p.add_argument("--camera", default="iso", help=f"viewing direction: {CAMERA_HELP} (default iso)")
     p.add_argument("--gantt", action="store_true", help="write the Gantt chart (.svg or .png)")
+    p.add_argument(
+        "--reach",
+        action="store_true",
+        help="write the reach map (.png or .svg): the scene from above with where each arm reaches at the "
+        "objects' pick height, to place arms by looking",
+    )
     p.set_defaults(func=cmd_render)
 
     p = sub.add_parser("graph", help="draw the collaborative manipulation task graph (CMTG): .dot, .svg or .png")
@@ -112,7 +124,7 @@ def cmd_render(args: argparse.Namespace) -> int:
         raise _usage(f"--camera {args.camera!r}: choose {CAMERA_HELP}")
     if not 0 < args.fps <= MAX_FPS:
         raise _usage(f"--fps must be above 0 and at most {MAX_FPS:g}")
-    kind = outputs.kind_of(args.output, args.gantt, args.plan is not None)
+    kind = outputs.kind_of(args.output, args.gantt, args.plan is not None, args.reach)
     mf = parse_file(args.file)
     inputs = list(mf.files) + ([args.plan] if args.plan else [])
     files.check_output(args.output, inputs)
@@ -128,7 +140,9 @@ def cmd_render(args: argparse.Namespace) -> int:
     opts = outputs.Options(width, height, args.fps, args.camera)
     source = args.plan or args.file
     with files.atomic_path(args.output, inputs) as tmp, _progress(f"drawing {os.path.basename(args.output)}") as bar:
-        if kind == "gantt":
+        if kind == "reach":
+            stats = outputs.write_reach(problem, tmp, opts, args.size != DEFAULT_SIZE)
+        elif kind == "gantt":
             assert plan is not None
             stats = outputs.write_gantt(problem, plan, tmp)
         elif kind == "html":
@@ -147,6 +161,9 @@ def cmd_render(args: argparse.Namespace) -> int:
 
 def _written(kind: str, path: str, stats: dict[str, Any]) -> str:
     where = os.path.abspath(path)
+    if kind == "reach":
+        reached = ", ".join(f"{r} reaches {n}" for r, n in stats["reached"].items()) or "no arms"
+        return f"{path}: reach map ({reached} of {stats['points']} points)\n  written to {where}"
     what = {
         "animation": f"replay of {stats['steps']} steps, {stats['frames']} frames",
         "sheet": f"contact sheet of {stats['frames']} key frames",

@@ -46,11 +46,18 @@ class Options:
     camera: str = DEFAULT_PRESET
 
 
-def kind_of(path: str, gantt: bool, has_plan: bool) -> str:
-    """``animation``, ``sheet``, ``scene``, ``html`` or ``gantt`` for output ``path`` (E000 when the name
-    or the missing plan does not allow one)."""
+def kind_of(path: str, gantt: bool, has_plan: bool, reach: bool = False) -> str:
+    """``animation``, ``sheet``, ``scene``, ``html``, ``gantt`` or ``reach`` for output ``path`` (E000 when
+    the name or the missing plan does not allow one)."""
     lower = path.lower()
     ext = os.path.splitext(lower)[1]
+    if reach:
+        if ext not in (".png", ".svg") or gantt or has_plan:
+            raise _usage(
+                "--reach writes the reach map of a problem as .png or .svg, without a plan or --gantt: "
+                f"mrgc render FILE --reach -o {os.path.splitext(os.path.basename(path))[0] or 'reach'}.png"
+            )
+        return "reach"
     if gantt or ext == ".svg" or lower.endswith("gantt.png"):
         if ext not in (".svg", ".png"):
             raise _usage(f"a Gantt chart is written as .svg or .png, not {ext or 'a file without extension'}")
@@ -74,6 +81,19 @@ def kind_of(path: str, gantt: bool, has_plan: bool) -> str:
 
 def _usage(message: str) -> InputError:
     return InputError([Diagnostic("E000", message)])
+
+
+#: the reach map's size when --size is not given (pixels)
+REACH_SIZE = (900, 700)
+
+
+def write_reach(problem: Problem, path: str, opts: Options, sized: bool) -> dict[str, Any]:
+    """The reach map (:mod:`mrgc.render.reach`) of ``problem``, ``opts``' size when ``sized`` (else
+    :data:`REACH_SIZE`)."""
+    from mrgc.render import reach
+
+    width, height = (opts.width, opts.height) if sized else REACH_SIZE
+    return reach.write(problem, path, width, height)
 
 
 def replay_frames(

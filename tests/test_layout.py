@@ -97,7 +97,11 @@ HEAVY = {
     "geofikpy": "geometry/ik_analytic.py",
 }
 #: heavy libraries a second module may import too: pybullet's renderer draws the pictures
-ALSO_HEAVY = {"render/raster.py": {"pybullet"}, "bench/figures.py": {"matplotlib"}}
+ALSO_HEAVY = {
+    "render/raster.py": {"pybullet"},
+    "render/reach.py": {"matplotlib"},
+    "bench/figures.py": {"matplotlib"},
+}
 
 
 def code_files() -> list[Path]:

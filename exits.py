@@ -31,7 +31,9 @@ MEANINGS: dict[ExitCode, str] = {
     ExitCode.OK: "success (`check`: every file is fine; `fmt --check`: every file is canonical)",
     ExitCode.NO_PLAN: "infeasible: no task skeleton exists under the facts (`plan`, `compile`; the reasons are "
     "printed and, for `plan`, in the plan's `why`); `fmt --check`: some file would be "
-    "reformatted; `validate`: the plan is invalid",
+    "reformatted; `validate`: the plan is invalid (a plan whose status is not `solved`, a record of a run that "
+    "found no plan, is invalid: violation `[status]`); `render`: the plan's status is not `solved` (nothing is "
+    "drawn unless `--force`)",
     ExitCode.INPUT: "input error: a bad `.mrg` file (any `E0xx`–`E2xx` code below), a bad plan file (`E5xx`), a "
     "bad study file or results database (`E6xx`, `mrgc bench`) or a bad command line (`E000`)",
     ExitCode.TIME_LIMIT: "time limit reached before an answer",

@@ -27,7 +27,7 @@ from __future__ import annotations
 import enum
 from collections import Counter
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Mapping
 
 from mrgc.exits import ExitCode
 
@@ -50,6 +50,19 @@ EXIT_CODES: dict[PlanStatus, ExitCode] = {
     PlanStatus.EXHAUSTED: ExitCode.EXHAUSTED,
     PlanStatus.INTERRUPTED: ExitCode.INTERRUPTED,
 }
+
+
+def not_solved(path: str, doc: Mapping[str, Any]) -> str | None:
+    """The one-line message of ``mrgc render`` about a plan file whose status is not ``solved`` (a planner's
+    record of a run that found no plan: nothing in it is a plan), else None.  (``mrgc validate`` reports
+    such a plan as invalid, violation ``[status]``.)"""
+    status = doc.get("status")
+    if status == "solved":
+        return None
+    why = doc.get("why")
+    summary = why.get("summary") if isinstance(why, Mapping) else None
+    reason = f" ({summary})" if isinstance(summary, str) and summary else ""
+    return f"{path}: warning: the plan's status is '{status}', not 'solved': mrgc plan found no plan{reason}"
 
 
 @dataclass(frozen=True)

@@ -53,6 +53,9 @@ def add_commands(sub: Any) -> None:
     p.add_argument("--camera", default="iso", help=f"viewing direction: {CAMERA_HELP} (default iso)")
     p.add_argument("--gantt", action="store_true", help="write the Gantt chart (.svg or .png)")
     p.add_argument(
+        "--force", action="store_true", help="draw a plan whose status is not 'solved' (exit code 1 all the same)"
+    )
+    p.add_argument(
         "--reach",
         action="store_true",
         help="write the reach map (.png or .svg): the scene from above with where each arm reaches at the "
@@ -131,9 +134,16 @@ def cmd_render(args: argparse.Namespace) -> int:
     plan = None
     name = args.problem
     if args.plan is not None:
+        from mrgc.planner.outcome import not_solved
         from mrgc.planner.validate import load_plan
 
         plan = load_plan(args.plan)
+        unsolved = not_solved(args.plan, plan)
+        if unsolved is not None:
+            print(unsolved, file=sys.stderr)
+            if not args.force:
+                print(f"mrgc render: nothing drawn (--force draws {os.path.basename(args.plan)})", file=sys.stderr)
+                return ExitCode.NO_PLAN
         if name is None and len(mf.problems) > 1 and any(p.name == plan["problem"] for p in mf.problems):
             name = plan["problem"]
     problem = mf.problem(name)
@@ -156,7 +166,7 @@ def cmd_render(args: argparse.Namespace) -> int:
             assert plan is not None
             stats = outputs.write_animation(problem, plan, tmp, opts, source, bar)
     print(_written(kind, args.output, stats))
-    return ExitCode.OK
+    return ExitCode.NO_PLAN if plan is not None and plan.get("status") != "solved" else ExitCode.OK
 
 
 def _written(kind: str, path: str, stats: dict[str, Any]) -> str:

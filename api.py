@@ -194,8 +194,10 @@ def compile(  # noqa: A001
 ) -> "CompileResult":
     """The first ``skeletons`` task skeletons of a problem in (makespan, objects moved) order, with a status
     (``optimal``, ``infeasible``, ``time limit``, ``error``), the compiler's reasons when there is none, and
-    statistics (``stats``: task-graph size, solver calls, seconds per phase).  ``facts`` default to the
-    problem's ``:init``, or phase 1 run now for a geometric problem without them."""
+    statistics (``stats``: task-graph size, solver calls, seconds per phase).  ``facts``: an iterable of
+    :class:`~mrgc.language.model.Fact` (``mrgc.Fact``; e.g. ``compute_facts(p).facts``) used as the
+    problem's facts; default: its ``:init``, or phase 1 run now for a geometric problem without them
+    (through the facts cache, docs/geometry.md)."""
     from mrgc.planner.skeletons import compile_problem, needs_facts, problem_facts
 
     problem = load_problem(source, name=name, allow_outside=allow_outside)
@@ -274,6 +276,7 @@ def plan(
     time_limit: float = 60.0,
     log: Callable[[str], None] | None = None,
     allow_outside: Sequence[str] = (),
+    facts: Iterable["Fact"] | None = None,
     **options: Any,
 ) -> "Plan":
     """Plan a problem end to end: phase 1 (unless the file holds its facts), task skeletons, then the
@@ -286,6 +289,11 @@ def plan(
     ``c``, ``alpha``, ``skeletons``, ``max_makespan``, ``anytime``, ``max_iterations``, ``motions``); ``log``
     gets one line per grounded skeleton.  The plan records the problem's content digest, so it validates
     against any file holding the same problem (its facts file too).
+
+    ``facts`` (an iterable of :class:`~mrgc.language.model.Fact`, e.g. ``compute_facts(p).facts`` or the
+    ``:init`` of a facts file) are used as the problem's facts, skipping phase 1; default: the file's
+    ``:init`` when it holds geometric facts, else phase 1, through the facts cache (docs/geometry.md, "The
+    facts cache").  Facts of another problem give wrong plans, which the validator then rejects.
     """
     import time
 
@@ -312,6 +320,7 @@ def plan(
         time_limit=time_limit,
         log=log,
         started=started,
+        **({"facts": list(facts)} if facts is not None else {}),
         **options,
     )
     result.problem_digest = digest

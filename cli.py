@@ -51,7 +51,13 @@ def main(argv: Sequence[str] | None = None) -> int:
             parser.print_help()
             return ExitCode.INPUT
         func: Callable[[argparse.Namespace], int] = args.func
-        code = func(args)
+        if getattr(args, "no_cache", False):
+            from mrgc.planner.facts_cache import disabled
+
+            with disabled():
+                code = func(args)
+        else:
+            code = func(args)
         if signals.received() is not None and code not in signals.EXIT_CODES.values():
             # something swallowed the signal's exception: the signal still ends the run
             print(f"mrgc: {signals.describe()}", file=sys.stderr)

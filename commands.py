@@ -463,6 +463,15 @@ def add_seed(p: argparse.ArgumentParser, metavar: str | None = None) -> None:
     p.add_argument("--seed", type=count("--seed"), default=0, metavar=metavar)
 
 
+def add_no_cache(p: argparse.ArgumentParser) -> None:
+    """``--no-cache``: neither read nor write the facts cache (mrgc.planner.facts_cache)."""
+    p.add_argument(
+        "--no-cache",
+        action="store_true",
+        help="compute phase 1 even when the facts cache holds its facts, and do not store them",
+    )
+
+
 def add_allow_outside(p: argparse.ArgumentParser) -> None:
     """``--allow-outside PATH``: a folder tree meshes and URDFs may come from besides the problem's own."""
     p.add_argument(
@@ -508,6 +517,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", metavar="OUT", help="write here (default: standard output)")
     p.add_argument("--problem", help="which problem of the file (default: its only one)")
     add_seed(p)
+    add_no_cache(p)
     p.add_argument(
         "--workers",
         type=count("--workers"),
@@ -552,6 +562,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="seconds for the whole search",
     )
     add_seed(p)
+    add_no_cache(p)
     add_allow_outside(p)
     p.add_argument("--emit", metavar="PATH", help="also write the model: .lp/.mps (mip), .smt2 (smt), .pbtxt (cpsat)")
     p.add_argument(
@@ -578,6 +589,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--backend", default="cpsat")
     p.add_argument("--encoding", default="time-of-move")
     add_seed(p)
+    add_no_cache(p)
     p.add_argument("--time-limit", type=number("--time-limit", positive=True), default=60.0, metavar="S")
     p.add_argument(
         "--skeletons",

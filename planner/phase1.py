@@ -28,8 +28,29 @@ def compute_problem_facts(
     problem: Problem, seed: int = 0, workers: int | None = None, deadline: float | None = None
 ) -> FactsResult:
     """All facts of a geometric problem (InputError E402 for a symbolic one); ``deadline`` (a
-    ``time.perf_counter`` value) cuts phase 1 short (``complete`` False, no facts)."""
-    return compute_facts(scene_from_problem(problem), seed=seed, workers=workers, deadline=deadline)
+    ``time.perf_counter`` value) cuts phase 1 short (``complete`` False, no facts).  The facts cache
+    (:mod:`mrgc.planner.facts_cache`) is asked first, and a complete phase 1 is stored there; a hit's
+    ``stats`` say ``cached`` 1, ``seconds`` the lookup's, ``computed_seconds`` the phase 1 that made it."""
+    import time
+
+    from mrgc.planner import facts_cache
+
+    t0 = time.perf_counter()
+    digest = None
+    if facts_cache.enabled() and not problem.symbolic:
+        from mrgc.language.digest import problem_digest
+
+        digest = problem_digest(problem)
+        hit = facts_cache.load(digest, seed)
+        if hit is not None:
+            facts, stats = hit
+            stats = {**stats, "computed_seconds": stats.get("seconds", 0.0), "cached": 1.0}
+            stats["seconds"] = round(time.perf_counter() - t0, 6)
+            return FactsResult(facts, stats)
+    result = compute_facts(scene_from_problem(problem), seed=seed, workers=workers, deadline=deadline)
+    if digest is not None and result.complete:  # a phase 1 cut short is never stored
+        facts_cache.store(digest, seed, list(result.facts), dict(result.stats))
+    return result
 
 
 @dataclass(frozen=True)

@@ -20,7 +20,7 @@ from mrgc.compiler.enumerate import BatchOutcome
 from mrgc.compiler.facts import FactBase
 from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action
-from mrgc.language.model import Problem
+from mrgc.language.model import Fact, Problem
 from mrgc.planner.deferral import Deferrals, describe
 from mrgc.planner.outcome import BlockingCycle, Failure, PlanStatus, Why
 from mrgc.planner.plan import Plan, PlannedAction, planner_motion_model
@@ -57,6 +57,7 @@ def plan_problem(
     max_iterations: int = 10_000,
     motions: str = "configurations",
     started: float | None = None,
+    facts: list[Fact] | None = None,
 ) -> Plan:
     """Plan ``problem`` (see the module docstring).  ``anytime`` keeps searching after the first plan until
     the time limit (or the end of the tree) and returns the best by (makespan, objects moved); ``log`` gets
@@ -64,13 +65,14 @@ def plan_problem(
     approaches, exchanges and the held object's transfers) or ``full`` (arms' empty-handed motions too, as
     paths; docs/validator.md).  ``started``: the ``time.perf_counter`` value the time limit and the plan's
     seconds count from (default: this call; :func:`mrgc.plan` passes its own start, before the layout checks
-    that load the robots' models)."""
+    that load the robots' models).  ``facts``: the problem's facts, when the caller has them (default: the
+    file's ``:init``, or phase 1 run now, through the facts cache)."""
     if motions not in MOTIONS:
         raise ValueError(f"motions is one of {', '.join(MOTIONS)}, not {motions!r}")
     t0 = time.perf_counter() if started is None else started
     deadline = t0 + time_limit
     say: Log = log or (lambda line: None)
-    found, facts_seconds = facts_until(problem, None, seed, deadline)
+    found, facts_seconds = facts_until(problem, facts, seed, deadline)
     plan = Plan(
         problem.name,
         problem_file,

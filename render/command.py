@@ -61,6 +61,7 @@ def add_commands(sub: Any) -> None:
         help="write the reach map (.png or .svg): the scene from above with where each arm reaches at the "
         "objects' pick height, to place arms by looking",
     )
+    add_no_cache(p)
     p.set_defaults(func=cmd_render)
 
     p = sub.add_parser("graph", help="draw the collaborative manipulation task graph (CMTG): .dot, .svg or .png")
@@ -71,7 +72,13 @@ def add_commands(sub: Any) -> None:
     p.add_argument("--backend", default="cpsat", help="backend generating skeletons for --skeleton (default cpsat)")
     p.add_argument("--encoding", default="time-of-move")
     p.add_argument("--seed", type=int, default=0)
+    add_no_cache(p)
     p.set_defaults(func=cmd_graph)
+
+
+def add_no_cache(p: Any) -> None:
+    """``--no-cache`` (as ``mrgc plan``'s): the facts of a problem without them come from phase 1 run now."""
+    p.add_argument("--no-cache", action="store_true", help="compute phase 1 even when the facts cache holds it")
 
 
 def _usage(message: str) -> InputError:

@@ -6,16 +6,30 @@ repository root ``ROOT``, the Panda model, ``mrgc`` run in this process), the va
 (``validator_plans``), a headless Chromium driver (``headless_chromium``) and issue 21's doctored plans
 (``doctor``).  (The independent skeleton oracle is installed with the package: ``mrgc.testing.oracle``.)
 
-Fixture: ``panda``, the Franka Panda's model, loaded once.
+Fixture: ``panda``, the Franka Panda's model, loaded once.  The facts cache: see below (its own folder, off
+unless a test turns it on).
 """
 
 from __future__ import annotations
 
+import atexit
 import importlib.util
+import os
+import shutil
 import sys
+import tempfile
 from pathlib import Path
 
 import pytest
+
+# The facts cache (planner/facts_cache.py) of the test session is its own, never the user's: a fresh
+# XDG_CACHE_HOME, removed at exit, inherited by the mrgc processes tests start.  It is also off by default,
+# so that no test's outcome depends on which tests ran before it (a deadline that cuts phase 1 short, the
+# seconds phase 1 took); tests of the cache turn it on (monkeypatch.delenv("MRGC_NO_CACHE")).
+_CACHE_HOME = tempfile.mkdtemp(prefix="mrgc-test-cache-")
+atexit.register(shutil.rmtree, _CACHE_HOME, True)
+os.environ["XDG_CACHE_HOME"] = _CACHE_HOME
+os.environ["MRGC_NO_CACHE"] = "1"
 
 for _name in ("support", "validator_plans", "headless_chromium", "doctor", "adversarial_round2"):
     if _name not in sys.modules:

@@ -107,6 +107,9 @@ def test_a_search_run_to_its_end_is_exhausted() -> None:
     plan = ap1(parse_string(text).problem())
     assert plan.status is PlanStatus.EXHAUSTED and plan.why and "to its end" in plan.why.summary
     assert plan.why.failures  # the failed steps are told
+    # numbered from the end, and the summary says so (issue 24)
+    assert all(f.step < 0 for f in plan.why.failures)
+    assert plan.why.summary.endswith("Ap1 numbers steps from the end (step -1: the plan's last, -2: the one before)")
 
 
 # ---------------------------------------------------------------- symbolic, random

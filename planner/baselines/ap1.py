@@ -41,7 +41,7 @@ from typing import Any, Callable
 from mrgc.compiler.facts import FactBase
 from mrgc.compiler.task_graph import Action, build_task_graph
 from mrgc.compiler.task_graph import _actions_for as facts_actions
-from mrgc.language.model import Problem
+from mrgc.language.model import Fact, Problem
 from mrgc.planner.ground import GroundedStep, label, moved_objects
 from mrgc.planner.outcome import Failure, PlanStatus, Why
 from mrgc.planner.plan import Plan, planner_motion_model
@@ -319,15 +319,16 @@ def plan_ap1(
     log: Log | None = None,
     motions: str = "configurations",
     started: float | None = None,
+    facts: list[Fact] | None = None,
 ) -> Plan:
     """Plan ``problem`` with Ap1 (see the module docstring); the same Plan, statuses and validation as
     :func:`mrgc.planner.search.plan_problem`, and the same ``motions`` (``full``: arms' empty-handed
-    motions planned too); ``started`` as there."""
+    motions planned too); ``started`` and ``facts`` as there."""
     if motions not in MOTIONS:
         raise ValueError(f"motions is one of {', '.join(MOTIONS)}, not {motions!r}")
     t0 = time.perf_counter() if started is None else started
     say: Log = log or (lambda line: None)
-    known, facts_seconds = facts_until(problem, None, seed, t0 + time_limit)
+    known, facts_seconds = facts_until(problem, facts, seed, t0 + time_limit)
     robots = [r.name for r in problem.robots]
     plan = Plan(
         problem.name,
@@ -381,6 +382,8 @@ def plan_ap1(
                 ended, PlanStatus.EXHAUSTED
             )
         why.summary = _summary(plan.status, time_limit, why)
+        if any(f.step < 0 for f in why.failures):  # Ap1 grounds backwards: say how its steps are numbered
+            why.summary += "; Ap1 numbers steps from the end (step -1: the plan's last, -2: the one before)"
         stats.update({k: (round(v, 4) if isinstance(v, float) else int(v)) for k, v in search.stats.items()})
         stats["validation_seconds"] = round(verdicts["seconds"], 4)
         if isinstance(steps, GeometricSteps):

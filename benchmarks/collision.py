@@ -1,4 +1,4 @@
-"""Collision query costs through the public CollisionWorld API (coal underneath), in microseconds.
+"""Collision query costs through the public CollisionWorld API and the kernel (coal underneath), in microseconds.
 
     python benchmarks/collision.py                 # default: 20 scene boxes, links 1/7/14, 2000 calls per row
     python benchmarks/collision.py --boxes 50 --calls 5000 --seed 1
@@ -8,6 +8,10 @@ convex hulls of 60 random points in a 10 × 10 × 20 cm ellipsoid, laid out as a
 a base beside the table at random joint angles, so some configurations reach into the objects and some
 do not.  Each row reports the median and 90th percentile of the per-call time over batches of calls (each
 batch runs the same query ``--repeat`` times; the per-call time is the batch time / repeat).
+
+The kernel rows (issue 22): a batch of 50 configurations of a 7-link chain against the scene in one query
+(``batch_collides``, per configuration), and two swept volumes (300 configurations × 7 links each, the size
+of a transfer) against each other, as a whole (``posed_collide``) and sample by sample (``paired_collide``).
 """
 
 from __future__ import annotations
@@ -21,7 +25,15 @@ from typing import Callable
 
 import numpy as np
 
-from mrgc.geometry.collision import CollisionShape, CollisionWorld, ConvexHull, collision_shape
+from mrgc.geometry.collision import (
+    CollisionShape,
+    CollisionWorld,
+    ConvexHull,
+    Posed,
+    collision_shape,
+    paired_collide,
+    posed_collide,
+)
 from mrgc.geometry.transforms import rot_z, rpy_matrix, translation
 from mrgc.language.model import Box
 
@@ -129,6 +141,30 @@ def main(argv: list[str] | None = None) -> None:
     links = make_links(7, rng)
     sweeps = [np.array([chain(7, np.random.default_rng(1000 * i + k)) for k in range(30)]) for i in range(batches)]
     row("sweep of 30 configurations × 7 links: `batch_hits`", lambda i: world.batch_hits(links, sweeps[i]), "")
+
+    # the kernel: configurations in batches, and volumes against volumes
+    batch = [np.array([chain(7, np.random.default_rng(77 * i + k)) for k in range(50)]) for i in range(batches)]
+    med, p90 = measure(lambda i: world.batch_collides(links, batch[i], against="movable"), batches, args.repeat)
+    rows.append(
+        (f"kernel: 50 configurations × 7 links vs {args.boxes} boxes, per configuration", med / 50, p90 / 50, "")
+    )
+    far = translation(0.0, 0.05, 0.0)
+    volumes = [
+        (
+            Posed.batch(links, np.array([chain(7, np.random.default_rng(5 * i + k)) for k in range(300)])),
+            Posed.batch(links, far @ np.array([chain(7, np.random.default_rng(5 * i + k + 1)) for k in range(300)])),
+        )
+        for i in range(min(batches, 20))
+    ]
+    slot = np.repeat(np.arange(300), 7)
+    row(
+        "kernel: volume vs volume, 2 × 2,100 pieces, `posed_collide`",
+        lambda i: posed_collide(*volumes[i % len(volumes)]),
+    )
+    row(
+        "kernel: the same, sample by sample, `paired_collide`",
+        lambda i: paired_collide(volumes[i % len(volumes)][0], slot, volumes[i % len(volumes)][1], slot),
+    )
 
     # colliding_with: which of the 20 objects does one object hit
     names = world.names("movable")

@@ -55,7 +55,7 @@ coal traps handled here (coal 3.0.3):
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Iterable, Sequence, Union
+from typing import TYPE_CHECKING, Any, Iterable, Iterator, Sequence, Union
 
 import numpy as np
 
@@ -100,29 +100,43 @@ Against = Union[str, Iterable[str], None]
 
 
 class CollisionShape:
-    """A geometry built for coal once: its coal geometry, a coal object that probes move, and its local AABB.
+    """A geometry built for coal once: its coal geometry, its local AABB, and the prebuilt narrowphase calls
+    against the other shapes it has been tested with.
 
-    Make one with :func:`collision_shape`; hand it to probes as often as needed.  Not thread-safe (a probe
-    moves the shape's own coal object), which is fine with one world per process.
+    Make one with :func:`collision_shape`; hand it to probes and worlds as often as needed: it is shared,
+    never copied (a world's objects and a probe's pieces only refer to it).
     """
 
-    __slots__ = ("geometry", "coal_geometry", "coal_object", "center", "half")
+    __slots__ = ("geometry", "coal_geometry", "coal_object", "center", "half", "box", "_calls")
 
     def __init__(self, geometry: Geometry, coal_geometry: Any) -> None:
-        import coal
-
         self.geometry = geometry
         self.coal_geometry = coal_geometry
-        self.coal_object = coal.CollisionObject(coal_geometry, coal.Transform3s())
+        #: a coal object of the geometry that small probes move (:meth:`CollisionWorld.probe_collides`)
+        self.coal_object = _kit().coal.CollisionObject(coal_geometry, _kit().coal.Transform3s())
         coal_geometry.computeLocalAABB()
         box = coal_geometry.aabb_local
         lo, hi = np.array(box.min_, dtype=float), np.array(box.max_, dtype=float)
         #: centre and half extents of the axis-aligned bounding box in the shape's own frame
         self.center: np.ndarray = (lo + hi) / 2
         self.half: np.ndarray = (hi - lo) / 2
+        #: both, stacked (2, 3)
+        self.box: np.ndarray = np.stack([self.center, self.half])
+        self._calls: dict[int, tuple[Any, CollisionShape]] = {}
 
     def __repr__(self) -> str:
         return f"CollisionShape({self.geometry!r})"
+
+    def call(self, other: "CollisionShape") -> Any:
+        """coal's ``ComputeCollision`` of this shape (first) and ``other``, made once per pair (it holds
+        ``other``, so the key, ``other``'s id, is never reused while it is cached)."""
+        found = self._calls.get(id(other))
+        if found is None:
+            found = self._calls[id(other)] = (
+                _kit().coal.ComputeCollision(self.coal_geometry, other.coal_geometry),
+                other,
+            )
+        return found[0]
 
 
 ShapeLike = Union[CollisionShape, Geometry]
@@ -198,27 +212,266 @@ def _thicken(pts: np.ndarray) -> np.ndarray:
     return np.concatenate(out) if len(out) > 1 else pts
 
 
+#: a kernel query tests every pair of pieces directly when there are at most this many; above it, the pieces
+#: are first grouped (:data:`GROUP` consecutive ones) and only the pairs of groups whose boxes meet are opened
+DIRECT_PAIRS = 1 << 14
+#: consecutive pieces of a :class:`Posed` bounded together in the broadphase's coarse level (a path's
+#: consecutive samples, an arm's links at one configuration: they lie close together)
+GROUP = 16
+
+
+class Posed:
+    """Shapes at world transforms as arrays, the kernel's unit: a probe, a volume, a selection of a world.
+
+    ``shapes`` are the distinct shapes, ``kind`` (N,) which of them each piece is, ``transforms`` (N, 4, 4)
+    where; ``lo`` / ``hi`` (N, 3) the world axis-aligned bounding boxes, grown by ``pad`` (a query's
+    tolerance: the boxes of two shapes within it of each other meet).  Built once, read by any number of
+    queries; nothing is copied into coal (the exact test moves no coal object: :func:`_exact`).
+    """
+
+    __slots__ = ("shapes", "kind", "transforms", "lo", "hi", "_coarse")
+
+    def __init__(self, shapes: Sequence[CollisionShape], kind: np.ndarray, transforms: np.ndarray, pad: float) -> None:
+        self.shapes = list(shapes)
+        self.kind = np.asarray(kind, dtype=np.intp)
+        self.transforms = np.asarray(transforms, dtype=float).reshape(-1, 4, 4)
+        self._coarse: tuple[np.ndarray, np.ndarray] | None = None
+        if not len(self.kind):
+            self.lo = self.hi = np.zeros((0, 3))
+            return
+        rot = self.transforms[:, :3, :3]
+        if len(self.shapes) == 1:  # (N, 3, 3) @ (3,): one shape's box everywhere
+            mid = rot @ self.shapes[0].center
+            reach = np.abs(rot) @ (self.shapes[0].half + pad)
+        else:
+            table = np.stack([s.box for s in self.shapes])[self.kind]  # (N, 2, 3)
+            mid = (rot @ table[:, 0, :, None])[..., 0]
+            reach = (np.abs(rot) @ (table[:, 1, :, None] + pad))[..., 0]
+        mid += self.transforms[:, :3, 3]
+        self.lo, self.hi = mid - reach, mid + reach
+
+    def __len__(self) -> int:
+        return len(self.kind)
+
+    @classmethod
+    def of(cls, pieces: Iterable[tuple[ShapeLike, np.ndarray]], pad: float = TOLERANCE) -> "Posed":
+        """The pieces of a probe or a volume ((shape, 4×4 world transform) pairs)."""
+        shapes: list[CollisionShape] = []
+        index: dict[int, int] = {}
+        kind: list[int] = []
+        transforms: list[np.ndarray] = []
+        for shape, t in pieces:
+            s = shape if type(shape) is CollisionShape else collision_shape(shape)
+            k = index.get(id(s))
+            if k is None:
+                k = index[id(s)] = len(shapes)
+                shapes.append(s)
+            kind.append(k)
+            transforms.append(t)
+        return cls(shapes, np.array(kind, dtype=np.intp), np.array(transforms, dtype=float).reshape(-1, 4, 4), pad)
+
+    @classmethod
+    def batch(cls, shapes: Sequence[ShapeLike], transforms: np.ndarray, pad: float = TOLERANCE) -> "Posed":
+        """Shapes ``L`` at ``transforms`` (L, 4, 4) or (C, L, 4, 4): C configurations of the same L links."""
+        links = [collision_shape(s) for s in shapes]
+        t = np.asarray(transforms, dtype=float)
+        if t.shape[-3:] != (len(links), 4, 4):
+            raise ValueError(f"transforms of shape {t.shape} do not match {len(links)} shapes")
+        flat = t.reshape(-1, 4, 4)
+        return cls(links, np.tile(np.arange(len(links)), len(flat) // max(1, len(links))), flat, pad)
+
+    def coarse(self) -> tuple[np.ndarray, np.ndarray]:
+        """The boxes of runs of :data:`GROUP` consecutive pieces (the last run may be shorter)."""
+        if self._coarse is None:
+            self._coarse = _grouped(self.lo, self.hi)
+        return self._coarse
+
+    def shape(self, i: int) -> CollisionShape:
+        """The shape of piece ``i``."""
+        return self.shapes[int(self.kind[i])]
+
+
+def _grouped(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    n = len(lo)
+    size = -(-n // GROUP) * GROUP
+    plo, phi = np.full((size, 3), np.inf), np.full((size, 3), -np.inf)
+    plo[:n], phi[:n] = lo, hi
+    return plo.reshape(-1, GROUP, 3).min(axis=1), phi.reshape(-1, GROUP, 3).max(axis=1)
+
+
+def _meet(alo: np.ndarray, ahi: np.ndarray, blo: np.ndarray, bhi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The index pairs (i, j) whose boxes meet, every pair tested."""
+    gap = np.maximum(alo[:, None, :] - bhi[None, :, :], blo[None, :, :] - ahi[:, None, :])
+    i, j = np.nonzero(gap.max(axis=2) <= 0)
+    return i, j
+
+
+def overlaps(a: Posed, b: Posed) -> tuple[np.ndarray, np.ndarray]:
+    """The broadphase: the pairs (piece of ``a``, piece of ``b``) whose bounding boxes meet.  Small queries
+    test every pair; large ones first the boxes of :data:`GROUP` consecutive pieces of each side, then the
+    pieces of the groups that meet (numpy throughout).  Sound: two shapes within the pad of each other have
+    boxes that meet."""
+    na, nb = len(a), len(b)
+    if not na or not nb:
+        empty = np.zeros(0, dtype=np.intp)
+        return empty, empty
+    if na * nb <= DIRECT_PAIRS:
+        return _meet(a.lo, a.hi, b.lo, b.hi)
+    parts = list(_chunks(a, b))
+    if not parts:
+        empty = np.zeros(0, dtype=np.intp)
+        return empty, empty
+    return np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])
+
+
+#: group pairs opened at once by :func:`_chunks` (a yes/no query stops after the first chunk that collides)
+CHUNK = 256
+
+
+def _chunks(a: Posed, b: Posed) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+    """:func:`overlaps` of two large sets, :data:`CHUNK` pairs of groups at a time."""
+    na, nb = len(a), len(b)
+    glo_a, ghi_a = a.coarse() if na > GROUP else (a.lo, a.hi)
+    glo_b, ghi_b = b.coarse() if nb > GROUP else (b.lo, b.hi)
+    all_a, all_b = _meet(glo_a, ghi_a, glo_b, ghi_b)
+    for start in range(0, len(all_a), CHUNK):
+        i, j = _opened(a, b, all_a[start : start + CHUNK], all_b[start : start + CHUNK])
+        if len(i):
+            yield i, j
+
+
+def _opened(a: Posed, b: Posed, ga: np.ndarray, gb: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The piece pairs of the group pairs (ga, gb) whose boxes meet."""
+    na, nb = len(a), len(b)
+    span_a = np.arange(GROUP) if na > GROUP else np.zeros(1, dtype=np.intp)
+    span_b = np.arange(GROUP) if nb > GROUP else np.zeros(1, dtype=np.intp)
+    step_a, step_b = (GROUP if na > GROUP else 1), (GROUP if nb > GROUP else 1)
+    i = (ga[:, None, None] * step_a + span_a[None, :, None]) + 0 * span_b[None, None, :]
+    j = (gb[:, None, None] * step_b + span_b[None, None, :]) + 0 * span_a[None, :, None]
+    i, j = i.ravel(), j.ravel()
+    keep = (i < na) & (j < nb)
+    i, j = i[keep], j[keep]
+    keep = np.all(a.lo[i] <= b.hi[j], axis=1) & np.all(b.lo[j] <= a.hi[i], axis=1)
+    return i[keep], j[keep]
+
+
+class _Kit:
+    """coal objects the exact test reuses (one per process): requests per tolerance, a result, two transforms."""
+
+    def __init__(self) -> None:
+        import coal
+
+        self.coal = coal
+        self.requests: dict[float, Any] = {}
+        self.result = coal.CollisionResult()
+        self.identity = coal.Transform3s()
+        self.relative = coal.Transform3s()
+
+    def request(self, tolerance: float) -> Any:
+        req = self.requests.get(tolerance)
+        if req is None:
+            req = self.requests[tolerance] = self.coal.CollisionRequest()
+            req.enable_contact = False
+            req.security_margin = tolerance
+            req.gjk_tolerance = GJK_TOLERANCE
+        return req
+
+
+_KIT: list[_Kit] = []
+
+
+def _kit() -> _Kit:
+    if not _KIT:
+        _KIT.append(_Kit())
+    return _KIT[0]
+
+
+def _exact(
+    a: Posed, b: Posed, i: np.ndarray, j: np.ndarray, tolerance: float, stop: bool, skip: np.ndarray | None = None
+) -> list[int]:
+    """coal's narrowphase on the candidate pairs (a's piece i[k], b's piece j[k]): the k of the pairs that
+    collide (within ``tolerance``, coal's security margin: the module docstring's semantics), the first one
+    only with ``stop``.  ``skip`` (a bool array over b's pieces): pairs whose b piece is marked are passed
+    over, and a colliding one marks it (which-objects queries need one contact per object).  Each call is a
+    prebuilt ``ComputeCollision`` of the two geometries (cached on the first shape), b's shape placed in a's
+    frame: no coal object is moved or copied."""
+    if not len(i):
+        return []
+    kit = _kit()
+    request, result, identity, relative = kit.request(tolerance), kit.result, kit.identity, kit.relative
+    ta, tb = a.transforms[i], b.transforms[j]
+    inv_rot = np.swapaxes(ta[:, :3, :3], -1, -2)
+    rel_rot = inv_rot @ tb[:, :3, :3]
+    rel_pos = (inv_rot @ (tb[:, :3, 3:] - ta[:, :3, 3:]))[..., 0]
+    out: list[int] = []
+    ka, kb = a.kind[i].tolist(), b.kind[j].tolist()
+    jl = j.tolist()
+    for k in range(len(ka)):
+        if skip is not None and skip[jl[k]]:
+            continue
+        result.clear()
+        relative.setRotation(rel_rot[k])
+        relative.setTranslation(rel_pos[k])
+        if a.shapes[ka[k]].call(b.shapes[kb[k]])(identity, relative, request, result):
+            out.append(k)
+            if stop:
+                break
+            if skip is not None:
+                skip[jl[k]] = True
+    return out
+
+
+def posed_collide(a: Posed, b: Posed, tolerance: float = TOLERANCE) -> bool:
+    """Whether some piece of ``a`` collides with some piece of ``b`` (within ``tolerance``); large sets are
+    opened a chunk of groups at a time, stopping at the first collision."""
+    if len(a) * len(b) <= DIRECT_PAIRS:
+        i, j = overlaps(a, b)
+        return bool(_exact(a, b, i, j, tolerance, stop=True))
+    return any(_exact(a, b, i, j, tolerance, stop=True) for i, j in _chunks(a, b))
+
+
+def pieces_collide(a: Probe, b: Probe, tolerance: float = TOLERANCE) -> bool:
+    """:func:`posed_collide` for two lists of (shape, 4×4 world transform) pieces."""
+    if not a or not b:
+        return False
+    return posed_collide(Posed.of(a), Posed.of(b), tolerance)
+
+
+def paired_collide(a: Posed, a_slot: np.ndarray, b: Posed, b_slot: np.ndarray, tolerance: float = TOLERANCE) -> bool:
+    """Whether a piece of ``a`` collides with a piece of ``b`` *in the same slot* (``a_slot`` (N,) and
+    ``b_slot`` (M,), both ascending): two motions compared sample by sample, slot = the sample pair."""
+    sb = np.searchsorted(b_slot, a_slot, "left")
+    count = np.searchsorted(b_slot, a_slot, "right") - sb
+    total = int(count.sum())
+    if not total:
+        return False
+    i = np.repeat(np.arange(len(a_slot)), count)
+    j = np.repeat(sb - (np.cumsum(count) - count), count) + np.arange(total)
+    keep = np.all(a.lo[i] <= b.hi[j], axis=1) & np.all(b.lo[j] <= a.hi[i], axis=1)
+    return bool(_exact(a, b, i[keep], j[keep], tolerance, stop=True))
+
+
+#: a yes/no probe of at most this many pieces goes through coal's broadphase tree of the selection (a few
+#: µs a piece) rather than the numpy kernel (a few tens of µs a query, whatever its size)
+SMALL_PROBE = 16
+
+
 class _Entry:
-    __slots__ = ("name", "group", "shape", "obj", "gid", "transform")
+    __slots__ = ("name", "group", "shape", "transform", "slot", "obj")
 
-    def __init__(self, name: str, group: str, shape: CollisionShape, obj: Any, gid: int, transform: np.ndarray) -> None:
-        self.name, self.group, self.shape, self.obj, self.gid, self.transform = (
-            name,
-            group,
-            shape,
-            obj,
-            gid,
-            transform,
-        )
+    def __init__(self, name: str, group: str, shape: CollisionShape, transform: np.ndarray, obj: Any) -> None:
+        self.name, self.group, self.shape, self.transform, self.obj = name, group, shape, transform, obj
+        self.slot = -1
 
 
-class _Selection:
-    """A coal broadphase manager over one selection of world objects, refit when objects have moved."""
+class _Tree:
+    """coal's broadphase tree over one selection of world objects (their coal objects share the shapes'
+    geometry), refit when objects have moved."""
 
-    __slots__ = ("manager", "version", "size")
+    __slots__ = ("manager", "version")
 
-    def __init__(self, manager: Any, version: int, size: int) -> None:
-        self.manager, self.version, self.size = manager, version, size
+    def __init__(self, manager: Any, version: int) -> None:
+        self.manager, self.version = manager, version
 
 
 class CollisionWorld:
@@ -228,36 +481,35 @@ class CollisionWorld:
     an object name, or an iterable of them; ``against=None`` means every object.  Tokens that name no
     group and no object select nothing.  A query's own objects are never tested against each other or
     themselves: several names in one query act as one body (a robot's links and the object it holds).
+
+    The kernel (module docstring): the world's objects are one :class:`Posed` (their shapes shared, never
+    copied), built on the first query after an object was added or removed; a move updates its row in
+    place; each selection (``against`` minus ``ignore`` minus the query's own objects) is an index array,
+    cached until objects are added or removed.  A probe is a :class:`Posed` too; the broadphase
+    (:func:`overlaps`) and coal's narrowphase on its pairs (:func:`_exact`) answer.
     """
 
-    #: how many selections (against × ignore × query objects) keep a broadphase manager
+    #: how many selections (against × ignore × query objects) are remembered
     MAX_SELECTIONS = 256
 
     def __init__(self, tolerance: float = TOLERANCE) -> None:
-        import coal
-
         if tolerance < TOLERANCE:
             raise ValueError(f"tolerance must be >= {TOLERANCE:g} (coal reports overlaps as free below it)")
         self.tolerance = float(tolerance)
         self._entries: dict[str, _Entry] = {}
         self._groups: dict[str, set[str]] = {}
-        self._by_gid: dict[int, str] = {}
-        self._selections: dict[Any, _Selection] = {}
-        self._version = 0  # bumped by every move; a selection refits its manager when it lags
-        self._coal = coal
-        # one callback stops at the first collision, the other collects every colliding pair
-        self._first = self._callback(coal, 1)
-        self._every = self._callback(coal, 1 << 30)
-
-    def _callback(self, coal: Any, max_contacts: int) -> Any:
-        request = coal.CollisionRequest()
+        self._selections: dict[Any, np.ndarray] = {}
+        self._posed: Posed | None = None  # every object, in insertion order (None: rebuilt on the next query)
+        self._order: list[_Entry] = []
+        self._trees: dict[Any, _Tree] = {}
+        self._version = 0  # bumped by every move; a tree refits when it lags
+        coal = _kit().coal
+        self._first = coal.CollisionCallBackDefault()  # stops at the first collision
+        request = self._first.data.request
         request.enable_contact = False
         request.security_margin = self.tolerance
         request.gjk_tolerance = GJK_TOLERANCE
-        request.num_max_contacts = max_contacts
-        callback = coal.CollisionCallBackDefault()
-        callback.data.request = request
-        return callback
+        request.num_max_contacts = 1
 
     # ----------------------------------------------------------------------------------------- contents
 
@@ -268,33 +520,40 @@ class CollisionWorld:
         if name in self._groups or group in self._entries:
             raise ValueError(f"'{name if name in self._groups else group}' is both an object and a group")
         shape = collision_shape(geometry)
-        geom = shape.coal_geometry.clone()  # its own geometry, so a contact's geometry id names the object
-        geom.computeLocalAABB()
         t = np.array(transform, dtype=float)
-        obj = self._coal.CollisionObject(geom, self._coal.Transform3s())
+        obj = _kit().coal.CollisionObject(shape.coal_geometry, _kit().coal.Transform3s())  # shared, not cloned
         _place(obj, t)
-        self._entries[name] = _Entry(name, group, shape, obj, geom.id(), t)
-        self._by_gid[geom.id()] = name
+        self._entries[name] = _Entry(name, group, shape, t, obj)
         self._groups.setdefault(group, set()).add(name)
-        self._selections.clear()
+        self._changed()
 
     def remove(self, name: str) -> None:
         """Take object ``name`` out of the world."""
-        self._selections.clear()  # first: managers hold raw pointers to the objects
         entry = self._entries.pop(name)
-        del self._by_gid[entry.gid]
         members = self._groups[entry.group]
         members.discard(name)
         if not members:
             del self._groups[entry.group]
+        self._changed()
+
+    def _changed(self) -> None:
+        self._posed = None
+        self._selections.clear()
+        self._trees.clear()  # trees hold raw pointers to the objects
 
     def set_transform(self, name: str, transform: np.ndarray) -> None:
-        """Move object ``name`` to ``transform`` (4×4, world frame)."""
+        """Move object ``name`` to ``transform`` (4×4, world frame): its row of the kernel is updated in place."""
         entry = self._entries[name]
         t = np.array(transform, dtype=float)
         entry.transform = t
         _place(entry.obj, t)
         self._version += 1
+        posed = self._posed
+        if posed is not None:
+            one = Posed([entry.shape], np.zeros(1, dtype=np.intp), t[None], 0.0)
+            posed.transforms[entry.slot] = t
+            posed.lo[entry.slot], posed.hi[entry.slot] = one.lo[0], one.hi[0]
+            posed._coarse = None
 
     def transform(self, name: str) -> np.ndarray:
         """Object ``name``'s pose (a copy)."""
@@ -318,110 +577,120 @@ class CollisionWorld:
 
     def collides(self, names: str | Iterable[str], against: Against = None, ignore: Against = ()) -> bool:
         """Does any of the named world objects collide with a selected object (other than themselves)?"""
-        entries = self._query_entries(names)
-        manager = self._manager(against, ignore, tuple(e.name for e in entries))
-        if manager is None:
-            return False
-        cb = self._first
-        result = cb.data.result
-        for e in entries:
-            manager.collide(e.obj, cb)
-            if result.isCollision():
-                return True
-        return False
+        entries = [self._entries[n] for n in ((names,) if isinstance(names, str) else names)]
+        tree = self._tree(against, ignore, tuple(e.name for e in entries))
+        return tree is not None and self._tree_collides(tree, [e.obj for e in entries])
 
     def colliding_with(self, names: str | Iterable[str], against: Against = None, ignore: Against = ()) -> set[str]:
         """The selected objects that any of the named world objects collides with."""
-        entries = self._query_entries(names)
-        manager = self._manager(against, ignore, tuple(e.name for e in entries))
-        hits: set[str] = set()
-        if manager is None:
-            return hits
-        own = {e.name for e in entries}
-        result = self._every.data.result
-        for e in entries:
-            manager.collide(e.obj, self._every)
-            if result.numContacts():
-                self._collect(result, hits, own)
+        own = self._own(names)
+        hits = self._query(own, self._select(against, ignore, tuple(e.name for e in own[1])), stop=False)
+        assert isinstance(hits, set)
         return hits
 
     def distance(self, a: str, b: str) -> float:
         """Distance between two world objects; negative is a penetration depth (convex shapes)."""
-        coal = self._coal
+        coal = _kit().coal
         result = coal.DistanceResult()
         return float(coal.distance(self._entries[a].obj, self._entries[b].obj, coal.DistanceRequest(), result))
 
     # ---------------------------------------------------------------------------------------- probes
 
-    def probe_collides(self, shapes: Probe, against: Against = None, ignore: Against = ()) -> bool:
+    def probe_collides(self, shapes: Probe | Posed, against: Against = None, ignore: Against = ()) -> bool:
         """Does any shape of the probe ((shape, 4×4 transform) pairs, not in the world) hit a selected object?"""
-        return self._probe_collides(shapes, against, ignore)
+        if not isinstance(shapes, Posed) and len(shapes) <= SMALL_PROBE:
+            tree = self._tree(against, ignore, ())
+            return tree is not None and self._tree_collides(tree, [_posed(s, t) for s, t in shapes])
+        return self._query(self._probe(shapes), self._select(against, ignore, ()), stop=True) is True
 
-    def probe_hits(self, shapes: Probe, against: Against = None, ignore: Against = ()) -> set[str]:
+    def probe_hits(self, shapes: Probe | Posed, against: Against = None, ignore: Against = ()) -> set[str]:
         """The selected objects that some shape of the probe hits."""
-        return self._probe_hits(shapes, against, ignore)
+        hits = self._query(self._probe(shapes), self._select(against, ignore, ()), stop=False)
+        assert isinstance(hits, set)
+        return hits
 
     def sweep_hits(self, probes: Iterable[Probe], against: Against = None, ignore: Against = ()) -> set[str]:
         """The union of the objects the probes hit (a swept volume given as configurations along a path)."""
-        return self._probe_hits([pair for probe in probes for pair in probe], against, ignore)
+        return self.probe_hits([pair for probe in probes for pair in probe], against, ignore)
 
     def batch_collides(
         self, shapes: Sequence[ShapeLike], transforms: np.ndarray, against: Against = None, ignore: Against = ()
     ) -> bool:
         """:meth:`probe_collides` for shapes ``L`` at ``transforms`` of shape (L, 4, 4) or (C, L, 4, 4)
         (C configurations of the same L links, as batched forward kinematics returns them)."""
-        return self._probe_collides(_batch(shapes, transforms), against, ignore)
+        return self.probe_collides(Posed.batch(shapes, transforms, self.tolerance), against, ignore)
 
     def batch_hits(
         self, shapes: Sequence[ShapeLike], transforms: np.ndarray, against: Against = None, ignore: Against = ()
     ) -> set[str]:
         """:meth:`probe_hits` (or :meth:`sweep_hits` for C configurations) in the batched form."""
-        return self._probe_hits(_batch(shapes, transforms), against, ignore)
+        return self.probe_hits(Posed.batch(shapes, transforms, self.tolerance), against, ignore)
 
     # -------------------------------------------------------------------------------------- internals
 
-    def _probe_collides(
-        self, shapes: Iterable[tuple[ShapeLike, np.ndarray]], against: Against, ignore: Against
-    ) -> bool:
-        manager = self._manager(against, ignore, ())
-        if manager is None:
-            return False
-        cb = self._first
-        result, collide = cb.data.result, manager.collide
-        for shape, t in shapes:
-            collide(_posed(shape, t), cb)  # the manager re-initialises the callback (clears its result) first
+    def _probe(self, shapes: Probe | Posed) -> Posed:
+        return shapes if isinstance(shapes, Posed) else Posed.of(shapes, self.tolerance)
+
+    def _own(self, names: str | Iterable[str]) -> tuple[Posed, list[_Entry]]:
+        entries = [self._entries[n] for n in ((names,) if isinstance(names, str) else names)]
+        pieces = Posed.of([(e.shape, e.transform) for e in entries], self.tolerance)
+        return pieces, entries
+
+    def _world(self) -> Posed:
+        """Every object of the world as one :class:`Posed` (insertion order), built when stale."""
+        if self._posed is None:
+            self._order = list(self._entries.values())
+            for k, e in enumerate(self._order):
+                e.slot = k
+            self._posed = Posed.of([(e.shape, e.transform) for e in self._order], 0.0)
+        return self._posed
+
+    def _query(self, probe: Posed | tuple[Posed, list[_Entry]], sel: np.ndarray, stop: bool) -> bool | set[str]:
+        """The probe against the selected objects: with ``stop``, whether something collides; else the names
+        of the selected objects something collides with."""
+        pieces = probe[0] if isinstance(probe, tuple) else probe
+        if not len(sel) or not len(pieces):
+            return False if stop else set()
+        world = self._world()
+        chosen = Posed.__new__(Posed)  # the selection's rows of the world (views of nothing: copies of a few rows)
+        chosen.shapes, chosen.kind, chosen.transforms = world.shapes, world.kind[sel], world.transforms[sel]
+        chosen.lo, chosen.hi, chosen._coarse = world.lo[sel], world.hi[sel], None
+        if stop:
+            return posed_collide(pieces, chosen, self.tolerance)
+        i, j = overlaps(pieces, chosen)
+        skip = np.zeros(len(sel), dtype=bool)
+        _exact(pieces, chosen, i, j, self.tolerance, stop=False, skip=skip)
+        return {self._order[int(k)].name for k in sel[skip]}
+
+    def _tree_collides(self, tree: _Tree, objs: list[Any]) -> bool:
+        if tree.version != self._version:
+            tree.manager.update()
+            tree.version = self._version
+        cb, collide = self._first, tree.manager.collide
+        result = cb.data.result
+        for obj in objs:
+            collide(obj, cb)  # the manager re-initialises the callback (clears its result) first
             if result.isCollision():
                 return True
         return False
 
-    def _probe_hits(
-        self, shapes: Iterable[tuple[ShapeLike, np.ndarray]], against: Against, ignore: Against
-    ) -> set[str]:
-        manager = self._manager(against, ignore, ())
-        hits: set[str] = set()
-        if manager is None:
-            return hits
-        cb = self._every
-        result, collide = cb.data.result, manager.collide
-        for shape, t in shapes:
-            collide(_posed(shape, t), cb)
-            if result.numContacts():
-                self._collect(result, hits)
-        return hits
-
-    def _collect(self, result: Any, hits: set[str], own: set[str] | None = None) -> None:
-        """Add the world objects the contacts in ``result`` name (other than ``own``) to ``hits``."""
-        by_gid = self._by_gid
-        for contact in result.getContacts():
-            for geometry in (contact.o1, contact.o2):
-                name = by_gid.get(geometry.id())
-                if name is not None and (own is None or name not in own):
-                    hits.add(name)
-
-    def _query_entries(self, names: str | Iterable[str]) -> list[_Entry]:
-        if isinstance(names, str):
-            names = (names,)
-        return [self._entries[n] for n in names]
+    def _tree(self, against: Against, ignore: Against, exclude: tuple[str, ...]) -> _Tree | None:
+        """coal's broadphase tree of a selection (None when it is empty), built on first use."""
+        sel = self._select(against, ignore, exclude)
+        if not len(sel):
+            return None
+        key = (against if against is None or isinstance(against, str) else frozenset(against), ignore, exclude)
+        key = (key[0], ignore if isinstance(ignore, str) else frozenset(ignore or ()), exclude)
+        tree = self._trees.get(key)
+        if tree is None:
+            manager = _kit().coal.DynamicAABBTreeCollisionManager()
+            for k in sel.tolist():  # insertion order: deterministic trees
+                manager.registerObject(self._order[k].obj)
+            manager.setup()
+            if len(self._trees) >= self.MAX_SELECTIONS:
+                del self._trees[next(iter(self._trees))]
+            tree = self._trees[key] = _Tree(manager, self._version)
+        return tree
 
     def _tokens(self, tokens: Against) -> set[str]:
         if tokens is None:
@@ -436,8 +705,8 @@ class CollisionWorld:
                 out.add(tok)
         return out
 
-    def _manager(self, against: Against, ignore: Against, exclude: tuple[str, ...]) -> Any:
-        """The broadphase manager of the selected objects (None when nothing is selected), refit if stale."""
+    def _select(self, against: Against, ignore: Against, exclude: tuple[str, ...]) -> np.ndarray:
+        """The rows of the selected objects (insertion order), cached until objects are added or removed."""
         key = (
             against if against is None or isinstance(against, str) else frozenset(against),
             ignore if isinstance(ignore, str) else frozenset(ignore or ()),
@@ -445,19 +714,13 @@ class CollisionWorld:
         )
         sel = self._selections.get(key)
         if sel is None:
+            self._world()
             chosen = self._tokens(against) - self._tokens(ignore) - set(exclude)
-            manager = self._coal.DynamicAABBTreeCollisionManager()
-            for name, entry in self._entries.items():  # insertion order: deterministic trees
-                if name in chosen:
-                    manager.registerObject(entry.obj)
-            manager.setup()
+            sel = np.array([e.slot for e in self._order if e.name in chosen], dtype=np.intp)
             if len(self._selections) >= self.MAX_SELECTIONS:
                 del self._selections[next(iter(self._selections))]
-            sel = self._selections[key] = _Selection(manager, self._version, len(chosen))
-        elif sel.version != self._version:
-            sel.manager.update()
-            sel.version = self._version
-        return sel.manager if sel.size else None
+            self._selections[key] = sel
+        return sel
 
 
 #: slack added to the bounds of :class:`PairCheck`'s pre-filter (m): hulls of flat clouds are thickened by up to
@@ -660,21 +923,9 @@ def _place(obj: Any, t: np.ndarray) -> None:
     obj.computeAABB()
 
 
-def _batch(shapes: Sequence[ShapeLike], transforms: np.ndarray) -> list[tuple[CollisionShape, np.ndarray]]:
-    t = np.asarray(transforms, dtype=float)
-    links = [collision_shape(s) for s in shapes]
-    if t.shape[-3:] != (len(links), 4, 4):
-        raise ValueError(f"transforms of shape {t.shape} do not match {len(links)} shapes")
-    flat = t.reshape(-1, 4, 4)
-    return list(zip(links * (len(flat) // max(1, len(links))), flat))
-
-
 def _posed(shape: ShapeLike, t: np.ndarray) -> Any:
     """The shape's probe object moved to ``t`` (4×4), its bounding box refreshed (coal trap: without
     ``computeAABB`` after a move the broadphase silently works on the old box)."""
     obj = (shape if type(shape) is CollisionShape else collision_shape(shape)).coal_object
-    t = np.asarray(t, dtype=float)
-    obj.setRotation(t[:3, :3])
-    obj.setTranslation(t[:3, 3])
-    obj.computeAABB()
+    _place(obj, t)
     return obj

@@ -14,12 +14,20 @@ grounds steps) and answers:
 
 Every answer carries a :class:`GroundStatus`; failures are values, never exceptions.  Seeds derive from the
 query, so the same queries in the same order give the same answers.
+
+**The run's deadline** (:attr:`Grounder.deadline`, a ``time.perf_counter()`` value; ``benchmarks/cpu_plan.py``
+swaps that clock for CPU time): every long loop reads it (placements, IK attempts, handover pairs, lifts,
+transfers, transits, RRT solves, lattice searches), and past it the query stops at once with what it has
+(status ``TIME_LIMIT`` where a status is the answer) and :attr:`Grounder.cut` turns True.  An answer made
+after the cut may be wrong, so the caller discards everything grounded since (the planner ends its search
+with ``time limit``); no clock decides an answer otherwise.
 """
 
 from __future__ import annotations
 
 import enum
 import hashlib
+import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -28,12 +36,12 @@ from typing import Callable, Hashable, Iterable, Iterator, Mapping, Sequence
 import numpy as np
 
 from mrgc.geometry.arm import Arm
-from mrgc.geometry.collision import CollisionShape, CollisionWorld, collision_shape, scene_world
+from mrgc.geometry.collision import CollisionShape, Posed, collision_shape, posed_collide, scene_world
 from mrgc.geometry.conventions import APPROACH_SAMPLES, ARM_PLACE_LIFT, lattice_offsets, se2, seed_for, to_se2
 from mrgc.geometry.grasps import APPROACH, finger_opening, fits, grasp_transform, pregrasp_transform
 from mrgc.geometry.ik import solve_ik_many
 from mrgc.geometry.lattice import Body, LatticePlanner, box_corners
-from mrgc.geometry.motion import MAX_CHECKS, plan_joint_path
+from mrgc.geometry.motion import MAX_CHECKS, MotionStatus, plan_joint_path
 from mrgc.geometry.planar import DiscGrid, PlanarRobot, is_planar, scene_bounds
 from mrgc.geometry.scene import Body as SceneBody
 from mrgc.geometry.scene import SceneSpec, half_extents, inside
@@ -178,6 +186,7 @@ class GroundStatus(str, enum.Enum):
     COLLISION = "collision"
     NO_PATH = "no path"
     UNKNOWN = "unknown"
+    TIME_LIMIT = "time limit"
 
 
 @dataclass
@@ -216,9 +225,8 @@ class Grounder:
         self._lattices: dict[str, LatticePlanner] = {}
         self._paths: dict[tuple[object, ...], Answer] = {}
         self._grips: dict[tuple[str, str], tuple[float, np.ndarray]] = {}
-        self._vol_world = _PieceWorld()
-        self._moving_world = _PieceWorld()
-        self._after_world = _PieceWorld()  # what an arm standing still afterwards keeps clear of (``after``)
+        #: volumes (V_fut, what the step's other robots sweep, ``after``) as the collision kernel reads them
+        self._volumes = _VolumeCache()
         # planar robots wait at their start pose (as the validator assumes): obstacles for the others
         self.parked: dict[str, str] = {}
         for spec in scene.robots:
@@ -228,6 +236,9 @@ class Grounder:
                 self.parked[spec.name] = f"@{spec.name}"
                 self.world.add(f"@{spec.name}", shape, pose, "robots")
         self.queries = 0
+        #: the run's deadline (``time.perf_counter()``; None: none), and whether it has cut a query short
+        self.deadline: float | None = None
+        self.cut = False
         self.coarse_misses = 0  # coarse arm paths that collided between their states (searched again, finely)
         #: arms wait at home while others move (the validator's rule): each arm's links at home, group
         #: ``home:<arm>``, an obstacle to the other arms' motions
@@ -240,6 +251,12 @@ class Grounder:
         #: arms of the step standing still away from home where they are known (:meth:`standing`): robot ->
         #: stance -> (world group, digest of its transforms)
         self._stands: dict[str, dict[Stance, tuple[str, bytes]]] = {}
+
+    def late(self) -> bool:
+        """Whether the run's :attr:`deadline` has passed (then :attr:`cut` is True: queries stop at once)."""
+        if not self.cut and self.deadline is not None and time.perf_counter() > self.deadline:
+            self.cut = True
+        return self.cut
 
     def _arm_homes(self) -> tuple[str, ...]:
         """Put every arm's links at home into the world (once) and name their groups."""
@@ -385,6 +402,24 @@ class Grounder:
         of the (object, grasp) held, or of ``grasp`` (approaching it), else fully open."""
         return self._arm_volume(robot, configs, holding, grasp)[0]
 
+    def arm_volumes(
+        self,
+        robot: str,
+        configs: np.ndarray,
+        holding: tuple[str, str] | None = None,
+        grasp: tuple[str, str] | None = None,
+    ) -> list[Volume]:
+        """:meth:`arm_volume` at each of ``configs`` separately (one volume per configuration: a motion's
+        samples), from one batched forward kinematics."""
+        configs = np.atleast_2d(configs)
+        volume = self._arm_volume(robot, configs, holding, grasp)[0]
+        links = len(self.arm(robot).probes[0])
+        out = [volume[k * links : (k + 1) * links] for k in range(len(configs))]
+        if holding is not None:  # the held object's pieces follow the links' (one per configuration)
+            for k, piece in enumerate(volume[links * len(configs) :]):
+                out[k].append(piece)
+        return out
+
     def free_volume(
         self,
         robot: str,
@@ -394,7 +429,10 @@ class Grounder:
     ) -> Volume | None:
         """:meth:`arm_volume`, or None when the arm collides with itself at one of ``configs``
         (:meth:`~mrgc.geometry.arm.Arm.self_collides`, on the same link transforms): every configuration the
-        grounding answers with (approaches, exchanges, transfers, transits, paths) is checked through here."""
+        grounding answers with (approaches, exchanges, transfers, transits, paths) is checked through here.
+        Past the run's deadline, None at once (:meth:`late`: every motion fails, the caller stops)."""
+        if self.late():
+            return None
         volume, transforms = self._arm_volume(robot, configs, holding, grasp)
         return None if self.arm(robot).self_collides_at(transforms) else volume
 
@@ -488,7 +526,7 @@ class Grounder:
             return
         rng = np.random.default_rng(seed_for("placement", obj, reg.name, key, seed=self.seed))
         h_o, h_r = half_extents(body.shape), half_extents(reg.shape)
-        vol_world = self._volume_world(volume) if volume else None
+        vol = self._volumes.posed(volume) if volume else None
         avoid = tuple(a for a in avoid if a != obj)
         shape = self.shape(obj)
         # first the 3 × 3 lattice phase 1 uses (so a placement the facts relied on is tried first), then
@@ -504,6 +542,8 @@ class Grounder:
             }
             fixed = sorted(fixed, key=lambda c: rank[c])  # stable
         for k in range(len(fixed) + samples):
+            if self.late():
+                return
             if k < len(fixed):
                 yaw, x, y = fixed[k]
             else:
@@ -520,11 +560,9 @@ class Grounder:
                 continue
             if avoid and self.world.probe_collides(probe, against=avoid):
                 continue
-            if vol_world is not None and vol_world.probe_collides(probe, against="volume"):
+            if vol is not None and posed_collide(Posed.of(probe), vol):
                 continue
             yield pose
-            if volume:  # the caller may have asked other placements meanwhile: the world holds ours again
-                vol_world = self._volume_world(volume)
 
     def crowded_out(
         self, objs: Iterable[str], region: str, avoid: Iterable[str] = (), volume: Volume | None = None, key: str = ""
@@ -536,6 +574,8 @@ class Grounder:
         sweep the whole bin leaves them none, and every grounding of an earlier step would then fail on it."""
         avoid, reg = tuple(avoid), self.scene.body(region)
         for obj in objs:
+            if self.late():
+                return None
             if inside(reg, self.scene.body(obj).shape, self.poses[obj]):
                 continue
             if next(self.placements(obj, region, avoid, volume, key=f"room:{key}", packed=True), None) is None:
@@ -559,14 +599,9 @@ class Grounder:
 
         return rank
 
-    def _volume_world(self, volume: Volume) -> CollisionWorld:
-        """A collision world holding ``volume`` (group "volume") for placements (V_fut), kept between calls:
-        see :class:`_PieceWorld`."""
-        return self._vol_world.holding(volume)
-
-    def _busy_world(self, volume: Pieces) -> CollisionWorld:
-        """The same for what other robots of a step sweep meanwhile (another world: both are used at once)."""
-        return self._moving_world.holding(volume)
+    def _busy(self, volume: Pieces) -> Posed | None:
+        """What other robots of a step sweep meanwhile (``busy``) as the kernel reads it (None: nothing)."""
+        return self._volumes.posed(volume) if volume else None
 
     # ------------------------------------------------------------ arm configurations
     def _approach(
@@ -592,7 +627,7 @@ class Grounder:
         avoid = tuple(a for a in avoid if a != obj)
         blockers: set[str] = set()
         status = GroundStatus.NO_IK
-        moving = self._busy_world(busy) if busy else None
+        moving = self._busy(busy)
         clash: tuple[str, Volume] | None = None  # the last attempt's collision not with ``avoid``: told at the end
         phase = key.split(":")[0]  # "pick", "place" or "handover"
         static = True  # every attempt so far failed on what never moves (IK, fixed bodies, bases)
@@ -623,17 +658,18 @@ class Grounder:
                 status, clash = GroundStatus.COLLISION, ("self", [])
                 continue
             self.queries += 1
-            if self._fixed_clash(robot, obj, grasp, configs, volume, held, self._others(robot, phase)):
+            posed = Posed.of(volume)
+            if self._fixed_clash(robot, obj, grasp, configs, posed, held, self._others(robot, phase)):
                 status, clash = GroundStatus.COLLISION, ("fixed", volume)
-                static = static and self._static_clash(robot, obj, volume, held)
+                static = static and self._static_clash(robot, obj, posed, held)
                 continue
             static = False  # this attempt failed (if it did) on what moves
-            hit = self.world.probe_hits(volume, against=avoid) if avoid else set()
+            hit = self.world.probe_hits(posed, against=avoid) if avoid else set()
             if hit:
                 blockers |= hit
                 status = GroundStatus.COLLISION
                 continue
-            if (moving is not None and moving.probe_collides(volume, against="volume")) or (
+            if (moving is not None and posed_collide(posed, moving)) or (
                 after and self._standing_clash(robot, obj, grasp, configs[-1], after)
             ):
                 # another robot of the step moves there meanwhile, or moves (or stands) where the arm stands
@@ -651,15 +687,15 @@ class Grounder:
         in the later phases it stands there (:meth:`step`).  Held: where it has let the object go, the object
         is there too then (placed, or held by the taker)."""
         volume = self.arm_volume(robot, q[None], holding=(obj, grasp))
-        return self._after_world.holding(after).probe_collides(volume, against="volume")
+        return posed_collide(Posed.of(volume), self._volumes.posed(after))
 
-    def _static_clash(self, robot: str, obj: str, volume: Volume, held: bool) -> bool:
+    def _static_clash(self, robot: str, obj: str, volume: Posed, held: bool) -> bool:
         """Whether an approach volume hits what never moves: a fixed body or another arm's base link."""
         bases = tuple(b for b in self._bases if b != f"base:{robot}")
         return self.world.probe_collides(volume, against=("fixed", *bases), ignore=() if held else (obj,))
 
     def _fixed_clash(
-        self, robot: str, obj: str, grasp: str, configs: np.ndarray, volume: Volume, held: bool, homes: tuple[str, ...]
+        self, robot: str, obj: str, grasp: str, configs: np.ndarray, volume: Posed, held: bool, homes: tuple[str, ...]
     ) -> bool:
         """Whether an approach (``configs``, swept as ``volume``) hits a fixed object or an arm at home
         (``homes``), or, picking, the object it picks before its contact segment (the last one: the validator
@@ -747,7 +783,7 @@ class Grounder:
         # configuration of the other arm drawn so far, until a pair does not collide
         found: dict[str, list[np.ndarray]] = {giver: [], taker: []}
         failed = Answer(GroundStatus.COLLISION)
-        worlds: list[CollisionWorld] = []  # the taker's configurations, one world each
+        worlds: list[Posed] = []  # the taker's configurations, as the kernel reads them
         later = after or {}
 
         def exchange(arm: str, grasp: str, attempt: int) -> Answer:
@@ -758,27 +794,27 @@ class Grounder:
             )
 
         for attempt in range(HANDOVER_PAIRS):
+            if self.late():
+                return Answer(GroundStatus.TIME_LIMIT)
             a, b = exchange(giver, g1, attempt), exchange(taker, g2, attempt)
             if not b.ok:
                 failed = b
             else:
                 assert b.configs is not None
                 found[taker].append(b.configs[-1])
-                world = CollisionWorld()
-                for i, (shape, t) in enumerate(self.arm_volume(taker, b.configs[-1:], grasp=(obj, g2))):
-                    world.add(f"t{i}", shape, t, "taker")
+                world = Posed.of(self.arm_volume(taker, b.configs[-1:], grasp=(obj, g2)))
                 worlds.append(world)
                 for q in found[giver]:  # the new taker configuration against the giver's earlier ones
-                    if not world.probe_collides(self.arm_volume(giver, q[None], grasp=(obj, g1)), against="taker"):
+                    if not posed_collide(Posed.of(self.arm_volume(giver, q[None], grasp=(obj, g1))), world):
                         return Answer(GroundStatus.OK, pose=pose, configs=np.stack([q, b.configs[-1]]))
             if not a.ok:
                 failed = a
             else:
                 assert a.configs is not None
                 found[giver].append(a.configs[-1])
-                volume = self.arm_volume(giver, a.configs[-1:], grasp=(obj, g1))
+                volume = Posed.of(self.arm_volume(giver, a.configs[-1:], grasp=(obj, g1)))
                 for q, world in zip(found[taker], worlds):  # the new giver configuration against every taker's
-                    if not world.probe_collides(volume, against="taker"):
+                    if not posed_collide(volume, world):
                         return Answer(GroundStatus.OK, pose=pose, configs=np.stack([a.configs[-1], q]))
         if not (found[giver] and found[taker]):  # one arm never got there: why (its last attempt)
             return Answer(failed.status, blockers=failed.blockers, detail=failed.detail)
@@ -811,16 +847,17 @@ class Grounder:
             *[a for a in avoid if not holding or a != holding[0]],
         )
         ignore = (holding[0],) if holding else ()
-        moving = self._busy_world(busy) if busy else None
+        moving = self._busy(busy)
 
         def free(configs: np.ndarray) -> bool:
             self.queries += 1
             volume = self.free_volume(robot, configs, holding, fingers)
             if volume is None:
                 return False
-            if moving is not None and moving.probe_collides(volume, against="volume"):
+            posed = Posed.of(volume)
+            if moving is not None and posed_collide(posed, moving):
                 return False
-            return not self.world.probe_collides(volume, against=against, ignore=ignore)
+            return not self.world.probe_collides(posed, against=against, ignore=ignore)
 
         def solve(step: float, budget: int) -> list[np.ndarray]:
             res = plan_joint_path(
@@ -832,7 +869,9 @@ class Grounder:
                 max_checks=budget,
                 seed=seed_for(robot, "arm-path", seed=self.seed),
                 resolution=step,
+                deadline=self.deadline,
             )
+            self.late()  # a solve the deadline stopped has set nothing: it is read here
             return list(res.path)
 
         if resolution < COARSE_RESOLUTION:
@@ -840,6 +879,8 @@ class Grounder:
             # ``resolution`` (one batch) and returned at that density; a path that collides between the coarse
             # states sends the search back to ``resolution`` with the whole budget
             coarse = solve(COARSE_RESOLUTION, max(1, round(max_checks * COARSE_BUDGET)))
+            if self.cut:
+                return Answer(GroundStatus.TIME_LIMIT)
             if coarse:
                 dense = joint_line(np.array(coarse), resolution)
                 if free(dense):
@@ -848,6 +889,8 @@ class Grounder:
             else:
                 return Answer(GroundStatus.NO_PATH)
         path = solve(resolution, max_checks)
+        if self.cut:
+            return Answer(GroundStatus.TIME_LIMIT)
         return Answer(GroundStatus.OK if path else GroundStatus.NO_PATH, path=path)
 
     def transfer(
@@ -880,12 +923,16 @@ class Grounder:
             self._presence(),
         ) + _fingerprint([start, goal, *poses], busy)
         if key not in self._paths:
-            self._remember(key, self._transfer(robot, obj, grasp, start, goal, avoid, lift, busy, lower, phase))
+            answer = self._transfer(robot, obj, grasp, start, goal, avoid, lift, busy, lower, phase)
+            self._remember(key, answer)
+            return answer
         return self._paths[key]
 
     def _remember(self, key: tuple[object, ...], answer: Answer) -> None:
         """Keep a path answer, forgetting the oldest beyond :data:`REMEMBERED` (insertion order: the same
         run forgets the same ones)."""
+        if self.cut:
+            return  # made after the deadline: not an answer to keep (the caller discards it too)
         if len(self._paths) >= REMEMBERED:
             del self._paths[next(iter(self._paths))]
         self._paths[key] = answer
@@ -917,7 +964,7 @@ class Grounder:
         held = (obj, grasp)
         others = tuple(a for a in avoid if a != obj)
         against = ("fixed", *self._others(robot, phase), *others)
-        moving = self._busy_world(busy) if busy else None
+        moving = self._busy(busy)
 
         crossed = [False]  # did the last blocked motion cross what another robot of the step sweeps?
 
@@ -926,12 +973,13 @@ class Grounder:
             itself)."""
             self.queries += 1
             volume = self.free_volume(robot, configs, holding=holding, grasp=held)
-            crossed[0] = volume is not None and moving is not None and moving.probe_collides(volume, against="volume")
-            if crossed[0] or volume is None:
+            posed = None if volume is None else Posed.of(volume)
+            crossed[0] = posed is not None and moving is not None and posed_collide(posed, moving)
+            if crossed[0] or posed is None:
                 return set()
-            if not self.world.probe_collides(volume, against=against, ignore=(obj,)):
+            if not self.world.probe_collides(posed, against=against, ignore=(obj,)):
                 return None
-            return self.world.probe_hits(volume, against=others, ignore=(obj,)) if others else set()
+            return self.world.probe_hits(posed, against=others, ignore=(obj,)) if others else set()
 
         back = np.asarray(start, dtype=float)[None]
         if lift:
@@ -1029,16 +1077,17 @@ class Grounder:
         (``to-pick``, ``giver-home`` ...: :meth:`step`), of ``avoid`` and of ``busy``; ``path`` as for
         :meth:`transfer`."""
         against = ("fixed", *self._others(robot, phase), *avoid)
-        moving = self._busy_world(busy) if busy else None
+        moving = self._busy(busy)
 
         def free(configs: np.ndarray) -> bool:
             self.queries += 1
             volume = self.free_volume(robot, configs, grasp=fingers)
             if volume is None:
                 return False
-            if moving is not None and moving.probe_collides(volume, against="volume"):
+            posed = Posed.of(volume)
+            if moving is not None and posed_collide(posed, moving):
                 return False
-            return not self.world.probe_collides(volume, against=against)
+            return not self.world.probe_collides(posed, against=against)
 
         if retreat is not None:
             start = np.asarray(start, dtype=float)
@@ -1147,6 +1196,8 @@ class Grounder:
         way = (0.0, 0.0, 1.0) if direction is None else tuple(float(v) for v in direction)
         out = [q]
         for dz in np.arange(1, round(height / 0.01) + 1) * 0.01:
+            if self.late():
+                break
             target = arm.ee_target(translation(way[0] * dz, way[1] * dz, way[2] * dz) @ tool)
             ik = solve_ik_many(arm.model, target[None], 0, q_init=out[-1], restarts=0)[0]
             if not ik.solved or ik.q is None or float(np.abs(ik.q - out[-1]).max()) > 0.2:
@@ -1174,7 +1225,9 @@ class Grounder:
         movers = sorted({a for a in avoid if not holding or a != holding[0]})
         key = (robot, holding, tuple(movers), *_fingerprint([start, goal, *(self.poses[a] for a in movers)], busy))
         if key not in self._paths:
-            self._remember(key, self._base_path(robot, start, goal, holding, movers, busy))
+            answer = self._base_path(robot, start, goal, holding, movers, busy)
+            self._remember(key, answer)
+            return answer
         return self._paths[key]
 
     def _base_path(
@@ -1200,19 +1253,17 @@ class Grounder:
         if not self._grids[robot].connected(np.asarray(start), np.asarray(goal), obstacles):
             return Answer(GroundStatus.NO_PATH)  # not even the footprint's inscribed disc gets through
 
-        sweep = None
-        if busy:
-            sweep = CollisionWorld()
-            for i, (shape, t) in enumerate(busy):
-                sweep.add(f"busy{i}", shape, t, "busy")
+        sweep = self._busy(busy)
 
         pr = self.planar(robot)
         carried = self._carried(robot, holding)
 
         def clear(q: np.ndarray, margin: float) -> bool:
             self.queries += 1
+            if self.late():
+                return False
             probe = pr.probe(q, carried, margin)
-            if sweep is not None and sweep.probe_collides(probe, against="busy"):
+            if sweep is not None and posed_collide(Posed.of(probe), sweep):
                 return False
             return not self.world.probe_collides(probe, against=against, ignore=ignore)
 
@@ -1240,7 +1291,11 @@ class Grounder:
             PATH_RESOLUTION,
             clear=clear,
             reach=pr.reach(carried),
+            deadline=self.deadline,
         )
+        if self.late() or res.status is MotionStatus.TIME_LIMIT:
+            self.cut = True
+            return Answer(GroundStatus.TIME_LIMIT)
         return Answer(GroundStatus.OK if res.solved else GroundStatus.NO_PATH, path=list(res.path))
 
     def _carried(self, robot: str, holding: tuple[str, str] | None) -> tuple[CollisionShape, np.ndarray] | None:
@@ -1251,30 +1306,26 @@ class Grounder:
         return self.shape(obj), self.planar(robot).carry_transform(self.scene.body(obj).shape, grasp)
 
 
-class _PieceWorld:
-    """A collision world holding a volume (group "volume"), kept between calls: pieces already in it (the
-    same tuple objects: the reverse search's volumes grow by concatenation) stay, the others are added or
-    removed, so a query pays only for what is new.  Booleans asked of it do not depend on the order the
-    pieces came in."""
+class _VolumeCache:
+    """Volumes as the collision kernel reads them (:class:`~mrgc.geometry.collision.Posed`), converted once
+    per list: the last few lists asked for (the same list object, unchanged: the reverse search's volumes
+    grow by concatenation into new lists) are kept with their conversion.  Nothing is copied into coal."""
+
+    SIZE = 8
 
     def __init__(self) -> None:
-        self.world = CollisionWorld()
-        self.pieces: dict[int, tuple[CollisionShape, np.ndarray]] = {}
-        self.last: tuple[object, int] | None = None  # the list last held and its length
+        self.kept: list[tuple[Pieces, int, Posed]] = []
 
-    def holding(self, volume: Pieces) -> CollisionWorld:
-        if self.last is not None and self.last[0] is volume and self.last[1] == len(volume):
-            return self.world  # the same list, unchanged (lists of volumes only grow by concatenation)
-        self.last = (volume, len(volume))
-        want = {id(piece): piece for piece in volume}
-        for key in [k for k in self.pieces if k not in want]:
-            self.world.remove(f"v{key}")
-            del self.pieces[key]
-        for key, piece in want.items():
-            if key not in self.pieces:
-                self.world.add(f"v{key}", piece[0], piece[1], "volume")
-                self.pieces[key] = piece  # held, so that its id is not reused while it is in the world
-        return self.world
+    def posed(self, volume: Pieces) -> Posed:
+        for k, (held, n, posed) in enumerate(self.kept):
+            if held is volume and n == len(volume):
+                if k:
+                    self.kept.insert(0, self.kept.pop(k))
+                return posed
+        posed = Posed.of(volume)
+        self.kept.insert(0, (volume, len(volume), posed))  # held, so that its id is not reused meanwhile
+        del self.kept[self.SIZE :]
+        return posed
 
 
 def _packing_grid(room: np.ndarray, cells: int = 15) -> list[tuple[float, float, float]]:

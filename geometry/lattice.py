@@ -37,7 +37,9 @@ search on a lattice of base poses, which finds a path whenever one exists among 
   (0.25 mm, below the validator's 1 mm contact tolerance).  Only segments that pass within ``L/2`` of an
   obstacle cost more than one test per state.
 
-Everything is deterministic: no random numbers, no clock.  The count of exact checks is reported in
+Everything is deterministic: no random numbers, and no clock but the run's ``deadline`` (a
+``time.perf_counter()`` value, :meth:`LatticePlanner.plan`): past it every test fails and the answer is
+``TIME_LIMIT``, never used as a result.  The count of exact checks is reported in
 :class:`~mrgc.geometry.motion.MotionResult` like the sampling planner's.
 """
 
@@ -173,20 +175,35 @@ class _Checks:
     answers remembered); ``count`` counts the tests made."""
 
     def __init__(
-        self, valid: Validity, clear: Clearance | None, reach: float, resolution: float, yaw_resolution: float
+        self,
+        valid: Validity,
+        clear: Clearance | None,
+        reach: float,
+        resolution: float,
+        yaw_resolution: float,
+        deadline: float | None = None,
     ) -> None:
         self.valid, self.clear, self.reach = valid, clear, reach
         self.resolution, self.yaw_resolution = resolution, yaw_resolution
         self.count = 0
         self._clear: dict[tuple[bytes, float], bool] = {}
+        self.deadline, self.late = deadline, False
+
+    def past(self) -> bool:
+        """Whether the run's deadline has passed (then every test fails: the answer is TIME_LIMIT)."""
+        if self.deadline is not None and not self.late and time.perf_counter() > self.deadline:
+            self.late = True
+        return self.late
 
     def state(self, q: np.ndarray) -> bool:
         """``valid(q)``, counted."""
         self.count += 1
-        return bool(self.valid(q.copy()))
+        return not self.past() and bool(self.valid(q.copy()))
 
     def _free(self, q: np.ndarray, margin: float) -> bool:
         assert self.clear is not None
+        if self.past():
+            return False
         key = (q.tobytes(), margin)
         if key not in self._clear:
             self.count += 1
@@ -324,16 +341,20 @@ class LatticePlanner:
         yaw_resolution: float,
         clear: Clearance | None = None,
         reach: float = 0.0,
+        deadline: float | None = None,
     ) -> MotionResult:
         """A path from ``start`` to ``goal`` through free lattice states, every state of it (at the
         resolutions) accepted by ``valid``; the first state is ``start``, the last ``goal``.  With ``clear``
         (and the robot's ``reach``, m), every motion between two states of the path is checked too
-        (:func:`segment_clear`)."""
+        (:func:`segment_clear`).  ``deadline`` (a ``time.perf_counter()`` value): past it the search stops
+        with status TIME_LIMIT."""
         t0 = time.perf_counter()
-        check = _Checks(valid, clear, reach, resolution, yaw_resolution)
+        check = _Checks(valid, clear, reach, resolution, yaw_resolution, deadline)
         ok, motion_ok = check.state, check.motion
 
         def result(status: MotionStatus, path: list[np.ndarray] | None = None) -> MotionResult:
+            if check.past():  # a test the deadline failed may have decided this answer
+                return MotionResult(MotionStatus.TIME_LIMIT, [], time.perf_counter() - t0, check.count)
             return MotionResult(status, path or [], time.perf_counter() - t0, check.count)
 
         p0 = np.array([start[0], start[1], wrap_angle(start[2])], dtype=float)
@@ -350,6 +371,8 @@ class LatticePlanner:
         if not starts or not goals:
             return result(MotionStatus.NO_PATH)
         for _ in range(REPAIRS + 1):
+            if check.past():
+                break
             nodes = self._wavefront(free, goals, starts)
             if nodes is None:
                 return result(MotionStatus.NO_PATH)

@@ -9,7 +9,9 @@ distance in radians/metres), and every returned state is one that OMPL's motion 
 
 Paths are not simplified unless asked (``simplify=True``): shortcutting costs 5–15× the solve (DESIGN §6).
 
-Determinism: no clock is read to decide anything.  A solve stops when RRTConnect connects its trees or
+Determinism: no clock is read to decide anything, except the run's ``deadline`` (a ``time.perf_counter()``
+value): past it a solve stops with status ``TIME_LIMIT`` (the planner then ends its search; an answer the
+deadline cut is never used as a result).  A solve stops when RRTConnect connects its trees or
 when it has made ``max_checks`` calls to ``is_valid`` (an OMPL ``PlannerTerminationCondition`` on a
 counter, evaluated by the planner between iterations, so a solve may overrun the budget by the checks of
 one iteration); OMPL's random generator is seeded per call.  The same inputs and seed therefore give the
@@ -42,6 +44,7 @@ class MotionStatus(str, enum.Enum):
     NO_PATH = "no-path"  # no exact solution within the budget of validity checks
     INVALID_START = "invalid-start"  # the start is out of bounds or fails is_valid
     INVALID_GOAL = "invalid-goal"  # the goal is out of bounds or fails is_valid
+    TIME_LIMIT = "time-limit"  # the run's deadline passed during the solve
 
 
 @dataclass(frozen=True)
@@ -90,11 +93,13 @@ def plan_joint_path(
     seed: int = 0,
     resolution: float = 0.05,
     simplify: bool = False,
+    deadline: float | None = None,
 ) -> MotionResult:
     """A collision-free path in the box ``lower <= q <= upper`` from ``start`` to ``goal`` (RRTConnect).
 
     ``is_valid(q)`` gets a fresh float array of the joint values; ``resolution`` is the largest step
-    between checked (and returned) states along a motion, in joint units.
+    between checked (and returned) states along a motion, in joint units.  ``deadline`` (a
+    ``time.perf_counter()`` value): the solve stops there with status ``TIME_LIMIT``.
     """
     lo, hi = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
     q0, q1 = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
@@ -119,7 +124,7 @@ def plan_joint_path(
         bounds.setHigh(i, float(hi[i]))
     space.setBounds(bounds)
     index = range(n)
-    budget = _Budget(max_checks)
+    budget = _Budget(max_checks, deadline)
 
     def check(state: Any) -> bool:
         budget.used += 1
@@ -141,15 +146,19 @@ def plan_joint_path(
 
 
 class _Budget:
-    """Validity checks allowed (``limit``) and made so far (``used``) by one solve."""
+    """Validity checks allowed (``limit``) and made so far (``used``) by one solve, and the run's deadline
+    (``late`` once it has passed)."""
 
-    __slots__ = ("limit", "used")
+    __slots__ = ("limit", "used", "deadline", "late")
 
-    def __init__(self, limit: int) -> None:
+    def __init__(self, limit: int, deadline: float | None = None) -> None:
         self.limit, self.used = int(limit), 0
+        self.deadline, self.late = deadline, False
 
     def spent(self) -> bool:
-        return self.used >= self.limit
+        if self.deadline is not None and not self.late and time.perf_counter() > self.deadline:
+            self.late = True
+        return self.late or self.used >= self.limit
 
 
 def _solve(
@@ -159,6 +168,8 @@ def _solve(
     t0 = time.perf_counter()  # statistics only: the budget is counted in validity checks
     # evaluated by the planner itself, between iterations (no watcher thread: no period argument)
     setup.solve(ob.PlannerTerminationCondition(budget.spent))
+    if budget.late:
+        return MotionResult(MotionStatus.TIME_LIMIT, [], time.perf_counter() - t0, budget.used)
     if not setup.haveExactSolutionPath():
         return MotionResult(MotionStatus.NO_PATH, [], time.perf_counter() - t0, budget.used)
     if simplify:

@@ -26,7 +26,7 @@ import numpy as np
 
 from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action
-from mrgc.geometry.collision import CollisionWorld
+from mrgc.geometry.collision import Posed, paired_collide, pieces_collide
 from mrgc.geometry.conventions import refine, to_se2
 from mrgc.geometry.grounding import BUSY, PHASES, SELF, Answer, Grounder, GroundStatus, Stance, Volume
 from mrgc.geometry.relays import spot_region
@@ -98,10 +98,13 @@ class ReverseGrounder:
         #: -> home, and for a handover the taker's way to the exchange and the giver's way home
         self.full = full
         self.movable = [b.name for b in grounder.scene.movable]
-        #: the search's time limit (``time.perf_counter()``): past it, a grounding stops with
-        #: :class:`DeadlineReached` before its next action (wall-clock time only ends the search; it never
-        #: decides what a grounding finds)
+        #: the search's time limit (``time.perf_counter()``): the grounder's queries read it in their long
+        #: loops and stop at once past it (:attr:`Grounder.cut <mrgc.geometry.grounding.Grounder.cut>`); a
+        #: grounding that the deadline cut short anywhere ends with :class:`DeadlineReached` and is discarded,
+        #: so the clock ends the search but never decides what a grounding finds
         self.deadline = deadline
+        if deadline is not None:
+            grounder.deadline = deadline
         #: the objects the steps grounded so far move (later in the plan than the step being grounded)
         self.grounded: set[str] = set()
         #: where the relays being grounded set their objects down (see :meth:`_relay_steps`)
@@ -112,7 +115,15 @@ class ReverseGrounder:
 
     def ground(self, skeleton: Skeleton, suffix: list[GroundedStep], key: str = "") -> Grounding:
         """Ground ``skeleton``'s steps, last first, before the already grounded ``suffix`` (see the module
-        docstring); ``key`` tells this query's seeds from other groundings'."""
+        docstring); ``key`` tells this query's seeds from other groundings'.  Raises :class:`DeadlineReached`
+        when the search's deadline cut a query of it short (its answer may then be wrong)."""
+        self._on_time()
+        result = self._ground(skeleton, suffix, key)
+        if self.g.cut:  # a query stopped at the deadline: what it answered decides nothing
+            raise DeadlineReached()
+        return result
+
+    def _ground(self, skeleton: Skeleton, suffix: list[GroundedStep], key: str) -> Grounding:
         fut_objs = {o for s in suffix for o in s.moved}
         skel_objs = set(skeleton.moved)
         out_objs = set(self.movable) - fut_objs - skel_objs
@@ -241,6 +252,7 @@ class ReverseGrounder:
             found, tried = 0, 0
             where = spot_region(g.scene, a.via, a.pick_robot, a.place_robot)
             for pose in g.placements(a.obj, where, avoid=others, volume=v_fut + taken, key=key):
+                self._on_time()
                 tried += 1
                 if tried > PLACEMENT_TRIES + OUT_OF_REACH_TRIES:
                     break
@@ -319,10 +331,9 @@ class ReverseGrounder:
                 for ph, path in action.paths.items()
             }
             return out
-        out.setdefault(action.pick_robot, {})["pick"] = [
-            g.arm_volume(action.pick_robot, q[None], grasp=(obj, action.pick_grasp))
-            for q in refine(np.array(action.configs["pick"]))
-        ]
+        out.setdefault(action.pick_robot, {})["pick"] = g.arm_volumes(
+            action.pick_robot, refine(np.array(action.configs["pick"])), grasp=(obj, action.pick_grasp)
+        )
         if "handover" in action.configs:
             giver, taker = np.array(action.configs["handover"])
             out[action.pick_robot]["handover"] = [
@@ -343,14 +354,12 @@ class ReverseGrounder:
         ):
             if phase in action.paths:
                 grip = (obj, grasp) if grasp is not None else None
-                out.setdefault(robot, {})[PATH_PHASE.get(phase, phase)] = [
-                    g.arm_volume(robot, np.array(q)[None], holding=grip if holds else None, grasp=grip)
-                    for q in action.paths[phase]
-                ]
-        out.setdefault(action.place_robot, {})["place"] = [
-            g.arm_volume(action.place_robot, q[None], (obj, action.place_grasp))
-            for q in refine(np.array(action.configs["place"]))
-        ]
+                out.setdefault(robot, {})[PATH_PHASE.get(phase, phase)] = g.arm_volumes(
+                    robot, np.array(action.paths[phase]), holding=grip if holds else None, grasp=grip
+                )
+        out.setdefault(action.place_robot, {})["place"] = g.arm_volumes(
+            action.place_robot, refine(np.array(action.configs["place"])), (obj, action.place_grasp)
+        )
         return out
 
     def _standing(self, action: PlannedAction, robot: str) -> dict[Stance, Volume]:
@@ -395,8 +404,8 @@ class ReverseGrounder:
         return [p for phase in PHASES if self.g.stance(robot, phase) is where for p in busy.get(phase, [])]
 
     def _on_time(self) -> None:
-        """Raise :class:`DeadlineReached` when the search's time limit has passed."""
-        if self.deadline is not None and time.perf_counter() > self.deadline:
+        """Raise :class:`DeadlineReached` when the search's time limit has passed (or cut a query short)."""
+        if self.g.cut or (self.deadline is not None and time.perf_counter() > self.deadline):
             raise DeadlineReached()
 
     def _action(
@@ -488,6 +497,7 @@ class ReverseGrounder:
         )
         looked = 0
         while looked < PLACEMENT_TRIES + OUT_OF_REACH_TRIES and tried < PLACEMENT_TRIES:
+            self._on_time()
             pose = next(spots, None)
             if pose is None:
                 return last or Failure(0, "", f"placement: no free pose of {a.obj} in {region}")
@@ -683,6 +693,7 @@ class ReverseGrounder:
             return _failed("drive to the pick", to_pick)
         last: Failure | None = None
         for k in range(PLACEMENT_TRIES):
+            self._on_time()
             spot = g.placement(a.obj, a.region, avoid=avoid, volume=v_fut, key=key, skip=k)
             if not spot.ok:
                 return last or Failure(0, "", f"placement: no free pose of {a.obj} in {a.region}")
@@ -804,30 +815,40 @@ def _robots_collide(mine: Motions, motions: Motions) -> tuple[str, tuple[str, ..
 
 def _phases_collide(mine: dict[str, list[Volume]], theirs: dict[str, list[Volume]]) -> str:
     """The first phase both robots move in where they collide, their samples paired by index (resampled);
-    "" when they never do."""
+    "" when they never do.  Each phase is one query of the collision kernel: every pair of samples at once,
+    only pieces of paired samples tested against each other."""
     for phase, samples in mine.items():
         other = theirs.get(phase)
         if not other:
             continue
         if len(samples) == 1 or len(other) == 1:  # one stands still: against every sample of the other at once
             still, moves = (samples, other) if len(samples) == 1 else (other, samples)
-            if _volumes_collide([p for vol in moves for p in vol], still[0]):
+            if pieces_collide([p for vol in moves for p in vol], still[0]):
                 return phase
             continue
-        n = max(len(samples), len(other))
-        for i in range(n):
-            if _volumes_collide(samples[i * len(samples) // n], other[i * len(other) // n]):
-                return phase
+        if _paired(samples, other):
+            return phase
     return ""
 
 
-def _volumes_collide(a: Volume, b: Volume) -> bool:
-    if not a or not b:
+def _paired(a: list[Volume], b: list[Volume]) -> bool:
+    """Whether sample ``i * len(a) // n`` of ``a`` collides with sample ``i * len(b) // n`` of ``b`` for some
+    ``i < n = max(len(a), len(b))`` (the validator's pairing of two motions)."""
+    n = max(len(a), len(b))
+    a_pieces: Volume = []
+    b_pieces: Volume = []
+    a_slot: list[int] = []
+    b_slot: list[int] = []
+    for i in range(n):
+        va, vb = a[i * len(a) // n], b[i * len(b) // n]
+        if va and vb:
+            a_pieces += va
+            b_pieces += vb
+            a_slot += [i] * len(va)
+            b_slot += [i] * len(vb)
+    if not a_pieces:
         return False
-    world = CollisionWorld()
-    for i, (shape, t) in enumerate(b):
-        world.add(f"b{i}", shape, t, "b")
-    return world.probe_collides(a, against="b")
+    return paired_collide(Posed.of(a_pieces), np.array(a_slot), Posed.of(b_pieces), np.array(b_slot))
 
 
 def moved_objects(steps: Iterable[GroundedStep]) -> set[str]:

@@ -543,3 +543,66 @@ def test_panda_grippers_in_handover_poses_agree(  # type: ignore[no-untyped-def]
     replay.set_config("r2", qs[1].q)
     near = replay.closest("r1", "r2", 0.1)
     agree("r1 / r2", world.batch_collides(shapes, t1, against="r2"), nearest, near.distance if near else 0.1)
+
+
+def _random_pieces(rng: np.random.Generator, n: int, spread: float) -> list[tuple[object, np.ndarray]]:
+    shapes = [
+        collision_shape(Box(0.05, 0.08, 0.03)),
+        collision_shape(Sphere(0.03)),
+        collision_shape(ConvexHull(rng.normal(size=(30, 3)) * 0.03)),
+    ]
+    out = []
+    for k in range(n):
+        t = np.eye(4)
+        t[:3, :3] = rpy_matrix(*rng.uniform(-math.pi, math.pi, 3))[:3, :3]
+        t[:3, 3] = rng.uniform(-spread, spread, 3)
+        out.append((shapes[k % 3], t))
+    return out
+
+
+def _pairwise(a: list[tuple[object, np.ndarray]], b: list[tuple[object, np.ndarray]]) -> bool:
+    """The reference: every pair through a world of one object (coal's own broadphase and narrowphase)."""
+    for shape, t in b:
+        world = CollisionWorld()
+        world.add("x", shape, t)  # type: ignore[arg-type]
+        if any(world.probe_collides([p]) for p in a):  # type: ignore[list-item]
+            return True
+    return False
+
+
+@pytest.mark.parametrize("n_a, n_b", [(1, 5), (12, 30), (40, 600)])
+def test_the_kernel_agrees_with_pairwise_coal(n_a: int, n_b: int) -> None:
+    """The kernel's answers (numpy broadphase, direct or grouped; coal's narrowphase on the pairs left) are
+    those of testing every pair with coal, on random boxes, spheres and hulls near each other."""
+    from mrgc.geometry.collision import Posed, overlaps, pieces_collide, posed_collide
+
+    rng = np.random.default_rng(n_a * 1000 + n_b)
+    for spread in (0.15, 0.4, 1.0):
+        a, b = _random_pieces(rng, n_a, spread), _random_pieces(rng, n_b, spread)
+        pa, pb = Posed.of(a), Posed.of(b)  # type: ignore[arg-type]
+        i, j = overlaps(pa, pb)
+        meet = {(int(x), int(y)) for x, y in zip(i, j)}
+        every = np.all(pa.lo[:, None] <= pb.hi[None], axis=2) & np.all(pb.lo[None] <= pa.hi[:, None], axis=2)
+        assert meet == {(int(x), int(y)) for x, y in zip(*np.nonzero(every))}  # grouping drops no pair
+        expected = _pairwise(a, b)
+        assert posed_collide(pa, pb) == expected
+        assert pieces_collide(a, b) == expected  # type: ignore[arg-type]
+        if n_b <= 30:  # which-objects: the world's numpy path against coal's, object by object
+            world = CollisionWorld()
+            for k, (shape, t) in enumerate(b):
+                world.add(f"b{k}", shape, t)  # type: ignore[arg-type]
+            hits = world.probe_hits(pa)
+            assert hits == {f"b{k}" for k, piece in enumerate(b) if _pairwise(a, [piece])}
+            assert world.probe_collides(pa) == expected == world.probe_collides(a)  # type: ignore[arg-type]
+
+
+def test_paired_collide_tests_only_pieces_of_the_same_slot() -> None:
+    """Two motions compared sample by sample: pieces of different samples never count."""
+    from mrgc.geometry.collision import Posed, paired_collide
+
+    box = collision_shape(Box(0.1, 0.1, 0.1))
+    a = Posed.of([(box, translation(0, 0, 0)), (box, translation(1, 0, 0))])
+    b = Posed.of([(box, translation(1, 0, 0)), (box, translation(0, 0, 0))])
+    assert not paired_collide(a, np.array([0, 1]), b, np.array([0, 1]))  # each sample apart from its pair
+    assert paired_collide(a, np.array([0, 1]), b, np.array([1, 1]))  # sample 1 of a against both of b
+    assert paired_collide(a, np.array([0, 0]), b, np.array([0, 0]))

@@ -391,3 +391,16 @@ def test_a_giver_lets_go_backing_its_fingers_off_the_object_the_taker_holds(pa3:
     for i, (shape, t) in enumerate(taker):
         world.add(f"taker{i}", shape, t, "taker")
     assert not world.probe_collides(pa3.arm_volume("r1", path, grasp=("o1", "top")), against="taker")
+
+
+def test_arm_volumes_are_the_volumes_of_each_configuration(pa3: Grounder) -> None:
+    """One batched forward kinematics for a motion's samples gives each sample's volume, held object
+    included, as :meth:`Grounder.arm_volume` does one by one."""
+    arm = pa3.arm("r1")
+    configs = arm.home[None] + np.linspace(0, 0.3, 4)[:, None]
+    for holding in (None, ("o1", "top")):
+        batched = pa3.arm_volumes("r1", configs, holding=holding, grasp=("o1", "top"))
+        for q, volume in zip(configs, batched):
+            one = pa3.arm_volume("r1", q[None], holding=holding, grasp=("o1", "top"))
+            assert [s for s, _ in volume] == [s for s, _ in one]
+            assert np.allclose(np.array([t for _, t in volume]), np.array([t for _, t in one]))

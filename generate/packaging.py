@@ -51,6 +51,11 @@ REGION_HEIGHT = 0.3
 BINS = 4  # at most this many bins (and at most one per goal)
 BIN_SIZE = (0.15, 0.35)
 BIN_GAP = 0.03  # free space between bins and the start region
+#: a bin's floor holds its goals when its area is at least this many times the sum of their cells (a cell:
+#: the square of the object's largest footprint side plus PLACE_GAP), and each side holds the largest cell
+BIN_ROOM = 1.5
+PLACE_GAP = 0.02
+BIN_GROW_MAX = 0.5  # a bin grown to hold its goals stays at most this long a side; more goals get a new bin
 HANDOVERS = 3  # at most this many handover points
 HANDOVER_Z = (0.25, 0.5)
 
@@ -99,7 +104,8 @@ def packaging(robots: int = 2, goals: int = 3, others: int = 2, seed: int = 0) -
     table, arms, start, objects, bins, handovers, pitch = layout
     goal_idx = _within_reach(arms, objects, [int(i) for i in rng.choice(len(objects), goals, replace=False)])
     goal_bin = {i: bins[int(rng.integers(len(bins)))].name for i in goal_idx}
-    # a stream of its own, so that a layout that needs no repair stays exactly as drawn
+    # streams of their own, so that a layout that needs no repair stays exactly as drawn
+    bins = _size_bins(np.random.default_rng([seed, 2]), table, arms, start, objects, bins, goal_bin)
     handovers = _connect(np.random.default_rng([seed, 1]), arms, table, objects, bins, goal_bin, handovers)
     name = f"packaging-r{robots}-g{goals}-o{others}-s{seed}"
     command = f"mrgc generate packaging --robots {robots} --goals {goals} --others {others} --seed {seed}"
@@ -293,6 +299,117 @@ def _handovers(
         else:
             return None
     return points
+
+
+def cell_side(obj: Item) -> float:
+    """The side of the square an object needs on a bin's floor: its largest footprint side (a cylinder's
+    diameter), whatever its yaw, plus PLACE_GAP."""
+    f = obj.foot
+    return 2 * (f.radius if f.disc else max(f.hx, f.hy)) + PLACE_GAP
+
+
+def holds(region: Footprint, goals: list[Item]) -> bool:
+    """Whether a bin's floor is roomy enough for ``goals`` (BIN_ROOM times their cells' area, each side at
+    least the largest cell): a rule of thumb a person would accept, not a packing."""
+    if not goals:
+        return True
+    side = max(cell_side(o) for o in goals)
+    need = BIN_ROOM * sum(cell_side(o) ** 2 for o in goals)
+    return min(2 * region.hx, 2 * region.hy) >= side and 4 * region.hx * region.hy >= need
+
+
+def _size_bins(
+    rng: np.random.Generator,
+    table: Footprint,
+    arms: list[Arm],
+    start: Item,
+    objects: list[Item],
+    bins: list[Item],
+    goal_bin: dict[int, str],
+) -> list[Item]:
+    """Bins that hold the goals sent to them (:func:`holds`).  A bin too small for its goals grows (at most
+    BIN_GROW_MAX a side) in place when it still fits there (on the table, clear of the bases and the other
+    regions), else at a spot drawn for its grown size; the goals that no such bin holds go, the last ones
+    first, to new bins sized for them (:func:`_new_bins`; processed the same way in turn); when no spot is
+    left for a new bin, they go to bins with room to spare, else they stay where they were sent (such an
+    instance may have no plan).  ``goal_bin`` is updated.  A layout whose bins hold their goals is left as
+    drawn (no random number is drawn for it)."""
+    out = list(bins)
+    k = 0
+    while k < len(out):
+        goals = sorted(i for i, b in goal_bin.items() if b == out[k].name)
+        taken = [start.foot] + [b.foot for j, b in enumerate(out) if j != k]
+        moved: list[int] = []
+        while goals and not holds(out[k].foot, [objects[i] for i in goals]):
+            grown = _grown(out[k].foot, [objects[i] for i in goals])
+            spot = _placed(rng, table, arms, grown, taken) if holds(grown, [objects[i] for i in goals]) else None
+            if spot is not None:
+                out[k] = Item(out[k].name, spot, REGION_HEIGHT)
+                break
+            moved.insert(0, goals.pop())
+        _new_bins(rng, table, arms, objects, out, goal_bin, moved, taken + [out[k].foot], out[k].name)
+        k += 1
+    return out
+
+
+def _new_bins(
+    rng: np.random.Generator,
+    table: Footprint,
+    arms: list[Arm],
+    objects: list[Item],
+    out: list[Item],
+    goal_bin: dict[int, str],
+    moved: list[int],
+    taken: list[Footprint],
+    sent: str,
+) -> None:
+    """New bins (appended to ``out``) for the goals ``moved`` out of bin ``sent``: one for all of them, or,
+    when no spot fits a bin that size, for the first half of them and so on; goals no new bin takes go to
+    bins with room to spare, else back to ``sent``."""
+    chunk = list(moved)
+    while moved and chunk:
+        foot = _grown(Footprint(0.0, 0.0, BIN_SIZE[0] / 2, BIN_SIZE[0] / 2), [objects[i] for i in chunk])
+        spot = _region_spot(rng, table, arms, foot.hx, foot.hy, taken + [b.foot for b in out])
+        if spot is None:
+            chunk = chunk[: len(chunk) // 2]
+            continue
+        out.append(Item(f"bin-{chr(ord('a') + len(out))}", spot, REGION_HEIGHT))
+        for i in chunk:
+            goal_bin[i] = out[-1].name
+        moved = [i for i in moved if i not in chunk]
+        chunk = list(moved)
+    for i in moved:
+        goal_bin[i] = next((b.name for b in out if _room_for(b, i, objects, goal_bin)), sent)
+
+
+def _room_for(region: Item, i: int, objects: list[Item], goal_bin: dict[int, str]) -> bool:
+    """Whether bin ``region`` holds its goals and object ``i`` besides."""
+    goals = [objects[j] for j, b in goal_bin.items() if b == region.name and j != i]
+    return holds(region.foot, goals + [objects[i]])
+
+
+def _grown(foot: Footprint, goals: list[Item]) -> Footprint:
+    """``foot`` scaled about its centre, keeping its aspect, until it holds ``goals``, each side at most
+    BIN_GROW_MAX (then it may not hold them)."""
+    side = max(cell_side(o) for o in goals)
+    need = BIN_ROOM * sum(cell_side(o) ** 2 for o in goals)
+    f = max(math.sqrt(need / (4 * foot.hx * foot.hy)), side / (2 * min(foot.hx, foot.hy)), 1.0)
+    hx = min(math.ceil(foot.hx * f * 1000) / 1000, BIN_GROW_MAX / 2)
+    hy = min(math.ceil(foot.hy * f * 1000) / 1000, BIN_GROW_MAX / 2)
+    return Footprint(foot.x, foot.y, hx, hy)
+
+
+def _placed(
+    rng: np.random.Generator, table: Footprint, arms: list[Arm], foot: Footprint, taken: list[Footprint]
+) -> Footprint | None:
+    """Where a grown bin ``foot`` goes: where it stands when it fits there, else a spot drawn for its size
+    (None: no spot found)."""
+    fits = (
+        foot.inside(table)
+        and all(foot.distance_to_point(a.x, a.y) >= BASE_CLEARANCE for a in arms)
+        and not any(overlaps(foot, t, BIN_GAP) for t in taken)
+    )
+    return foot if fits else _region_spot(rng, table, arms, foot.hx, foot.hy, taken)
 
 
 def reaches(arm: Arm, item: Item) -> bool:

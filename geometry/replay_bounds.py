@@ -54,7 +54,9 @@ class ArmBounds:
     ``self_pairs``: the link pairs checked against each other; ``fingers``: the finger links (and what
     hangs on them), which touch a held object; ``gripper``: the end-effector link and every link attached
     below it across joints outside the chain (hand and fingers), which may touch the object it picks in the
-    pick's contact segment; ``turns`` (dof,): 1 for a revolute chain joint, 0 for a prismatic one."""
+    pick's contact segment; ``turns`` (dof,): 1 for a revolute chain joint, 0 for a prismatic one;
+    ``spheres`` (len(links),): the radius of a sphere about each link's centre of mass holding its collision
+    shapes (:func:`_spheres`)."""
 
     links: tuple[int, ...]
     reach: np.ndarray
@@ -63,6 +65,7 @@ class ArmBounds:
     fingers: frozenset[int]
     gripper: frozenset[int]
     turns: np.ndarray
+    spheres: np.ndarray
 
     def column(self, link: int) -> int:
         """The column of ``reach`` that belongs to pybullet link ``link``."""
@@ -180,7 +183,10 @@ def arm_bounds(rs: ReplayScene, robot: str, home: np.ndarray) -> ArmBounds:
         ]
     )
     turns = np.array([tree.kind[j] != tree.prismatic for j in chain], dtype=float)
-    return ArmBounds(shaped, reach.reshape(len(chain), len(shaped)), ee_chain, pairs, fingers, tree.gripper(), turns)
+    spheres = _spheres(rs, robot, shaped, verts, home)
+    return ArmBounds(
+        shaped, reach.reshape(len(chain), len(shaped)), ee_chain, pairs, fingers, tree.gripper(), turns, spheres
+    )
 
 
 def _up_to(path: list[int], stop: int) -> list[int]:
@@ -206,6 +212,40 @@ def _radii(rs: ReplayScene, robot: str, links: tuple[int, ...], home: np.ndarray
             best[link] = min(best[link], float(np.linalg.norm(corners - frame, axis=1).max()))
     rs.set_config(robot, home)
     return best
+
+
+def _spheres(
+    rs: ReplayScene, robot: str, links: tuple[int, ...], verts: dict[int, np.ndarray], home: np.ndarray
+) -> np.ndarray:
+    """The radius of a sphere about each link's centre of mass (as pybullet places it:
+    :meth:`~mrgc.geometry.replay_world.ReplayScene.link_centres`) holding its collision shapes: the smallest
+    of (a) the farthest of the link's collision vertices (+ :data:`RADIUS_PAD`), where every shape of the
+    link is a mesh (pybullet's shape is the hull of those vertices), and (b) at home and
+    :data:`RADIUS_CONFIGS` more configurations, the farthest corner of pybullet's bounding box of the link
+    (which holds its shapes, margins included).  Each is a true bound: shapes and centre of mass are rigid in
+    the link's frame."""
+    r = rs.robots[robot]
+    rng = np.random.default_rng(1)
+    lo = np.where(np.isfinite(r.lower), r.lower, -np.pi)
+    hi = np.where(np.isfinite(r.upper), r.upper, np.pi)
+    best = dict.fromkeys(links, np.inf)
+    rs.set_config(robot, home)
+    centres = rs.link_centres(robot, list(links))
+    for k, link in enumerate(links):
+        v = verts.get(link)
+        if v is not None and rs.all_meshes(robot, link):
+            frame = _frame(rs, r, link)
+            local = frame[:3, :3].T @ (centres[k] - frame[:3, 3])
+            best[link] = float(np.linalg.norm(v - local, axis=1).max()) + RADIUS_PAD
+    for k in range(RADIUS_CONFIGS + 1):
+        rs.set_config(robot, home if k == 0 else rng.uniform(lo, hi))
+        centres = rs.link_centres(robot, list(links))
+        for i, link in enumerate(links):
+            box = np.array(rs.pb.getAABB(r.body, link, physicsClientId=rs.cid))
+            corners = np.array([[box[a][0], box[b][1], box[c][2]] for a in (0, 1) for b in (0, 1) for c in (0, 1)])
+            best[link] = min(best[link], float(np.linalg.norm(corners - centres[i], axis=1).max()) + RADIUS_PAD)
+    rs.set_config(robot, home)
+    return np.array([best[link] for link in links])
 
 
 def _frame(rs: ReplayScene, r: Any, link: int) -> np.ndarray:

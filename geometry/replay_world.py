@@ -33,6 +33,18 @@ PARKED = (0.0, 0.0, -1.0e3)
 MESH_MARGIN = 1e-3
 
 
+def rotations(quat: np.ndarray) -> np.ndarray:
+    """Rotation matrices (N, 3, 3) of quaternions (N, 4; x, y, z, w), normalised first (pybullet's are single
+    precision)."""
+    q = quat / np.linalg.norm(quat, axis=1, keepdims=True)
+    x, y, z, w = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
+    out = np.empty((len(q), 3, 3))
+    out[:, 0, 0], out[:, 0, 1], out[:, 0, 2] = 1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)
+    out[:, 1, 0], out[:, 1, 1], out[:, 1, 2] = 2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)
+    out[:, 2, 0], out[:, 2, 1], out[:, 2, 2] = 2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)
+    return out
+
+
 @dataclass(frozen=True)
 class Closest:
     """The deepest pair of points between two bodies: ``distance`` (signed, negative when they overlap)
@@ -257,9 +269,8 @@ class ReplayScene:
             pos, orn = tf.to_quaternion(base @ r.lift)
             self.pb.resetBasePositionAndOrientation(r.body, pos, orn, physicsClientId=self.cid)
             return
-        self.pb.resetJointStatesMultiDof(
-            r.body, r.joints, [[float(v)] for v in q[: len(r.joints)]], physicsClientId=self.cid
-        )
+        values = np.asarray(q[: len(r.joints)], dtype=float).reshape(-1, 1).tolist()
+        self.pb.resetJointStatesMultiDof(r.body, r.joints, values, physicsClientId=self.cid)
 
     def set_fingers(self, robot: str, opening: float | None) -> None:
         """Open an arm's fingers ``opening`` metres apart (None: back to their frozen, fully open values)."""
@@ -278,6 +289,40 @@ class ReplayScene:
             return base
         st = self.pb.getLinkState(r.body, r.ee, computeForwardKinematics=True, physicsClientId=self.cid)
         return pose_of(st[4], st[5])
+
+    def link_centres(self, robot: str, links: Sequence[int]) -> np.ndarray:
+        """The world positions (L, 3) of the centres of mass of links ``links`` of arm ``robot`` (-1: its
+        base) at its current configuration, as pybullet places them (one call for the links)."""
+        r = self.robots[robot]
+        states = self.pb.getLinkStates(
+            r.body, [max(link, 0) for link in links], computeForwardKinematics=True, physicsClientId=self.cid
+        )
+        pos = np.array([st[0] for st in states], dtype=float).reshape(len(links), 3)
+        for k, link in enumerate(links):
+            if link == -1:  # pybullet's base position is the base link's centre of mass
+                pos[k] = self.pb.getBasePositionAndOrientation(r.body, physicsClientId=self.cid)[0]
+        return pos
+
+    def position(self, name: str) -> np.ndarray:
+        """The world position (3,) of rigid body ``name``'s frame (an object, a planar robot's footprint)."""
+        r = self.robots.get(name)
+        body = r.body if r is not None else self.bodies[name]
+        return np.array(self.pb.getBasePositionAndOrientation(body, physicsClientId=self.cid)[0], dtype=float)
+
+    def body_frame(self, name: str) -> tuple[np.ndarray, np.ndarray]:
+        """The world frame of rigid body ``name`` (an object, or a planar robot's footprint body): position
+        (3,) and rotation (3, 3)."""
+        r = self.robots.get(name)
+        pos, orn = self.pb.getBasePositionAndOrientation(
+            r.body if r is not None else self.bodies[name], physicsClientId=self.cid
+        )
+        return np.array(pos, dtype=float), rotations(np.array([orn], dtype=float))[0]
+
+    def all_meshes(self, robot: str, link: int) -> bool:
+        """Whether every collision shape of link ``link`` of ``robot`` is a mesh (pybullet's hull of its
+        vertices)."""
+        data = self.pb.getCollisionShapeData(self.robots[robot].body, link, physicsClientId=self.cid)
+        return bool(data) and all(d[2] == self.pb.GEOM_MESH for d in data)
 
     # ------------------------------------------------------------------ distances
     def aabb(self, name: str) -> tuple[float, float, float, float, float, float]:
@@ -323,28 +368,68 @@ class ReplayScene:
         """Signed distances (margin-corrected) between the links of bodies ``a`` and ``b`` closer than
         ``max_distance``: (link of a, link of b) -> the least distance (-1 for a rigid object), after the
         base-link rule; with ``a == b`` (a robot against itself) ``links_a`` names the two links to ask."""
+        return self.prober(a, b, max_distance, links_a)()
+
+    def prober(
+        self, a: str, b: str, max_distance: float, links_a: tuple[int, ...] | None = None
+    ) -> Callable[[], dict[tuple[int, int], float]]:
+        """:meth:`link_distances` of ``a`` and ``b`` as a function of no arguments, everything it needs to
+        look up done once (the sweep asks one pair many times)."""
+        pb, cid, margin = self.pb, self.cid, self._margin
         ba = self.robots[a].body if a in self.robots else self.bodies[a]
         bb = self.robots[b].body if b in self.robots else self.bodies[b]
         extra = float(max_distance) + 2 * MESH_MARGIN
-        if links_a is not None:
-            pts = self.pb.getClosestPoints(
-                ba, bb, extra, linkIndexA=links_a[0], linkIndexB=links_a[1], physicsClientId=self.cid
+        links = {} if links_a is None else {"linkIndexA": links_a[0], "linkIndexB": links_a[1]}
+        skip_a = -1 if a in self.robots and not self.robots[a].planar and b in self.fixed else -2
+        skip_b = -1 if b in self.robots and not self.robots[b].planar and a in self.fixed else -2
+        margin_a = {link: m for (body, link), m in margin.items() if body == ba}
+        margin_b = {link: m for (body, link), m in margin.items() if body == bb}
+
+        def probe() -> dict[tuple[int, int], float]:
+            pts = pb.getClosestPoints(ba, bb, extra, physicsClientId=cid, **links)
+            self.queries += 1
+            out: dict[tuple[int, int], float] = {}
+            for p in pts:
+                la, lb = p[3], p[4]
+                if la == skip_a or lb == skip_b:  # the base-link rule
+                    continue
+                d = p[8] + margin_a.get(la, 0.0) + margin_b.get(lb, 0.0)
+                if d < max_distance and d < out.get((la, lb), math.inf):
+                    out[(la, lb)] = d
+            return out
+
+        return probe
+
+    def carrier(self, robot: str, obj: str, offset: np.ndarray) -> Callable[[], None]:
+        """A function of no arguments that puts object ``obj`` where arm ``robot``, at its current
+        configuration, holds it: at ``offset`` (4×4, the object's frame in the end-effector link's frame)
+        from its end-effector link frame (pybullet's forward kinematics, the quaternion normalised, the
+        product in double precision: what ``set_pose(obj, ee_pose(robot) @ offset)`` does, without the
+        matrices)."""
+        pb, cid = self.pb, self.cid
+        body, ee, target = self.robots[robot].body, self.robots[robot].ee, self.bodies[obj]
+        (ox, oy, oz), (bx, by, bz, bw) = tf.to_quaternion(np.asarray(offset, dtype=float))
+
+        def put() -> None:
+            st = pb.getLinkState(body, ee, computeForwardKinematics=True, physicsClientId=cid)
+            (px, py, pz), (x, y, z, w) = st[4], st[5]
+            n = math.sqrt(x * x + y * y + z * z + w * w)
+            x, y, z, w = x / n, y / n, z / n, w / n
+            tx, ty, tz = 2 * (y * oz - z * oy), 2 * (z * ox - x * oz), 2 * (x * oy - y * ox)  # q v q*
+            pos = (
+                px + ox + w * tx + (y * tz - z * ty),
+                py + oy + w * ty + (z * tx - x * tz),
+                pz + oz + w * tz + (x * ty - y * tx),
             )
-        else:
-            pts = self.pb.getClosestPoints(ba, bb, extra, physicsClientId=self.cid)
-        self.queries += 1
-        skip_a = a in self.robots and not self.robots[a].planar and b in self.fixed
-        skip_b = b in self.robots and not self.robots[b].planar and a in self.fixed
-        out: dict[tuple[int, int], float] = {}
-        margin = self._margin
-        for p in pts:
-            la, lb = int(p[3]), int(p[4])
-            if (skip_a and la == -1) or (skip_b and lb == -1):
-                continue
-            d = float(p[8]) + margin.get((ba, la), 0.0) + margin.get((bb, lb), 0.0)
-            if d < max_distance and d < out.get((la, lb), np.inf):
-                out[(la, lb)] = d
-        return out
+            orn = (
+                w * bx + x * bw + y * bz - z * by,
+                w * by - x * bz + y * bw + z * bx,
+                w * bz + x * by - y * bx + z * bw,
+                w * bw - x * bx - y * by - z * bz,
+            )
+            pb.resetBasePositionAndOrientation(target, pos, orn, physicsClientId=cid)
+
+        return put
 
     def link_name(self, name: str, index: int) -> str | None:
         """The name of link ``index`` of robot ``name`` (None for a rigid object)."""

@@ -72,13 +72,13 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass, field
-from typing import Any, Sequence
+from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from mrgc.geometry.replay_bounds import arm_bounds, planar_radius
+from mrgc.geometry.replay_bounds import ArmBounds, arm_bounds, planar_radius
 from mrgc.geometry.replay_world import ReplayScene
-from mrgc.geometry.scene import SceneSpec, inside, outline, scene_from_problem
+from mrgc.geometry.scene import SceneSpec, half_extents, inside, outline, scene_from_problem
 from mrgc.geometry.transforms import translation
 from mrgc.language.model import Problem
 from mrgc.planner.plan import MotionModel
@@ -279,6 +279,79 @@ class _PhaseWorld:
         return w
 
 
+class _Spheres:
+    """Lower bounds on the distances of a phase's sub-pairs without asking pybullet (the sweep's
+    :attr:`~mrgc.planner.sweep.Sweep.bound`): every robot link is held by a sphere about its centre of mass
+    (:attr:`~mrgc.geometry.replay_bounds.ArmBounds.spheres`), a planar robot's footprint and a carried object
+    by one about its frame, every object that stands still in the phase by its bounding box; two spheres are
+    at least the distance of their centres less both radii apart, a sphere and a box the distance of the
+    centre from the box less the radius.  Positions are pybullet's, read at the time the world is set to."""
+
+    def __init__(self, ph: _PhaseWorld, pairs: list[Pair], sides: list[tuple[_Part, _Part, Any, str]]) -> None:
+        rp, rs = ph.rp, ph.rp.rs
+        self.rs = rs
+        index: dict[tuple[str, int], int] = {}
+        radius: list[float] = []
+        half: list[np.ndarray | None] = []
+        self.arms: list[tuple[str, list[int], np.ndarray]] = []  # moving arm, its links, their elements
+        self.bodies: list[tuple[str, int]] = []  # moving rigid bodies (planar robots, carried objects)
+        moving = {tr.robot for tr in ph.tracks}
+        static: list[tuple[str, int]] = []
+        for part in (*ph.parts.values(), *ph.objects.values()):
+            first = len(radius)
+            arm = part.robot and not rp.planar[part.name]
+            for link in part.rows:
+                index[(part.name, link)] = len(radius)
+                if arm:
+                    b = rp.bounds[part.name]
+                    radius.append(float(b.spheres[b.column(link)]))
+                    half.append(None)
+                    continue
+                h = half_extents(rp.footprint_shape[part.name] if part.robot else rp.shapes[part.name])
+                radius.append(float(np.linalg.norm(h)) + 1e-6)
+                half.append(None if part.robot or part.track >= 0 else h + 1e-6)
+            elems = np.arange(first, len(radius))
+            if arm:
+                self.arms.append((part.name, list(part.rows), elems))
+            elif part.track >= 0 or part.name in moving:
+                self.bodies.append((part.name, first))
+            else:
+                static.append((part.name, first))
+        self.radius = np.array(radius)
+        self.box = np.array([h is not None for h in half])
+        self.half = np.array([h if h is not None else np.zeros(3) for h in half]).reshape(-1, 3)
+        self.centre = np.zeros((len(radius), 3))
+        self.rot = np.tile(np.eye(3), (len(radius), 1, 1))
+        for name, e in static:  # what stands still, where it stands at the start of the phase
+            self.centre[e], self.rot[e] = rs.body_frame(name)
+        self.arms_moving = [arm for arm in self.arms if arm[0] in moving]
+        for robot, links, elems in self.arms:
+            self.centre[elems] = rs.link_centres(robot, links)
+        ends = np.array(
+            [(index[(a.name, la)], index[(b.name, lb)]) for p, (a, b, _, _) in zip(pairs, sides) for la, lb in p.subs]
+        ).reshape(-1, 2)
+        flip = self.box[ends[:, 0]] & ~self.box[ends[:, 1]]  # the sphere first, the box second
+        ends[flip] = ends[flip][:, ::-1]
+        self.a, self.b = ends[:, 0], ends[:, 1]
+        self.reach = self.radius[self.a] + np.where(self.box[self.b], 0.0, self.radius[self.b])
+        self.to_box = np.flatnonzero(self.box[self.b])
+        self.box_a, self.box_b = self.a[self.to_box], self.b[self.to_box]
+
+    def __call__(self) -> np.ndarray:
+        """The lower bound of every sub-pair's distance (in the sweep's order) at the world's current state."""
+        rs, centre = self.rs, self.centre
+        for robot, links, elems in self.arms_moving:
+            centre[elems] = rs.link_centres(robot, links)
+        for name, e in self.bodies:
+            centre[e] = rs.position(name)
+        gap = centre[self.a] - centre[self.b]
+        if len(self.to_box):  # the sphere's centre in the box's frame, its distance from the box
+            inside = np.einsum("nji,nj->ni", self.rot[self.box_b], gap[self.to_box])
+            gap[self.to_box] = np.maximum(np.abs(inside) - self.half[self.box_b], 0.0)
+        out: np.ndarray = np.sqrt(np.einsum("ij,ij->i", gap, gap)) - self.reach
+        return out
+
+
 class _Stop(Exception):
     """The first violation is known and no more are wanted."""
 
@@ -334,6 +407,19 @@ def _world(problem: Problem) -> tuple[SceneSpec, ReplayScene]:
     return scene, rs
 
 
+def _arm_bounds(rs: ReplayScene, homes: dict[str, np.ndarray]) -> dict[str, ArmBounds]:
+    """Each arm's :class:`~mrgc.geometry.replay_bounds.ArmBounds`, derived once per world (they depend on
+    the URDF as loaded and on the arm's home only) and kept with it."""
+    kept: dict[tuple[int, str], tuple[np.ndarray, ArmBounds]] = _WORLD.setdefault("bounds", {})
+    out = {}
+    for robot, home in homes.items():
+        key = (id(rs), robot)
+        if key not in kept or not np.array_equal(kept[key][0], home):
+            kept[key] = (np.array(home), arm_bounds(rs, robot, home))
+        out[robot] = kept[key][1]
+    return out
+
+
 class _Replayer(ActionReader):
     def __init__(self, scene: SceneSpec, rs: ReplayScene, model: MotionModel) -> None:
         super().__init__(scene, rs, model)
@@ -345,7 +431,8 @@ class _Replayer(ActionReader):
         self.budget_spent = False
         self._worst: dict[tuple[Any, ...], tuple[float, str, str]] = {}
         self.first_only = False
-        self.bounds = {r: arm_bounds(rs, r, self.home[r]) for r, planar in self.planar.items() if not planar}
+        self.bounds = _arm_bounds(rs, {r: self.home[r] for r, planar in self.planar.items() if not planar})
+        self.footprint_shape = {r.name: r.kind.footprint for r in scene.robots if r.kind.footprint is not None}
         self.footprint = {
             r.name: planar_radius(outline(r.kind.footprint))
             for r in scene.robots
@@ -479,23 +566,27 @@ class _Replayer(ActionReader):
         pairs, sides = self._pairs(ph)
         rs = self.rs
 
+        carry = [self._carrier(tr) for tr in tracks]
+
         def set_state(s: float) -> None:
-            for tr in tracks:
-                q = config_at(tr.configs, s, self.planar[tr.robot])
-                rs.set_config(tr.robot, q)
-                if tr.holding and tr.grasp and tr.carries:
-                    rs.set_pose(tr.holding, self.held_pose_now(tr.robot, tr.holding, tr.grasp))
+            for tr, put in zip(tracks, carry):
+                rs.set_config(tr.robot, config_at(tr.configs, s, self.planar[tr.robot]))
+                if put is not None:
+                    put()
             self.samples += len(tracks)
 
+        probes = [rs.prober(a.name, b.name, CAP, links) for a, b, links, _ in sides]
+
         def query(p: int, s: float) -> dict[tuple[int, int], float]:
-            a, b, links, _ = sides[p]
-            return rs.link_distances(a.name, b.name, CAP, links)
+            return probes[p]()
 
         def report(p: int, sub: tuple[int, int], d: float, s: float) -> None:
             a, b, _, kind = sides[p]
             self._hit_at(t, phase, kind, (a, sub[0]), (b, sub[1]), d, ph.everyone, s)
 
         sweep = Sweep(ph.breakpoints(), ph.speeds, pairs, set_state, query, report, CONTACT_TOL, MAX_SAMPLES)
+        if pairs:
+            sweep.bound = _Spheres(ph, pairs, sides)
         if self.first_only:
             sweep.stop = lambda: bool(self._worst)
         sweep.run()
@@ -504,6 +595,16 @@ class _Replayer(ActionReader):
                 t, None, "too-long", f"{phase}: the motions need more than {MAX_SAMPLES} checked samples; not checked"
             )
         self.stop_if_found()
+
+    def _carrier(self, tr: _Track) -> Callable[[], None] | None:
+        """What puts the object track ``tr`` carries where its robot holds it now (None: it carries none)."""
+        if not (tr.holding and tr.grasp and tr.carries):
+            return None
+        robot, obj, grasp = tr.robot, tr.holding, tr.grasp
+        if self.planar[robot]:
+            return lambda: self.rs.set_pose(obj, self.held_pose_now(robot, obj, grasp))
+        self.held_pose_now(robot, obj, grasp)  # the grasp's offset, computed once
+        return self.rs.carrier(robot, obj, self.tcp[robot] @ self._held[(robot, obj, grasp)])
 
     def _pairs(self, ph: _PhaseWorld) -> tuple[list[Pair], list[tuple[_Part, _Part, tuple[int, int] | None, str]]]:
         """The pairs a phase checks, with their two sides, link indices (self pairs) and collision kind:

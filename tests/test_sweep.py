@@ -137,3 +137,27 @@ def test_the_sweep_passes_a_clear_motion_with_few_checks() -> None:
     sweep.run()
     assert not hits
     assert 5 < sweep.events < 200
+
+
+@settings(max_examples=25, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1))
+def test_the_spheres_hold_every_link(panda: Any, seed: int) -> None:
+    """The sphere about each link's centre of mass (the sweep's lower bounds: a pair farther apart than its
+    spheres is not asked of pybullet) holds the link: pybullet's distance between two links, and between a
+    link and a box, is never less than the bound at random configurations within the limits."""
+    rs, bounds, _ = panda
+    r = rs.robots["r1"]
+    rng = np.random.default_rng(seed)
+    rs.set_config("r1", rng.uniform(r.lower, r.upper))
+    links = list(bounds.links)
+    centres = rs.link_centres("r1", links)
+    pos, rot = rs.body_frame("o1")
+    half = np.array([0.02, 0.02, 0.05])  # o1 of pa5: a box 0.04 x 0.04 x 0.1
+    near = rs.link_distances("r1", "o1", 10.0)
+    for k, a in enumerate(links):
+        local = np.maximum(np.abs(rot.T @ (centres[k] - pos)) - half, 0.0)
+        assert near.get((a, -1), 10.0) >= float(np.linalg.norm(local)) - bounds.spheres[k] - 1e-6
+        for m in range(k + 1, len(links)):
+            b = links[m]
+            d = rs.link_distances("r1", "r1", 10.0, (a, b)).get((a, b), 10.0)
+            assert d >= float(np.linalg.norm(centres[k] - centres[m])) - bounds.spheres[k] - bounds.spheres[m] - 1e-6

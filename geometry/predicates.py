@@ -31,7 +31,7 @@ from typing import Callable, TypeVar
 import numpy as np
 
 from mrgc.geometry.arm import Arm
-from mrgc.geometry.collision import CollisionWorld, scene_world
+from mrgc.geometry.collision import Posed, posed_collide, scene_world
 from mrgc.geometry.conventions import APPROACH_SAMPLES, ARM_PLACE_LIFT, lattice_offsets, refine, seed_for
 from mrgc.geometry.facts import FactsResult, HandoverConfig, RobotFacts
 from mrgc.geometry.grasps import finger_opening, fits, grasp_transform, pregrasp_transform
@@ -427,7 +427,7 @@ def _handovers(scene: SceneSpec, per_robot: dict[str, RobotFacts], deadline: flo
     """``enable-goal-handover`` from the robots' handover configurations, checking robot–robot collisions;
     None when ``deadline`` passed first (it is read per goal object)."""
     out: set[Fact] = set()
-    arms: dict[str, Arm] = {}
+    arms = _ArmPoses(scene)
     for obj in scene.goal:
         if deadline is not None and time.perf_counter() > deadline:
             return None
@@ -442,14 +442,14 @@ def _handovers(scene: SceneSpec, per_robot: dict[str, RobotFacts], deadline: flo
                         fact = Fact("enable-goal-handover", (obj, g1, g2, r1, r2))
                         if o2 != obj or point2 != point or fact in out:
                             continue
-                        a1 = arms.setdefault(r1, Arm(scene.robot(r1)))
-                        a2 = arms.setdefault(r2, Arm(scene.robot(r2)))
                         shape = scene.body(obj).shape
                         w1 = finger_opening(scene.grasp(g1), shape)
                         w2 = finger_opening(scene.grasp(g2), shape)
                         if any(
                             # an arm may reach into the other one's home only: that one is at the exchange
-                            c1.homes <= {r2} and c2.homes <= {r1} and not _arms_collide(a1, c1.q, w1, a2, c2.q, w2)
+                            c1.homes <= {r2}
+                            and c2.homes <= {r1}
+                            and not posed_collide(arms.at(r1, c1.q, w1), arms.at(r2, c2.q, w2))
                             for c1 in c1s
                             for c2 in c2s
                         ):
@@ -457,11 +457,19 @@ def _handovers(scene: SceneSpec, per_robot: dict[str, RobotFacts], deadline: flo
     return out
 
 
-def _arms_collide(a1: Arm, q1: np.ndarray, w1: float, a2: Arm, q2: np.ndarray, w2: float) -> bool:
-    """Whether two arms collide, their fingers ``w1`` and ``w2`` apart."""
-    world = CollisionWorld()
-    shapes2, _ = a2.probes
-    for i, (shape, t) in enumerate(zip(shapes2, a2.link_transforms(q2, w2))):
-        world.add(f"{a2.name}#{i}", shape, t, "robot")
-    shapes1, _ = a1.probes
-    return world.batch_collides(shapes1, a1.link_transforms(q1, w1), against="robot")
+class _ArmPoses:
+    """The probed links of the scene's arms at handover configurations, posed once per (arm, configuration,
+    finger opening) however many partners they are checked against."""
+
+    def __init__(self, scene: SceneSpec) -> None:
+        self.scene = scene
+        self.arms: dict[str, Arm] = {}
+        self.posed: dict[tuple[str, bytes, float], Posed] = {}
+
+    def at(self, robot: str, q: np.ndarray, opening: float) -> Posed:
+        """The links of ``robot`` at ``q``, its fingers ``opening`` apart."""
+        key = (robot, np.asarray(q, dtype=float).tobytes(), opening)
+        if key not in self.posed:
+            arm = self.arms.setdefault(robot, Arm(self.scene.robot(robot)))
+            self.posed[key] = Posed.batch(arm.probes[0], arm.link_transforms(np.asarray(q)[None], opening)[0])
+        return self.posed[key]

@@ -74,6 +74,19 @@ class Camera:
         ys = (1 - (np.arange(height) + 0.5) / height * 2) * ty
         return f + xs[None, :, None] * r + ys[:, None, None] * u  # type: ignore[no-any-return]
 
+    def project(self, points: np.ndarray, width: int, height: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Pixel columns, rows (from the top-left corner, as floats) and eye-space depths of world points
+        (N, 3) in a ``width`` × ``height`` picture; a point behind the eye has depth <= 0."""
+        r, u, f = self.axes()
+        rel = np.asarray(points, dtype=float).reshape(-1, 3) - self.eye
+        z = rel @ f
+        safe = np.where(z > 1e-9, z, 1e-9)
+        ty = math.tan(math.radians(self.fov) / 2)
+        tx = ty * width / height
+        cols = ((rel @ r) / safe / tx + 1) / 2 * width
+        rows = (1 - (rel @ u) / safe / ty) / 2 * height
+        return cols, rows, z
+
     def linear_depth(self, zbuffer: np.ndarray) -> np.ndarray:
         """Eye-space depth from an OpenGL depth buffer in [0, 1]."""
         n, f = self.near, self.far

@@ -51,6 +51,10 @@ def add_commands(sub: Any) -> None:
     )
     p.add_argument("--fps", type=float, default=10.0, help="frames per second of the replay (default 10)")
     p.add_argument("--camera", default="iso", help=f"viewing direction: {CAMERA_HELP} (default iso)")
+    p.add_argument(
+        "--object-labels", action="store_true", help="name the movable objects too (robots and regions always are)"
+    )
+    p.add_argument("--no-labels", action="store_true", help="no names and no legend: the scene and the caption alone")
     p.add_argument("--gantt", action="store_true", help="write the Gantt chart (.svg or .png)")
     p.add_argument(
         "--force", action="store_true", help="draw a plan whose status is not 'solved' (exit code 1 all the same)"
@@ -69,6 +73,11 @@ def add_commands(sub: Any) -> None:
     p.add_argument("-o", "--output", metavar="OUT", required=True, help=".dot, or .svg/.png through Graphviz's dot")
     p.add_argument("--problem", help="which problem of the file (default: its only one)")
     p.add_argument("--skeleton", type=int, metavar="K", help="highlight the K-th task skeleton (1 = the first)")
+    p.add_argument(
+        "--full",
+        action="store_true",
+        help="draw every action of a large graph (more than 24 actions; by default only a skeleton's)",
+    )
     p.add_argument("--backend", default="cpsat", help="backend generating skeletons for --skeleton (default cpsat)")
     p.add_argument("--encoding", default="time-of-move")
     p.add_argument("--seed", type=int, default=0)
@@ -154,7 +163,8 @@ def cmd_render(args: argparse.Namespace) -> int:
         if name is None and len(mf.problems) > 1 and any(p.name == plan["problem"] for p in mf.problems):
             name = plan["problem"]
     problem = mf.problem(name)
-    opts = outputs.Options(width, height, args.fps, args.camera)
+    names = () if args.no_labels else ("robot", "region", "object") if args.object_labels else ("robot", "region")
+    opts = outputs.Options(width, height, args.fps, args.camera, names, not args.no_labels)
     source = args.plan or args.file
     with files.atomic_path(args.output, inputs) as tmp, _progress(f"drawing {os.path.basename(args.output)}") as bar:
         if kind == "reach":
@@ -212,11 +222,11 @@ def cmd_graph(args: argparse.Namespace) -> int:
     if ext != ".dot":
         graph.require_dot()
     problem = mf.problem(args.problem)
-    text, info = graph.task_graph_dot(problem, args.skeleton, args.backend, args.encoding, args.seed)
+    text, info = graph.task_graph_dot(problem, args.skeleton, args.backend, args.encoding, args.seed, args.full)
     if ext == ".dot":
         files.write_text(args.output, text, list(mf.files))
     else:
         with files.atomic_path(args.output, list(mf.files)) as tmp:
-            graph.run_dot(text, ext[1:], tmp)
+            info += "; " + graph.run_dot(text, ext[1:], tmp)
     print(f"{args.output}: task graph of {problem.name}: {info}")
     return ExitCode.OK

@@ -11,12 +11,16 @@ viser records what a live ``ViserServer`` sends, so a server is started for the 
 bound to the loopback interface on a free port (``127.0.0.1:0``); no client ever connects and it is stopped
 before the file is written.  The scene is :class:`~mrgc.render.world.World`'s drawables: fixed objects,
 regions (translucent), objects coloured by role, robots as their collision shapes; each frame updates only
-the poses that changed, and a label shows the caption.
+the poses that changed, and a label shows the caption.  Robots, regions and (on request) objects carry
+their names as viser labels under the scene node ``/labels`` (the viewer's scene tree hides them all with
+one click; a planar robot's name moves with it), and a legend of the colours is plain HTML added to the
+page over the viewer's top-left corner.
 """
 
 from __future__ import annotations
 
 import contextlib
+import html
 import io
 import math
 from typing import Any, Callable
@@ -26,7 +30,7 @@ import numpy as np
 from mrgc.geometry.transforms import to_quaternion
 from mrgc.render.camera import Camera
 from mrgc.render.frames import Frame
-from mrgc.render.palette import REGION_ALPHA, byte_colour
+from mrgc.render.palette import REGION_ALPHA, byte_colour, darker, hex_colour
 from mrgc.render.world import Drawable, World, shape_drawable
 
 
@@ -37,9 +41,14 @@ def write(
     fps: float,
     path: str,
     progress: Callable[[int, int], None] | None = None,
+    labels: tuple[str, ...] = ("robot", "region"),
+    legend: bool = True,
 ) -> int:
-    """Write the replay of ``frames`` (one frame: a still scene) to ``path``; returns its size in bytes."""
-    page = build(world, frames, camera, fps, progress)
+    """Write the replay of ``frames`` (one frame: a still scene) to ``path``, naming ``labels``' kinds,
+    with the legend when ``legend``; returns the file's size in bytes."""
+    page = build(world, frames, camera, fps, progress, labels)
+    if legend:
+        page = with_legend(page, legend_html(world))
     data = page.encode("utf-8")
     with open(path, "wb") as fh:
         fh.write(data)
@@ -47,17 +56,54 @@ def write(
 
 
 def build(
-    world: World, frames: list[Frame], camera: Camera, fps: float, progress: Callable[[int, int], None] | None = None
+    world: World,
+    frames: list[Frame],
+    camera: Camera,
+    fps: float,
+    progress: Callable[[int, int], None] | None = None,
+    labels: tuple[str, ...] = ("robot", "region"),
 ) -> str:
-    """The HTML page of the replay."""
+    """The HTML page of the replay (names of ``labels``' kinds under the scene node ``/labels``)."""
     with contextlib.redirect_stdout(io.StringIO()):  # viser reports its server's start and stop
         import viser
 
         server = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
         try:
-            return _record(server, world, frames, camera, fps, progress)
+            return _record(server, world, frames, camera, fps, progress, labels)
         finally:
             server.stop()
+
+
+def with_legend(page: str, legend: str) -> str:
+    """``page`` with ``legend`` (HTML) as the last element of its body."""
+    at = page.rfind("</body>")
+    return page[:at] + legend + page[at:] if at >= 0 else page + legend
+
+
+def legend_html(world: World) -> str:
+    """The legend as a box of plain HTML over the viewer's top-right corner (the top-left one is the
+    viewer's notices'): each colour's swatch and meaning, the regions' names after their kind, and how to
+    hide the names."""
+    from mrgc.render.labels import world_legend
+
+    goal = set(world.scene.goal.values())
+    regions = {"goal region": [b.name for b, _ in world.regions if b.name in goal]}
+    regions["region"] = [b.name for b, _ in world.regions if b.name not in goal]
+    rows = []
+    for e in world_legend(world):
+        names = regions.get(e.text, []) if e.kind == "region" else []
+        text = html.escape(e.text + (": " + ", ".join(names) if names else ""))
+        rows.append(
+            f'<div class="mrgc-{e.kind}"><span style="display:inline-block;width:0.9em;height:0.9em;'
+            f"margin-right:0.4em;vertical-align:-0.1em;background:{hex_colour(e.colour)};"
+            f'border:1px solid {hex_colour(darker(e.colour))}"></span>{text}</div>'
+        )
+    hint = "names: Scene tree button, then the eye of /labels"
+    return (
+        '<div id="mrgc-legend" style="position:fixed;right:0.6em;top:0.6em;z-index:5;pointer-events:none;'
+        "background:rgba(255,255,255,0.88);color:#222;font:11px/1.3 sans-serif;padding:0.4em 0.6em;"
+        f'border-radius:4px">{"".join(rows)}<div style="color:#666;margin-top:0.3em">{hint}</div></div>'
+    )
 
 
 def _record(
@@ -67,12 +113,14 @@ def _record(
     camera: Camera,
     fps: float,
     progress: Callable[[int, int], None] | None,
+    labels: tuple[str, ...],
 ) -> str:
     """The replay as one HTML file: the scene at the first frame, then each frame's moves recorded one
     ``1 / fps`` apart."""
     handles, label = _first_frame(server, world, frames[0], camera)
+    names = _add_names(server.scene, world, frames[0], labels)
     serializer = server.get_scene_serializer()
-    last = dict.fromkeys(handles)
+    last = dict.fromkeys([*handles, *names])
     text = frames[0].caption
     for i, frame in enumerate(frames[1:], 2):
         serializer.insert_sleep(1.0 / fps)
@@ -81,6 +129,8 @@ def _record(
         for robot, q in frame.configs.items():
             for part, pose in world.robots[robot].part_poses(q, frame.fingers.get(robot)):
                 _move(handles[part.name], pose, last, part.name)
+        for key, pose in _name_poses(world, frame, labels).items():
+            _move(names[key], pose, last, key)
         if frame.caption != text:
             label.text = text = frame.caption
         if progress is not None:
@@ -116,6 +166,36 @@ def _first_frame(server: Any, world: World, first: Frame, camera: Camera) -> tup
         "/caption", first.caption, position=tuple(float(v) for v in top), anchor="bottom-center", font_screen_scale=1.2
     )
     return handles, label
+
+
+def _name_poses(world: World, frame: Frame, labels: tuple[str, ...]) -> dict[str, np.ndarray]:
+    """Where each name of ``labels``' kinds is at ``frame`` (a pose: only its position counts), by its node."""
+    from mrgc.render.labels import anchors
+
+    out = {}
+    for label, points in anchors(world, frame, labels):
+        pose = np.eye(4)
+        pose[:3, 3] = points.mean(axis=0) if points.ndim == 2 else points
+        out[f"/labels/{label.kind}s/{label.text}"] = pose
+    return out
+
+
+def _add_names(scene: Any, world: World, first: Frame, labels: tuple[str, ...]) -> dict[str, Any]:
+    """A label for each robot, region and (when asked) object under ``/labels`` (hidden all at once in the
+    viewer's scene tree): above its top, an arm's under its base; the handles by node name."""
+    from mrgc.render.labels import anchors
+
+    below = {f"/labels/{lb.kind}s/{lb.text}" for lb, _ in anchors(world, first, labels) if lb.below}
+    out = {}
+    for node, pose in _name_poses(world, first, labels).items():
+        out[node] = scene.add_label(
+            node,
+            node.rsplit("/", 1)[1],
+            position=tuple(float(v) for v in pose[:3, 3]),
+            anchor="top-center" if node in below else "bottom-center",
+            font_screen_scale=1.0 if "/objects/" not in node else 0.8,
+        )
+    return out
 
 
 def _move(handle: Any, pose: np.ndarray, last: dict[str, Any], name: str) -> None:

@@ -38,12 +38,15 @@ HTML_BACK_OFF = 1.35
 
 @dataclass(frozen=True)
 class Options:
-    """How to draw: picture size in pixels, frames per second, camera preset."""
+    """How to draw: picture size in pixels, frames per second, camera preset; the kinds of thing named
+    (:data:`mrgc.render.labels.KINDS`) and whether a legend is drawn."""
 
     width: int = 400
     height: int = 300
     fps: float = 10.0
     camera: str = DEFAULT_PRESET
+    labels: tuple[str, ...] = ("robot", "region")
+    legend: bool = True
 
 
 def kind_of(path: str, gantt: bool, has_plan: bool, reach: bool = False) -> str:
@@ -96,6 +99,17 @@ def write_reach(problem: Problem, path: str, opts: Options, sized: bool) -> dict
     return reach.write(problem, path, width, height)
 
 
+def frame_layout(world: World, frames: list[Frame], opts: Options, captions: bool = True, legend: bool = True) -> Any:
+    """The :class:`~mrgc.render.picture.Layout` of ``frames``: their captions (when ``captions``), the
+    world's legend (when ``legend`` and ``opts.legend``), the names ``opts`` asks for."""
+    from mrgc.render.labels import world_legend
+    from mrgc.render.picture import layout
+
+    entries = world_legend(world) if legend and opts.legend else []
+    texts = [f.caption for f in frames] if captions else []
+    return layout(opts.width, opts.height, texts, entries, opts.labels)
+
+
 def replay_frames(
     problem: Problem, plan: Mapping[str, Any], opts: Options, source: str
 ) -> tuple[World, Timeline, list[Frame], Camera]:
@@ -106,13 +120,15 @@ def replay_frames(
     return world, timeline, frames, frame_camera(world, frames, opts)
 
 
-def frame_camera(world: World, frames: list[Frame], opts: Options) -> Camera:
-    """The camera of ``opts.camera`` showing the scene and every robot and object in ``frames``."""
+def frame_camera(world: World, frames: list[Frame], opts: Options, layout: Any = None) -> Camera:
+    """The camera of ``opts.camera`` showing the scene and every robot and object in ``frames`` in the
+    scene part of ``layout`` (default: :func:`frame_layout`)."""
+    lay = layout or frame_layout(world, frames, opts)
     pts = [world.static_points()]
     for f in frames[::FRAMING_STRIDE] + frames[-1:]:
         pts.append(world.robot_points(f.configs))
         pts.append(np.array([p[:3, 3] for p in f.poses.values()]).reshape(-1, 3))
-    return fit(np.concatenate(pts), opts.camera, opts.width / opts.height)
+    return fit(np.concatenate(pts), opts.camera, opts.width / lay.scene_height)
 
 
 def draw(
@@ -122,19 +138,24 @@ def draw(
     opts: Options,
     progress: Progress | None = None,
     captions: bool = True,
+    layout: Any = None,
 ) -> tuple[list[np.ndarray], float]:
-    """Every frame as an image (captioned), and the seconds the drawing took.  Long replays are drawn by
-    one forked process per usable core (:func:`mrgc.workers.map_in_workers`), each its own renderer over a
-    contiguous share of the frames; the images are the same either way."""
+    """Every frame as an image laid out by ``layout`` (default :func:`frame_layout`; with ``captions``
+    False and no layout: the scene alone, nothing written on it), and the seconds the drawing took.  Long
+    replays are drawn by one forked process per usable core (:func:`mrgc.workers.map_in_workers`), each
+    its own renderer over a contiguous share of the frames; the images are the same either way."""
+    from mrgc.render.picture import Layout
     from mrgc.workers import map_in_workers, worker_count
 
+    if layout is None:
+        layout = frame_layout(world, frames, opts) if captions else Layout(opts.width, opts.height, 9)
     t0 = time.perf_counter()
     workers = worker_count(None, len(frames) // PARALLEL_FRAMES)
     if workers <= 1:
-        images = _draw_share((world, frames, camera, opts, captions), progress)
+        images = _draw_share((world, frames, camera, opts, layout), progress)
     else:
         size = -(-len(frames) // workers)
-        shares = [(world, frames[i : i + size], camera, opts, captions) for i in range(0, len(frames), size)]
+        shares = [(world, frames[i : i + size], camera, opts, layout) for i in range(0, len(frames), size)]
         _SHARES[:] = shares  # forked workers find their share here (nothing large is pickled to them)
         try:
             images = [img for part in map_in_workers(_draw_job, list(range(len(shares))), workers) for img in part]
@@ -147,23 +168,26 @@ def draw(
 
 #: fewest frames per worker process worth forking for
 PARALLEL_FRAMES = 24
-_SHARES: list[tuple[World, list[Frame], Camera, Options, bool]] = []
+_SHARES: list[tuple[World, list[Frame], Camera, Options, Any]] = []
 
 
 def _draw_job(index: int) -> list[np.ndarray]:
     return _draw_share(_SHARES[index], None)
 
 
-def _draw_share(share: tuple[World, list[Frame], Camera, Options, bool], progress: Progress | None) -> list[np.ndarray]:
-    from mrgc.render.picture import caption
+def _draw_share(share: tuple[World, list[Frame], Camera, Options, Any], progress: Progress | None) -> list[np.ndarray]:
+    from mrgc.render.labels import frame_labels
+    from mrgc.render.picture import compose
     from mrgc.render.raster import Rasterizer
 
-    world, frames, camera, opts, captions = share
+    world, frames, camera, opts, lay = share
     images = []
+    h = lay.scene_height
     with Rasterizer(world) as r:
         for i, f in enumerate(frames, 1):
-            img = r.draw(f, camera, opts.width, opts.height)
-            images.append(caption(img, f.caption) if captions else img)
+            img = r.draw(f, camera, opts.width, h)
+            names = frame_labels(world, f, camera, opts.width, h, lay.labels) if lay.labels else []
+            images.append(compose(img, lay, f.caption, names))
             if progress is not None:
                 progress(i, len(frames))
     return images
@@ -200,12 +224,15 @@ def write_sheet(
     problem: Problem, plan: Mapping[str, Any], path: str, opts: Options, source: str, progress: Progress | None = None
 ) -> dict[str, Any]:
     """A contact sheet of the key frames (the start, the end of every pick, handover and place, the end)."""
-    from mrgc.render.picture import sheet, write_png
+    from mrgc.render.labels import world_legend
+    from mrgc.render.picture import sheet, text_size, with_legend, write_png
 
-    world, timeline, frames, camera = replay_frames(problem, plan, opts, source)
+    world, timeline, frames, _ = replay_frames(problem, plan, opts, source)
     keys = [f for f in frames if f.key]
-    images, seconds = draw(world, keys, camera, opts, progress)
-    write_png(path, sheet(images))
+    lay = frame_layout(world, keys, opts, legend=False)  # one legend for the whole sheet
+    images, seconds = draw(world, keys, frame_camera(world, frames, opts, lay), opts, progress, layout=lay)
+    legend = world_legend(world) if opts.legend else []
+    write_png(path, with_legend(sheet(images), legend, text_size(max(opts.height, 300))))
     return {"frames": len(images), "steps": timeline.steps, "draw_seconds": seconds}
 
 
@@ -260,9 +287,19 @@ def write_html(
         timeline = build_timeline(world, plan, source)
         frames = timeline.frames(opts.fps)
         steps = timeline.steps
-    fitted = frame_camera(world, frames, opts)
-    # a browser window has any shape and a control bar: start further back than the fitted picture
-    camera = Camera(
+    camera = html_camera(world, frames, opts)
+    t0 = time.perf_counter()
+    size = write(world, frames, camera, opts.fps, path, progress, opts.labels, opts.legend)
+    return {"frames": len(frames), "steps": steps, "draw_seconds": time.perf_counter() - t0, "bytes": size}
+
+
+def html_camera(world: World, frames: list[Frame], opts: Options) -> Camera:
+    """The HTML replay's first view: the fitted camera (whole picture, no bands) moved back by
+    :data:`HTML_BACK_OFF`, since a browser window has any shape and a control bar."""
+    from mrgc.render.picture import Layout
+
+    fitted = frame_camera(world, frames, opts, Layout(opts.width, opts.height, 9))
+    return Camera(
         fitted.target + HTML_BACK_OFF * (fitted.eye - fitted.target),
         fitted.target,
         fitted.up,
@@ -270,9 +307,6 @@ def write_html(
         fitted.near,
         fitted.far * HTML_BACK_OFF,
     )
-    t0 = time.perf_counter()
-    size = write(world, frames, camera, opts.fps, path, progress)
-    return {"frames": len(frames), "steps": steps, "draw_seconds": time.perf_counter() - t0, "bytes": size}
 
 
 def write_gantt(problem: Problem, plan: Mapping[str, Any], path: str) -> dict[str, Any]:

@@ -6,10 +6,11 @@ them to a frame's poses and renders.  Robots are their collision shapes (see :mo
 pybullet's Panda visual meshes hold about 30 times more triangles and cost about 0.08 s per image whatever
 its size, four times the collision meshes' cost at 320×240.
 
-The TinyRenderer ignores alpha, so regions are not bodies: they are drawn afterwards, translucent, by
-casting each pixel's view ray against the region boxes and blending the region colour wherever the box's
-near face lies in front of the rendered depth (:func:`tint_regions`).  A region that is not a box is drawn
-as its bounding box.
+The TinyRenderer ignores alpha, so regions are not bodies: they are drawn afterwards by casting each
+pixel's view ray against the region boxes (:func:`tint_regions`): the region's floor is tinted where it is
+what the pixel sees (nothing stands in front of it), and the box's edges are drawn where they lie in front
+of the rendered depth.  Robots and objects inside a region are therefore never blended with its colour.  A
+region that is not a box is drawn as its bounding box.
 """
 
 from __future__ import annotations
@@ -25,7 +26,7 @@ from mrgc.geometry.scene import half_extents
 from mrgc.geometry.transforms import to_quaternion
 from mrgc.render.camera import Camera
 from mrgc.render.frames import Frame
-from mrgc.render.palette import REGION_ALPHA, RGB
+from mrgc.render.palette import REGION_FLOOR_ALPHA, RGB, darker
 from mrgc.render.world import Drawable, World
 
 #: light: direction towards the light (world), ambient and diffuse shares
@@ -62,7 +63,8 @@ class Rasterizer:
 
     def _body(self, d: Drawable) -> int:
         pb, cid = self.pb, self.cid
-        key = (d.kind, d.size, d.mesh_path, d.colour)
+        # a mesh given by its triangles (no file) is its own shape
+        key = (d.kind, d.size, d.mesh_path, d.colour, d.name if d.kind == "mesh" and d.mesh_path is None else "")
         if key not in self._shapes:
             rgba = [*d.colour, 1.0]
             if d.kind == "box":
@@ -150,25 +152,28 @@ class Rasterizer:
 
 @dataclass(frozen=True)
 class RegionPatch:
-    """A region as seen by one camera: the pixel rectangle it covers, the eye-space depth of its near face
-    per pixel (inf where the ray misses it), and the colour and opacity to blend there."""
+    """A region as seen by one camera: the pixel rectangle it covers; per pixel the eye-space depth where the
+    view ray meets the region's floor (its bottom face; inf where it does not), and where it crosses one of
+    the box's edges, near or far (inf where it does not); the floor's tint and the edges' colour."""
 
     rows: slice
     cols: slice
-    near: np.ndarray
-    alpha: np.ndarray
+    floor: np.ndarray
+    near_edge: np.ndarray
+    far_edge: np.ndarray
     tint: np.ndarray
+    line: np.ndarray
+
+
+#: how opaque a region's near and far edges are drawn
+NEAR_EDGE_ALPHA, FAR_EDGE_ALPHA = 0.9, 0.55
 
 
 def region_patches(
-    camera: Camera,
-    regions: list[tuple[np.ndarray, np.ndarray, RGB]],
-    width: int,
-    height: int,
-    alpha: float = REGION_ALPHA,
+    camera: Camera, regions: list[tuple[np.ndarray, np.ndarray, RGB]], width: int, height: int
 ) -> list[RegionPatch]:
-    """Cast the view rays of the pixels each region box (pose, half extents, colour) covers: faces shaded by
-    their direction, edges darker and more opaque.  Depends on the camera only, so it is done once."""
+    """Cast the view rays of the pixels each region box (pose, half extents, colour) covers: where they meet
+    its floor and cross its edges (1.5 pixels wide).  Depends on the camera only, so it is done once."""
     rays = camera.rays(width, height)
     pixel = 2 * math.tan(math.radians(camera.fov) / 2) / height  # size of a pixel at unit depth
     out = []
@@ -183,37 +188,55 @@ def region_patches(
         with np.errstate(divide="ignore", invalid="ignore"):
             t1 = (-half - o) / d
             t2 = (half - o) / d
-        tmin = np.nan_to_num(np.minimum(t1, t2), nan=-np.inf)
-        tmax = np.nan_to_num(np.maximum(t1, t2), nan=np.inf)
-        enter, leave = tmin.max(axis=2), tmax.min(axis=2)
-        near = np.maximum(enter, 0.0)
+        enter = np.nan_to_num(np.minimum(t1, t2), nan=-np.inf).max(axis=2)
+        leave = np.nan_to_num(np.maximum(t1, t2), nan=np.inf).min(axis=2)
         miss = (enter > leave) | (leave <= 0)
-        shade = np.array([0.82, 0.92, 1.0])[tmin.argmax(axis=2)]
-        local = o + near[..., None] * d
-        eps = 1.5 * pixel * np.maximum(near, 1e-6)
-        edge = (np.abs(np.abs(local) - half) <= eps[..., None]).sum(axis=2) >= 2
+        near = np.maximum(enter, 0.0)
+        t_floor = np.nan_to_num(t1[..., 2], nan=-1.0, posinf=-1.0, neginf=-1.0)
+        on_floor = np.abs(o[:2] + t_floor[..., None] * d[..., :2]) <= half[:2]
+        floor = np.where((t_floor > 0) & on_floor.all(axis=2), t_floor, np.inf)
+        hits = ~miss
         out.append(
             RegionPatch(
                 slice(r0, r1),
                 slice(c0, c1),
-                np.where(miss, np.inf, near),
-                np.where(edge, min(1.0, 2.5 * alpha), alpha)[..., None],
-                np.array(colour) * 255 * np.where(edge, 0.55, shade)[..., None],
+                floor,
+                _edge(o, d, half, near, pixel, hits),
+                _edge(o, d, half, leave, pixel, hits),
+                np.array(colour) * 255,
+                np.array(darker(colour, 0.55)) * 255,
             )
         )
     return out
 
 
+def _edge(o: np.ndarray, d: np.ndarray, half: np.ndarray, t: np.ndarray, pixel: float, hits: np.ndarray) -> np.ndarray:
+    """``t`` where the ray from ``o`` along ``d`` (box frame), at ``t``, lies on an edge of the box of half
+    extents ``half`` (within 1.5 pixels), inf elsewhere."""
+    local = o + t[..., None] * d
+    eps = 1.5 * pixel * np.maximum(t, 1e-6)
+    on = (np.abs(np.abs(local) - half) <= eps[..., None]).sum(axis=2) >= 2
+    return np.where(on & hits, t, np.inf)
+
+
 def tint_regions(rgb: np.ndarray, depth: np.ndarray, patches: list[RegionPatch]) -> np.ndarray:
-    """``rgb`` with each region blended in where its near face lies in front of ``depth`` (eye-space)."""
+    """``rgb`` with each region's floor tinted where nothing stands in front of it (what stands in a region
+    keeps its colour) and its edges drawn where they are in front of ``depth`` (eye-space)."""
     out = rgb.copy()
     for p in patches:
-        hit = p.near < depth[p.rows, p.cols]
-        if not hit.any():
+        seen = depth[p.rows, p.cols]
+        slack = 0.003 + 0.002 * seen  # the depth buffer's precision: a table top under a region is its floor
+        floor = p.floor <= seen + slack
+        near = p.near_edge <= seen + slack
+        far = (p.far_edge <= seen + slack) & ~near
+        if not (floor.any() or near.any() or far.any()):
             continue
         patch = out[p.rows, p.cols].astype(float)
-        blended = (1 - p.alpha) * patch + p.alpha * p.tint
-        out[p.rows, p.cols] = np.where(hit[..., None], blended, patch).clip(0, 255).astype(np.uint8)
+        alpha = np.where(floor, REGION_FLOOR_ALPHA, 0.0)[..., None]
+        patch = (1 - alpha) * patch + alpha * p.tint
+        alpha = np.where(near, NEAR_EDGE_ALPHA, np.where(far, FAR_EDGE_ALPHA, 0.0))[..., None]
+        patch = (1 - alpha) * patch + alpha * p.line
+        out[p.rows, p.cols] = patch.clip(0, 255).astype(np.uint8)
     return out
 
 
@@ -222,15 +245,9 @@ def _pixel_box(camera: Camera, pose: np.ndarray, half: np.ndarray, w: int, h: in
     lies behind the eye); None when it is off the picture."""
     signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=float)
     pts = (signs * half) @ pose[:3, :3].T + pose[:3, 3]
-    r, u, f = camera.axes()
-    rel = pts - camera.eye
-    z = rel @ f
+    cols, rows, z = camera.project(pts, w, h)
     if (z <= camera.near).any():
         return 0, h, 0, w
-    ty = math.tan(math.radians(camera.fov) / 2)
-    tx = ty * w / h
-    cols = ((rel @ r) / z / tx + 1) / 2 * w
-    rows = (1 - (rel @ u) / z / ty) / 2 * h
     c0, c1 = max(0, int(cols.min()) - 1), min(w, int(math.ceil(cols.max())) + 1)
     r0, r1 = max(0, int(rows.min()) - 1), min(h, int(math.ceil(rows.max())) + 1)
     return (r0, r1, c0, c1) if r0 < r1 and c0 < c1 else None

@@ -18,7 +18,7 @@ import numpy as np
 
 from mrgc.geometry.scene import Body, half_extents, outline, scene_from_problem
 from mrgc.language.model import Box, Cylinder, Problem, Sphere
-from mrgc.render.palette import FIXED, GOAL_REGION, OTHER_REGION, ROLE_COLOURS, Role, robot_colours
+from mrgc.render.palette import FIXED, GOAL_REGION, OTHER_REGION, ROLE_COLOURS, Role, darker, robot_colours
 
 #: points of a round outline
 ROUND = 32
@@ -55,7 +55,7 @@ def write(problem: Problem, path: str, width: int, height: int) -> dict[str, Any
         for region in scene.regions:
             rc = GOAL_REGION if region.name in goal.values() else OTHER_REGION
             xy = _shape_xy(region)
-            ax.add_patch(Polygon(xy, closed=True, fill=False, edgecolor=_darker(rc), linestyle="--", lw=1.4, zorder=3))
+            ax.add_patch(Polygon(xy, closed=True, fill=False, edgecolor=darker(rc), linestyle="--", lw=1.4, zorder=3))
             ax.annotate(
                 region.name,
                 (float(xy[:, 0].mean()), float(xy[:, 1].max())),
@@ -63,7 +63,7 @@ def write(problem: Problem, path: str, width: int, height: int) -> dict[str, Any
                 textcoords="offset points",
                 ha="center",
                 va="bottom",
-                color=_darker(rc),
+                color=darker(rc),
                 fontweight="bold",
                 zorder=6,
             )
@@ -82,8 +82,8 @@ def write(problem: Problem, path: str, width: int, height: int) -> dict[str, Any
         handles += [
             Patch(facecolor=ROLE_COLOURS[Role.GOAL], edgecolor="black", label="goal object"),
             Patch(facecolor=ROLE_COLOURS[Role.UNTOUCHED], edgecolor="black", label="other object"),
-            Patch(fill=False, edgecolor=_darker(GOAL_REGION), linestyle="--", label="goal region"),
-            Patch(fill=False, edgecolor=_darker(OTHER_REGION), linestyle="--", label="region"),
+            Patch(fill=False, edgecolor=darker(GOAL_REGION), linestyle="--", label="goal region"),
+            Patch(fill=False, edgecolor=darker(OTHER_REGION), linestyle="--", label="region"),
             Patch(facecolor=FIXED, alpha=0.5, label="fixed object"),
         ]
         if scene.handover_points:
@@ -133,7 +133,7 @@ def _robot(ax: Any, name: str, base: np.ndarray, colour: tuple[float, float, flo
             zorder=7,
         )
     ax.annotate(
-        name, (x, y), xytext=(6, -10), textcoords="offset points", color=_darker(colour), fontweight="bold", zorder=7
+        name, (x, y), xytext=(6, -10), textcoords="offset points", color=darker(colour), fontweight="bold", zorder=7
     )
 
 
@@ -174,10 +174,6 @@ def _hull(points: np.ndarray) -> np.ndarray:
 
 def _cross(o: tuple[float, float], a: tuple[float, float], b: tuple[float, float]) -> float:
     return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-
-
-def _darker(rgb: tuple[float, float, float], k: float = 0.6) -> tuple[float, float, float]:
-    return (rgb[0] * k, rgb[1] * k, rgb[2] * k)
 
 
 def _metadata(path: str) -> dict[str, Any]:

@@ -4,7 +4,8 @@ each one is for given robot configurations and object poses.
 Robots are drawn with the geometry the planner and the validator check: an arm's links are its URDF's
 *collision* shapes (:class:`~mrgc.geometry.kinematics.RobotModel`), placed by the geometry layer's forward
 kinematics (:func:`~mrgc.geometry.fk.fk`, which agrees with pybullet's to 1e-7 m), fingers at the opening
-the validator uses; a planar robot is its footprint (:class:`~mrgc.geometry.planar.PlanarRobot`).  A held
+the validator uses; a planar robot is its footprint (:class:`~mrgc.geometry.planar.PlanarRobot`) with a
+flat white arrowhead on top pointing where it faces.  A held
 object rides at its grasp: an arm's tool pose composed with the inverse of the grasp frame
 (:mod:`mrgc.geometry.grasps`), a planar robot's carry pose.  Both renderers (the TinyRenderer images and
 the HTML replay) draw from this one description.
@@ -22,7 +23,17 @@ from mrgc.geometry.conventions import wrap_angle
 from mrgc.geometry.scene import Body, SceneSpec, outline, scene_from_problem
 from mrgc.geometry.transforms import from_pose, inverse
 from mrgc.language.model import Box, Cylinder, Mesh, Problem, Shape, Sphere
-from mrgc.render.palette import FIXED, GOAL_REGION, OTHER_REGION, RGB, ROLE_COLOURS, moved_objects, robot_colours, roles
+from mrgc.render.palette import (
+    FIXED,
+    GOAL_REGION,
+    HEADING,
+    OTHER_REGION,
+    RGB,
+    ROLE_COLOURS,
+    moved_objects,
+    robot_colours,
+    roles,
+)
 
 
 @dataclass(frozen=True, eq=False)
@@ -59,6 +70,17 @@ def shape_drawable(name: str, shape: Shape, colour: RGB, opacity: float = 1.0) -
     return Drawable(name, "mesh", (shape.scale,) * 3, colour, shape.path, v * shape.scale, f, opacity)
 
 
+def heading_marker(name: str, hx: float, hy: float) -> Drawable:
+    """A flat arrowhead lying on a planar robot's footprint (half length ``hx``, half width ``hy``), its tip
+    at the front edge (+x): where the robot faces.  Its frame is the footprint's top centre."""
+    thick = max(0.004, 0.05 * min(hx, hy))
+    tri = [(0.95 * hx, 0.0), (-0.45 * hx, 0.6 * hy), (-0.2 * hx, 0.0), (-0.45 * hx, -0.6 * hy)]
+    vertices = np.array([(x, y, z) for z in (0.0, thick) for x, y in tri], dtype=float)
+    faces = [(4, 5, 6), (4, 6, 7), (0, 2, 1), (0, 3, 2)]  # top and bottom (two triangles each)
+    faces += [(i, (i + 1) % 4, 4 + (i + 1) % 4) for i in range(4)] + [(i, 4 + (i + 1) % 4, 4 + i) for i in range(4)]
+    return Drawable(name, "mesh", (1.0, 1.0, 1.0), HEADING, vertices=vertices, faces=np.array(faces, dtype=int))
+
+
 class RobotView:
     """A robot as drawn: home configuration, parts at a configuration, tool and held-object poses."""
 
@@ -74,8 +96,12 @@ class RobotView:
 
             self.mobile = PlanarRobot(self.spec)
             self.home: np.ndarray = to_se2(self.spec.base)
+            hx, hy, hz = (float(v) for v in self.mobile.half)
+            top = np.eye(4)
+            top[2, 3] = hz
             self.parts: list[tuple[int, Drawable, np.ndarray]] = [
-                (-1, shape_drawable(f"{name}/footprint", self.mobile.footprint, colour), np.eye(4))
+                (-1, shape_drawable(f"{name}/footprint", self.mobile.footprint, colour), np.eye(4)),
+                (-1, heading_marker(f"{name}/heading", hx, hy), top),
             ]
             return
         from mrgc.geometry.kinematics import model_for_kind

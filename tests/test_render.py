@@ -212,18 +212,46 @@ def test_html_replay_is_self_contained_and_shows_the_robots_in_chromium(
     # nothing is fetched from elsewhere: no script, stylesheet or image from a URL
     assert not re.search(r"""<(script|link|img)[^>]+(src|href)=["']?(https?:)?//""", page, re.I)
     blue, purple = (byte_colour(c) for c in ROBOT_COLOURS[:2])
+    from mrgc.render import outputs
+    from mrgc.render.labels import anchors
+
+    plan = json.loads(plan_file.read_text())
+    world = World(parse_file(str(HANDOVER)).problem(None), plan)
+    frames = build_timeline(world, plan).frames(5)
+    camera = outputs.html_camera(world, frames, outputs.Options())
+    points = {lb.text: p.reshape(-1, 3).mean(axis=0, keepdims=True) for lb, p in anchors(world, frames[0])}
+
+    def unnamed(picture: np.ndarray) -> list[str]:
+        """The names of robots and regions without dark text (which nothing else in the scene is) near
+        where their anchors project."""
+        h, w = picture.shape[:2]
+        dark = picture.max(axis=2) < 90
+        out = []
+        for name, point in points.items():
+            c, r, _ = camera.project(point, w, h)
+            x, y = int(c[0]), int(r[0])
+            if dark[max(0, y - 80) : y + 40, max(0, x - 70) : x + 70].sum() < 8:
+                out.append(name)
+        return out
+
     picture, ok = screenshot_when(
         out.as_uri(),
-        lambda p: colour_share(p, blue) > 0.004 and colour_share(p, purple) > 0.004,
+        lambda p: colour_share(p, blue) > 0.004 and colour_share(p, purple) > 0.004 and not unnamed(p),
         timeout=150,
         size=(640, 480),
     )
     Image.fromarray(picture).save(tmp_path / "chromium.png")
     assert non_blank(picture), "the page stayed blank"
     assert ok, (
-        f"the robots did not appear (blue {colour_share(picture, blue):.4f}, purple "
-        f"{colour_share(picture, purple):.4f}); screenshot at {tmp_path / 'chromium.png'}"
+        f"the robots or their names did not appear (blue {colour_share(picture, blue):.4f}, purple "
+        f"{colour_share(picture, purple):.4f}, unnamed {unnamed(picture)}); screenshot at {tmp_path / 'chromium.png'}"
     )
+    assert {"r1", "r2", "bin-b", "start"} <= set(points)
+    # the legend (plain HTML) shows each robot's colour, and names the robots and regions
+    for colour in (blue, purple):
+        assert (np.abs(picture.astype(int) - colour).sum(axis=2) <= 24).sum() >= 30, colour
+    legend = page[page.index('<div id="mrgc-legend"') :]
+    assert ">r1</div>" in legend and ">r2</div>" in legend and "bin-b" in legend
 
 
 def test_bad_requests_are_one_line_errors(plan_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -278,6 +306,38 @@ def test_graph_styles_edges_as_the_paper(tmp_path: Path, capsys: pytest.CaptureF
     assert all(ACTION_EDGE in ln for ln in edges if re.match(r'\s*"o', ln))  # object -> action
     assert all(BLOCK_PICK in ln or BLOCK_PLACE in ln for ln in edges if re.match(r'\s*"a\d', ln))
     assert any(BLOCK_PICK in ln for ln in edges) or any(BLOCK_PLACE in ln for ln in edges)
+
+
+def test_a_large_graph_draws_a_skeleton_clustered_at_a_readable_size(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from mrgc.render import graph
+
+    problem, facts = tmp_path / "cell.mrg", tmp_path / "cell.facts.mrg"
+    args = ["--robots", 3, "--goals", 5, "--others", 3, "--seed", 1, "-o", problem]
+    assert run(["generate", "packaging", *args], capsys)[0] == 0
+    assert run(["facts", problem, "-o", facts], capsys)[0] == 0
+    out = tmp_path / "cell.png"
+    code, stdout, err = run(["graph", facts, "-o", out], capsys)
+    assert code == 0, err
+    actions = int(re.search(r"(\d+) actions", stdout).group(1))  # type: ignore[union-attr]
+    assert actions > graph.LARGE_ACTIONS and "skeleton 1's" in stdout and "--full" in stdout
+    with Image.open(out) as img:
+        assert max(img.size) <= graph.MAX_PIXELS and min(img.size) >= 200, img.size
+    dot = tmp_path / "cell.dot"
+    assert run(["graph", facts, "-o", dot], capsys)[0] == 0
+    text = dot.read_text()
+    shown = re.findall(r'^\s*"a\d+" \[shape=box.*$', text, re.M)
+    assert 0 < len(shown) < actions and all("\\nstep " in ln for ln in shown)  # the skeleton's actions only
+    assert 'subgraph "cluster_' in text and "moves of " in text
+    full = tmp_path / "full.dot"
+    assert run(["graph", facts, "-o", full, "--full"], capsys)[0] == 0
+    assert len(re.findall(r'^\s*"a\d+" \[shape=box', full.read_text(), re.M)) == actions
+    monkeypatch.setattr(graph, "MAX_PIXELS", 600)  # the size guard scales a drawing down to fit
+    code, stdout, _ = run(["graph", facts, "-o", tmp_path / "small.png", "--full"], capsys)
+    assert code == 0 and "scaled down" in stdout
+    with Image.open(tmp_path / "small.png") as img:
+        assert max(img.size) <= 600 + 2, img.size
 
 
 def test_graph_svg_through_dot_and_a_clear_message_without_it(
@@ -342,3 +402,100 @@ def test_phases_are_the_validators() -> None:
 
     assert set(PATH_PHASES) <= {"to-pick", "to-handover", "taker-to-handover", "to-place", "home", "giver-home"}
     assert PHASES == ("to-pick", "pick", "to-handover", "handover", "to-place", "place", "home")
+
+
+# ------------------------------------------------------------------------------------------- names, legend
+def _label_pixels(img: np.ndarray, box: tuple[int, int, int, int], fill: tuple[int, int, int]) -> tuple[float, int]:
+    """The share of a label box's pixels in its fill colour, and how many are far from it (the name)."""
+    x0, y0, x1, y1 = box
+    part = img[y0 + 1 : y1, x0 + 1 : x1].astype(int)
+    diff = np.abs(part - np.array(fill)).sum(axis=2)
+    return float((diff <= 12).mean()), int((diff > 200).sum())
+
+
+def test_sheet_names_robots_and_regions_and_has_a_legend(
+    plan_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from mrgc.render import outputs
+    from mrgc.render.labels import frame_labels, world_legend
+    from mrgc.render.picture import label_style, legend_band, place_labels, text_size
+
+    plan = json.loads(plan_file.read_text())
+    opts = outputs.Options(240, 180, 4.0)
+    sheets = {}
+    for name, flags in (("names", []), ("plain", ["--no-labels"])):
+        sheets[name] = tmp_path / f"{name}.png"
+        args = ["render", HANDOVER, plan_file, "-o", sheets[name], "--size", "240x180", "--fps", "4", *flags]
+        assert run(args, capsys)[0] == 0
+    # where the first tile's names are: the same layout, camera and placement as the command's
+    world, _, frames, _ = outputs.replay_frames(parse_file(str(HANDOVER)).problem(None), plan, opts, "plan")
+    keys = [f for f in frames if f.key]
+    lay = outputs.frame_layout(world, keys, opts, legend=False)
+    camera = outputs.frame_camera(world, frames, opts, lay)
+    labels = frame_labels(world, keys[0], camera, 240, lay.scene_height, lay.labels)
+    assert {lb.text for lb in labels} == {"r1", "r2", *(b.name for b, _ in world.regions)}
+    named = np.asarray(Image.open(sheets["names"]).convert("RGB"))
+    plain = np.asarray(Image.open(sheets["plain"]).convert("RGB"))
+    top = legend_band(named.shape[1], world_legend(world), text_size(300)).shape[0]
+    assert named.shape[0] == plain.shape[0] + top  # the legend band over the sheet
+    for label, (x0, y0, x1, y1) in place_labels(labels, lay.size, 240, lay.scene_height):
+        fill = label_style(label)[0]
+        share, ink = _label_pixels(named, (x0, y0 + top, x1, y1 + top), fill)
+        assert share > 0.35 and ink >= 3, (label.text, share, ink)  # the box in its colour, the name in it
+        share, ink = _label_pixels(plain, (x0, y0, x1, y1), fill)
+        assert share < 0.35 or ink < 3, label.text  # (the check fails without names)
+    legend = named[:top]
+    for colour in ROBOT_COLOURS[:2]:
+        assert (np.abs(legend.astype(int) - byte_colour(colour)).sum(axis=2) <= 6).sum() >= 20
+
+
+def test_planar_robots_are_named_where_they_stand_and_show_their_heading(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from mrgc.render import outputs
+    from mrgc.render.labels import frame_labels
+
+    bo8 = ROOT / "domains" / "box-moving" / "bo8-two-doors.mrg"
+    out = tmp_path / "bo8.png"
+    assert run(["render", bo8, "-o", out, "--camera", "top", "--object-labels"], capsys)[0] == 0
+    img = np.asarray(Image.open(out).convert("RGB"))
+    world = World(parse_file(str(bo8)).problem(None))
+    frame = outputs.scene_frame(world)
+    opts = outputs.Options(400, 300, labels=("robot", "region", "object"))
+    lay = outputs.frame_layout(world, [frame], opts)
+    camera = outputs.frame_camera(world, [frame], opts, lay)
+    names = {lb.text: lb for lb in frame_labels(world, frame, camera, 400, lay.scene_height, lay.labels)}
+    assert {"r1", "r2", "start", "goal", "g1", "b3"} <= set(names)
+    for robot in ("r1", "r2"):
+        view = world.robots[robot]
+        parts = {p.name: pose for p, pose in view.part_poses(view.home)}
+        heading = parts[f"{robot}/heading"]
+        tip = heading[:3, :3] @ np.array([0.95 * view.mobile.half[0], 0, 0])
+        yaw = view.home[2]
+        assert np.allclose(tip[:2] / np.linalg.norm(tip[:2]), [np.cos(yaw), np.sin(yaw)])  # it points ahead
+        # the name sits over the robot: its anchor projects inside the robot's footprint's picture
+        c, r, _ = camera.project(parts[f"{robot}/footprint"][:3, 3].reshape(1, 3), 400, lay.scene_height)
+        assert abs(names[robot].x - c[0]) < 25 and 0 <= r[0] - names[robot].y < 40
+    # white arrowheads on the robots' tops (from above)
+    assert (img[lay.top : lay.top + lay.scene_height].min(axis=2) > 225).sum() > 20
+
+
+def test_what_stands_in_a_region_keeps_its_colour() -> None:
+    from mrgc.render.camera import Camera
+    from mrgc.render.raster import region_patches, tint_regions
+
+    camera = Camera(np.array([0.0, 0.0, 3.0]), np.zeros(3), np.array([0.0, 1.0, 0.0]))
+    pose = np.eye(4)
+    pose[2, 3] = 0.25  # a 1 × 1 × 0.5 region standing on the floor (z = 0)
+    patches = region_patches(camera, [(pose, np.array([0.5, 0.5, 0.25]), GOAL_REGION)], 100, 100)
+    depth = np.full((100, 100), 3.0)  # the floor
+    depth[45:55, 45:55] = 2.8  # a robot standing in the region
+    robot = byte_colour(ROBOT_COLOURS[0])
+    rgb = np.empty((100, 100, 3), dtype=np.uint8)
+    rgb[:] = (200, 200, 200)
+    rgb[45:55, 45:55] = robot
+    out = tint_regions(rgb, depth, patches)
+    assert (out[47:53, 47:53] == robot).all()  # the robot is not veiled
+    floor = out[30, 40].astype(int)
+    assert floor[1] > floor[0] and floor[1] > floor[2]  # the floor in the region is tinted green
+    assert (out[2, 2] == (200, 200, 200)).all()  # outside the region nothing changes

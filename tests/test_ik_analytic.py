@@ -23,6 +23,12 @@ from mrgc.geometry.kinematics import load_robot_model
 PANDA = "franka_panda/panda.urdf"
 
 
+@pytest.fixture(autouse=True)
+def analytic(monkeypatch):
+    """The dispatch on (off by default: geometry/ik.py ``ANALYTIC``)."""
+    monkeypatch.setattr(I, "ANALYTIC", True)
+
+
 @pytest.fixture(scope="module")
 def panda():
     return load_robot_model(PANDA, ".", "panda_hand")

@@ -9,7 +9,8 @@ answer, so a target's result does not depend on the other targets of a batch.  R
 ``numpy.random.default_rng(seed)``: the same (model, target, seed) always gives the same configuration.
 
 Arms with a Franka Panda's kinematics (recognised from their URDF chain, :func:`~mrgc.geometry.ik_analytic.
-panda_chain`) are solved analytically instead (:mod:`mrgc.geometry.ik_analytic`): the branch nearest
+panda_chain`) are solved analytically instead when the caller asks for it (``analytic=True``: phase 1, which
+asks whether a pose is reachable at all; :mod:`mrgc.geometry.ik_analytic`): the branch nearest
 ``q_init`` (the middle of the limits when None), verified by forward kinematics to the same tolerances; it
 does not depend on ``seed``, ``restarts`` or ``max_iters``.  When no branch qualifies the result is
 NO_CONVERGENCE, without the numeric solver (docs/geometry.md, "Analytic IK", measures why), except for
@@ -41,9 +42,9 @@ STALL_RATIO = 0.9
 REDRAWS_PER_RESTART = 2
 #: targets per batch in :func:`solve_ik_many` (larger batches fall out of the CPU caches)
 CHUNK = 128
-#: solve Panda-kinematics arms analytically (:mod:`mrgc.geometry.ik_analytic`); False forces the numeric solver
-#: for every arm (benchmarks and tests compare the two)
-ANALYTIC = True
+#: solve Panda-kinematics arms analytically (:mod:`mrgc.geometry.ik_analytic`) when a call does not say
+#: (``analytic=None``); phase 1 says so (``analytic=True``), grounding does not (benchmarks and tests switch it)
+ANALYTIC = False
 #: a solve from ``q_init`` alone (``restarts`` 0: tracking a Cartesian line) whose analytic answer moves a joint
 #: farther than this (rad), or has none, also runs the numeric solver from ``q_init`` and keeps the nearer
 #: answer: near a wrist or shoulder singularity the analytic branches, q7 held near its start, jump
@@ -126,6 +127,7 @@ def solve_ik(
     tol_pos: float = 1e-4,
     tol_rot: float = 1e-3,
     max_iters: int = 100,
+    analytic: bool | None = None,
 ) -> IKResult:
     """A configuration putting the end-effector link at ``target`` (4×4 in the robot's base frame).
 
@@ -135,7 +137,7 @@ def solve_ik(
     target rounded to 1e-9, seed, q_init, parameters).
     """
     return solve_ik_many(
-        model, np.asarray(target, dtype=float)[None], seed, q_init, restarts, tol_pos, tol_rot, max_iters
+        model, np.asarray(target, dtype=float)[None], seed, q_init, restarts, tol_pos, tol_rot, max_iters, analytic
     )[0]
 
 
@@ -148,12 +150,18 @@ def solve_ik_many(
     tol_pos: float = 1e-4,
     tol_rot: float = 1e-3,
     max_iters: int = 100,
+    analytic: bool | None = None,
 ) -> list[IKResult]:
     """:func:`solve_ik` for each of ``targets`` (M, 4, 4), solved together in one batch: the same results
     as M separate calls, at a fraction of the cost when M is large.  ``q_init`` may be one configuration for
-    all targets or an (M, dof) array giving each target its own first start."""
+    all targets or an (M, dof) array giving each target its own first start.  ``analytic``: solve arms with
+    a Panda's kinematics analytically (module docstring; None: :data:`ANALYTIC`).  Grounding leaves it off:
+    its motions are joint-space lines from the configurations it solves, and the numeric solver's answers,
+    found from the start, keep those lines on their Cartesian paths where the analytic branch nearest the
+    start (q7 locked) did not (docs/geometry.md, "Analytic IK": pa10 seed 0, pa3-handover, the carry and
+    self-collision tests)."""
     targets = np.asarray(targets, dtype=float).reshape(-1, 4, 4)
-    chain = panda_chain(model) if ANALYTIC else None
+    chain = panda_chain(model) if (ANALYTIC if analytic is None else analytic) else None
     params: tuple[object, ...]
     if chain is not None:  # the analytic answer depends on neither the seed nor the numeric solver's budget
         seed, params = 0, ("analytic", tol_pos, tol_rot, restarts <= 0 and max_iters)

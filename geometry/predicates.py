@@ -85,21 +85,33 @@ class RobotEvaluator:
         attempt: int = 0,
         restarts: int = 8,
     ) -> list[np.ndarray | None]:
-        """IK for many tool poses in one batch (``q_init``: one start for all, or one per pose)."""
+        """IK for many tool poses in one batch (``q_init``: one start for all, or one per pose).  Solves from
+        one start (or none) are analytic for arms with a Panda's kinematics (:mod:`mrgc.geometry.ik`):
+        retries (``attempt`` > 0) without a start then start from a configuration drawn for the attempt, so
+        that they reach other branches.  Solves with a start per pose (a pre-grasp from its grasp) are
+        numeric from that start, as grounding solves them: the approach between the two stays on its line."""
         if not tool_poses:
             return []
         targets = np.stack([self.arm.ee_target(t) for t in tool_poses])
         self.out.ik_solves += len(targets)
-        start = self.arm.home if q_init is None else q_init
+        seed = seed_for(self.arm.name, key, str(attempt), seed=self.seed)
+        start = q_init
+        if start is None:
+            start = self.arm.home if attempt == 0 else np.random.default_rng(seed).uniform(*self._limits)
         res = solve_ik_many(
             self.arm.model,
             targets,
-            seed_for(self.arm.name, key, str(attempt), seed=self.seed),
+            seed,
             q_init=start,
             restarts=restarts,
             max_iters=IK_ITERS,
+            analytic=np.ndim(start) == 1,
         )
         return [r.q if r.solved else None for r in res]
+
+    @property
+    def _limits(self) -> tuple[np.ndarray, np.ndarray]:
+        return self.arm.model.lower, self.arm.model.upper
 
     def usable(self, obj: str, grasp: str) -> bool:
         """Whether this arm can use ``grasp`` on ``obj``: the grasp has geometry and the gripper opens wide
@@ -423,7 +435,7 @@ def compute_facts(
     return FactsResult(sorted(facts, key=lambda f: (order[f.predicate], f.args)), stats)
 
 
-def _handovers(scene: SceneSpec, per_robot: dict[str, RobotFacts], deadline: float | None) -> set[Fact] | None:
+def _handovers(scene: SceneSpec, per_robot: dict[str, RobotFacts], deadline: float | None = None) -> set[Fact] | None:
     """``enable-goal-handover`` from the robots' handover configurations, checking robot–robot collisions;
     None when ``deadline`` passed first (it is read per goal object)."""
     out: set[Fact] = set()

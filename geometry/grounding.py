@@ -1226,6 +1226,11 @@ class Grounder:
         key = (robot, holding, tuple(movers), *_fingerprint([start, goal, *(self.poses[a] for a in movers)], busy))
         if key not in self._paths:
             answer = self._base_path(robot, start, goal, holding, movers, busy)
+            if answer.status is GroundStatus.NO_PATH and busy and not self.cut:
+                # no path: is it the step's other robots (a path exists without them) or the scene?
+                alone = self.base_path(robot, start, goal, holding, avoid, ())
+                if alone.ok:
+                    answer = Answer(GroundStatus.NO_PATH, detail=BUSY)
             self._remember(key, answer)
             return answer
         return self._paths[key]

@@ -20,7 +20,7 @@ import enum
 import time
 from contextlib import ExitStack
 from dataclasses import dataclass, field, replace
-from typing import Any, Iterable
+from typing import Any, Callable, Iterable
 
 import numpy as np
 
@@ -43,6 +43,8 @@ PARKING_REGIONS = 2
 RELAY_TRIES = 3  # spots tried per relay (the k-th spot both of its robots reach at the k-th try)
 #: paths replayed in another path's phase (the validator's execution model): name -> phase
 PATH_PHASE = {"taker-to-handover": "to-handover"}
+#: a skeleton's order constraints: an action's obstacles, (object, strict) (``TaskGraph.obstacles``)
+Order = Callable[[Action], list[tuple[str, bool]]]
 #: each robot's volume at every sample of every phase of its motions (one volume for a phase it stands still
 #: in, away from home): robot -> phase -> volumes
 Motions = dict[str, dict[str, list[Volume]]]
@@ -76,6 +78,11 @@ class Grounding:
     reason: str = ""
     #: why steps failed (the strict attempt of a PARTIAL step, or the failing step of a FAIL)
     failures: list[Failure] = field(default_factory=list)
+    #: the step failures of robots in each other's way that a re-timing or a split got around, in grounding
+    #: order (the log and the plan's statistics report them)
+    resolved: list[Failure] = field(default_factory=list)
+    #: actions re-timed into an earlier skeleton step: (action label, from step, to step)
+    retimed: list[tuple[str, int, int]] = field(default_factory=list)
 
 
 def _matrix(t: np.ndarray) -> list[list[float]]:
@@ -112,32 +119,46 @@ class ReverseGrounder:
         #: (robot, object, grasp, placement) whose place failed on what never moves (no IK, fixed bodies):
         #: later groundings pass over them without spending one of their tries
         self._dead_spots: set[tuple[str, str, str, tuple[float, ...]]] = set()
+        #: the skeleton being grounded, its actions as re-timed so far (see :class:`_Retiming`)
+        self._plan = _Retiming([], None)
 
-    def ground(self, skeleton: Skeleton, suffix: list[GroundedStep], key: str = "") -> Grounding:
+    def ground(
+        self, skeleton: Skeleton, suffix: list[GroundedStep], key: str = "", order: Order | None = None
+    ) -> Grounding:
         """Ground ``skeleton``'s steps, last first, before the already grounded ``suffix`` (see the module
-        docstring); ``key`` tells this query's seeds from other groundings'.  Raises :class:`DeadlineReached`
-        when the search's deadline cut a query of it short (its answer may then be wrong)."""
+        docstring); ``key`` tells this query's seeds from other groundings'.  ``order``: the skeleton's order
+        constraints (each action's obstacles, :meth:`TaskGraph.obstacles
+        <mrgc.compiler.task_graph.TaskGraph.obstacles>`); with them, an action in the way of another robot
+        of its step is first *re-timed* into an earlier step where its robots are free and its obstacles
+        already moved (:meth:`_retime_to`), and only then is the step split; when a grounding with
+        re-timings does not succeed, the skeleton is grounded again without them.  Raises
+        :class:`DeadlineReached` when the search's deadline cut a query of it short (its answer may then be
+        wrong)."""
         self._on_time()
-        result = self._ground(skeleton, suffix, key)
+        result = self._ground(skeleton, suffix, key, order)
+        if result.retimed and result.outcome is not Outcome.SUCCESS:
+            result = self._ground(skeleton, suffix, key, None)
         if self.g.cut:  # a query stopped at the deadline: what it answered decides nothing
             raise DeadlineReached()
         return result
 
-    def _ground(self, skeleton: Skeleton, suffix: list[GroundedStep], key: str) -> Grounding:
+    def _ground(self, skeleton: Skeleton, suffix: list[GroundedStep], key: str, order: Order | None) -> Grounding:
         fut_objs = {o for s in suffix for o in s.moved}
         skel_objs = set(skeleton.moved)
         out_objs = set(self.movable) - fut_objs - skel_objs
         volume: Volume = [p for s in suffix for p in s.volume]
         grounded: list[GroundedStep] = []
+        self._plan = _Retiming([list(step) for step in skeleton.steps], order)
         for t in range(skeleton.makespan - 1, -1, -1):
-            step = skeleton.steps[t]
-            same = {a.obj for a in step}
+            step = tuple(self._plan.steps[t])
             self.grounded = set(fut_objs)
             strict = self._steps(step, fut_objs | out_objs, volume, f"{key}:{t}", t + 1)
             if isinstance(strict, Failure):
+                self._plan.rollback()
                 relaxed = self._steps(step, fut_objs, volume, f"{key}:{t}:relaxed", t + 1)
+                self._plan.commit()
                 if isinstance(relaxed, Failure):
-                    return Grounding(Outcome.FAIL, reason=relaxed.line(), failures=[relaxed])
+                    return self._plan.told(Grounding(Outcome.FAIL, reason=relaxed.line(), failures=[relaxed]))
                 grounded[:0] = relaxed
                 steps = grounded + suffix
                 moved = {o for s in steps for o in s.moved}
@@ -148,17 +169,20 @@ class ReverseGrounder:
                     [p for s in steps for p in s.volume], among=sorted(o for o in self.movable if o not in moved)
                 )
                 must = {o for o in self.goal if o not in moved} | blockers
-                return Grounding(
-                    Outcome.PARTIAL,
-                    steps,
-                    must,
-                    reason=f"step {t + 1} needs {sorted(blockers)} moved",
-                    failures=[strict],
+                return self._plan.told(
+                    Grounding(
+                        Outcome.PARTIAL,
+                        steps,
+                        must,
+                        reason=f"step {t + 1} needs {sorted(blockers)} moved",
+                        failures=[strict],
+                    )
                 )
+            self._plan.commit()
             grounded[:0] = strict
             volume = volume + [p for s in strict for p in s.volume]
-            fut_objs |= same
-        return Grounding(Outcome.SUCCESS, grounded + suffix)
+            fut_objs |= moved_objects(strict)  # re-timed actions left for an earlier step
+        return self._plan.told(Grounding(Outcome.SUCCESS, grounded + suffix))
 
     # ------------------------------------------------------------ one joint action
     def _steps(
@@ -179,11 +203,20 @@ class ReverseGrounder:
             return done
         alone = next(a for a in step if label(a) == done.action)
         rest = tuple(a for a in step if a is not alone)
+        # first the same actions over the skeleton's steps: the failing action in an earlier step
+        mark = self._plan.mark()
+        if self._plan.retime(alone, index):
+            again = self._steps(rest, avoid, v_fut, key, index)
+            if not isinstance(again, Failure):
+                self._plan.noted.append(done)
+                return again
+            self._plan.rollback(mark)
         for later, earlier in (((alone,), rest), (rest, (alone,))):
             # the reverse search grounds the later part first; the earlier one then avoids its objects (at
             # their initial poses) and its volume
             tail = self._steps(later, avoid, v_fut, f"{key}:late", index)
             if isinstance(tail, Failure):
+                self._plan.rollback(mark)
                 continue
             before = self.grounded
             self.grounded = before | {a.obj for a in later}
@@ -198,7 +231,9 @@ class ReverseGrounder:
             finally:
                 self.grounded = before
             if not isinstance(head, Failure):
+                self._plan.noted.append(done)
                 return head + tail
+            self._plan.rollback(mark)
         return done
 
     def _relay_steps(
@@ -298,7 +333,14 @@ class ReverseGrounder:
             # what the other robots of the step sweep or occupy in each phase: this action keeps clear of it
             busy = _swept_by_others(motions, (a.pick_robot, a.place_robot))
             action = self._action(a, avoid_a, v_fut + step_volume, f"{key}:{a.obj}", placed, busy)
+            if isinstance(action, Failure) and action.detail == BUSY:
+                # kept clear of the whole of what the others sweep (when they pass ignored), it fails: then as
+                # they pass, the sample-paired comparison below (the validator's) decides
+                timed = self._action(a, avoid_a, v_fut + step_volume, f"{key}:{a.obj}", placed, {})
+                action = action if isinstance(timed, Failure) else timed
             if isinstance(action, Failure):
+                if action.detail == BUSY:  # name the step's robots in the way, and what they carry
+                    action = replace(action, bodies=_others_of(actions, a))
                 return replace(action, step=index, action=label(a))
             moves = self._motions(action)
             mine = _joined(moves, self._stood(action))
@@ -758,6 +800,78 @@ class ReverseGrounder:
         return failure
 
 
+class _Retiming:
+    """A skeleton's steps as the reverse search re-times its actions (beyond the paper): an action in the way
+    of another robot of its step goes to the latest earlier step (not grounded yet: the reverse search
+    grounds later steps first) where its robots are free, that holds no relay, and where the skeleton's order
+    constraints (``order``: the action's obstacles, (object, strict)) still hold: each obstacle moved by the
+    skeleton strictly before that step, or no later for a non-strict one.  The actions that wait for the
+    re-timed one's object (it is their obstacle) only gain: it now moves earlier.  A step with a handover
+    takes no second one (a single handover point: the skeleton model's rule, kept for any number).  Geometry
+    agrees: the objects of earlier steps are at their initial poses for the later ones, which ignore them,
+    and their placements avoid what the later steps sweep, whatever step they are in.  Moves (and the
+    failures they or a split got around) are pending until the step that made them is grounded
+    (:meth:`commit`); :meth:`rollback` takes back those made since a :meth:`mark`."""
+
+    def __init__(self, steps: list[list[Action]], order: Order | None) -> None:
+        self.steps, self.order = steps, order
+        self.pending: list[tuple[Action, int, int]] = []  # (action, from step, to step), 1-based
+        self.noted: list[Failure] = []
+        self.done: list[tuple[str, int, int]] = []
+        self.resolved: list[Failure] = []
+
+    def retime(self, a: Action, index: int) -> bool:
+        """Move ``a`` from step ``index`` to an earlier one where it may go (pending); False when none."""
+        if self.order is None or a.via is not None or a not in self.steps[index - 1]:
+            return False
+        to = self._target(a, index)
+        if to is None:
+            return False
+        self.steps[index - 1].remove(a)
+        self.steps[to - 1].append(a)
+        self.pending.append((a, index, to))
+        return True
+
+    def _target(self, a: Action, index: int) -> int | None:
+        assert self.order is not None
+        when = {b.obj: t for t, step in enumerate(self.steps, 1) for b in step}
+        obstacles = self.order(a)
+        for to in range(index - 1, 0, -1):
+            step = self.steps[to - 1]
+            if any(set(b.robots) & set(a.robots) or b.via is not None for b in step):
+                continue
+            if a.handover and any(b.handover for b in step):
+                continue
+            if all(o in when and (when[o] < to if strict else when[o] <= to) for o, strict in obstacles):
+                return to
+        return None
+
+    def mark(self) -> tuple[int, int]:
+        """Where the pending moves and notes stand now."""
+        return len(self.pending), len(self.noted)
+
+    def rollback(self, mark: tuple[int, int] = (0, 0)) -> None:
+        """Take back the moves and notes made since ``mark`` (default: all pending ones)."""
+        while len(self.pending) > mark[0]:
+            a, at, to = self.pending.pop()
+            self.steps[to - 1].remove(a)
+            self.steps[at - 1].append(a)
+        del self.noted[mark[1] :]
+
+    def commit(self) -> None:
+        """The pending moves hold: the step that made them is grounded."""
+        self.done += [(label(a), at, to) for a, at, to in self.pending]
+        self.resolved += self.noted
+        self.pending.clear()
+        self.noted.clear()
+
+    def told(self, grounding: Grounding) -> Grounding:
+        """``grounding`` with the re-timings and the resolved failures of robots in each other's way."""
+        grounding.retimed = list(self.done)
+        grounding.resolved = list(self.resolved)
+        return grounding
+
+
 def label(a: Action) -> str:
     """An action as a failure line names it: ``r1 moves o3 to bin-a (top)``, ``r1->r2 hands o3 to bin-a ...``,
     ``r1->r2 relay o3 to bin-a via start (top->top)``."""
@@ -789,6 +903,15 @@ def _swept_by_others(motions: Motions, robots: tuple[str, ...]) -> dict[str, Vol
             for phase, samples in phases.items():
                 busy.setdefault(phase, []).extend(p for vol in samples for p in vol)
     return busy
+
+
+def _others_of(actions: list[PlannedAction], a: Action) -> tuple[str, ...]:
+    """The robots of the step's actions grounded before ``a`` (other than ``a``'s) and the objects they
+    move: what an action that keeps clear of them (``busy``) was kept from."""
+    mine = {a.pick_robot, a.place_robot}
+    return tuple(
+        sorted({n for p in actions if not mine & {p.pick_robot, p.place_robot} for n in (p.object, *p.robots())})
+    )
 
 
 def _joined(moves: Motions, stood: Motions) -> Motions:

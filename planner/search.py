@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, Any, Callable
 from mrgc.compiler.enumerate import BatchOutcome
 from mrgc.compiler.facts import FactBase
 from mrgc.compiler.skeleton import Skeleton
-from mrgc.compiler.task_graph import Action
+from mrgc.compiler.task_graph import Action, TaskGraph
 from mrgc.language.model import Fact, Problem
 from mrgc.planner.deferral import Deferrals, describe
 from mrgc.planner.outcome import BlockingCycle, Failure, PlanStatus, Why
@@ -112,10 +112,12 @@ def plan_problem(
         reverse = ReverseGrounder(grounder, problem.goal_regions, full=motions == "full", deadline=deadline)
         count = [0]
         validation: dict[str, Any] = {}
+        timing = _Timing()
 
         def ground(skel: Skeleton, suffix: list[GroundedStep]) -> Grounding:
             count[0] += 1
-            result = reverse.ground(skel, suffix, key=str(count[0]))
+            result = reverse.ground(skel, suffix, key=str(count[0]), order=sources.order_of(skel))
+            timing.grounded(skel, suffix, result)
             if result.outcome is Outcome.SUCCESS:
                 result = _referee(problem, problem_file, plan, result, why, validation)
             for f in result.failures:
@@ -136,6 +138,7 @@ def plan_problem(
         stats["geometric_queries"] = grounder.queries
         stats["deferred"] = sorted(describe(p) for p in sources.deferrals.deferred)
         stats["validation_seconds"] = round(validation.get("seconds", 0.0), 4)
+        stats.update(timing.of(result.steps))
         why.summary = _summary(plan.status, result.ended, time_limit, max_iterations, why)
     stats["seconds"] = round(time.perf_counter() - t0, 4)
     plan.stats = stats
@@ -157,14 +160,41 @@ def phase1_cut(plan: Plan, problem: Problem, time_limit: float, t0: float, facts
     return plan
 
 
+class _Timing:
+    """How the grounded plans' steps compare with their skeletons' (``-v`` and the plan's statistics): per
+    grounded sequence (a node's suffix, a full plan) the skeletons' makespan it grounds, the actions re-timed
+    into an earlier skeleton step, and the steps split because robots were in each other's way."""
+
+    def __init__(self) -> None:
+        self.of_steps: dict[int, tuple[int, int, int]] = {}  # id(steps) -> (skeleton makespan, retimed, split)
+
+    def grounded(self, skel: Skeleton, suffix: list[GroundedStep], result: Grounding) -> None:
+        if not result.steps:
+            return
+        span, retimed, split = self.of_steps.get(id(suffix), (len(suffix), 0, 0))
+        resolved = len(result.resolved) - len(result.retimed)
+        self.of_steps[id(result.steps)] = (span + skel.makespan, retimed + len(result.retimed), split + resolved)
+
+    def of(self, steps: list[GroundedStep] | None) -> dict[str, int]:
+        """The statistics of the returned plan (none without one)."""
+        if steps is None or id(steps) not in self.of_steps:
+            return {}
+        span, retimed, split = self.of_steps[id(steps)]
+        return {"makespan": len(steps), "skeleton_makespan": span, "retimed_actions": retimed, "split_steps": split}
+
+
 class _Skeletons:
     """One skeleton source as the search asks it (:class:`~mrgc.planner.mcts.Node`'s ``more``): called with
     ``k``, the next ``k`` skeletons within the time left; it counts the skeletons it gave and keeps why its
     last batch stopped."""
 
-    def __init__(self, source: SkeletonSource, deadline: float, deferrals: Deferrals) -> None:
+    def __init__(
+        self, source: SkeletonSource, deadline: float, deferrals: Deferrals, graphs: dict[Skeleton, TaskGraph]
+    ) -> None:
         self.source = source
         self.deadline = deadline
+        #: the task graph each skeleton given came from (shared by every source)
+        self.graphs = graphs
         #: the search's deferred actions (shared by every source; read at each call)
         self.deferrals = deferrals
         self.count = 0
@@ -175,6 +205,8 @@ class _Skeletons:
         gen = self.source.generator
         gen.defer(self.deferrals.among(gen.graph.actions))
         batch = self.source.next(k, time_limit=left)
+        for skel in batch.skeletons:
+            self.graphs.setdefault(skel, gen.graph)
         self.count += len(batch.skeletons)
         self.outcome = batch.outcome
         return batch.skeletons
@@ -211,6 +243,8 @@ class _Sources:
         self.roots: list[_Skeletons] = []
         #: what failed groundings failed at, and what is deferred (docs/planner.md, "Deferred actions")
         self.deferrals = Deferrals()
+        #: the task graph of each skeleton given (its order constraints: re-timing, planner/ground.py)
+        self.graphs: dict[Skeleton, TaskGraph] = {}
 
     def __call__(self, need: set[str], moved: set[str]) -> _Skeletons:
         src = SkeletonSource(
@@ -222,7 +256,7 @@ class _Sources:
             self.max_makespan,
             self.seed,
         )
-        more = _Skeletons(src, self.deadline, self.deferrals)
+        more = _Skeletons(src, self.deadline, self.deferrals, self.graphs)
         if not self.roots:
             self.roots.append(more)
         return more
@@ -231,6 +265,14 @@ class _Sources:
     def root(self) -> _Skeletons:
         """The first source made: the root's."""
         return self.roots[0]
+
+    def order_of(self, skel: Skeleton) -> Callable[[Action], list[tuple[str, bool]]] | None:
+        """``skel``'s order constraints: each of its actions' obstacles, (object, strict)."""
+        graph = self.graphs.get(skel)
+        if graph is None:
+            return None
+        index = {a: i for i, a in enumerate(graph.actions)}
+        return lambda a: graph.obstacles(index[a])
 
 
 def _conclude_symbolic(plan: Plan, why: Why, more: _Skeletons, time_limit: float) -> None:
@@ -352,12 +394,21 @@ def _log_line(elapsed: float, n: int, skel: Skeleton, suffix: list[GroundedStep]
 
     head = f"[t={elapsed:.1f}s] skeleton {n} (makespan {skel.makespan}, moves {len(skel.moved)}"
     head += f", under a suffix of {len(suffix)} step{'s' * (len(suffix) != 1)})" if suffix else ")"
+    retimed = "".join(f"\n  re-timed: {what} from step {at} to step {to}" for what, at, to in result.retimed)
+    resolved = "".join(f"\n  robots in each other's way, resolved: {f.line()}" for f in result.resolved)
     if result.outcome is Outcome.SUCCESS:
-        return f"{head}: plan found, makespan {len(result.steps)}, {len(moved_objects(result.steps))} moved, valid"
+        span = (
+            f" (the skeleton's {skel.makespan + len(suffix)})"
+            if len(result.steps) != skel.makespan + len(suffix)
+            else ""
+        )
+        moved = len(moved_objects(result.steps))
+        return f"{head}: plan found, makespan {len(result.steps)}{span}, {moved} moved, valid{retimed}{resolved}"
     if result.outcome is Outcome.PARTIAL:
         f = result.failures[0] if result.failures else None
         why = f" ({f.line()})" if f else ""
-        return f"{head}: grounded {len(result.steps) - len(suffix)} step(s); must move {sorted(result.must_move)}{why}"
+        grounded = len(result.steps) - len(suffix)
+        return f"{head}: grounded {grounded} step(s); must move {sorted(result.must_move)}{why}{retimed}{resolved}"
     f = result.failures[0] if result.failures else None
     return f"{head}: fails at {f.line() if f else result.reason}"
 

@@ -178,9 +178,16 @@ class ReplayScene:
     def _add_arm(self, name: str, model: RobotModel, base: np.ndarray) -> None:
         pb, cid = self.pb, self.cid
         pos, orn = tf.to_quaternion(np.asarray(base, dtype=float))
-        with quiet_output():
+        with quiet_output():  # collision geometry only: the Panda's visual meshes are 90 % of its loading time
             body = int(
-                pb.loadURDF(model.urdf, basePosition=pos, baseOrientation=orn, useFixedBase=True, physicsClientId=cid)
+                pb.loadURDF(
+                    model.urdf,
+                    basePosition=pos,
+                    baseOrientation=orn,
+                    useFixedBase=True,
+                    flags=pb.URDF_IGNORE_VISUAL_SHAPES,
+                    physicsClientId=cid,
+                )
             )
         by_link: dict[str, int] = {pb.getBodyInfo(body, physicsClientId=cid)[0].decode(): -1}
         info = {}

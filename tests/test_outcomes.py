@@ -224,6 +224,7 @@ class ScriptedGrounder:
         self.crowded = crowded  # objects whose pick collides with whatever another robot of the step sweeps
         self.poses = {m: np.eye(4) for m in movable}
         self.steps: list[list[str]] = []
+        self.cut = False  # no query of the script stops at a deadline
 
     def is_planar(self, robot: str) -> bool:
         return False
@@ -300,6 +301,9 @@ class ScriptedGrounder:
     def arm_volume(self, robot: str, configs: np.ndarray, holding: Any = None, grasp: Any = None) -> list[Any]:
         return [(f"arm:{robot}:{holding[0] if holding else ''}", None)]
 
+    def arm_volumes(self, robot: str, configs: np.ndarray, holding: Any = None, grasp: Any = None) -> list[Any]:
+        return [self.arm_volume(robot, configs, holding, grasp)]  # one token volume for the whole motion
+
     def shape(self, obj: str) -> str:
         return f"shape:{obj}"
 
@@ -329,10 +333,15 @@ def test_m_star_keeps_the_blockers_of_an_older_suffix() -> None:
     assert failure.step == 2 and failure.check.startswith("pick by r1") and failure.bodies == ("d",)
 
 
-def test_a_step_whose_robots_collide_is_split() -> None:
+def test_a_step_whose_robots_collide_is_split(monkeypatch: pytest.MonkeyPatch) -> None:
     """r1 and r2 pick a and b in one skeleton step, but b's pick collides with what r1 sweeps meanwhile: the
     step is grounded as two (b alone one step later), keeping the skeleton's actions; the grounder was told
     each time which arms pick and place in the step (arms of the step are not at home then)."""
+    import mrgc.planner.ground as ground_module
+
+    # the script's volumes are tokens: the sample-paired check of the step's robots says what the script
+    # says, they collide while picking
+    monkeypatch.setattr(ground_module, "_phases_collide", lambda a, b: "pick" if "pick" in a and "pick" in b else "")
     grounder = ScriptedGrounder(["a", "b"], blocked_by={}, sweeps={}, crowded=frozenset({"b"}))
     reverse = ReverseGrounder(grounder, {"a": "goal", "b": "goal"})  # type: ignore[arg-type]
     skeleton = Skeleton(
@@ -351,7 +360,7 @@ def test_a_step_is_not_split_for_other_failures(monkeypatch: pytest.MonkeyPatch)
     """A pick blocked by an avoided object is not a conflict between the step's robots: no split, M* grows."""
     import mrgc.planner.ground as ground_module
 
-    monkeypatch.setattr(ground_module, "_volumes_collide", lambda a, b: False)  # the script's volumes are tokens
+    monkeypatch.setattr(ground_module, "_phases_collide", lambda a, b: "")  # the script's volumes are tokens
     grounder = ScriptedGrounder(["a", "b", "c"], blocked_by={"b": {"c"}}, sweeps={"arm:r2:": {"c"}})
     reverse = ReverseGrounder(grounder, {"a": "goal", "b": "goal"})  # type: ignore[arg-type]
     skeleton = Skeleton(

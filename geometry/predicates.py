@@ -85,33 +85,30 @@ class RobotEvaluator:
         attempt: int = 0,
         restarts: int = 8,
     ) -> list[np.ndarray | None]:
-        """IK for many tool poses in one batch (``q_init``: one start for all, or one per pose).  Solves from
-        one start (or none) are analytic for arms with a Panda's kinematics (:mod:`mrgc.geometry.ik`):
-        retries (``attempt`` > 0) without a start then start from a configuration drawn for the attempt, so
-        that they reach other branches.  Solves with a start per pose (a pre-grasp from its grasp) are
-        numeric from that start, as grounding solves them: the approach between the two stays on its line."""
+        """IK for many tool poses in one batch (``q_init``: one start for all, or one per pose).  A first
+        attempt from one start (or none: home) is analytic for arms with a Panda's kinematics
+        (:mod:`mrgc.geometry.ik`); retries (``attempt`` > 0) are numeric with seeded restarts, which reach the
+        other branches the analytic answer (nearest the start, whatever the seed) does not.  Solves with a
+        start per pose (a pre-grasp from its grasp) are numeric from that start, as grounding solves them:
+        the approach between the two stays on its line."""
         if not tool_poses:
             return []
         targets = np.stack([self.arm.ee_target(t) for t in tool_poses])
         self.out.ik_solves += len(targets)
-        seed = seed_for(self.arm.name, key, str(attempt), seed=self.seed)
-        start = q_init
-        if start is None:
-            start = self.arm.home if attempt == 0 else np.random.default_rng(seed).uniform(*self._limits)
+        start = self.arm.home if q_init is None else q_init
+        one_start = np.ndim(start) == 1
+        # numeric retries draw the restarts numeric attempts 0, 1, ... drew before the analytic first try
+        tries = attempt - 1 if one_start and attempt > 0 else attempt
         res = solve_ik_many(
             self.arm.model,
             targets,
-            seed,
+            seed_for(self.arm.name, key, str(tries), seed=self.seed),
             q_init=start,
             restarts=restarts,
             max_iters=IK_ITERS,
-            analytic=np.ndim(start) == 1,
+            analytic=attempt == 0 and one_start,
         )
         return [r.q if r.solved else None for r in res]
-
-    @property
-    def _limits(self) -> tuple[np.ndarray, np.ndarray]:
-        return self.arm.model.lower, self.arm.model.upper
 
     def usable(self, obj: str, grasp: str) -> bool:
         """Whether this arm can use ``grasp`` on ``obj``: the grasp has geometry and the gripper opens wide

@@ -225,12 +225,13 @@ def test_html_replay_is_self_contained_and_shows_the_robots_in_chromium(
         """The names of robots and regions without dark text (which nothing else in the scene is) near
         where their anchors project."""
         h, w = picture.shape[:2]
-        dark = picture.max(axis=2) < 90
+        # a short name drawn by software WebGL is a few anti-aliased grey glyphs (r1: none below 94)
+        dark = picture.max(axis=2) < 150
         out = []
         for name, point in points.items():
             c, r, _ = camera.project(point, w, h)
             x, y = int(c[0]), int(r[0])
-            if dark[max(0, y - 80) : y + 40, max(0, x - 70) : x + 70].sum() < 8:
+            if dark[max(0, y - 80) : y + 40, max(0, x - 70) : x + 70].sum() < 12:
                 out.append(name)
         return out
 

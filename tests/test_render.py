@@ -500,3 +500,63 @@ def test_what_stands_in_a_region_keeps_its_colour() -> None:
     floor = out[30, 40].astype(int)
     assert floor[1] > floor[0] and floor[1] > floor[2]  # the floor in the region is tinted green
     assert (out[2, 2] == (200, 200, 200)).all()  # outside the region nothing changes
+
+
+SHIPPED_REPLAYS = [ROOT / "domains" / "packaging" / "pa10.mrg", ROOT / "domains" / "box-moving" / "bo8-two-doors.mrg"]
+
+
+@pytest.mark.parametrize("problem", SHIPPED_REPLAYS, ids=lambda p: p.stem)
+def test_sheets_and_html_replays_of_pa10_and_bo8_name_their_robots_and_regions(
+    problem: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Issue 24's "done when": a PNG sheet and the HTML replay of pa10 and bo8 show robot and region names
+    (the sheet by the pixels of each name's box, which fail without names; the replay in headless Chromium:
+    the legend names every robot and region, and dark glyphs stand where each region's name is anchored)."""
+    from mrgc.render import outputs
+    from mrgc.render.labels import anchors, frame_labels, world_legend
+    from mrgc.render.picture import label_style, legend_band, place_labels, text_size
+
+    plan_path = tmp_path / "plan.json"
+    assert cli.main(["plan", str(problem), "-o", str(plan_path), "--time-limit", "300"]) == 0
+    plan = json.loads(plan_path.read_text())
+    opts = outputs.Options(320, 240, 4.0)
+    sheet = tmp_path / "sheet.png"
+    assert run(["render", problem, plan_path, "-o", sheet, "--size", "320x240", "--fps", "4"], capsys)[0] == 0
+    world, _, frames, _ = outputs.replay_frames(parse_file(str(problem)).problem(None), plan, opts, "plan")
+    keys = [f for f in frames if f.key]
+    lay = outputs.frame_layout(world, keys, opts, legend=False)
+    camera = outputs.frame_camera(world, frames, opts, lay)
+    labels = frame_labels(world, keys[0], camera, 320, lay.scene_height, lay.labels)
+    robots = {r.name for r in parse_file(str(problem)).problem(None).robots}
+    regions = {b.name for b, _ in world.regions}
+    assert {lb.text for lb in labels} == robots | regions
+
+    named = np.asarray(Image.open(sheet).convert("RGB"))
+    top = legend_band(named.shape[1], world_legend(world), text_size(300)).shape[0]
+    for label, (x0, y0, x1, y1) in place_labels(labels, lay.size, 320, lay.scene_height):
+        share, ink = _label_pixels(named, (x0, y0 + top, x1, y1 + top), label_style(label)[0])
+        assert share > 0.35 and ink >= 3, (problem.stem, label.text, share, ink)
+    page_path = tmp_path / "replay.html"
+    assert run(["render", problem, plan_path, "-o", page_path, "--fps", "5"], capsys)[0] == 0
+    page = page_path.read_text(encoding="utf-8")
+    legend = page[page.index('<div id="mrgc-legend"') :]
+    assert all(f">{name}</div>" in legend for name in robots), robots
+    assert all(name in legend for name in regions), regions
+    html_frames = build_timeline(world, plan).frames(5)
+    html_camera = outputs.html_camera(world, html_frames, outputs.Options())
+    points = {lb.text: p.reshape(-1, 3).mean(axis=0) for lb, p in anchors(world, html_frames[0]) if lb.text in regions}
+
+    def unnamed(picture: np.ndarray) -> list[str]:
+        h, w = picture.shape[:2]
+        dark = picture.max(axis=2) < 150
+        out = []
+        for name, point in points.items():
+            c, r, _ = html_camera.project(point[None], w, h)
+            x, y = int(c[0]), int(r[0])
+            if dark[max(0, y - 80) : y + 40, max(0, x - 70) : x + 70].sum() < 12:
+                out.append(name)
+        return out
+
+    picture, ok = screenshot_when(page_path.as_uri(), lambda p: non_blank(p) and not unnamed(p), timeout=150)
+    Image.fromarray(picture).save(tmp_path / "chromium.png")
+    assert ok, f"region names missing in the replay: {unnamed(picture)} ({tmp_path / 'chromium.png'})"

@@ -24,6 +24,9 @@ from mrgc.geometry.transforms import from_pose, inverse
 #: about 0.05 mm; the clearance covers that and what moves between two configurations the planner checks
 SELF_CLEARANCE = 0.003
 
+#: link hulls by model key (shared collision shapes: immutable once built)
+_HULLS: dict[str, dict[int, CollisionShape]] = {}
+
 
 class Arm:
     """A fixed-base arm of a scene (one per robot; built once per process)."""
@@ -45,33 +48,41 @@ class Arm:
 
     @cached_property
     def hulls(self) -> dict[int, CollisionShape]:
-        """The collision hull of every :attr:`~mrgc.geometry.kinematics.Link.solid` link, by link index."""
-        return {
-            link.index: collision_shape(ConvexHull(np.asarray(link.points, dtype=float)))
-            for link in self.model.links
-            if link.solid
-        }
+        """The collision hull of every :attr:`~mrgc.geometry.kinematics.Link.solid` link, by link index
+        (built once per model and process: the arms of one kind share them)."""
+        hulls = _HULLS.get(self.model.key)
+        if hulls is None:
+            hulls = _HULLS[self.model.key] = {
+                link.index: collision_shape(ConvexHull(np.asarray(link.points, dtype=float)))
+                for link in self.model.links
+                if link.solid
+            }
+        return hulls
 
     @cached_property
     def probes(self) -> tuple[list[CollisionShape], list[int]]:
-        """Collision hulls of the links that can hit anything (the base link, bolted in place, is left out)."""
-        index = [k for k in self.hulls if k != 0]
+        """Collision hulls of the links that can hit anything: every solid link but the mount
+        (:attr:`RobotModel.mount`: the root link and the links fixed to it, bolted in place, whatever they are
+        called), which stands on what the arm is mounted on."""
+        mount = set(self.model.mount)
+        index = [k for k in self.hulls if k not in mount]
         return [self.hulls[k] for k in index], index
 
     @cached_property
-    def base_hull(self) -> tuple[CollisionShape, np.ndarray] | None:
-        """The base link's hull and world pose: left out of :attr:`probes` (it cannot move, and this arm's
-        own links start on it), it is an obstacle to every other arm (None: the link has no geometry)."""
-        if 0 not in self.hulls:
-            return None
-        pose: np.ndarray = fk_world(self.model, self.home[None], self.base)[0, 0]
-        return self.hulls[0], pose
+    def base_hulls(self) -> tuple[tuple[str, CollisionShape, np.ndarray], ...]:
+        """The mount's solid links (name, hull, world pose): left out of :attr:`probes` (they cannot move,
+        and this arm's own links start on them), they are obstacles to every other arm."""
+        mount = [k for k in self.model.mount if k in self.hulls]
+        if not mount:
+            return ()
+        poses = fk_world(self.model, self.home[None], self.base)[0]
+        return tuple((self.model.links[k].name, self.hulls[k], poses[k]) for k in mount)
 
     @cached_property
     def _self_check(self) -> PairCheck:
-        """The self-collision check over the solid links: the base link (when solid) first, then the
+        """The self-collision check over the solid links: the mount's solid links first, then the
         :attr:`probes` in their order."""
-        index = ([0] if 0 in self.hulls else []) + self.probes[1]
+        index = [k for k in self.model.mount if k in self.hulls] + self.probes[1]
         at = {k: i for i, k in enumerate(index)}
         pairs = [(at[a], at[b]) for a, b in self.model.self_collision_pairs]
         return PairCheck([self.hulls[k] for k in index], pairs, SELF_CLEARANCE)
@@ -93,11 +104,11 @@ class Arm:
         return self._self_check.collides(self._with_base(transforms))
 
     def _with_base(self, transforms: np.ndarray) -> np.ndarray:
-        """The probed links' transforms (C, L, 4, 4) with the base link's (fixed) in front when it is solid."""
+        """The probed links' transforms (C, L, 4, 4) with the mount's solid links' (fixed) in front."""
         t = np.asarray(transforms, dtype=float).reshape(-1, len(self.probes[1]), 4, 4)
-        if self.base_hull is None:
+        if not self.base_hulls:
             return t
-        base = np.broadcast_to(self.base_hull[1], (len(t), 1, 4, 4))
+        base = np.broadcast_to(np.stack([pose for _, _, pose in self.base_hulls]), (len(t), len(self.base_hulls), 4, 4))
         return np.concatenate([base, t], axis=1)
 
     def ee_target(self, tool_world: np.ndarray) -> np.ndarray:

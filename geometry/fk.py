@@ -139,8 +139,9 @@ _FINGER_STEPS: dict[tuple[str, float], tuple[tuple[int, int, int, np.ndarray | N
 
 
 def _steps(model: RobotModel, p: _Plan, fingers: float | None) -> tuple[tuple[int, int, int, np.ndarray | None], ...]:
-    """The chaining steps of ``p`` with the finger joints (off-chain prismatic) at ``fingers`` (clamped into
-    their limits) instead of their frozen values; cached per (model, value)."""
+    """The chaining steps of ``p`` with the gripper's joints at drive value ``fingers``
+    (:meth:`RobotModel.gripper_value`: mimic rules applied, clamped into their limits) instead of their
+    frozen values; cached per (model, value)."""
     if fingers is None:
         return p.steps
     key = (model.key, round(float(fingers), 12))
@@ -154,12 +155,7 @@ def _steps(model: RobotModel, p: _Plan, fingers: float | None) -> tuple[tuple[in
                 k,
                 parent,
                 ci,
-                _local(
-                    "prismatic",
-                    links[k].origin,
-                    links[k].axis,
-                    min(max(float(fingers), links[k].lower), links[k].upper),
-                )
+                _local(links[k].joint_kind, links[k].origin, links[k].axis, model.gripper_value(k, float(fingers)))
                 if links[k].finger
                 else const,
             )
@@ -173,7 +169,7 @@ def fk(model: RobotModel, q: np.ndarray, base: BasePose = None, fingers: float |
     """Frames of every link (in ``model.links`` order): shape ``q.shape[:-1] + (L, 4, 4)``.
 
     In the base-link frame, or in the world when ``base`` (the base link's pose) is given.  ``fingers``
-    sets the finger joints (see :meth:`RobotModel.finger_value`); None leaves them frozen (open).
+    is the gripper's drive value (see :meth:`RobotModel.finger_value`); None leaves it frozen (open).
     """
     q = _as_q(model, q)
     p = plan(model)

@@ -243,7 +243,7 @@ class Grounder:
         #: arms wait at home while others move (the validator's rule): each arm's links at home, group
         #: ``home:<arm>``, an obstacle to the other arms' motions
         self.homes: tuple[str, ...] = ()
-        #: each arm's base link, group ``base:<arm>``: an obstacle to the other arms, home or not
+        #: each arm's mount links (its base), group ``base:<arm>``: an obstacle to the other arms, home or not
         self._bases: tuple[str, ...] = ()
         #: the step being grounded (see :meth:`step`): each of its robots' role, and the arms' motion model
         self._roles: dict[str, str] = {}
@@ -266,8 +266,9 @@ class Grounder:
                     arm = self.arm(spec.name)
                     for i, (shape, t) in enumerate(self.arm_volume(spec.name, arm.home[None])):
                         self.world.add(f"@{spec.name}:{i}", shape, t, f"home:{spec.name}")
-                    if arm.base_hull is not None:  # bolted in place: there whether the arm is home or not
-                        self.world.add(f"@{spec.name}:base", *arm.base_hull, f"base:{spec.name}")
+                    for j, (_, shape, t) in enumerate(arm.base_hulls):  # bolted in place: there, home or not
+                        self.world.add(f"@{spec.name}:base" + (f":{j}" if j else ""), shape, t, f"base:{spec.name}")
+                    if arm.base_hulls:
                         self._bases += (f"base:{spec.name}",)
             self.homes = tuple(f"home:{s.name}" for s in self.scene.robots if not is_planar(s))
         return self.homes

@@ -13,11 +13,24 @@ that imports it); its forward and inverse kinematics and distance references, wh
 compare this module's models against, are :mod:`mrgc.testing.pybullet_reference`.
 
 Frames: a link's frame is its URDF link frame (pybullet's ``worldLinkFrame``, not its centre of mass); a
-movable joint's frame is its child link's frame.  Off-chain movable joints (the Panda's fingers) are frozen
-at :attr:`Link.frozen_value`: a prismatic one at its upper limit (gripper open), a revolute one at 0
-clamped into its limits.  The fingers are the off-chain prismatic joints: forward kinematics can set them
-to another value (:meth:`RobotModel.finger_value` turns a finger opening into it: each finger travels
-half the opening, so a Panda finger joint is opening / 2).
+movable joint's frame is its child link's frame.  Off-chain movable joints are frozen at
+:attr:`Link.frozen_value`: a prismatic one at its upper limit (gripper open), a revolute one at 0 clamped
+into its limits, a ``<mimic>`` one at ``multiplier * value + offset`` of the joint it mimics (clamped).
+
+**The gripper** is the off-chain movable joints below the end-effector link (:attr:`Link.finger`): a
+Panda's two prismatic fingers, an xArm's revolute knuckles and fingers (a parallel linkage whose joints but
+one mimic that one).  Forward kinematics sets them from one *drive value* (:meth:`RobotModel.finger_value`
+turns a finger opening into it): every gripper joint that mimics none takes it, every mimic joint follows
+its URDF rule (:meth:`RobotModel.gripper_value`).  Prismatic fingers each travel half the opening (a Panda
+finger joint is opening / 2); a revolute gripper's opening is measured: the gap between its two fingertips
+(:attr:`RobotModel.fingertips`, the gripper links reaching farthest along the end effector's +z) across the
+closing direction, tabulated over the drive joint's range and inverted (:attr:`RobotModel.opening_table`);
+such a gripper is frozen open at the drive value of the widest gap.
+
+**The mount** (:attr:`RobotModel.mount`): the root link and every link fixed to it through fixed joints
+(a Panda's ``panda_link0``; an xArm's dummy root ``world`` and ``link_base``) stand on what the robot is
+bolted to: they never move, and they are exempt from collisions with the surface under them (they are
+left out of an arm's collision probes and are obstacles to the other arms), whatever they are called.
 """
 
 from __future__ import annotations
@@ -45,6 +58,7 @@ __all__ = [
     "Joint",
     "Link",
     "RobotModel",
+    "gripper_frames",
     "load_robot_model",
     "model_for_kind",
     "read_mesh",
@@ -103,11 +117,18 @@ class Link:
     points: np.ndarray
     lower: float = 0.0
     upper: float = 0.0
+    #: the index of the link whose joint this link's joint mimics (``<mimic>``), -1 when it mimics none
+    mimic: int = -1
+    multiplier: float = 1.0
+    offset: float = 0.0
+    #: an off-chain movable joint below the end-effector link: a joint of the gripper
+    gripper: bool = False
 
     @property
     def finger(self) -> bool:
-        """An off-chain prismatic joint: a gripper finger."""
-        return self.chain_index < 0 and self.joint_kind == "prismatic"
+        """A joint of the gripper (off the chain, movable, below the end-effector link): the finger opening
+        drives it (:meth:`RobotModel.gripper_value`)."""
+        return self.gripper
 
     @property
     def solid(self) -> bool:
@@ -156,6 +177,11 @@ class RobotModel:
     max_velocity: np.ndarray
     shoulder: np.ndarray
     reach: float
+    #: a revolute gripper's drive values (ascending) and the fingertip gap (m) at each; None: prismatic
+    #: fingers (each travels half the opening) or no gripper
+    opening_table: tuple[np.ndarray, np.ndarray] | None = None
+    #: the gripper links whose tips reach farthest along the end effector's +z (module docstring)
+    fingertips: tuple[int, ...] = ()
 
     @property
     def dof(self) -> int:
@@ -212,10 +238,33 @@ class RobotModel:
                 return link.index
         raise KeyError(name)
 
+    @functools.cached_property
+    def mount(self) -> tuple[int, ...]:
+        """The root link and every link attached to it through fixed joints only (module docstring): the
+        links standing on what the robot is bolted to, exempt from collisions with it."""
+        out = [0]
+        for link in self.links[1:]:
+            if link.joint_kind == "fixed" and link.parent in out:
+                out.append(link.index)
+        return tuple(out)
+
     def finger_value(self, opening: float) -> float:
-        """The finger joint value that opens the gripper ``opening`` metres: each of the two fingers
-        travels half of it (forward kinematics clamps it into each finger joint's limits)."""
-        return opening / 2
+        """The drive value that opens the gripper ``opening`` metres: prismatic fingers each travel half of
+        it; a revolute gripper's from :attr:`opening_table` (an opening beyond its range: the nearest end).
+        Forward kinematics clamps it into each gripper joint's limits."""
+        if self.opening_table is None:
+            return opening / 2
+        values, gaps = self.opening_table
+        order = np.argsort(gaps, kind="stable")
+        return float(np.interp(opening, gaps[order], values[order]))
+
+    def gripper_value(self, k: int, drive: float) -> float:
+        """The value of gripper link ``k``'s joint when the gripper's drive value is ``drive``: the drive
+        itself for a joint that mimics none, ``multiplier * value + offset`` of the mimicked joint for the
+        others (its URDF ``<mimic>``), clamped into the joint's limits."""
+        link = self.links[k]
+        v = drive if link.mimic < 0 else link.multiplier * self.gripper_value(link.mimic, drive) + link.offset
+        return float(min(max(v, link.lower), link.upper))
 
     def clamp(self, q: np.ndarray) -> np.ndarray:
         """``q`` clipped into the joint limits."""
@@ -368,6 +417,7 @@ def _build_model(path: str, end_effector: str, roots: tuple[str, ...] = ()) -> R
             )
         )
 
+    links, table, tips = _gripper(urdf, links, ee)
     joints: list[Joint] = []
     prev = 0  # frame of the previous chain joint (its child link) or the base link
     for name in chain_names:
@@ -405,7 +455,156 @@ def _build_model(path: str, end_effector: str, roots: tuple[str, ...] = ()) -> R
         max_velocity=_ro(np.array([j.max_velocity for j in joints])),
         shoulder=_ro(shoulder),
         reach=reach,
+        opening_table=table,
+        fingertips=tips,
     )
+
+
+def _gripper(
+    urdf: Urdf, links: list[Link], ee: int
+) -> tuple[list[Link], tuple[np.ndarray, np.ndarray] | None, tuple[int, ...]]:
+    """The links with their mimic rules, gripper flags and frozen values set (module docstring), a revolute
+    gripper's opening table and the fingertip links."""
+    by_joint = {link.joint: link.index for link in links if link.joint is not None}
+    below = {ee}
+    for link in links:  # parents first: the links below the end effector
+        if link.parent in below:
+            below.add(link.index)
+    out = list(links)
+    for link in links:
+        uj = urdf.joint_of.get(link.name)
+        movable_off_chain = link.chain_index < 0 and link.joint_kind in ("revolute", "prismatic")
+        src = by_joint.get(uj.mimic[0], -1) if uj is not None and uj.mimic is not None else -1
+        if not movable_off_chain or src < 0 or links[src].chain_index >= 0 or src == link.index:
+            src = -1  # a mimic of a chain joint (or of nothing known) stays frozen on its own
+        out[link.index] = replace(
+            link,
+            mimic=src,
+            multiplier=uj.mimic[1] if src >= 0 and uj is not None and uj.mimic else 1.0,
+            offset=uj.mimic[2] if src >= 0 and uj is not None and uj.mimic else 0.0,
+            gripper=movable_off_chain and link.index in below and link.index != ee,
+        )
+    for link in out:  # break mimic cycles: a joint whose mimic chain comes back to it mimics none
+        seen, k = {link.index}, link.mimic
+        while k >= 0 and k not in seen:
+            seen.add(k)
+            k = out[k].mimic
+        if k >= 0:
+            out[link.index] = replace(out[link.index], mimic=-1)
+    tips = _fingertips(out, ee)
+    table = (
+        _opening_table(out, ee, tips)
+        if any(link.gripper and link.mimic < 0 and link.joint_kind == "revolute" for link in out)
+        else None
+    )
+    drive_open = float(table[0][int(np.argmax(table[1]))]) if table is not None else None
+    for link in out:
+        if link.chain_index >= 0 or link.joint_kind not in ("revolute", "prismatic"):
+            continue
+        if link.mimic >= 0:
+            value = _frozen_mimic(out, link.index, drive_open)
+        elif link.gripper and drive_open is not None:
+            value = min(max(drive_open, link.lower), link.upper)
+        else:
+            value = link.frozen_value
+        out[link.index] = replace(link, frozen_value=float(value))
+    return out, table, tips
+
+
+def _frozen_mimic(links: list[Link], k: int, drive_open: float | None) -> float:
+    """The frozen value of a mimic joint: its rule applied to the frozen value of the joint it mimics."""
+    link = links[k]
+    if link.mimic < 0:
+        v = drive_open if link.gripper and drive_open is not None else link.frozen_value
+    else:
+        v = link.multiplier * _frozen_mimic(links, link.mimic, drive_open) + link.offset
+    return float(min(max(v, link.lower), link.upper))
+
+
+def _gripper_frames(links: list[Link], ee: int, drive: float | None) -> dict[int, np.ndarray]:
+    """The frames of the links below ``ee`` in its frame, the gripper at ``drive`` (None: frozen values)."""
+    frames: dict[int, np.ndarray] = {ee: np.eye(4)}
+    for link in links:  # parents first
+        if link.parent in frames and link.index not in frames:
+            value = link.frozen_value if drive is None or not link.gripper else _gripper_at(links, link.index, drive)
+            frames[link.index] = frames[link.parent] @ _joint_local(link, value)
+    return frames
+
+
+def _gripper_at(links: list[Link], k: int, drive: float) -> float:
+    link = links[k]
+    v = drive if link.mimic < 0 else link.multiplier * _gripper_at(links, link.mimic, drive) + link.offset
+    return float(min(max(v, link.lower), link.upper))
+
+
+def _joint_local(link: Link, value: float) -> np.ndarray:
+    """The transform parent link → ``link`` with its joint at ``value`` (Rodrigues about its axis)."""
+    if link.joint_kind == "prismatic":
+        move = np.eye(4)
+        move[:3, 3] = link.axis * value
+        return link.origin @ move
+    if link.joint_kind != "revolute" or value == 0.0:
+        return link.origin
+    x, y, z = link.axis
+    k = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
+    turn = np.eye(4)
+    turn[:3, :3] = np.eye(3) + math.sin(value) * k + (1 - math.cos(value)) * (k @ k)
+    return link.origin @ turn
+
+
+def _moved_by_gripper(links: list[Link], ee: int, k: int) -> bool:
+    while k != ee and k >= 0:
+        if links[k].gripper:
+            return True
+        k = links[k].parent
+    return False
+
+
+def _fingertips(links: list[Link], ee: int) -> tuple[int, ...]:
+    """The solid links the gripper moves whose geometry reaches within 5 mm of the farthest any of them
+    reaches along the end effector's +z, the gripper open (frozen values)."""
+    frames = _gripper_frames(links, ee, None)
+    moved = [k for k in frames if k != ee and links[k].solid and _moved_by_gripper(links, ee, k)]
+    if not moved:
+        return ()
+    reach = {k: float(np.max((frames[k][:3, :3] @ links[k].points.T)[2] + frames[k][2, 3])) for k in moved}
+    top = max(reach.values())
+    return tuple(sorted(k for k in moved if reach[k] >= top - 0.005))
+
+
+def _opening_table(
+    links: list[Link], ee: int, tips: tuple[int, ...], samples: int = 49
+) -> tuple[np.ndarray, np.ndarray] | None:
+    """A revolute gripper's fingertip gap over its drive joint's range (module docstring); None when its
+    fingertips are not two sides of a gap."""
+    drive = next(link for link in links if link.gripper and link.mimic < 0 and link.joint_kind == "revolute")
+    if len(tips) < 2:
+        return None
+    values = np.linspace(drive.lower, drive.upper, samples)
+    frames = _gripper_frames(links, ee, float(values[0]))
+    centres = np.array([frames[k][:3, :3] @ links[k].points.mean(axis=0) + frames[k][:3, 3] for k in tips])
+    axis = centres[0] - centres[-1]
+    axis[2] = 0.0
+    if float(np.linalg.norm(axis)) < 1e-6:
+        return None
+    axis /= np.linalg.norm(axis)
+    side = (centres - centres.mean(axis=0)) @ axis > 0
+    gaps = []
+    for v in values:
+        frames = _gripper_frames(links, ee, float(v))
+        across = [(frames[k][:3, :3] @ links[k].points.T).T @ axis + frames[k][:3, 3] @ axis for k in tips]
+        gaps.append(
+            min(float(a.min()) for a, s in zip(across, side) if s)
+            - max(float(a.max()) for a, s in zip(across, side) if not s)
+        )
+    return _ro(values), _ro(np.maximum(np.array(gaps), 0.0))
+
+
+def gripper_frames(model: RobotModel, drive: float | None = None) -> dict[int, np.ndarray]:
+    """The frames of the links below the end-effector link, in its frame, by link index (the end effector
+    itself included): the gripper at drive value ``drive`` (:meth:`RobotModel.finger_value`), or open
+    (frozen values) when None."""
+    return _gripper_frames(list(model.links), model.ee_link, drive)
 
 
 def _fixed_between(links: list[Link], ancestor: int, k: int) -> np.ndarray:

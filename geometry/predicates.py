@@ -70,8 +70,8 @@ class RobotEvaluator:
                 shapes, _ = other.probes
                 for i, (shape, t) in enumerate(zip(shapes, other.link_transforms(other.home[None])[0])):
                     self.world.add(f"@{spec.name}:{i}", shape, t, "fixed")
-                if other.base_hull is not None:  # bolted in place: an obstacle even when that arm moves
-                    self.world.add(f"^{spec.name}:base", *other.base_hull, "fixed")
+                for j, (_, shape, t) in enumerate(other.base_hulls):  # bolted in place: there when that arm moves
+                    self.world.add(f"^{spec.name}:base:{j}", shape, t, "fixed")
         self.seed = seed
         self.out = RobotFacts()
         self.current = {m.name: r.name for m in scene.movable for r in scene.regions if inside(r, m.shape, m.pose)}

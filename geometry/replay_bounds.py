@@ -90,6 +90,7 @@ class _Tree:
             axis = np.asarray(ji[13], dtype=float)
             self.axis[j] = axis / max(float(np.linalg.norm(axis)), 1e-12)
         self.prismatic = pb.JOINT_PRISMATIC
+        self.movable = (pb.JOINT_PRISMATIC, pb.JOINT_REVOLUTE)
         self.chain = set(r.joints)
         self.shaped = tuple(
             link for link in range(-1, n) if pb.getCollisionShapeData(r.body, link, physicsClientId=cid)
@@ -110,11 +111,13 @@ class _Tree:
         return sum(1 for link in path if link in self.chain)  # link j hangs on joint j
 
     def fingers(self) -> frozenset[int]:
-        """The links below an off-chain prismatic joint between them and the end effector."""
+        """The links below an off-chain movable joint (prismatic fingers, a revolute finger linkage) between
+        them and the end effector."""
         return frozenset(
             link
             for link in range(self.n)
-            if any(self.kind.get(x) == self.prismatic and x not in self.chain for x in _up_to(self.up(link), self.r.ee))
+            if any(self.kind.get(x) in self.movable and x not in self.chain for x in _up_to(self.up(link), self.r.ee))
+            and self.r.ee in self.up(link)
         )
 
     def gripper(self) -> frozenset[int]:

@@ -80,6 +80,11 @@ class ReplayRobot:
     joint_names: tuple[str, ...] = ("x", "y", "yaw")
     fingers: tuple[tuple[int, float, float, float], ...] = ()
     finger_value: Callable[[float], float] | None = None
+    #: the links standing on the mount: pybullet's base link -1 and every link fixed to it through fixed
+    #: joints (an xArm's ``link_base`` below its dummy root ``world``), exempt from contact with fixed objects
+    mount: frozenset[int] = frozenset({-1})
+    #: gripper joint values (pybullet index -> value) as functions of the drive value, their URDF mimic rules
+    finger_joint: Callable[[int, float], float] | None = None
 
     @property
     def dof(self) -> int:
@@ -100,9 +105,10 @@ class ReplayScene:
     pybullet's margin around mesh shapes (:data:`MESH_MARGIN`; a link with any mesh shape counts as a mesh).
 
     **The base-link rule.**  A fixed-base arm is bolted to the surface it stands on, so contacts between an
-    arm's *base link* and any *fixed* object are ignored (its base standing on the table is not a
-    collision; a base inside a wall would be a fault of the problem file, not of a plan).  The base link
-    still counts against movable objects and other robots.
+    arm's *mount* (its base link and every link fixed to it through fixed joints, as pybullet's joint info
+    reads them: an xArm's ``link_base`` below its dummy root ``world``) and any *fixed* object are ignored
+    (its base standing on the table is not a collision; a base inside a wall would be a fault of the problem
+    file, not of a plan).  The mount still counts against movable objects and other robots.
 
     Use as a context manager, or call :meth:`close`.
     """
@@ -191,10 +197,13 @@ class ReplayScene:
             )
         by_link: dict[str, int] = {pb.getBodyInfo(body, physicsClientId=cid)[0].decode(): -1}
         info = {}
+        mount = {-1}
         for j in range(pb.getNumJoints(body, physicsClientId=cid)):
             ji = pb.getJointInfo(body, j, physicsClientId=cid)
             by_link[ji[12].decode()] = j
             info[ji[1].decode()] = ji
+            if ji[2] == pb.JOINT_FIXED and int(ji[16]) in mount:  # parents come first in pybullet's order
+                mount.add(j)
         for index in by_link.values():
             if any(d[2] == pb.GEOM_MESH for d in pb.getCollisionShapeData(body, index, physicsClientId=cid)):
                 self._margin[(body, index)] = MESH_MARGIN
@@ -206,12 +215,14 @@ class ReplayScene:
             lower.append(lo if lo <= hi else -math.inf)  # pybullet reports an unlimited joint as lower > upper
             upper.append(hi if lo <= hi else math.inf)
         fingers = []
+        gripper = {}  # pybullet joint -> the model's link, for the mimic rules
         for link in model.links:  # off-chain movable joints stay at their frozen values (fingers open)
             j = by_link.get(link.name, -1)
             if link.chain_index < 0 and link.joint_kind in ("revolute", "prismatic") and j >= 0:
                 pb.resetJointState(body, j, float(link.frozen_value), physicsClientId=cid)
                 if link.finger:
                     fingers.append((j, link.lower, link.upper, float(link.frozen_value)))
+                    gripper[j] = link.index
         self.robots[name] = ReplayRobot(
             name=name,
             body=body,
@@ -226,6 +237,8 @@ class ReplayScene:
             joint_names=tuple(jt.name for jt in model.joints),
             fingers=tuple(fingers),
             finger_value=model.finger_value,
+            mount=frozenset(mount),
+            finger_joint=lambda j, drive: model.gripper_value(gripper[j], drive),
         )
         self._owner[body] = name
 
@@ -282,8 +295,12 @@ class ReplayScene:
     def set_fingers(self, robot: str, opening: float | None) -> None:
         """Open an arm's fingers ``opening`` metres apart (None: back to their frozen, fully open values)."""
         r = self.robots[robot]
+        drive = None if opening is None or r.finger_value is None else r.finger_value(opening)
         for j, lo, hi, frozen in r.fingers:
-            v = frozen if opening is None or r.finger_value is None else min(max(r.finger_value(opening), lo), hi)
+            if drive is None:
+                v = frozen
+            else:
+                v = r.finger_joint(j, drive) if r.finger_joint is not None else min(max(drive, lo), hi)
             self.pb.resetJointState(r.body, j, float(v), physicsClientId=self.cid)
 
     def ee_pose(self, robot: str) -> np.ndarray:
@@ -357,12 +374,12 @@ class ReplayScene:
         # ask for 2 margins more: a mesh pair reported up to 2 mm short may still be within max_distance
         pts = self.pb.getClosestPoints(ba, bb, float(max_distance) + 2 * MESH_MARGIN, physicsClientId=self.cid)
         self.queries += 1
-        skip_a = a in self.robots and not self.robots[a].planar and b in self.fixed
-        skip_b = b in self.robots and not self.robots[b].planar and a in self.fixed
+        skip_a = self._mount(a, b)
+        skip_b = self._mount(b, a)
         best: Closest | None = None
         margin = self._margin
         for p in pts:
-            if (skip_a and p[3] == -1) or (skip_b and p[4] == -1):
+            if p[3] in skip_a or p[4] in skip_b:
                 continue
             d = float(p[8]) + margin.get((ba, p[3]), 0.0) + margin.get((bb, p[4]), 0.0)
             if d < max_distance and (best is None or d < best.distance):
@@ -387,8 +404,7 @@ class ReplayScene:
         bb = self.robots[b].body if b in self.robots else self.bodies[b]
         extra = float(max_distance) + 2 * MESH_MARGIN
         links = {} if links_a is None else {"linkIndexA": links_a[0], "linkIndexB": links_a[1]}
-        skip_a = -1 if a in self.robots and not self.robots[a].planar and b in self.fixed else -2
-        skip_b = -1 if b in self.robots and not self.robots[b].planar and a in self.fixed else -2
+        skip_a, skip_b = self._mount(a, b), self._mount(b, a)
         margin_a = {link: m for (body, link), m in margin.items() if body == ba}
         margin_b = {link: m for (body, link), m in margin.items() if body == bb}
 
@@ -398,7 +414,7 @@ class ReplayScene:
             out: dict[tuple[int, int], float] = {}
             for p in pts:
                 la, lb = p[3], p[4]
-                if la == skip_a or lb == skip_b:  # the base-link rule
+                if la in skip_a or lb in skip_b:  # the base-link rule
                     continue
                 d = p[8] + margin_a.get(la, 0.0) + margin_b.get(lb, 0.0)
                 if d < max_distance and d < out.get((la, lb), math.inf):
@@ -406,6 +422,11 @@ class ReplayScene:
             return out
 
         return probe
+
+    def _mount(self, a: str, b: str) -> frozenset[int]:
+        """The links of ``a`` exempt from contact with ``b``: an arm's mount when ``b`` is a fixed object."""
+        r = self.robots.get(a)
+        return r.mount if r is not None and not r.planar and b in self.fixed else frozenset()
 
     def carrier(self, robot: str, obj: str, offset: np.ndarray) -> Callable[[], None]:
         """A function of no arguments that puts object ``obj`` where arm ``robot``, at its current

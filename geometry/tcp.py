@@ -9,11 +9,12 @@ end-effector link.  A kind without ``:tcp`` gets one from its URDF, tried in thi
    ``graspframe``, ``tcp`` or ``toolcenterpoint`` (pybullet_data's Franka Panda has ``panda_grasptarget``,
    0.105 m along the hand's z axis: exactly the shipped domain's ``:tcp (0 0 0.105 0)``).  Its origin is
    the TCP; its rotation must be a turn about z (a ``:tcp`` is a pose with a yaw), else it is not used;
-2. **the fingertips**: the gripper fingers (the off-chain prismatic joints below the end-effector link,
-   :attr:`~mrgc.geometry.kinematics.Link.finger`), fully open; when their collision geometry lies along
-   the end-effector link's +z axis (the approach direction of every built-in grasp, docs/geometry.md), the
-   TCP is the middle between the fingers (the mean of their frames' x and y) at the far end of their
-   collision geometry along z (the fingertips).
+2. **the fingertips**: the gripper's fingertip links (:attr:`~mrgc.geometry.kinematics.RobotModel.fingertips`:
+   the links the gripper's joints move, prismatic fingers or a revolute linkage with mimic joints, that
+   reach farthest along the end-effector link's +z), fully open; when their collision geometry lies along
+   that axis (the approach direction of every built-in grasp, docs/geometry.md), the TCP is the middle
+   between the fingers (the mean of their frames' x and y) at the far end of their collision geometry
+   along z (the fingertips).
 
 A kind for which neither works (no such link, no fingers, fingers that do not point along +z) keeps the
 end-effector link's origin as its TCP, and ``mrgc check`` warns (W273): grasps would put the link's
@@ -134,19 +135,14 @@ def _fingertips(path: str, end_effector: str, roots: tuple[str, ...]) -> Derived
         model = load_robot_model(path, os.path.dirname(path), end_effector, roots=roots)
     except InputError:
         return None
-    ee = model.ee_link
-    frames: dict[int, np.ndarray] = {ee: np.eye(4)}
-    for link in model.links:  # parents come first: each link below the end effector, in its frame
-        if link.parent in frames and link.index not in frames:
-            move = np.eye(4)
-            if link.joint_kind == "prismatic":
-                move[:3, 3] = link.axis * link.frozen_value
-            frames[link.index] = frames[link.parent] @ link.origin @ move
-    fingers = [link for link in model.links if link.index in frames and link.finger and link.solid]
+    from mrgc.geometry.kinematics import gripper_frames
+
+    frames = gripper_frames(model)  # the gripper open
+    fingers = [model.links[k] for k in model.fingertips]
     if len(fingers) < 2:
         return None
     points = np.concatenate([(frames[f.index][:3, :3] @ f.points.T).T + frames[f.index][:3, 3] for f in fingers])
-    axes = [frames[f.index][:3, :3] @ f.axis for f in fingers]
+    axes = [frames[f.index][:3, :3] @ f.axis for f in fingers if f.finger]
     if np.min(points[:, 2]) < -1e-9 or any(abs(float(a[2])) > 1e-6 for a in axes):
         return None  # not fingers closing across the end effector's +z axis
     middle = np.mean([frames[f.index][:3, 3] for f in fingers], axis=0)

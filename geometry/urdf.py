@@ -63,6 +63,8 @@ class UrdfJoint:
     upper: float
     velocity: float
     line: int = 0
+    #: ``<mimic joint=J multiplier=m offset=o>``: this joint's value is ``m * value(J) + o`` (None: it has none)
+    mimic: tuple[str, float, float] | None = None
 
 
 @dataclass(frozen=True)
@@ -246,6 +248,15 @@ def _joint(el: ET.Element, lines: dict[ET.Element, int]) -> UrdfJoint:
     elif kind == "prismatic" and max(abs(lo), abs(hi)) > bound:
         raise UrdfError(f"joint {name!r}: limits {lo:g} .. {hi:g} exceed {bound:g}", lim_line)
     org = el.find("origin")
+    mimic = None
+    mim = el.find("mimic")
+    if mim is not None and mim.get("joint"):
+        mim_line = lines.get(mim, line)
+        mimic = (
+            mim.get("joint", ""),
+            scalar(mim.get("multiplier"), 1.0, mim_line, "mimic multiplier", MAX_ANGLE),
+            scalar(mim.get("offset"), 0.0, mim_line, "mimic offset", MAX_ANGLE),
+        )
     return UrdfJoint(
         name,
         kind,
@@ -257,6 +268,7 @@ def _joint(el: ET.Element, lines: dict[ET.Element, int]) -> UrdfJoint:
         hi,
         vel,
         line,
+        mimic,
     )
 
 

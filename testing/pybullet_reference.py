@@ -61,7 +61,7 @@ def _set_state(model: RobotModel, q: Array, base: Array | None, fingers: float |
     for j, link in movable:
         v = q[link.chain_index] if link.chain_index >= 0 else link.frozen_value
         if link.finger and fingers is not None:
-            v = min(max(fingers, link.lower), link.upper)
+            v = model.gripper_value(link.index, fingers)
         pb.resetJointState(body, j, float(v), physicsClientId=cid)
     return pb, cid, body
 

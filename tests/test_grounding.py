@@ -284,9 +284,9 @@ def test_other_arms_bases_are_obstacles_home_or_not(pa3: Grounder) -> None:
     """An arm's base link (left out of its probes: its own links start on it) is an obstacle to every other
     arm, also while that arm is away from home in the step (generated i67/i69: the validator rejected
     grounded plans whose arm grazed another arm's base by 1.1-21.7 mm)."""
-    hull = pa3.arm("r2").base_hull
-    assert hull is not None
-    probe = [hull]
+    hulls = pa3.arm("r2").base_hulls
+    assert len(hulls) == 1
+    probe = [(shape, pose) for _, shape, pose in hulls]
     for roles in ({}, {"r2": "pick-place"}):  # r2 at home, then r2 picking in the step (its home links gone)
         pa3.step(roles)
         assert pa3.world.probe_hits(probe, against=pa3._others("r1", phase="pick")) >= {"@r2:base"}

@@ -300,11 +300,12 @@ def plan(
     from mrgc import __version__
     from mrgc.language.digest import problem_digest
     from mrgc.planner.baselines import plan_with
+    from mrgc.planner.outcome import PlanStatus
     from mrgc.planner.plan import file_sha256
 
     started = time.perf_counter()  # the time limit covers the layout checks, which load the robots' models
     problem, path = _resolve(source, name, allow_outside)
-    _checked_layout(problem)
+    warnings = _checked_layout(problem)
     digest = problem_digest(problem)
     problem_file = path if path is not None else (problem.source or "<string>")
     sha256 = file_sha256(path) if path is not None else digest
@@ -324,6 +325,10 @@ def plan(
         **options,
     )
     result.problem_digest = digest
+    if result.why is not None and result.status is not PlanStatus.SOLVED:  # an arm that reaches nothing, and why
+        from mrgc.geometry.arm_diagnosis import reasons
+
+        result.why.facts[:0] = reasons(warnings)
     return result
 
 

@@ -14,7 +14,10 @@ Each finding is a located :class:`~mrgc.errors.Diagnostic` (docs/errors.md).  Tw
 - ``W270`` (:func:`mrgc.geometry.grasps.grasp_warnings`) a grasp no gripper opens wide enough for;
 - ``W271`` a movable object lies in no region at its start pose (``in-region`` holds for none): unless it
   is a goal object it can never move, so an obstacle in no region makes its goals unreachable;
-- ``W273`` an arm kind has no ``:tcp`` and none can be derived from its URDF (:mod:`mrgc.geometry.tcp`).
+- ``W273`` an arm kind has no ``:tcp`` and none can be derived from its URDF (:mod:`mrgc.geometry.tcp`);
+- ``W274``-``W276`` an arm that can reach nothing, and why (:mod:`mrgc.geometry.arm_diagnosis`; these load
+  the arms' models, and are reported by ``facts`` and ``plan`` too): every configuration collides, its home
+  configuration collides, or IK never converges.
 
 **With robot models** (``mrgc facts`` and the commands that run phase 1, ``plan``):
 
@@ -62,6 +65,10 @@ def layout_diagnostics(problem: Problem) -> list[Diagnostic]:
     out += grasp_warnings(problem)
     out += region_diagnostics(problem)
     out += tcp_diagnostics(problem)
+    if not any(d.severity != "warning" for d in out):  # an arm that can reach nothing, and why
+        from mrgc.geometry.arm_diagnosis import arm_diagnostics
+
+        out += arm_diagnostics(problem)
     return out
 
 
@@ -277,7 +284,9 @@ def robot_diagnostics(problem: Problem) -> list[Diagnostic]:
     out = _arms_at_home(problem, scene, arms)
     if arms and len(arms) == len(scene.robots):
         out += _regions_out_of_reach(problem, scene, arms)
-    return out
+    from mrgc.geometry.arm_diagnosis import arm_diagnostics
+
+    return out + arm_diagnostics(problem)
 
 
 def _arms_at_home(problem: Problem, scene: SceneSpec, arms: list[Arm]) -> list[Diagnostic]:

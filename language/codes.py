@@ -79,6 +79,9 @@ CODES: dict[str, str] = {
     "W271": "object in no region",
     "W272": "region outside every robot's workspace",
     "W273": "no tool centre point",
+    "W274": "every configuration of an arm collides",
+    "W275": "an arm's home configuration collides",
+    "W276": "IK finds no solution for an arm",
 }
 
 #: codes that are warnings: reported, but the input is accepted (exit code 0)
@@ -242,6 +245,20 @@ HELP: dict[str, str] = {
     "docs/language.md, 'Robot kinds'), so grasps put the end-effector link's origin on the object: the "
     "fingers would reach past it into the object or the table. Give `:tcp (x y z yaw)`, the point between the "
     "fingertips relative to the end-effector link.",
+    "W274": "A warning, not an error: an arm collides with a fixed object wherever it goes: of 64 configurations "
+    "drawn within its joint limits, one of its links collides (touching counts) with the same fixed object in "
+    "every one, so phase 1 finds it no fact at all. The line names the link, the object, how deep and the height "
+    "of the link's lowest point. Typical causes: the robot's `:base` sunk into the table or standing inside a "
+    "wall. The links standing on the mount (the URDF's root link and every link fixed to it) are exempt from "
+    "what they stand on, whatever they are called. Reported by `mrgc check`, `mrgc facts` and `mrgc plan`.",
+    "W275": "A warning, not an error: an arm's `:home` configuration collides with a fixed object (touching "
+    "counts) or with the arm itself; every motion of the arm starts and ends at home, so no plan can move it, "
+    "whatever the facts say. Change the kind's `:home`. Reported by `mrgc check`, `mrgc facts` and `mrgc plan` "
+    "(a penetration deeper than 1 mm of an object is also E266 for `facts` and `plan`).",
+    "W276": "A warning, not an error: inverse kinematics finds no configuration of an arm for any grasp of any "
+    "object within its reach bound, collisions ignored: the chain from the URDF's base to the `:end-effector` "
+    "link cannot put that link there. Usually `:end-effector` names the wrong link (the message says how many "
+    "joints its chain has) or `:tcp` is far off. Reported by `mrgc check`, `mrgc facts` and `mrgc plan`.",
     "W270": "A warning, not an error: the object is wider along the grasp's finger axis (plus the 1 cm "
     "clearance) than a robot kind's `:gripper-opening`, so robots of that kind get no facts for this "
     "(object, grasp). `mrgc check` exits 0.",

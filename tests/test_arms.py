@@ -25,48 +25,42 @@ from mrgc.testing.pybullet_reference import pybullet_fk
 XARM = "xarm/xarm6_with_gripper.urdf"
 
 #: a 6-DOF arm of boxes and cylinders, its hand a palm with two prismatic fingers (the right one mimics the
-#: left), 0.87 m of reach
-ARM6 = """<?xml version="1.0"?>
-<robot name="arm6">
-  <link name="base_link">
-    <collision><origin xyz="0 0 0.05"/><geometry><cylinder radius="0.07" length="0.1"/></geometry></collision>
-  </link>
-  <joint name="j1" type="revolute"><parent link="base_link"/><child link="l1"/><origin xyz="0 0 0.1"/>
-    <axis xyz="0 0 1"/><limit lower="-3.1416" upper="3.1416" effort="10" velocity="2"/></joint>
-  <link name="l1"><collision><origin xyz="0 0 0.05"/><geometry><cylinder radius="0.05" length="0.08"/></geometry>
-  </collision></link>
-  <joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/><origin xyz="0 0 0.12"/>
-    <axis xyz="0 1 0"/><limit lower="-2" upper="2" effort="10" velocity="2"/></joint>
-  <link name="l2"><collision><origin xyz="0 0 0.175"/><geometry><box size="0.06 0.06 0.27"/></geometry></collision>
-  </link>
-  <joint name="j3" type="revolute"><parent link="l2"/><child link="l3"/><origin xyz="0 0 0.35"/>
-    <axis xyz="0 1 0"/><limit lower="-2.6" upper="2.6" effort="10" velocity="2"/></joint>
-  <link name="l3"><collision><origin xyz="0 0 0.14"/><geometry><box size="0.05 0.05 0.2"/></geometry></collision>
-  </link>
-  <joint name="j4" type="revolute"><parent link="l3"/><child link="l4"/><origin xyz="0 0 0.28"/>
-    <axis xyz="0 0 1"/><limit lower="-3.1416" upper="3.1416" effort="10" velocity="2"/></joint>
-  <link name="l4"><collision><geometry><cylinder radius="0.03" length="0.04"/></geometry></collision></link>
-  <joint name="j5" type="revolute"><parent link="l4"/><child link="l5"/><origin xyz="0 0 0.06"/>
-    <axis xyz="0 1 0"/><limit lower="-2.2" upper="2.2" effort="10" velocity="2"/></joint>
-  <link name="l5"><collision><origin xyz="0 0 0.02"/><geometry><box size="0.04 0.04 0.03"/></geometry></collision>
-  </link>
-  <joint name="j6" type="revolute"><parent link="l5"/><child link="l6"/><origin xyz="0 0 0.05"/>
-    <axis xyz="0 0 1"/><limit lower="-3.1416" upper="3.1416" effort="10" velocity="2"/></joint>
-  <link name="l6"><collision><origin xyz="0 0 0.005"/><geometry><cylinder radius="0.03" length="0.01"/></geometry>
-  </collision></link>
-  <joint name="flange" type="fixed"><parent link="l6"/><child link="hand"/><origin xyz="0 0 0.01"/></joint>
-  <link name="hand"><collision><origin xyz="0 0 0.02"/><geometry><box size="0.04 0.12 0.04"/></geometry></collision>
-  </link>
-  <joint name="finger_l" type="prismatic"><parent link="hand"/><child link="finger_left"/><origin xyz="0 0 0.04"/>
-    <axis xyz="0 1 0"/><limit lower="0" upper="0.045" effort="10" velocity="0.2"/></joint>
-  <link name="finger_left"><collision><origin xyz="0 0.006 0.03"/><geometry><box size="0.02 0.012 0.06"/></geometry>
-  </collision></link>
-  <joint name="finger_r" type="prismatic"><parent link="hand"/><child link="finger_right"/><origin xyz="0 0 0.04"/>
-    <axis xyz="0 -1 0"/><limit lower="0" upper="0.045" effort="10" velocity="0.2"/><mimic joint="finger_l"/></joint>
-  <link name="finger_right"><collision><origin xyz="0 -0.006 0.03"/><geometry><box size="0.02 0.012 0.06"/>
-  </geometry></collision></link>
-</robot>
-"""
+#: left), 0.87 m of reach: (link, its collision geometry and origin z, joint type, joint origin z, axis, limit)
+ARM6_LINKS = [
+    ("base_link", '<cylinder radius="0.07" length="0.1"/>', 0.05, None, 0.0, "", 0.0),
+    ("l1", '<cylinder radius="0.05" length="0.08"/>', 0.05, "revolute", 0.1, "0 0 1", 3.1416),
+    ("l2", '<box size="0.06 0.06 0.27"/>', 0.175, "revolute", 0.12, "0 1 0", 2.0),
+    ("l3", '<box size="0.05 0.05 0.2"/>', 0.14, "revolute", 0.35, "0 1 0", 2.6),
+    ("l4", '<cylinder radius="0.03" length="0.04"/>', 0.0, "revolute", 0.28, "0 0 1", 3.1416),
+    ("l5", '<box size="0.04 0.04 0.03"/>', 0.02, "revolute", 0.06, "0 1 0", 2.2),
+    ("l6", '<cylinder radius="0.03" length="0.01"/>', 0.005, "revolute", 0.05, "0 0 1", 3.1416),
+    ("hand", '<box size="0.04 0.12 0.04"/>', 0.02, "fixed", 0.01, "", 0.0),
+]
+
+
+def arm6_urdf() -> str:
+    """The URDF of the 6-DOF arm above, with its fingers (``finger_r`` mimics ``finger_l``)."""
+    out = ['<?xml version="1.0"?>', '<robot name="arm6">']
+    for k, (name, geometry, z, kind, jz, axis, limit) in enumerate(ARM6_LINKS):
+        if kind is not None:
+            parent = ARM6_LINKS[k - 1][0]
+            out.append(f'<joint name="j{k}" type="{kind}"><parent link="{parent}"/><child link="{name}"/>')
+            out.append(f'<origin xyz="0 0 {jz}"/>')
+            if kind == "revolute":
+                out.append(f'<axis xyz="{axis}"/><limit lower="-{limit}" upper="{limit}" effort="10" velocity="2"/>')
+            out.append("</joint>")
+        out.append(f'<link name="{name}"><collision><origin xyz="0 0 {z}"/><geometry>{geometry}</geometry>')
+        out.append("</collision></link>")
+    for side, sign, mimic in (("left", "", ""), ("right", "-", '<mimic joint="finger_left"/>')):
+        out.append(
+            f'<joint name="finger_{side}" type="prismatic"><parent link="hand"/><child link="finger_{side}_link"/>'
+        )
+        out.append(f'<origin xyz="0 0 0.04"/><axis xyz="0 {sign}1 0"/>')
+        out.append(f'<limit lower="0" upper="0.045" effort="10" velocity="0.2"/>{mimic}</joint>')
+        out.append(f'<link name="finger_{side}_link"><collision><origin xyz="0 {sign}0.006 0.03"/>')
+        out.append('<geometry><box size="0.02 0.012 0.06"/></geometry></collision></link>')
+    return "\n".join([*out, "</robot>", ""])
+
 
 KINDS = {
     "panda": """(:robot-kind panda
@@ -124,7 +118,7 @@ def write(folder: Path, arm: str) -> Path:
     if arm == "xarm6":
         path.write_text(docs_example(), encoding="utf-8")
     else:
-        (folder / "arm6.urdf").write_text(ARM6, encoding="utf-8")
+        (folder / "arm6.urdf").write_text(arm6_urdf(), encoding="utf-8")
         path.write_text(scene(arm, 0.7 if arm == "panda" else 0.6, 0.4 if arm == "panda" else 0.3), encoding="utf-8")
     return path
 
@@ -201,7 +195,7 @@ def test_numeric_ik_solves_6_dof_arms(arm: str, tmp_path: Path) -> None:
     if arm == "xarm":
         model = load_robot_model(XARM, str(ROOT), "xarm_gripper_base_link")
     else:
-        (tmp_path / "arm6.urdf").write_text(ARM6, encoding="utf-8")
+        (tmp_path / "arm6.urdf").write_text(arm6_urdf(), encoding="utf-8")
         model = load_robot_model("arm6.urdf", str(tmp_path), "hand")
         assert panda_chain(model) is None
     rng = np.random.default_rng(7)

@@ -21,10 +21,10 @@ Each finding is a located :class:`~mrgc.errors.Diagnostic` (docs/errors.md).  Tw
 
 **With robot models** (``mrgc facts`` and the commands that run phase 1, ``plan``):
 
-- ``E266`` an arm at its home configuration overlaps a movable object or a fixed object (the base link,
-  bolted in place, is left out, as everywhere in the geometry layer).  Arms overlapping each other at home
-  are not checked: the grounding keeps every motion clear of the other arms at home, so such arms only
-  narrow what can be planned;
+- ``E266`` an arm at its home configuration overlaps a movable object or a fixed object (the mount, the base
+  link and the links fixed to it, bolted in place, is left out, as everywhere in the geometry layer).  Arms
+  overlapping each other at home are not checked: the grounding keeps every motion clear of the other arms
+  at home, so such arms only narrow what can be planned;
 - ``W272`` a region lies outside the workspace of every robot: farther from each arm's shoulder than its
   reach bound (:attr:`~mrgc.geometry.kinematics.RobotModel.reach`).  Planar robots drive, so a problem with
   one has no such warning.

@@ -135,7 +135,8 @@ class RobotView:
             return
         from mrgc.geometry.fk import fk
 
-        frames = fk(self.model, np.asarray(q, dtype=float), self.spec.base, fingers)
+        drive = None if fingers is None else self.model.finger_value(fingers)  # the opening as the gripper's drive
+        frames = fk(self.model, np.asarray(q, dtype=float), self.spec.base, drive)
         for link, part, origin in self.parts:
             yield part, frames[link] @ origin
 

@@ -77,10 +77,13 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 from mrgc.geometry.replay_bounds import ArmBounds, arm_bounds, planar_radius
+from mrgc.geometry.replay_fk import ArmChain, motion_spheres
 from mrgc.geometry.replay_world import ReplayScene
-from mrgc.geometry.scene import SceneSpec, half_extents, inside, outline, scene_from_problem
+from mrgc.geometry.scene import SceneSpec, inside, outline, scene_from_problem
 from mrgc.geometry.transforms import translation
 from mrgc.language.model import Problem
+from mrgc.planner.certify import Certifier, Phase
+from mrgc.planner.phase_bounds import PhaseBounds
 from mrgc.planner.plan import MotionModel
 from mrgc.planner.plan_reader import Action
 from mrgc.planner.replay_actions import PATH_PHASES, ActionGeometry, ActionReader
@@ -277,79 +280,6 @@ class _PhaseWorld:
             else:
                 w[at : at + len(d)] = np.abs(d)
         return w
-
-
-class _Spheres:
-    """Lower bounds on the distances of a phase's sub-pairs without asking pybullet (the sweep's
-    :attr:`~mrgc.planner.sweep.Sweep.bound`): every robot link is held by a sphere about its centre of mass
-    (:attr:`~mrgc.geometry.replay_bounds.ArmBounds.spheres`), a planar robot's footprint and a carried object
-    by one about its frame, every object that stands still in the phase by its bounding box; two spheres are
-    at least the distance of their centres less both radii apart, a sphere and a box the distance of the
-    centre from the box less the radius.  Positions are pybullet's, read at the time the world is set to."""
-
-    def __init__(self, ph: _PhaseWorld, pairs: list[Pair], sides: list[tuple[_Part, _Part, Any, str]]) -> None:
-        rp, rs = ph.rp, ph.rp.rs
-        self.rs = rs
-        index: dict[tuple[str, int], int] = {}
-        radius: list[float] = []
-        half: list[np.ndarray | None] = []
-        self.arms: list[tuple[str, list[int], np.ndarray]] = []  # moving arm, its links, their elements
-        self.bodies: list[tuple[str, int]] = []  # moving rigid bodies (planar robots, carried objects)
-        moving = {tr.robot for tr in ph.tracks}
-        static: list[tuple[str, int]] = []
-        for part in (*ph.parts.values(), *ph.objects.values()):
-            first = len(radius)
-            arm = part.robot and not rp.planar[part.name]
-            for link in part.rows:
-                index[(part.name, link)] = len(radius)
-                if arm:
-                    b = rp.bounds[part.name]
-                    radius.append(float(b.spheres[b.column(link)]))
-                    half.append(None)
-                    continue
-                h = half_extents(rp.footprint_shape[part.name] if part.robot else rp.shapes[part.name])
-                radius.append(float(np.linalg.norm(h)) + 1e-6)
-                half.append(None if part.robot or part.track >= 0 else h + 1e-6)
-            elems = np.arange(first, len(radius))
-            if arm:
-                self.arms.append((part.name, list(part.rows), elems))
-            elif part.track >= 0 or part.name in moving:
-                self.bodies.append((part.name, first))
-            else:
-                static.append((part.name, first))
-        self.radius = np.array(radius)
-        self.box = np.array([h is not None for h in half])
-        self.half = np.array([h if h is not None else np.zeros(3) for h in half]).reshape(-1, 3)
-        self.centre = np.zeros((len(radius), 3))
-        self.rot = np.tile(np.eye(3), (len(radius), 1, 1))
-        for name, e in static:  # what stands still, where it stands at the start of the phase
-            self.centre[e], self.rot[e] = rs.body_frame(name)
-        self.arms_moving = [arm for arm in self.arms if arm[0] in moving]
-        for robot, links, elems in self.arms:
-            self.centre[elems] = rs.link_centres(robot, links)
-        ends = np.array(
-            [(index[(a.name, la)], index[(b.name, lb)]) for p, (a, b, _, _) in zip(pairs, sides) for la, lb in p.subs]
-        ).reshape(-1, 2)
-        flip = self.box[ends[:, 0]] & ~self.box[ends[:, 1]]  # the sphere first, the box second
-        ends[flip] = ends[flip][:, ::-1]
-        self.a, self.b = ends[:, 0], ends[:, 1]
-        self.reach = self.radius[self.a] + np.where(self.box[self.b], 0.0, self.radius[self.b])
-        self.to_box = np.flatnonzero(self.box[self.b])
-        self.box_a, self.box_b = self.a[self.to_box], self.b[self.to_box]
-
-    def __call__(self) -> np.ndarray:
-        """The lower bound of every sub-pair's distance (in the sweep's order) at the world's current state."""
-        rs, centre = self.rs, self.centre
-        for robot, links, elems in self.arms_moving:
-            centre[elems] = rs.link_centres(robot, links)
-        for name, e in self.bodies:
-            centre[e] = rs.position(name)
-        gap = centre[self.a] - centre[self.b]
-        if len(self.to_box):  # the sphere's centre in the box's frame, its distance from the box
-            inside = np.einsum("nji,nj->ni", self.rot[self.box_b], gap[self.to_box])
-            gap[self.to_box] = np.maximum(np.abs(inside) - self.half[self.box_b], 0.0)
-        out: np.ndarray = np.sqrt(np.einsum("ij,ij->i", gap, gap)) - self.reach
-        return out
 
 
 class _Stop(Exception):
@@ -584,9 +514,12 @@ class _Replayer(ActionReader):
             a, b, _, kind = sides[p]
             self._hit_at(t, phase, kind, (a, sub[0]), (b, sub[1]), d, ph.everyone, s)
 
-        sweep = Sweep(ph.breakpoints(), ph.speeds, pairs, set_state, query, report, CONTACT_TOL, MAX_SAMPLES)
-        if pairs:
-            sweep.bound = _Spheres(ph, pairs, sides)
+        bp = ph.breakpoints()
+        bounds = PhaseBounds(ph, pairs, sides, self._offsets(tracks), self._chain) if pairs else None
+        if bounds is not None and self._certified(ph, pairs, sides, bounds, set_state, probes):
+            return
+        sweep = Sweep(bp, ph.speeds, pairs, set_state, query, report, CONTACT_TOL, MAX_SAMPLES)
+        sweep.bound = bounds
         if self.first_only:
             sweep.stop = lambda: bool(self._worst)
         sweep.run()
@@ -595,6 +528,69 @@ class _Replayer(ActionReader):
                 t, None, "too-long", f"{phase}: the motions need more than {MAX_SAMPLES} checked samples; not checked"
             )
         self.stop_if_found()
+
+    def _chain(self, robot: str) -> tuple[ArmChain, list[tuple[np.ndarray, np.ndarray]]]:
+        """Arm ``robot``'s numpy kinematics with its fingers as they stand now, and its links' motion spheres
+        (kept with the world, per finger values)."""
+        r = self.rs.robots[robot]
+        fingers = tuple(
+            float(self.rs.pb.getJointState(r.body, j, physicsClientId=self.rs.cid)[0]) for j, *_ in r.fingers
+        )
+        kept: dict[tuple[int, str, tuple[float, ...]], Any] = _WORLD.setdefault("chains", {})
+        key = (id(self.rs), robot, fingers)
+        if key not in kept:
+            chain = ArmChain(self.rs, robot)
+            motion = _WORLD.setdefault("motion", {})
+            if (id(self.rs), robot) not in motion:
+                motion[(id(self.rs), robot)] = motion_spheres(self.rs, robot, self.bounds[robot], chain)
+            kept[key] = (chain, motion[(id(self.rs), robot)])
+        out: tuple[ArmChain, list[tuple[np.ndarray, np.ndarray]]] = kept[key]
+        return out
+
+    def _offsets(self, tracks: list[_Track]) -> dict[int, np.ndarray]:
+        """For each track that carries an object: the object's frame in its robot's end-effector frame (a
+        planar robot's: its base frame)."""
+        out = {}
+        for i, tr in enumerate(tracks):
+            if tr.holding and tr.grasp and tr.carries:
+                key = (tr.robot, tr.holding, tr.grasp)
+                if key not in self._held:
+                    self.held_pose_now(*key)
+                out[i] = self.tcp[tr.robot] @ self._held[key]
+        return out
+
+    def _certified(
+        self,
+        ph: _PhaseWorld,
+        pairs: list[Pair],
+        sides: list[tuple[_Part, _Part, tuple[int, int] | None, str]],
+        bounds: PhaseBounds,
+        set_state: Callable[[float], None],
+        probes: list[Callable[[], dict[tuple[int, int], float]]],
+    ) -> bool:
+        """Whether the certifier (:mod:`mrgc.planner.certify`) proves the phase free of overlaps beyond the
+        tolerance; when it cannot, the sweep checks the phase and reports."""
+        rows = bounds.rows
+        same = np.concatenate(
+            [np.full(len(p.subs), a.track >= 0 and a.track == b.track) for p, (a, b, _, _) in zip(pairs, sides)]
+        )
+        ga, gb = rows[bounds.ends[:, 0]] > 0, rows[bounds.ends[:, 1]] > 0
+        side_a = np.where(same[:, None], ga & ~gb, True)
+        side_b = np.where(same[:, None], gb & ~ga, True)
+        bp = ph._bp
+        speeds = np.array([ph.speeds(k) for k in range(len(bp) - 1)]).reshape(len(bp) - 1, rows.shape[1])
+        phase = Phase(
+            bp,
+            speeds,
+            pairs,
+            bounds.ends,
+            np.stack([side_a, side_b], axis=1).astype(float),
+            rows,
+            bounds.at,
+            set_state,
+            lambda p: probes[p](),
+        )
+        return Certifier(phase, CONTACT_TOL, MAX_SAMPLES).run()
 
     def _carrier(self, tr: _Track) -> Callable[[], None] | None:
         """What puts the object track ``tr`` carries where its robot holds it now (None: it carries none)."""

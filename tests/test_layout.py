@@ -56,8 +56,11 @@ VALIDATOR = [
     "planner/sampling.py",
     "planner/stability.py",
     "planner/sweep.py",
+    "planner/certify.py",
+    "planner/phase_bounds.py",
     "geometry/replay_world.py",
     "geometry/replay_bounds.py",
+    "geometry/replay_fk.py",
 ]
 NOT_FOR_THE_VALIDATOR = {
     "mrgc.planner.ground",

@@ -1,0 +1,235 @@
+"""Bounds of a phase's pairs without pybullet's distance queries: lower bounds on distances, motion rates.
+
+Every robot link is held by a sphere about its centre of mass
+(:attr:`~mrgc.geometry.replay_bounds.ArmBounds.spheres`), a planar robot's footprint and a carried object
+by one about its frame, every object that stands still in the phase by its bounding box; two spheres are at
+least the distance of their centres less both radii apart, a sphere and a box the distance of the centre
+from the box less the radius.
+
+:class:`Spheres` reads the positions from pybullet at the state the world is set to (the sweep's
+:attr:`~mrgc.planner.sweep.Sweep.bound`); :class:`PhaseBounds` computes them for many times at once with
+the validator's numpy kinematics (:mod:`mrgc.geometry.replay_fk`), and with them each element's motion
+rate at those times (its points' largest distance from each joint's axis, from its motion spheres, at most
+its global rate), for the certifier (:mod:`mrgc.planner.certify`).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any, Callable
+
+import numpy as np
+
+from mrgc.geometry.conventions import wrap_angle
+from mrgc.geometry.replay_fk import ArmChain, axis_reach, pack
+from mrgc.geometry.scene import half_extents
+from mrgc.planner.sweep import Pair
+
+if TYPE_CHECKING:
+    from mrgc.geometry.replay_world import ReplayScene
+
+FK_PAD = 1e-5  # m: the numpy kinematics against pybullet's single-precision frames (measured 3e-7)
+
+
+class Spheres:
+    """Lower bounds on the distances of a phase's sub-pairs (module docstring), positions read from pybullet
+    at the world's current state (:meth:`__call__`).  ``ph``: the replay's phase world (its parts, tracks,
+    objects); ``pairs`` and ``sides``: the sweep's pairs and their two parts."""
+
+    def __init__(self, ph: Any, pairs: list[Pair], sides: list[tuple[Any, Any, Any, str]]) -> None:
+        rp, rs = ph.rp, ph.rp.rs
+        self.rs: ReplayScene = rs
+        index: dict[tuple[str, int], int] = {}
+        radius: list[float] = []
+        half: list[np.ndarray | None] = []
+        rows: list[np.ndarray] = []
+        self.arms: list[tuple[str, list[int], np.ndarray]] = []  # arm, its links, their elements
+        self.bodies: list[tuple[str, int]] = []  # moving rigid bodies (planar robots, carried objects)
+        self.owner: list[tuple[Any, int]] = []  # each element's part and link
+        moving = {tr.robot for tr in ph.tracks}
+        static: list[tuple[str, int]] = []
+        for part in (*ph.parts.values(), *ph.objects.values()):
+            first = len(radius)
+            arm = part.robot and not rp.planar[part.name]
+            for link, row in part.rows.items():
+                index[(part.name, link)] = len(radius)
+                rows.append(row)
+                self.owner.append((part, link))
+                if arm:
+                    b = rp.bounds[part.name]
+                    radius.append(float(b.spheres[b.column(link)]))
+                    half.append(None)
+                    continue
+                h = half_extents(rp.footprint_shape[part.name] if part.robot else rp.shapes[part.name])
+                radius.append(float(np.linalg.norm(h)) + 1e-6)
+                half.append(None if part.robot or part.track >= 0 else h + 1e-6)
+            elems = np.arange(first, len(radius))
+            if arm:
+                self.arms.append((part.name, list(part.rows), elems))
+            elif part.track >= 0 or part.name in moving:
+                self.bodies.append((part.name, first))
+            else:
+                static.append((part.name, first))
+        self.index = index
+        self.rows = np.array(rows).reshape(len(rows), -1)
+        self.radius = np.array(radius)
+        self.box = np.array([h is not None for h in half])
+        self.half = np.array([h if h is not None else np.zeros(3) for h in half]).reshape(-1, 3)
+        self.centre = np.zeros((len(radius), 3))
+        self.rot = np.tile(np.eye(3), (len(radius), 1, 1))
+        for name, e in static:  # what stands still, where it stands at the start of the phase
+            self.centre[e], self.rot[e] = rs.body_frame(name)
+        self.arms_moving = [arm for arm in self.arms if arm[0] in moving]
+        for robot, links, elems in self.arms:
+            self.centre[elems] = rs.link_centres(robot, links)
+        ends = np.array(
+            [(index[(a.name, la)], index[(b.name, lb)]) for p, (a, b, _, _) in zip(pairs, sides) for la, lb in p.subs]
+        ).reshape(-1, 2)
+        self.ends = ends.copy()  # (side a, side b) as the pairs list them
+        flip = self.box[ends[:, 0]] & ~self.box[ends[:, 1]]  # the sphere first, the box second
+        ends[flip] = ends[flip][:, ::-1]
+        self.a, self.b = ends[:, 0], ends[:, 1]
+        self.reach = self.radius[self.a] + np.where(self.box[self.b], 0.0, self.radius[self.b])
+        self.to_box = np.flatnonzero(self.box[self.b])
+        self.box_a, self.box_b = self.a[self.to_box], self.b[self.to_box]
+
+    def __call__(self) -> np.ndarray:
+        """The lower bound of every sub-pair's distance (in the sweep's order) at the world's current state."""
+        rs, centre = self.rs, self.centre
+        for robot, links, elems in self.arms_moving:
+            centre[elems] = rs.link_centres(robot, links)
+        for name, e in self.bodies:
+            centre[e] = rs.position(name)
+        out: np.ndarray = self._bound(centre[None])[0]
+        return out
+
+    def _bound(self, centre: np.ndarray) -> np.ndarray:
+        """Lower bounds (T, S) from element centres (T, E, 3)."""
+        gap = centre[:, self.a] - centre[:, self.b]
+        if len(self.to_box):  # the sphere's centre in the box's frame, its distance from the box
+            inside = np.einsum("nji,tnj->tni", self.rot[self.box_b], gap[:, self.to_box])
+            gap[:, self.to_box] = np.maximum(np.abs(inside) - self.half[self.box_b], 0.0)
+        out: np.ndarray = np.sqrt(np.einsum("tij,tij->ti", gap, gap)) - self.reach
+        return out
+
+
+class PhaseBounds(Spheres):
+    """:class:`Spheres` for many times at once from the numpy kinematics, and each element's motion rate
+    (module docstring; the certifier's :attr:`~mrgc.planner.certify.Phase.bounds`).  ``offsets``: for each
+    track that carries an object, the object's frame in its robot's end-effector frame (a planar robot's:
+    its base frame); ``chains(robot)``: an arm's :class:`~mrgc.geometry.replay_fk.ArmChain` with its fingers
+    as they are now, and its links' motion spheres (:func:`~mrgc.geometry.replay_fk.motion_spheres`)."""
+
+    def __init__(
+        self,
+        ph: Any,
+        pairs: list[Pair],
+        sides: list[tuple[Any, Any, Any, str]],
+        offsets: dict[int, np.ndarray],
+        chains: Callable[[str], tuple[ArmChain, list[tuple[np.ndarray, np.ndarray]]]],
+    ) -> None:
+        super().__init__(ph, pairs, sides)
+        rp, rs = ph.rp, ph.rp.rs
+        self.tracks = ph.tracks
+        self.planar = [rp.planar[tr.robot] for tr in ph.tracks]
+        self.offset = ph.offset
+        self.chains: dict[int, ArmChain] = {}
+        self.links: dict[int, list[tuple[int, int]]] = {}  # track -> (element, pybullet link) of its arm
+        self.motion: dict[int, list[tuple[int, int, np.ndarray, np.ndarray]]] = {}  # track -> spheres
+        self.carried: dict[int, tuple[int, np.ndarray]] = {}  # track -> (element, object origin in ee frame)
+        self.lift: dict[int, float] = {}
+        self.packed: dict[int, tuple[np.ndarray, tuple[np.ndarray, ...]]] = {}
+        self.ee: dict[int, int] = {}
+        for i, tr in enumerate(ph.tracks):
+            part = ph.parts[tr.robot]
+            if self.planar[i]:
+                self.lift[i] = float(rs.robots[tr.robot].lift[2, 3])
+                continue
+            self.chains[i], spheres = chains(tr.robot)
+            self.ee[i] = rs.robots[tr.robot].ee
+            b = rp.bounds[tr.robot]
+            self.links[i] = [(self.index[(tr.robot, link)], link) for link in part.rows]
+            self.motion[i] = [(self.index[(tr.robot, link)], link, *spheres[b.column(link)]) for link in part.rows]
+        for o, part in ph.objects.items():
+            if part.track >= 0 and part.track in offsets:
+                e = self.index[(o, -1)]
+                self.carried[part.track] = (e, offsets[part.track])
+                if not self.planar[part.track]:
+                    self.motion[part.track].append(
+                        (
+                            e,
+                            self.ee[part.track],
+                            offsets[part.track][:3, 3][None].copy(),
+                            np.array([float(rp.radius[o])]),
+                        )
+                    )
+        self.revolute = np.zeros(self.rows.shape[1], dtype=bool)
+        for i, tr in enumerate(ph.tracks):
+            if not self.planar[i]:
+                turns = rp.bounds[tr.robot].turns > 0
+                self.revolute[self.offset[i] : self.offset[i] + len(turns)] = turns
+
+    def at(self, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Lower bounds (T, S) of every sub-pair's distance and rates (T, E, C) of every element at
+        ``times``."""
+        t = np.asarray(times, dtype=float)
+        centre = np.repeat(self.centre[None], len(t), axis=0)
+        rate = np.repeat(self.rows[None], len(t), axis=0)
+        for i, tr in enumerate(self.tracks):
+            q = _configs_at(tr.configs, t, self.planar[i])
+            if self.planar[i]:
+                self._planar(i, q, centre)
+                continue
+            chain = self.chains[i]
+            rot, pos = chain.frames(q)
+            elems = np.array([e for e, _ in self.links[i]])
+            links = np.array([link + 1 for _, link in self.links[i]])
+            centre[:, elems] = pos[:, links] + np.einsum("tlij,lj->tli", rot[:, links], chain.com[links])
+            self._arm_rates(i, rot, pos, centre, rate)
+        return self._bound(centre) - FK_PAD, rate
+
+    def _planar(self, i: int, q: np.ndarray, centre: np.ndarray) -> None:
+        """A planar track's footprint and carried object at configurations ``q`` (T, 3)."""
+        x, y, yaw = q[:, 0], q[:, 1], q[:, 2]
+        part = self.tracks[i].robot
+        e = self.index[(part, -1)]
+        centre[:, e] = np.stack([x, y, np.full(len(q), self.lift[i])], axis=1)
+        if i in self.carried:
+            e, off = self.carried[i]
+            c, s = np.cos(yaw), np.sin(yaw)
+            ox, oy, oz = off[:3, 3]
+            centre[:, e] = np.stack([x + c * ox - s * oy, y + s * ox + c * oy, np.full(len(q), oz)], axis=1)
+
+    def _arm_rates(self, i: int, rot: np.ndarray, pos: np.ndarray, centre: np.ndarray, rate: np.ndarray) -> None:
+        """An arm track's carried object's centre, and its elements' rates: the largest distance of their
+        motion spheres from each revolute joint's axis (at most the global rate)."""
+        chain = self.chains[i]
+        at = self.offset[i]
+        cols = slice(at, at + len(chain.child))
+        if i in self.carried:
+            e, off = self.carried[i]
+            ee = self.ee[i] + 1
+            centre[:, e] = pos[:, ee] + rot[:, ee] @ off[:3, 3]
+        if i not in self.packed:
+            motion = self.motion[i]
+            self.packed[i] = (np.array([m[0] for m in motion]), pack([m[2:] for m in motion], [m[1] for m in motion]))
+        elems, packed = self.packed[i]
+        tight = axis_reach(chain, rot, pos, packed) + FK_PAD  # (T, elements, dof)
+        g = self.rows[elems][:, cols]
+        rate[:, elems, cols] = np.where(self.revolute[cols], np.minimum(g[None], tight), g[None])
+
+
+def _configs_at(configs: np.ndarray, t: np.ndarray, planar: bool) -> np.ndarray:
+    """Configurations (T, dof) of a motion at times ``t`` (:func:`mrgc.planner.sampling.config_at`, many at
+    once)."""
+    m = len(configs)
+    if m == 1:
+        return np.repeat(np.asarray(configs[:1], dtype=float), len(t), axis=0)
+    x = t * (m - 1)
+    j = np.clip(np.floor(x).astype(int), 0, m - 2)
+    u = (x - j)[:, None]
+    d = configs[j + 1] - configs[j]
+    if planar:
+        d = d.copy()
+        d[:, 2] = wrap_angle(d[:, 2])
+    out: np.ndarray = configs[j] + u * d
+    return out

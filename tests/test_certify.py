@@ -21,16 +21,14 @@ from mrgc.geometry.scene import scene_from_problem
 from mrgc.planner.certify import Certifier, Phase, interval_rate
 from mrgc.planner.sweep import CAP, Pair
 
-PA5 = str(ROOT / "domains" / "packaging" / "pa5.mrg")
-
 
 @pytest.fixture(scope="module")
 def panda() -> Any:
-    scene = scene_from_problem(load_problem(PA5))
-    rs = ReplayScene(scene)
-    home = np.array(scene.robots[0].kind.home, dtype=float)
-    yield rs, arm_bounds(rs, "r1", home), home
-    rs.close()
+    """pa5's Panda r1 in a replay world of its own, its bounds and home (closed after the module)."""
+    scene = scene_from_problem(load_problem(str(ROOT / "domains" / "packaging" / "pa5.mrg")))
+    with ReplayScene(scene) as rs:
+        home = np.array(scene.robots[0].kind.home, dtype=float)
+        yield rs, arm_bounds(rs, "r1", home), home
 
 
 def _frame(rs: ReplayScene, link: int) -> np.ndarray:
@@ -43,7 +41,11 @@ def _frame(rs: ReplayScene, link: int) -> np.ndarray:
 
 @settings(max_examples=20, deadline=None)
 @given(st.integers(0, 2**31 - 1), st.floats(0.0, 0.08))
-def test_the_numpy_kinematics_equal_pybullets(panda: Any, seed: int, opening: float) -> None:
+def test_the_numpy_kinematics_equal_pybullets(
+    panda: Any,
+    seed: int,
+    opening: float,
+) -> None:
     """Every link frame and centre of mass of the validator's numpy kinematics equals pybullet's at random
     configurations within the limits, the fingers at a random opening."""
     rs, _, home = panda

@@ -270,8 +270,8 @@ def plan(
     *,
     name: str | None = None,
     planner: str = "mcts",
-    backend: str = DEFAULT_BACKEND,
-    encoding: str = DEFAULT_ENCODING,
+    backend: str | None = None,
+    encoding: str | None = None,
     seed: int = 0,
     time_limit: float = 60.0,
     log: Callable[[str], None] | None = None,
@@ -284,10 +284,12 @@ def plan(
 
     Returns a :class:`~mrgc.planner.plan.Plan`: ``status`` (:class:`~mrgc.planner.outcome.PlanStatus`:
     solved, infeasible, exhausted, time limit, interrupted), ``why`` (the reasons behind it), ``steps``,
-    ``stats`` and ``dumps()`` (the plan JSON, docs/plan.schema.json).  ``planner`` is ``mcts`` (the paper's
-    method) or ``ap1`` (its baseline, docs/baselines.md); ``options`` are the planner's own (``mcts``:
-    ``c``, ``alpha``, ``skeletons``, ``max_makespan``, ``anytime``, ``max_iterations``, ``motions``); ``log``
-    gets one line per grounded skeleton.  The plan records the problem's content digest, so it validates
+    ``stats`` and ``dumps()`` (the plan JSON, docs/plan.schema.json).  ``planner`` names a method of
+    :data:`mrgc.planner.registry.PLANNERS` (``mcts``, the paper's method, or a baseline, docs/baselines.md);
+    ``options`` are the options it declares (``mcts``: ``backend`` and ``encoding`` (default cpsat,
+    time-of-move), ``c``, ``alpha``, ``skeletons``, ``max_makespan``, ``anytime``, ``max_iterations``; every
+    method: ``motions``); an option the method does not declare is InputError E000; ``log`` gets the
+    search's log lines.  The plan records the problem's content digest, so it validates
     against any file holding the same problem (its facts file too).
 
     ``facts`` (an iterable of :class:`~mrgc.language.model.Fact`, e.g. ``compute_facts(p).facts`` or the
@@ -315,12 +317,11 @@ def plan(
         problem_file,
         sha256,
         __version__,
-        backend=backend,
-        encoding=encoding,
         seed=seed,
         time_limit=time_limit,
         log=log,
         started=started,
+        **{k: v for k, v in (("backend", backend), ("encoding", encoding)) if v is not None},
         **({"facts": list(facts)} if facts is not None else {}),
         **options,
     )

@@ -14,7 +14,7 @@ import argparse
 import contextlib
 import os
 import sys
-from typing import TYPE_CHECKING, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Sequence
 
 from mrgc import __version__
 from mrgc.errors import Diagnostic, InputError
@@ -360,17 +360,11 @@ def cmd_plan(args: argparse.Namespace) -> int:
         plan = api.plan(
             problem,
             planner=args.planner,
-            backend=args.backend,
-            encoding=args.encoding,
             seed=args.seed,
             time_limit=args.time_limit,
             log=log,
-            c=args.c,
-            alpha=args.alpha,
-            skeletons=args.skeletons,
-            max_makespan=args.max_makespan,
-            anytime=args.anytime,
             motions=args.motions,
+            **planner_options(args),
         )
     status = PlanStatus(plan.status)
     # a signal ends the run as interrupted even where the search did not see it (never a verdict, never a file)
@@ -483,9 +477,51 @@ def add_allow_outside(p: argparse.ArgumentParser) -> None:
     )
 
 
+def add_planner_options(p: argparse.ArgumentParser) -> None:
+    """The options the planning methods declare (:mod:`mrgc.planner.registry`), each once, for the methods
+    that declare it; an option not given is not passed (its method's default applies, and another method
+    refuses it only when it is given)."""
+    from mrgc.planner.registry import declared_options
+
+    for owners in declared_options().values():
+        option = owners[0][1]
+        if not option.cli:
+            continue
+        methods = ", ".join(m for m, _ in owners)
+        shown = f"{option.default:g}" if isinstance(option.default, float) else str(option.default)
+        default = "" if option.default in (None, False) else f"; default {shown}"
+        text = f"{option.help} ({methods}{default})"
+        if option.kind == "flag":
+            p.add_argument(option.flag, dest=option.name, action="store_true", default=argparse.SUPPRESS, help=text)
+            continue
+        parse: Callable[[str], Any] = str
+        if option.kind == "count":
+            parse = count(option.flag)
+        elif option.kind == "number":
+            parse = number(option.flag)
+        p.add_argument(
+            option.flag,
+            dest=option.name,
+            type=parse,
+            metavar=option.metavar,
+            choices=option.choices,
+            default=argparse.SUPPRESS,
+            help=text,
+        )
+
+
+def planner_options(args: argparse.Namespace) -> dict[str, Any]:
+    """The planner options given on the command line (see :func:`add_planner_options`)."""
+    from mrgc.planner.registry import declared_options
+
+    return {name: getattr(args, name) for name in declared_options() if hasattr(args, name)}
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The ``mrgc`` argument parser with the commands of this module (usage errors are one ``E000`` line,
     exit 2); :func:`mrgc.cli.build_parser` adds render's and bench's."""
+    from mrgc.planner.registry import PLANNERS
+
     parser = _Parser(prog="mrgc", description="Multi-robot geometric task-and-motion planning compiler and solver.")
     parser.add_argument("--version", action="version", version=f"mrgc {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
@@ -584,30 +620,12 @@ def build_parser() -> argparse.ArgumentParser:
         "--planner",
         default="mcts",
         metavar="NAME",
-        help="mcts (the paper's method, default) | ap1 (its baseline Ap1; docs/baselines.md)",
+        help=f"the planning method: {' | '.join(PLANNERS)} (default mcts, the paper's; the baselines: "
+        "docs/baselines.md)",
     )
-    p.add_argument("--backend", default="cpsat")
-    p.add_argument("--encoding", default="time-of-move")
     add_seed(p)
     add_no_cache(p)
     p.add_argument("--time-limit", type=number("--time-limit", positive=True), default=60.0, metavar="S")
-    p.add_argument(
-        "--skeletons",
-        type=count("--skeletons"),
-        default=5,
-        metavar="K",
-        help="skeletons per generator call (default 5)",
-    )
-    p.add_argument("--max-makespan", type=count("--max-makespan"), default=None, metavar="T")
-    p.add_argument("-c", type=number("-c"), default=1.0, help="PUCT exploration constant (default 1)")
-    p.add_argument(
-        "--alpha", type=number("--alpha"), default=1.0, help="reward weight of fewer moved objects (default 1)"
-    )
-    p.add_argument(
-        "--anytime",
-        action="store_true",
-        help="keep searching after the first plan until the time limit; return the best (makespan, then objects moved)",
-    )
     p.add_argument(
         "--motions",
         choices=["configurations", "full"],
@@ -615,6 +633,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="arms' motion model: configurations (the paper's packaging model: approaches, exchanges, "
         "transfers; default) or full (every motion planned as a path; docs/validator.md)",
     )
+    add_planner_options(p)
     p.add_argument("-v", "--verbose", action="store_true", help="print a search log line per grounded skeleton")
     add_allow_outside(p)
     p.set_defaults(func=cmd_plan)

@@ -1,12 +1,13 @@
 """Methods as command lines: a study's method becomes ``mrgc plan ...`` or ``mrgc compile ...`` arguments.
 
 The options a method may give are the options of the installed ``mrgc plan`` / ``mrgc compile`` (read from
-the command line's own parser, :mod:`mrgc.commands`, so a planner option added to ``mrgc plan`` is usable
-in studies at once); an unknown option, a value of the wrong type, an unknown backend or encoding is a
-located study error (E601).  A planner that this mrgc does not offer (``planner: ap1`` before ``mrgc plan
---planner ap1`` exists) is *not* an error: the spec stays valid for the mrgc that offers it, and ``bench
-run`` skips that method's runs with the reason, storing none of them, so that a later ``bench run`` of the
-same study runs them (docs/bench.md).
+the command line's own parser, :mod:`mrgc.commands`, which builds ``mrgc plan``'s from the options each
+planning method declares, :mod:`mrgc.planner.registry`: an option a planner declares is usable in studies at
+once, and an option its planner does not declare is refused); an unknown option, a value of the wrong
+type, an unknown backend or encoding is a located study error (E601).  A planner that this mrgc does not offer
+(``planner: ap1`` before ``mrgc plan --planner ap1`` exists) is *not* an error: the spec stays valid for the mrgc
+that offers it, and ``bench run`` skips that method's runs with the reason, storing none of them, so that a later
+``bench run`` of the same study runs them (docs/bench.md).
 """
 
 from __future__ import annotations
@@ -16,9 +17,7 @@ from typing import Any
 
 from mrgc.bench.study import E_STUDY_SCHEMA, Method, Study
 from mrgc.errors import Diagnostic
-
-#: the planner of ``mrgc plan`` without ``--planner`` (the paper's method)
-DEFAULT_PLANNER = "mcts"
+from mrgc.planner.registry import DEFAULT_PLANNER
 
 #: options the runner sets itself; a method may not give them in ``options``
 RESERVED = {
@@ -101,10 +100,21 @@ def _method_problems(m: Method, tables: dict[str, dict[str, argparse.Action]], b
         )
     command = "compile" if m.compile else "plan"
     table = tables[command]
+    declared = None if m.compile else _declared_by(m.planner)
+    if declared is not None:
+        out += [
+            f"planner '{m.planner}' has no option {key} (it declares: {', '.join(sorted(declared)) or 'none'})"
+            for key, given in (("backend", m.backend), ("encoding", m.encoding))
+            if given is not None and key not in declared
+        ]
     for key, value in m.options:
         flag = option_flag(key)
         action = table.get(flag)
-        if flag in RESERVED:
+        if declared is not None and flag not in RESERVED and action is not None and key not in declared:
+            out.append(
+                f"planner '{m.planner}' has no option {key} (it declares: {', '.join(sorted(declared)) or 'none'})"
+            )
+        elif flag in RESERVED:
             out.append(f"option '{key}' is set by the study itself (seeds:, limits:, backend:, encoding:, planner:)")
         elif action is None:
             known = sorted(s.lstrip("-") for s in table if s not in RESERVED and s.startswith("--"))
@@ -114,6 +124,16 @@ def _method_problems(m: Method, tables: dict[str, dict[str, argparse.Action]], b
             if problem:
                 out.append(f"option '{key}': {problem}")
     return out
+
+
+def _declared_by(planner: str) -> set[str] | None:
+    """The options planner ``planner`` declares (:attr:`Planner.options <mrgc.planner.method.Planner.options>`);
+    None for a planner this mrgc does not offer (its runs are skipped, not refused)."""
+    from mrgc.planner.registry import PLANNERS, planner_class
+
+    if planner not in PLANNERS:
+        return None
+    return {o.name for o in planner_class(planner).options}
 
 
 def _bad_value(action: argparse.Action, value: Any) -> str:

@@ -146,7 +146,7 @@ def build_task_graph(facts: FactBase, must_move: Iterable[str], moved: Iterable[
         if obj in nodes or obj in done:
             continue
         nodes[obj] = None
-        for act in _actions_for(facts, obj):
+        for act in actions_for(facts, obj):
             pick_obs = facts.occludes_pick.get((obj, act.pick_grasp, act.pick_robot), ())
             place_obs: tuple[str, ...] = ()
             if obj in facts.goal:
@@ -170,7 +170,7 @@ def build_task_graph(facts: FactBase, must_move: Iterable[str], moved: Iterable[
     )
 
 
-def _actions_for(facts: FactBase, obj: str) -> list[Action]:
+def actions_for(facts: FactBase, obj: str) -> list[Action]:
     """Lines 5-20 of Alg. 1: the direct and handover actions moving ``obj`` to its target region (and the
     relays of a goal object, after them)."""
     is_goal = obj in facts.goal

@@ -304,6 +304,16 @@ class ReverseGrounder:
                 return Failure(0, label(a), f"relay: no spot in {a.via} where both robots reach {a.obj}")
         return out
 
+    def ground_step(
+        self, step: tuple[Action, ...], avoid: set[str], v_fut: Volume, key: str, index: int = 0
+    ) -> GroundedStep | Failure:
+        """One joint action grounded on its own (the unit the baselines search over, planner/baselines/): the
+        actions of ``step`` in one plan step, clear of the objects ``avoid`` where the grounder has them (their
+        initial poses, or those :meth:`Grounder.moved <mrgc.geometry.grounding.Grounder.moved>` gives them),
+        of each other and of the volume ``v_fut``; ``key`` seeds its sampling, ``index`` numbers its failure.
+        No splitting, re-timing or relays (those are the skeleton grounding's, :meth:`ground`)."""
+        return self._step(step, avoid, {a.obj for a in step}, v_fut, key, index)
+
     def _step(
         self, step: tuple[Action, ...], avoid: set[str], same: set[str], v_fut: Volume, key: str, index: int = 0
     ) -> GroundedStep | Failure:

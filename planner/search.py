@@ -1,4 +1,6 @@
-"""``mrgc plan``: phase 1, then the MCTS over skeletons with reverse-search grounding, then a Plan.
+"""The paper's method (``mrgc plan``, planner ``mcts``): the MCTS over task skeletons with reverse-search
+grounding, as a :class:`~mrgc.planner.method.Planner` (the harness, :mod:`mrgc.planner.harness`, runs phase 1
+before it and makes the Plan after it).
 
 Symbolic problems have no geometry to ground: their plan is the best skeleton (documented in
 docs/planner.md).  Every outcome is a :class:`~mrgc.planner.outcome.PlanStatus` on the plan, with its
@@ -6,8 +8,8 @@ reasons (:class:`~mrgc.planner.outcome.Why`) and statistics: time per phase, ske
 grounded, tree size, geometric queries.
 
 **Nothing is solved until the validator says so.**  Each complete plan the search grounds is replayed by
-the independent validator (:mod:`mrgc.planner.validate`) before it is accepted; a rejected plan is a
-grounding failure like any other (reward 0, memoised) and the search goes on.  The plan records the
+the independent validator (the harness's referee, :mod:`mrgc.planner.referee`) before it is accepted; a
+rejected plan is a grounding failure like any other (reward 0, memoised) and the search goes on.  The plan records the
 verdict (``validation``).
 """
 
@@ -20,11 +22,12 @@ from mrgc.compiler.enumerate import BatchOutcome
 from mrgc.compiler.facts import FactBase
 from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action, TaskGraph
-from mrgc.language.model import Fact, Problem
+from mrgc.language.model import Problem
 from mrgc.planner.deferral import Deferrals, describe
-from mrgc.planner.outcome import BlockingCycle, Failure, PlanStatus, Why
-from mrgc.planner.plan import Plan, PlannedAction, planner_motion_model
-from mrgc.planner.skeletons import DEFAULT_BACKEND, DEFAULT_ENCODING, SkeletonSource, facts_until, must_move
+from mrgc.planner.method import Context, Option, Planner, Result
+from mrgc.planner.outcome import BlockingCycle, PlanStatus, Why
+from mrgc.planner.plan import Plan, PlannedAction
+from mrgc.planner.skeletons import DEFAULT_BACKEND, DEFAULT_ENCODING, SkeletonSource
 
 if TYPE_CHECKING:  # the geometric modules load numpy and coal: a symbolic problem never imports them
     from mrgc.geometry.grounding import Grounder
@@ -35,129 +38,104 @@ if TYPE_CHECKING:  # the geometric modules load numpy and coal: a symbolic probl
 Log = Callable[[str], None]
 
 
-#: the arms' motion models ``plan_problem`` can plan (docs/validator.md)
-MOTIONS = ("configurations", "full")
+class Mcts(Planner):
+    """The paper's method, ``mrgc plan`` without ``--planner`` (see the module docstring)."""
 
-
-def plan_problem(
-    problem: Problem,
-    problem_file: str,
-    sha256: str,
-    version: str,
-    backend: str = DEFAULT_BACKEND,
-    encoding: str = DEFAULT_ENCODING,
-    seed: int = 0,
-    time_limit: float = 60.0,
-    c: float = 1.0,
-    alpha: float = 1.0,
-    skeletons: int = 5,
-    max_makespan: int | None = None,
-    anytime: bool = False,
-    log: Log | None = None,
-    max_iterations: int = 10_000,
-    motions: str = "configurations",
-    started: float | None = None,
-    facts: list[Fact] | None = None,
-) -> Plan:
-    """Plan ``problem`` (see the module docstring).  ``anytime`` keeps searching after the first plan until
-    the time limit (or the end of the tree) and returns the best by (makespan, objects moved); ``log`` gets
-    one line per grounded skeleton.  ``motions``: ``configurations`` (the paper's packaging model: arms'
-    approaches, exchanges and the held object's transfers) or ``full`` (arms' empty-handed motions too, as
-    paths; docs/validator.md).  ``started``: the ``time.perf_counter`` value the time limit and the plan's
-    seconds count from (default: this call; :func:`mrgc.plan` passes its own start, before the layout checks
-    that load the robots' models).  ``facts``: the problem's facts, when the caller has them (default: the
-    file's ``:init``, or phase 1 run now, through the facts cache)."""
-    if motions not in MOTIONS:
-        raise ValueError(f"motions is one of {', '.join(MOTIONS)}, not {motions!r}")
-    t0 = time.perf_counter() if started is None else started
-    deadline = t0 + time_limit
-    say: Log = log or (lambda line: None)
-    found, facts_seconds = facts_until(problem, facts, seed, deadline)
-    plan = Plan(
-        problem.name,
-        problem_file,
-        sha256,
-        version,
-        backend,
-        encoding,
-        seed,
-        PlanStatus.EXHAUSTED,
-        symbolic=problem.symbolic,
+    name = "mcts"
+    title = "the paper's method: skeletons + MCTS + reverse grounding"
+    options = (
+        Option("backend", "text", DEFAULT_BACKEND, "skeleton solver backend (mrgc backends)"),
+        Option("encoding", "text", DEFAULT_ENCODING, "skeleton encoding: paper | disaggregated | time-of-move"),
+        Option("skeletons", "count", 5, "skeletons per generator call", metavar="K"),
+        Option("max_makespan", "count", None, "horizon limit of the skeletons", metavar="T"),
+        Option("c", "number", 1.0, "PUCT exploration constant"),
+        Option("alpha", "number", 1.0, "reward weight of fewer moved objects"),
+        Option(
+            "anytime",
+            "flag",
+            False,
+            "keep searching after the first plan until the time limit; return the best (makespan, then objects moved)",
+        ),
+        Option("max_iterations", "count", 10_000, "the search's iteration limit", cli=False),
     )
-    plan.motion_model = None if problem.symbolic else planner_motion_model(motions)
-    why = Why()
-    plan.why = why
-    if found is None:
-        return phase1_cut(plan, problem, time_limit, t0, facts_seconds)
-    facts = found
-    base = FactBase.from_problem(problem, facts)
-    stats: dict[str, Any] = {
-        "robots": [r.name for r in problem.robots],
-        "facts": len(facts),
-        "facts_seconds": round(facts_seconds, 4),
-    }
-    sources = _Sources(base, _order(problem), backend, encoding, max_makespan, seed, deadline)
-    start = must_move(problem, facts)
-    if problem.symbolic:
-        _conclude_symbolic(plan, why, sources(set(start), set()), time_limit)
-        stats["skeleton_seconds"] = round(time.perf_counter() - t0 - facts_seconds, 4)
-    else:
-        from mrgc.geometry.grounding import Grounder
-        from mrgc.geometry.scene import scene_from_problem
-        from mrgc.planner.ground import Outcome, ReverseGrounder
-        from mrgc.planner.mcts import MCTS
+    exhausted = "every skeleton the compiler could generate was tried; none could be grounded into a valid plan"
 
-        scene = scene_from_problem(problem)
-        grounder = Grounder(scene, seed=seed)
-        reverse = ReverseGrounder(grounder, problem.goal_regions, full=motions == "full", deadline=deadline)
-        count = [0]
-        validation: dict[str, Any] = {}
-        timing = _Timing()
+    def record(self, options: dict[str, Any]) -> tuple[str, str]:
+        """The skeleton backend and encoding."""
+        return str(options["backend"]), str(options["encoding"])
 
-        def ground(skel: Skeleton, suffix: list[GroundedStep]) -> Grounding:
-            count[0] += 1
-            result = reverse.ground(skel, suffix, key=str(count[0]), order=sources.order_of(skel))
-            timing.grounded(skel, suffix, result)
-            if result.outcome is Outcome.SUCCESS:
-                result = _referee(problem, problem_file, plan, result, why, validation)
-            for f in result.failures:
-                why.add(f)
-            failed = result.outcome is Outcome.FAIL and bool(result.failures)
-            deferred = sources.deferrals.failed(skel, result.failures[0]) if failed else None
-            say(_log_line(time.perf_counter() - t0, count[0], skel, suffix, result))
-            if deferred is not None:
-                after = sources.deferrals.after
-                say(f"  deferred after {after} failures: {describe(deferred)} (skeletons without it first)")
+    def solve(self, context: Context, deadline: float) -> Result:
+        """Symbolic problems: the best skeleton; geometric ones: the MCTS over skeletons."""
+        o = context.options
+        sources = _Sources(
+            context.base,
+            _order(context.problem),
+            o["backend"],
+            o["encoding"],
+            o["max_makespan"],
+            context.seed,
+            deadline,
+        )
+        if context.problem.symbolic:
+            result = _conclude_symbolic(context.why, sources(set(context.goals), set()), context.time_limit)
+            result.stats["skeleton_seconds"] = round(time.perf_counter() - context.started - context.facts_seconds, 4)
             return result
-
-        search = MCTS(ground, sources, set(start), c=c, alpha=alpha, k=skeletons)
-        result = search.run(deadline, max_iterations=max_iterations, anytime=anytime)
-        _conclude_search(plan, why, result, sources.root, grounder, validation, deadline)
-        stats.update({k: (round(v, 4) if isinstance(v, float) else v) for k, v in result.stats.items()})
-        stats["iterations"] = result.iterations
-        stats["geometric_queries"] = grounder.queries
-        stats["deferred"] = sorted(describe(p) for p in sources.deferrals.deferred)
-        stats["validation_seconds"] = round(validation.get("seconds", 0.0), 4)
-        stats.update(timing.of(result.steps))
-        why.summary = _summary(plan.status, result.ended, time_limit, max_iterations, why)
-    stats["seconds"] = round(time.perf_counter() - t0, 4)
-    plan.stats = stats
-    return plan
+        return _search(context, sources, deadline)
 
 
-def phase1_cut(plan: Plan, problem: Problem, time_limit: float, t0: float, facts_seconds: float) -> Plan:
-    """``plan`` (of any planner) as the time limit leaves it when it cut phase 1 (the geometric facts) short:
-    status ``time limit``, no facts, no search."""
-    plan.status = PlanStatus.TIME_LIMIT
-    plan.why = plan.why or Why()
-    plan.why.summary = f"phase 1 (the geometric facts) did not finish within the time limit of {time_limit:g} s"
-    plan.stats = {
-        "robots": [r.name for r in problem.robots],
-        "facts": 0,
-        "facts_seconds": round(facts_seconds, 4),
-        "seconds": round(time.perf_counter() - t0, 4),
-    }
-    return plan
+def plan_problem(problem: Problem, problem_file: str, sha256: str, version: str, **options: Any) -> Plan:
+    """Plan ``problem`` with the paper's method (:class:`Mcts`) through the harness: ``options`` are the
+    harness's (``seed``, ``time_limit``, ``log``, ``motions``, ``started``, ``facts``: see
+    :func:`mrgc.planner.harness.run`) and :attr:`Mcts.options` (``backend``, ``encoding``, ``c``, ``alpha``,
+    ``skeletons``, ``max_makespan``, ``anytime``, ``max_iterations``)."""
+    from mrgc.planner.harness import run
+
+    return run(Mcts(), problem, problem_file, sha256, version, **options)
+
+
+def _search(context: Context, sources: _Sources, deadline: float) -> Result:
+    """The MCTS over skeletons with reverse-search grounding, each complete plan judged by the referee."""
+    from mrgc.geometry.grounding import Grounder
+    from mrgc.geometry.scene import scene_from_problem
+    from mrgc.planner.ground import Outcome, ReverseGrounder
+    from mrgc.planner.mcts import MCTS
+
+    problem, o, why, say = context.problem, context.options, context.why, context.log
+    grounder = Grounder(scene_from_problem(problem), seed=context.seed)
+    reverse = ReverseGrounder(grounder, problem.goal_regions, full=context.full, deadline=deadline)
+    count = [0]
+    timing = _Timing()
+
+    def ground(skel: Skeleton, suffix: list[GroundedStep]) -> Grounding:
+        count[0] += 1
+        result = reverse.ground(skel, suffix, key=str(count[0]), order=sources.order_of(skel))
+        timing.grounded(skel, suffix, result)
+        if result.outcome is Outcome.SUCCESS:
+            result = _referee(context, result)
+        for f in result.failures:
+            why.add(f)
+        failed = result.outcome is Outcome.FAIL and bool(result.failures)
+        deferred = sources.deferrals.failed(skel, result.failures[0]) if failed else None
+        say(_log_line(time.perf_counter() - context.started, count[0], skel, suffix, result))
+        if deferred is not None:
+            after = sources.deferrals.after
+            say(f"  deferred after {after} failures: {describe(deferred)} (skeletons without it first)")
+        return result
+
+    search = MCTS(ground, sources, set(context.goals), c=o["c"], alpha=o["alpha"], k=o["skeletons"])
+    result = search.run(deadline, max_iterations=o["max_iterations"], anytime=o["anytime"])
+    out = _conclude_search(why, result, sources.root, grounder, deadline)
+    stats = out.stats
+    stats.update({k: (round(v, 4) if isinstance(v, float) else v) for k, v in result.stats.items()})
+    stats["iterations"] = result.iterations
+    stats["geometric_queries"] = grounder.queries
+    stats["deferred"] = sorted(describe(p) for p in sources.deferrals.deferred)
+    stats.update(timing.of(result.steps))
+    if out.status is PlanStatus.TIME_LIMIT and result.ended == "iteration limit":
+        out.summary = f"the search's iteration limit ({o['max_iterations']}) was reached before a plan was found"
+    elif out.status is PlanStatus.INFEASIBLE:
+        out.summary = "infeasible by the facts: no task skeleton exists"
+    return out
 
 
 class _Timing:
@@ -275,47 +253,34 @@ class _Sources:
         return lambda a: graph.obstacles(index[a])
 
 
-def _conclude_symbolic(plan: Plan, why: Why, more: _Skeletons, time_limit: float) -> None:
+def _conclude_symbolic(why: Why, more: _Skeletons, time_limit: float) -> Result:
     """A symbolic problem's plan: the best skeleton, else why there is none."""
     first = more(1)
     if first:
-        plan.status = PlanStatus.SOLVED
-        plan.steps = [planned for step in first[0].steps for planned in planned_steps(step)]
-    elif more.infeasible:
-        plan.status = PlanStatus.INFEASIBLE
+        steps = [planned for step in first[0].steps for planned in planned_steps(step)]
+        return Result(PlanStatus.SOLVED, steps)
+    if more.infeasible:
         why.facts = more.reasons()
-        why.summary = "infeasible by the facts"
-    else:
-        plan.status = PlanStatus.TIME_LIMIT
-        why.summary = f"skeleton generation did not finish within {time_limit:g} s"
+        return Result(PlanStatus.INFEASIBLE, summary="infeasible by the facts")
+    return Result(PlanStatus.TIME_LIMIT, summary=f"skeleton generation did not finish within {time_limit:g} s")
 
 
-def _conclude_search(
-    plan: Plan,
-    why: Why,
-    result: SearchResult,
-    root: _Skeletons,
-    grounder: Grounder,
-    validation: dict[str, Any],
-    deadline: float,
-) -> None:
-    """The plan's status (and steps, verdict, reasons) from how the search ended."""
+def _conclude_search(why: Why, result: SearchResult, root: _Skeletons, grounder: Grounder, deadline: float) -> Result:
+    """The status (and steps, reasons) from how the search ended."""
     if result.steps is not None:
-        plan.steps = [s.actions for s in result.steps]
-        plan.status = PlanStatus.SOLVED if result.ended != "interrupted" else PlanStatus.INTERRUPTED
-        plan.validation = _verdict_of(plan, validation)
-    elif result.ended == "interrupted":
-        plan.status = PlanStatus.INTERRUPTED
-    elif result.ended in ("time limit", "iteration limit") or time.perf_counter() >= deadline:
-        plan.status = PlanStatus.TIME_LIMIT
-    elif root.infeasible:
-        plan.status = PlanStatus.INFEASIBLE
+        status = PlanStatus.SOLVED if result.ended != "interrupted" else PlanStatus.INTERRUPTED
+        return Result(status, [s.actions for s in result.steps])
+    if result.ended == "interrupted":
+        return Result(PlanStatus.INTERRUPTED)
+    if result.ended in ("time limit", "iteration limit") or time.perf_counter() >= deadline:
+        return Result(PlanStatus.TIME_LIMIT)
+    if root.infeasible:
         why.facts = root.reasons()
         why.cycles = _cycles_with_evidence(root.source, grounder)
         if why.cycles:  # the cycles are told with their evidence instead
             why.facts = [f for f in why.facts if not f.startswith("blocking cycle")]
-    else:
-        plan.status = PlanStatus.EXHAUSTED
+        return Result(PlanStatus.INFEASIBLE)
+    return Result(PlanStatus.EXHAUSTED)
 
 
 def _cycles_with_evidence(source: SkeletonSource, grounder: Grounder, per_edge: int = 2) -> list[BlockingCycle]:
@@ -338,55 +303,15 @@ def _cycles_with_evidence(source: SkeletonSource, grounder: Grounder, per_edge: 
     return out
 
 
-def _referee(
-    problem: Problem, problem_file: str, plan: Plan, result: Grounding, why: Why, verdicts: dict[str, Any]
-) -> Grounding:
+def _referee(context: Context, result: Grounding) -> Grounding:
     """The validator's verdict on a complete grounded plan: SUCCESS stays SUCCESS only when it accepts it;
     otherwise the grounding is a failure (named by the validator's first violation)."""
     from mrgc.planner.ground import Grounding, Outcome
-    from mrgc.planner.validate import validate
 
-    candidate = plan.candidate([s.actions for s in result.steps], [r.name for r in problem.robots])
-    t0 = time.perf_counter()
-    report = validate(problem, candidate.to_json(), problem_file, first_only=True)  # the verdict, fast
-    seconds = time.perf_counter() - t0
-    verdicts["seconds"] = verdicts.get("seconds", 0.0) + seconds
-    verdicts["checked"] = verdicts.get("checked", 0) + 1
-    if report.ok:
+    failure = context.referee([s.actions for s in result.steps])
+    if failure is None:
         return result
-    why.rejected_plans += 1
-    first = report.violations[0]
-    failure = Failure(
-        first.step or 0,
-        f"validator ({len(report.violations)} violation{'s' * (len(report.violations) != 1)})",
-        first.code,
-        (first.subject,) if first.subject else (),
-        first.message,
-    )
     return Grounding(Outcome.FAIL, reason=failure.line(), failures=[failure])
-
-
-def _verdict_of(plan: Plan, verdicts: dict[str, Any]) -> dict[str, Any]:
-    """What the plan JSON records of the validator's verdict on the returned plan."""
-    return {
-        "valid": True,
-        "validator": "mrgc validate (independent pybullet replay)",
-        "plans_checked": verdicts.get("checked", 0),
-    }
-
-
-def _summary(status: PlanStatus, ended: str, time_limit: float, max_iterations: int, why: Why) -> str:
-    if status is PlanStatus.SOLVED:
-        return "solved" + (f" after the validator rejected {why.rejected_plans} plan(s)" if why.rejected_plans else "")
-    if status is PlanStatus.INFEASIBLE:
-        return "infeasible by the facts: no task skeleton exists"
-    if status is PlanStatus.INTERRUPTED:
-        return "interrupted"
-    if status is PlanStatus.TIME_LIMIT:
-        if ended == "iteration limit":
-            return f"the search's iteration limit ({max_iterations}) was reached before a plan was found"
-        return f"no plan within the time limit of {time_limit:g} s"
-    return "every skeleton the compiler could generate was tried; none could be grounded into a valid plan"
 
 
 def _log_line(elapsed: float, n: int, skel: Skeleton, suffix: list[GroundedStep], result: Grounding) -> str:

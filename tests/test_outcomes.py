@@ -186,7 +186,7 @@ def test_every_solved_plan_carries_the_validators_verdict(tmp_path: Path) -> Non
 def test_a_plan_the_validator_rejects_is_a_failure_fed_back() -> None:
     from mrgc.planner.outcome import Why
     from mrgc.planner.plan import Plan
-    from mrgc.planner.search import _referee
+    from mrgc.planner.referee import Referee
 
     path = ROOT / "domains" / "packaging" / "pa3-handover.mrg"
     problem = parse_file(path).problem()
@@ -197,12 +197,11 @@ def test_a_plan_the_validator_rejects_is_a_failure_fed_back() -> None:
     moved = [row[:] for row in action.place_pose]
     moved[2][3] += 0.12  # released 12 cm higher than its place configuration puts it
     action.place_pose = moved
-    result = SimpleNamespace(outcome=Outcome.SUCCESS, steps=[GroundedStep([action], [], (action.object,))])
     why = Why()
     shell = Plan(problem.name, str(path), file_sha256(str(path)), __version__, "cpsat", "time-of-move", 1, "solved")
-    verdict = _referee(problem, str(path), shell, result, why, {})  # type: ignore[arg-type]
-    assert verdict.outcome is Outcome.FAIL and why.rejected_plans == 1
-    assert verdict.failures[0].check == "grasp" and verdict.failures[0].step == 1
+    failure = Referee(problem, shell, why)([[action]])  # the harness's referee, as every planner calls it
+    assert failure is not None and why.rejected_plans == 1
+    assert failure.check == "grasp" and failure.step == 1 and failure.action.startswith("validator (")
 
 
 # ------------------------------------------------------------------ M* as the paper defines it

@@ -36,17 +36,16 @@ import hashlib
 import random
 import time
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import TYPE_CHECKING, Any, Callable
 
 from mrgc.compiler.facts import FactBase
-from mrgc.compiler.task_graph import Action, build_task_graph
-from mrgc.compiler.task_graph import _actions_for as facts_actions
-from mrgc.language.model import Fact, Problem
-from mrgc.planner.ground import GroundedStep, label, moved_objects
+from mrgc.compiler.task_graph import Action, actions_for, build_task_graph
+from mrgc.planner.method import Context, Planner, Result
 from mrgc.planner.outcome import Failure, PlanStatus, Why
-from mrgc.planner.plan import Plan, planner_motion_model
-from mrgc.planner.search import MOTIONS, phase1_cut, planned_action
-from mrgc.planner.skeletons import facts_until, must_move
+from mrgc.planner.search import planned_action
+
+if TYPE_CHECKING:  # the grounding loads numpy and the geometry: the command line reads Ap1's declaration
+    from mrgc.planner.ground import GroundedStep
 
 #: joint-action groundings the first depth-first run may make; every restart doubles it
 RESTART_BUDGET = 64
@@ -75,13 +74,14 @@ class Attempt:
 class GeometricSteps:
     """Joint actions grounded on the scene by the planner's reverse grounding (planner/ground.py)."""
 
-    def __init__(self, problem: Problem, seed: int, full: bool = False) -> None:
+    def __init__(self, context: Context) -> None:
         from mrgc.geometry.grounding import Grounder
         from mrgc.geometry.scene import scene_from_problem
         from mrgc.planner.ground import ReverseGrounder
 
-        self.grounder = Grounder(scene_from_problem(problem), seed=seed)
-        self.reverse = ReverseGrounder(self.grounder, problem.goal_regions, full=full)
+        problem = context.problem
+        self.grounder = Grounder(scene_from_problem(problem), seed=context.seed)
+        self.reverse = ReverseGrounder(self.grounder, problem.goal_regions, full=context.full)
 
     def ground(
         self,
@@ -97,7 +97,7 @@ class GeometricSteps:
         (moved by nothing yet) too when ``strict``, else the objects of ``free`` the step hits are returned."""
         same = {a.obj for a in actions}
         avoid = fut | free if strict else set(fut)
-        step = self.reverse._step(actions, avoid, same, v_fut, key, index)
+        step = self.reverse.ground_step(actions, avoid, v_fut, key, index)
         if isinstance(step, Failure):
             return step
         among = sorted(free - same)
@@ -123,6 +123,8 @@ class SymbolicSteps:
     ) -> Attempt | Failure:
         """Ground the step ``actions`` against the future volume (reverse search): an :class:`Attempt` or the
         :class:`~mrgc.planner.outcome.Failure` that stopped it."""
+        from mrgc.planner.ground import GroundedStep, label
+
         facts, same = self.facts, {a.obj for a in actions}
         hits: set[str] = set()
         for a in actions:
@@ -168,7 +170,7 @@ class Ap1Search:
         single-robot ones first, then the handovers, each in the facts' order (no relays: Ap1 keeps the
         paper's model, each object moved once by one action)."""
         if obj not in self._actions:
-            acts = [a for a in facts_actions(self.facts, obj) if a.via is None]
+            acts = [a for a in actions_for(self.facts, obj) if a.via is None]
             self._actions[obj] = [a for a in acts if not a.handover] + [a for a in acts if a.handover]
         return self._actions[obj]
 
@@ -209,6 +211,8 @@ class Ap1Search:
             return suffix if self.accept(suffix) else None
         state = (pending, signature)
         self.stats["nodes"] += 1
+        from mrgc.planner.ground import moved_objects
+
         fut = moved_objects(suffix)
         free = set(self.facts.objects) - fut - set(pending)
         v_fut = [p for s in suffix for p in s.volume]
@@ -309,88 +313,48 @@ class Ap1Search:
         return got
 
 
-def plan_ap1(
-    problem: Problem,
-    problem_file: str,
-    sha256: str,
-    version: str,
-    seed: int = 0,
-    time_limit: float = 60.0,
-    log: Log | None = None,
-    motions: str = "configurations",
-    started: float | None = None,
-    facts: list[Fact] | None = None,
-) -> Plan:
-    """Plan ``problem`` with Ap1 (see the module docstring); the same Plan, statuses and validation as
-    :func:`mrgc.planner.search.plan_problem`, and the same ``motions`` (``full``: arms' empty-handed
-    motions planned too); ``started`` and ``facts`` as there."""
-    if motions not in MOTIONS:
-        raise ValueError(f"motions is one of {', '.join(MOTIONS)}, not {motions!r}")
-    t0 = time.perf_counter() if started is None else started
-    say: Log = log or (lambda line: None)
-    known, facts_seconds = facts_until(problem, facts, seed, t0 + time_limit)
-    robots = [r.name for r in problem.robots]
-    plan = Plan(
-        problem.name,
-        problem_file,
-        sha256,
-        version,
-        "none",
-        "none",
-        seed,
-        PlanStatus.EXHAUSTED,
-        symbolic=problem.symbolic,
+class Ap1(Planner):
+    """Ap1 as a planning method (see the module docstring)."""
+
+    name = "ap1"
+    title = "baseline Ap1: multi-robot ResolveSpatialConstraints"
+    exhausted = (
+        "the depth-first search ran to its end (every object of the stack, with every action, at every "
+        "step); no valid plan"
     )
-    plan.motion_model = None if problem.symbolic else planner_motion_model(motions)
-    why = plan.why = Why()
-    if known is None:
-        return phase1_cut(plan, problem, time_limit, t0, facts_seconds)
-    facts = known
-    base = FactBase.from_problem(problem, facts)
-    stats: dict[str, Any] = {
-        "planner": "ap1",
-        "robots": robots,
-        "facts": len(facts),
-        "facts_seconds": round(facts_seconds, 4),
-    }
-    goals = must_move(problem, facts)
-    reasons = _infeasible(base, goals)
-    if reasons:
-        plan.status, why.facts, why.summary = PlanStatus.INFEASIBLE, reasons, "infeasible by the facts"
-    else:
-        verdicts: dict[str, float] = {"checked": 0, "seconds": 0.0}
+
+    def solve(self, context: Context, deadline: float) -> Result:
+        """The facts' diagnosis first (as ``mrgc plan``), then the depth-first search with restarts."""
+        base, why = context.base, context.why
+        reasons = _infeasible(base, context.goals)
+        if reasons:
+            why.facts = reasons
+            return Result(PlanStatus.INFEASIBLE)
 
         def accept(steps: list[GroundedStep]) -> bool:
-            return _referee(problem, plan, steps, why, verdicts)
+            failure = context.referee([s.actions for s in steps])
+            if failure is not None:
+                why.add(failure)
+            return failure is None
 
-        steps = SymbolicSteps(base) if problem.symbolic else GeometricSteps(problem, seed, full=motions == "full")
-        search = Ap1Search(steps, base, accept, t0 + time_limit, why, one_handover=base.handover_capacity == 1)
-        try:
-            found, ended = search.run(goals, seed, lambda line: say(f"[t={time.perf_counter() - t0:.1f}s] {line}"))
-        except KeyboardInterrupt:
-            found, ended = None, "interrupted"
-        if found is not None:
-            plan.steps = [s.actions for s in found]
-            plan.status = PlanStatus.SOLVED
-            plan.validation = {
-                "valid": True,
-                "validator": "mrgc validate (independent replay)",
-                "plans_checked": int(verdicts["checked"]),
-            }
-        else:
-            plan.status = {"time limit": PlanStatus.TIME_LIMIT, "interrupted": PlanStatus.INTERRUPTED}.get(
-                ended, PlanStatus.EXHAUSTED
-            )
-        why.summary = _summary(plan.status, time_limit, why)
-        if any(f.step < 0 for f in why.failures):  # Ap1 grounds backwards: say how its steps are numbered
-            why.summary += "; Ap1 numbers steps from the end (step -1: the plan's last, -2: the one before)"
-        stats.update({k: (round(v, 4) if isinstance(v, float) else int(v)) for k, v in search.stats.items()})
-        stats["validation_seconds"] = round(verdicts["seconds"], 4)
+        steps = SymbolicSteps(base) if context.problem.symbolic else GeometricSteps(context)
+        search = Ap1Search(steps, base, accept, deadline, why, one_handover=base.handover_capacity == 1)
+        stamp = context.started
+        found, ended = search.run(
+            context.goals, context.seed, lambda line: context.log(f"[t={time.perf_counter() - stamp:.1f}s] {line}")
+        )
+        stats: dict[str, Any] = {k: (round(v, 4) if isinstance(v, float) else int(v)) for k, v in search.stats.items()}
         if isinstance(steps, GeometricSteps):
             stats["geometric_queries"] = steps.grounder.queries
-    stats["seconds"] = round(time.perf_counter() - t0, 4)
-    plan.stats = stats
-    return plan
+        note = None
+        if any(f.step < 0 for f in why.failures):  # Ap1 grounds backwards: say how its steps are numbered
+            note = "Ap1 numbers steps from the end (step -1: the plan's last, -2: the one before)"
+        if found is not None:
+            return Result(PlanStatus.SOLVED, [s.actions for s in found], stats=stats, note=note)
+        status = {"time limit": PlanStatus.TIME_LIMIT, "interrupted": PlanStatus.INTERRUPTED}.get(
+            ended, PlanStatus.EXHAUSTED
+        )
+        return Result(status, stats=stats, note=note)
 
 
 def _infeasible(facts: FactBase, goals: list[str]) -> list[str]:
@@ -399,37 +363,3 @@ def _infeasible(facts: FactBase, goals: list[str]) -> list[str]:
     from mrgc.compiler.diagnose import explain_infeasible
 
     return explain_infeasible(build_task_graph(facts, goals), facts)
-
-
-def _referee(problem: Problem, plan: Plan, steps: list[GroundedStep], why: Why, verdicts: dict[str, float]) -> bool:
-    """Whether the independent validator accepts the complete plan ``steps``; a rejection is counted as a
-    failure named by its first violation."""
-    from mrgc.planner.validate import validate
-
-    t0 = time.perf_counter()
-    candidate = plan.candidate([s.actions for s in steps], [r.name for r in problem.robots], symbolic=problem.symbolic)
-    # the referee judges the plan against the problem it was made for (no file need exist: a problem parsed
-    # from a string is planned too); ``mrgc validate`` checks the file's digest besides.  The first violation
-    # is the verdict, so the replay stops there.
-    report = validate(problem, candidate.to_json(), None, first_only=True)
-    verdicts["seconds"] += time.perf_counter() - t0
-    verdicts["checked"] += 1
-    if report.ok:
-        return True
-    why.rejected_plans += 1
-    v = report.violations[0]
-    why.add(Failure(v.step or 0, "validator", v.code, (v.subject,) if v.subject else (), v.message))
-    return False
-
-
-def _summary(status: PlanStatus, time_limit: float, why: Why) -> str:
-    if status is PlanStatus.SOLVED:
-        return "solved" + (f" after the validator rejected {why.rejected_plans} plan(s)" if why.rejected_plans else "")
-    if status is PlanStatus.TIME_LIMIT:
-        return f"no plan within the time limit of {time_limit:g} s"
-    if status is PlanStatus.INTERRUPTED:
-        return "interrupted"
-    return (
-        "the depth-first search ran to its end (every object of the stack, with every action, at every "
-        "step); no valid plan"
-    )

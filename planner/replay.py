@@ -265,20 +265,31 @@ class _PhaseWorld:
 
     def speeds(self, k: int) -> np.ndarray:
         """The absolute speeds (per unit of phase time) on ``[breakpoints[k], breakpoints[k + 1]]``."""
-        mid = 0.5 * (self._bp[k] + self._bp[k + 1])
-        w = np.zeros(self.columns)
+        out: np.ndarray = self.all_speeds()[k]
+        return out
+
+    def all_speeds(self) -> np.ndarray:
+        """:meth:`speeds` of every stretch between breakpoints (K, columns), computed once."""
+        kept: np.ndarray | None = getattr(self, "_speeds", None)
+        if kept is not None:
+            return kept
+        bp = self._bp
+        mid = 0.5 * (bp[:-1] + bp[1:])
+        w = np.zeros((len(mid), self.columns))
         for i, tr in enumerate(self.tracks):
             m = len(tr.configs)
             if m < 2:
                 continue
-            j = min(int(mid * (m - 1)), m - 2)
+            j = np.minimum((mid * (m - 1)).astype(int), m - 2)
             planar = self.rp.planar[tr.robot]
-            d = deltas(tr.configs[j : j + 2], planar)[0] * (m - 1)
+            d = deltas(tr.configs, planar)[j] * (m - 1)
             at = self.offset[i]
             if planar:
-                w[at : at + 2] = (float(np.hypot(d[0], d[1])), abs(float(d[2])))
+                w[:, at] = np.hypot(d[:, 0], d[:, 1])
+                w[:, at + 1] = np.abs(d[:, 2])
             else:
-                w[at : at + len(d)] = np.abs(d)
+                w[:, at : at + d.shape[1]] = np.abs(d)
+        self._speeds = w
         return w
 
 
@@ -578,7 +589,7 @@ class _Replayer(ActionReader):
         side_a = np.where(same[:, None], ga & ~gb, True)
         side_b = np.where(same[:, None], gb & ~ga, True)
         bp = ph._bp
-        speeds = np.array([ph.speeds(k) for k in range(len(bp) - 1)]).reshape(len(bp) - 1, rows.shape[1])
+        speeds = ph.all_speeds()
         phase = Phase(
             bp,
             speeds,

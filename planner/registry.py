@@ -4,7 +4,10 @@ through :data:`PLANNERS`.
 - ``mcts``: the paper's method (phase 1, task skeletons from the MIP, MCTS with reverse-search grounding;
   :mod:`mrgc.planner.search`), the default;
 - ``ap1``: the paper's baseline Ap1, a multi-robot ResolveSpatialConstraints (Stilman et al. 2007)
-  (:mod:`mrgc.planner.baselines.ap1`, docs/baselines.md).
+  (:mod:`mrgc.planner.baselines.ap1`, docs/baselines.md);
+- ``ap2``: the paper's baseline Ap2 (Pan et al. 2021): optimal task plans on z3 over a growing horizon,
+  motion failures back as constraints, a scheduler trying other robot assignments
+  (:mod:`mrgc.planner.baselines.ap2`, docs/baselines.md).
 
 Every method is a :class:`~mrgc.planner.method.Planner` class run by the one harness
 (:mod:`mrgc.planner.harness`): the same problem, the same :class:`~mrgc.planner.plan.Plan` (JSON, statuses,
@@ -28,6 +31,7 @@ if TYPE_CHECKING:
 PLANNERS: dict[str, str] = {
     "mcts": "mrgc.planner.search:Mcts",
     "ap1": "mrgc.planner.baselines.ap1:Ap1",
+    "ap2": "mrgc.planner.baselines.ap2:Ap2",
 }
 
 DEFAULT_PLANNER = "mcts"

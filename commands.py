@@ -510,6 +510,31 @@ def add_planner_options(p: argparse.ArgumentParser) -> None:
         )
 
 
+class _PlanParser(_Parser):
+    """``mrgc plan``'s parser: the options the planning methods declare (:func:`add_planner_options`) are
+    added when it is first used (to parse, or for its help), since reading them imports the methods'
+    modules, which no other command needs (CLI start-up, docs/benchmarks.md)."""
+
+    _with_methods = False
+
+    def with_planner_options(self) -> "_PlanParser":
+        """This parser with the methods' options (added once)."""
+        if not self._with_methods:
+            self._with_methods = True
+            add_planner_options(self)
+        return self
+
+    def parse_known_args(  # type: ignore[override]
+        self, args: Sequence[str] | None = None, namespace: argparse.Namespace | None = None
+    ) -> tuple[argparse.Namespace, list[str]]:
+        """Parse, with the methods' options."""
+        return super(_PlanParser, self.with_planner_options()).parse_known_args(args, namespace)
+
+    def format_help(self) -> str:
+        """The help, with the methods' options."""
+        return super(_PlanParser, self.with_planner_options()).format_help()
+
+
 def planner_options(args: argparse.Namespace) -> dict[str, Any]:
     """The planner options given on the command line (see :func:`add_planner_options`)."""
     from mrgc.planner.registry import declared_options
@@ -612,7 +637,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--format", choices=["text", "json"], default="text")
     p.set_defaults(func=cmd_compile)
 
+    sub._parser_class = _PlanParser  # the methods' options are added when this parser is first used
     p = sub.add_parser("plan", help="plan end to end: facts, skeletons, MCTS with reverse-search grounding")
+    sub._parser_class = _Parser
     p.add_argument("file", metavar="FILE")
     p.add_argument("--problem", help="which problem of the file (default: its only one)")
     p.add_argument("-o", "--output", metavar="PLAN", help="write the plan JSON here (default: standard output)")
@@ -633,7 +660,6 @@ def build_parser() -> argparse.ArgumentParser:
         help="arms' motion model: configurations (the paper's packaging model: approaches, exchanges, "
         "transfers; default) or full (every motion planned as a path; docs/validator.md)",
     )
-    add_planner_options(p)
     p.add_argument("-v", "--verbose", action="store_true", help="print a search log line per grounded skeleton")
     add_allow_outside(p)
     p.set_defaults(func=cmd_plan)

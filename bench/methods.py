@@ -41,7 +41,9 @@ RESERVED = {
 def _command_parser(command: str) -> argparse.ArgumentParser:
     from mrgc.commands import build_parser, subcommands
 
-    return subcommands(build_parser()).choices[command]
+    parser = subcommands(build_parser()).choices[command]
+    with_methods = getattr(parser, "with_planner_options", None)  # mrgc plan: the methods' declared options
+    return with_methods() if with_methods is not None else parser
 
 
 def _options(command: str) -> dict[str, argparse.Action]:

@@ -47,7 +47,13 @@ class Mcts(Planner):
         Option("backend", "text", DEFAULT_BACKEND, "skeleton solver backend (mrgc backends)"),
         Option("encoding", "text", DEFAULT_ENCODING, "skeleton encoding: paper | disaggregated | time-of-move"),
         Option("skeletons", "count", 5, "skeletons per generator call", metavar="K"),
-        Option("max_makespan", "count", None, "horizon limit of the skeletons", metavar="T"),
+        Option(
+            "max_makespan",
+            "count",
+            None,
+            "horizon limit in steps (default and cap: the task graph's objects)",
+            metavar="T",
+        ),
         Option("c", "number", 1.0, "PUCT exploration constant"),
         Option("alpha", "number", 1.0, "reward weight of fewer moved objects"),
         Option(

@@ -278,7 +278,15 @@ class Ap2(Planner):
 
     name = "ap2"
     title = "baseline Ap2: optimal task planning on z3 (IDTMP style) with a scheduler"
-    options = (Option("max_makespan", "count", None, "horizon limit of the task plans", metavar="T"),)
+    options = (
+        Option(
+            "max_makespan",
+            "count",
+            None,
+            "horizon limit in steps (default and cap: the task graph's objects)",
+            metavar="T",
+        ),
+    )
     exhausted = "every task plan up to the horizon limit was tried; none could be grounded into a valid plan"
 
     def check(self, problem: Problem) -> None:

@@ -53,6 +53,12 @@ class Option:
         return f"-{self.name}" if len(self.name) == 1 else "--" + self.name.replace("_", "-")
 
 
+#: the horizon limit of methods that plan over a growing number of steps (``--max-makespan``)
+HORIZON_LIMIT = Option(
+    "max_makespan", "count", None, "horizon limit in steps (default and cap: the task graph's objects)", metavar="T"
+)
+
+
 @dataclass
 class Context:
     """What the harness gives a method: the problem and its facts (``base``: indexed; ``goals``: the goal
@@ -119,4 +125,4 @@ class Planner(ABC):
         must have been accepted by ``context.referee``."""
 
 
-__all__ = ["KINDS", "Context", "Log", "Option", "Planner", "Result"]
+__all__ = ["HORIZON_LIMIT", "KINDS", "Context", "Log", "Option", "Planner", "Result"]

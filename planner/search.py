@@ -24,7 +24,7 @@ from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action, TaskGraph
 from mrgc.language.model import Problem
 from mrgc.planner.deferral import Deferrals, describe
-from mrgc.planner.method import Context, Option, Planner, Result
+from mrgc.planner.method import HORIZON_LIMIT, Context, Option, Planner, Result
 from mrgc.planner.outcome import BlockingCycle, PlanStatus, Why
 from mrgc.planner.plan import Plan, PlannedAction
 from mrgc.planner.skeletons import DEFAULT_BACKEND, DEFAULT_ENCODING, SkeletonSource
@@ -47,13 +47,7 @@ class Mcts(Planner):
         Option("backend", "text", DEFAULT_BACKEND, "skeleton solver backend (mrgc backends)"),
         Option("encoding", "text", DEFAULT_ENCODING, "skeleton encoding: paper | disaggregated | time-of-move"),
         Option("skeletons", "count", 5, "skeletons per generator call", metavar="K"),
-        Option(
-            "max_makespan",
-            "count",
-            None,
-            "horizon limit in steps (default and cap: the task graph's objects)",
-            metavar="T",
-        ),
+        HORIZON_LIMIT,
         Option("c", "number", 1.0, "PUCT exploration constant"),
         Option("alpha", "number", 1.0, "reward weight of fewer moved objects"),
         Option(

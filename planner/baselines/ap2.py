@@ -44,7 +44,7 @@ from mrgc.compiler.ir import SkeletonModel, SolveStatus
 from mrgc.compiler.skeleton import Skeleton, skeleton_from_schedule
 from mrgc.compiler.task_graph import Action, TaskGraph, build_task_graph
 from mrgc.errors import Diagnostic, InputError
-from mrgc.planner.method import Context, Option, Planner, Result
+from mrgc.planner.method import HORIZON_LIMIT, Context, Planner, Result
 from mrgc.planner.outcome import DeadlineReached, Failure, PlanStatus
 
 if TYPE_CHECKING:
@@ -278,15 +278,7 @@ class Ap2(Planner):
 
     name = "ap2"
     title = "baseline Ap2: optimal task planning on z3 (IDTMP style) with a scheduler"
-    options = (
-        Option(
-            "max_makespan",
-            "count",
-            None,
-            "horizon limit in steps (default and cap: the task graph's objects)",
-            metavar="T",
-        ),
-    )
+    options = (HORIZON_LIMIT,)
     exhausted = "every task plan up to the horizon limit was tried; none could be grounded into a valid plan"
 
     def check(self, problem: Problem) -> None:

@@ -179,8 +179,8 @@ class Certifier:
             raise _Unsure  # an overlap, or a pair at the tolerance: the sweep follows it
         least = np.maximum(np.minimum(e0, e1), 1e-9)
         pieces = reach / (2 * least)
-        weak = (pieces > MANY) | (np.minimum(e0, e1) < FAR)
-        ask0, ask1 = weak & ~x0, weak & ~x1
+        many = pieces > MANY
+        ask0, ask1 = ~x0 & (many | (e0 < FAR)), ~x1 & (many | (e1 < FAR))
         if ask0.any() or ask1.any():
             self._ask(np.concatenate([i0[ask0], i1[ask1]]), np.concatenate([js[ask0], js[ask1]]))
             keep = ask0 | ask1  # asked now: judged again next round

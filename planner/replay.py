@@ -528,6 +528,7 @@ class _Replayer(ActionReader):
         bp = ph.breakpoints()
         bounds = PhaseBounds(ph, pairs, sides, self._offsets(tracks), self._chain) if pairs else None
         if bounds is not None and self._certified(ph, pairs, sides, bounds, set_state, probes):
+            self.stop_if_found()  # as after a sweep: with first_only, what earlier checks found ends the replay
             return
         sweep = Sweep(bp, ph.speeds, pairs, set_state, query, report, CONTACT_TOL, MAX_SAMPLES)
         sweep.bound = bounds

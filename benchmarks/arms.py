@@ -4,6 +4,7 @@ random, planned with a few seeds; each plan is replayed by the validator.
 
     .venv/bin/python benchmarks/arms.py [--variants 6] [--time-limit 120] [--out results.jsonl]
 
+``--arms issue`` draws issue 27's own scene instead (two xArm6 at ±0.45 m, three 4 cm boxes, two goals).
 Prints one row per run (arm, variant, seed, facts, status, validated, makespan, handover, CPU s, wall s) and
 a summary per arm; CPU seconds count the process and its phase-1 workers.
 """
@@ -67,6 +68,42 @@ def variant(arm: str, k: int) -> str:
     return text.replace("(h1 :position (0 0 0.3))", f"(h1 :position (0 0 {height:.2f}))")
 
 
+def issue_scene(k: int) -> str:
+    """Issue 27's own scene, drawn: two xArm6 at x = ±0.45 standing on the table (z = 0), three 4 cm boxes
+    0.25-0.4 m in front of a1 (|y| <= 0.12, 6 cm apart), a bin in front of a2, a handover point; two goals."""
+    rng = np.random.default_rng(2750 + k)
+    while True:
+        xy = np.column_stack([rng.uniform(-0.2, -0.05, 3), rng.uniform(-0.12, 0.12, 3)])
+        if min(np.linalg.norm(xy[i] - xy[j]) for i in range(3) for j in range(i)) > 0.06:
+            break
+    boxes = "\n".join(
+        f"    (o{i + 1} :shape (box 0.04 0.04 0.04) :pose ({x:.3f} {y:.3f} 0.02 {rng.uniform(-45, 45):.0f}))"
+        for i, (x, y) in enumerate(xy)
+    )
+    kind = _xarm_kind()
+    return f"""(define (domain xarm)
+  (:requirements :handover)
+  {kind}
+  (:grasps top top-x side-x+ side-x- side-y+ side-y-))
+
+(define (problem issue27)
+  (:domain xarm)
+  (:robots
+    (a1 :kind xarm6 :base (-0.45 0 0 0))
+    (a2 :kind xarm6 :base (0.45 0 0 180)))
+  (:fixed
+    (table :shape (box 1.4 1 0.05) :pose (0 0 -0.025 0)))
+  (:regions
+    (start :shape (box 0.2 0.34 0.2) :pose (-0.125 0 0.1 0))
+    (bin :shape (box 0.16 0.16 0.2) :pose (0.2 {rng.uniform(-0.15, 0.15):.2f} 0.1 0)))
+  (:movable
+{boxes})
+  (:handover-points
+    (h1 :position (0 0 0.3)))
+  (:goal (and (in-region o1 bin) (in-region o2 bin))))
+"""
+
+
 def _xarm_kind() -> str:
     example = test_arms.docs_example()
     found = re.search(r"\(:robot-kind xarm6.*?:gripper-opening 0.085\)", example, re.S)
@@ -78,7 +115,7 @@ def run(arm: str, k: int, seed: int, time_limit: float, folder: Path) -> dict[st
     """One plan of variant ``k`` of ``arm``, validated."""
     path = folder / f"{arm}-{k}.mrg"
     (folder / "arm6.urdf").write_text(test_arms.arm6_urdf(), encoding="utf-8")
-    path.write_text(variant(arm, k), encoding="utf-8")
+    path.write_text(issue_scene(k) if arm == "issue" else variant(arm, k), encoding="utf-8")
     c0, t0 = cpu(), time.perf_counter()
     problem = mrgc.parse_file(path).problem()
     facts = mrgc.compute_facts(problem, seed=seed)
@@ -110,7 +147,7 @@ def main() -> int:
     ap.add_argument("--variants", type=int, default=6)
     ap.add_argument("--seeds", type=int, nargs="+", default=[0, 1])
     ap.add_argument("--time-limit", type=float, default=120.0)
-    ap.add_argument("--arms", nargs="+", default=list(ARMS))
+    ap.add_argument("--arms", nargs="+", default=list(ARMS), help="xarm6, panda, arm6, or issue (issue 27's scene)")
     ap.add_argument("--out")
     args = ap.parse_args()
     rows = []

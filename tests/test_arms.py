@@ -212,7 +212,7 @@ def test_an_arm_whose_ik_never_converges_says_why(tmp_path: Path, capsys: pytest
     """:end-effector 'link3' leaves the xArm a 3-joint chain: check, facts and plan say so in one line each,
     at the robot's declaration."""
     text = docs_example().replace('"xarm_gripper_base_link"', '"link3" :tcp (0 0 0 0)')
-    text = text.replace(":home (0 -0.5 -0.8 0 1.3 0)", ":home (0 -0.5 -0.8)")
+    text = re.sub(r":home \(([^ ]+ [^ ]+ [^ ]+) [^)]*\)", r":home (\1)", text)  # the first three joints
     path = tmp_path / "short.mrg"
     path.write_text(text, encoding="utf-8")
     code, _, err = run_cli(capsys, "check", path)

@@ -47,7 +47,7 @@ from __future__ import annotations
 
 import math
 import time
-from typing import Callable, Hashable, Sequence, Union
+from typing import Any, Callable, Hashable, Sequence, Union
 
 import numpy as np
 
@@ -57,9 +57,11 @@ from mrgc.geometry.motion import MotionResult, MotionStatus
 from mrgc.geometry.scene import outline
 from mrgc.language.model import Shape
 
-#: lattice cell side (m) and number of headings
+#: lattice cell side (m) and number of headings (at most :data:`MAX_YAWS`)
 CELL = 0.05
 YAWS = 32
+#: the search packs a cell's headings into the bits of one 64-bit word (:meth:`LatticePlanner._wavefront`)
+MAX_YAWS = 64
 #: searches repeated after an exact check rejected a lattice move
 REPAIRS = 12
 #: lattice states tried to join the start (and the goal) to the lattice
@@ -227,6 +229,8 @@ class LatticePlanner:
 
     def __init__(self, bounds: Sequence[float], cell: float = CELL, yaws: int = YAWS) -> None:
         self.xmin, xmax, self.ymin, ymax = (float(b) for b in bounds)
+        if not 1 <= int(yaws) <= MAX_YAWS:
+            raise ValueError(f"a lattice has 1 to {MAX_YAWS} headings, not {yaws}")
         self.cell, self.yaws = float(cell), int(yaws)
         self.nx = max(1, int(math.floor((xmax - self.xmin) / cell)))
         self.ny = max(1, int(math.floor((ymax - self.ymin) / cell)))
@@ -403,47 +407,57 @@ class LatticePlanner:
     def _wavefront(
         self, free: np.ndarray, goals: list[tuple[int, int, int]], starts: list[tuple[int, int, int]]
     ) -> list[tuple[int, int, int]] | None:
-        """Lattice states from a start to a goal (inclusive), fewest moves, or None when none connect."""
-        dist = np.full(free.shape, -1, dtype=np.int32)
-        front = np.zeros(free.shape, dtype=bool)
-        for goal in goals:
-            front[goal] = True
-        dist[front] = 0
-        open_ = free & ~front  # free states not reached yet
-        grown, plane = np.zeros_like(front), np.zeros_like(front)
-        # the reached states lie in a window that grows by one cell a layer: work on it only
+        """Lattice states from a start to a goal (inclusive), fewest moves, or None when none connect.
+
+        A breadth-first search from the goals over :data:`_MOVES` (8 neighbours in the plane, one heading
+        either way, cyclic), layer by layer until a start is reached, then back from the nearest start
+        (the first of equally near ones) through the first move of :data:`_MOVES` one layer closer.  A
+        cell's headings are the bits of one 64-bit word (:func:`_pack`): a layer is a few operations on an
+        ``nx`` × ``ny`` array, a heading move a rotation of the bits."""
+        yaws, nx, ny = free.shape
+        word = _word(yaws)
+        bit = [word(1) << word(k) for k in range(yaws)]
+        reached = np.zeros((nx, ny), dtype=word)
+        for k, i, j in goals:
+            reached[i, j] |= bit[k]
+        open_ = _pack(free, word) & ~reached
+        # the states reached lie in a window that grows by one cell a layer: work on it only
         i0, i1 = min(g[1] for g in goals), max(g[1] for g in goals)
         j0, j1 = min(g[2] for g in goals), max(g[2] for g in goals)
-        d = 0
-        while all(dist[s] < 0 for s in starts):
-            i0, i1, j0, j1 = max(i0 - 1, 0), min(i1 + 1, self.nx - 1), max(j0 - 1, 0), min(j1 + 1, self.ny - 1)
-            win = (slice(None), slice(i0, i1 + 1), slice(j0, j1 + 1))
-            f, p, g = front[win], plane[win], grown[win]
-            # the 8 neighbours in the plane (x, then y of the x-grown layer), then one heading either way
-            np.copyto(p, f)
-            p[:, 1:, :] |= f[:, :-1, :]
-            p[:, :-1, :] |= f[:, 1:, :]
-            np.copyto(g, p)
-            g[:, :, 1:] |= p[:, :, :-1]
-            g[:, :, :-1] |= p[:, :, 1:]
-            g[1:] |= f[:-1]
-            g[0] |= f[-1]
-            g[:-1] |= f[1:]
-            g[-1] |= f[0]
-            g &= open_[win]
-            if not g.any():
+        # layers[d]: the states d moves from a goal, as the corner of a window and the window's words
+        layers = [(i0, j0, reached[i0 : i1 + 1, j0 : j1 + 1].copy())]
+
+        def found() -> bool:
+            return any(reached[i, j] & bit[k] for k, i, j in starts)
+
+        while not found():
+            i0, i1, j0, j1 = max(i0 - 1, 0), min(i1 + 1, nx - 1), max(j0 - 1, 0), min(j1 + 1, ny - 1)
+            win = (slice(i0, i1 + 1), slice(j0, j1 + 1))
+            li, lj, last = layers[-1]
+            front = np.zeros((i1 - i0 + 1, j1 - j0 + 1), dtype=word)
+            front[li - i0 : li - i0 + last.shape[0], lj - j0 : lj - j0 + last.shape[1]] = last
+            grown = _grow(front, yaws) & open_[win]
+            if not grown.any():
                 return None
-            d += 1
-            dist[win][g] = d
-            open_[win][g] = False
-            front, grown = grown, front
-        here = min((s for s in starts if dist[s] >= 0), key=lambda s: (dist[s], starts.index(s)))
+            layers.append((i0, j0, grown))
+            reached[win] |= grown
+            open_[win] &= ~grown
+
+        def at(state: tuple[int, int, int], d: int) -> bool:
+            k, i, j = state
+            li, lj, words = layers[d]
+            i, j = i - li, j - lj
+            return 0 <= i < words.shape[0] and 0 <= j < words.shape[1] and bool(words[i, j] & bit[k])
+
+        d = next(d for d in range(len(layers)) if any(at(s, d) for s in starts))
+        here = next(s for s in starts if at(s, d))
         path = [here]
-        while dist[here] > 0:
+        while d > 0:
             k, i, j = here
+            d -= 1
             for dk, di, dj in _MOVES:
                 n = ((k + dk) % self.yaws, i + di, j + dj)
-                if 0 <= n[1] < self.nx and 0 <= n[2] < self.ny and dist[n] == dist[here] - 1:
+                if 0 <= n[1] < self.nx and 0 <= n[2] < self.ny and at(n, d):
                     here = n
                     break
             path.append(here)
@@ -471,3 +485,36 @@ class LatticePlanner:
         for a, b in zip(kept, kept[1:]):
             dense.extend(interpolate(waypoints[a], waypoints[b], resolution, yaw_resolution))
         return dense
+
+
+def _word(yaws: int) -> type[np.unsignedinteger[Any]]:
+    """The smallest unsigned integer type with a bit for each of ``yaws`` headings."""
+    return next(t for t in (np.uint8, np.uint16, np.uint32, np.uint64) if np.dtype(t).itemsize * 8 >= yaws)
+
+
+def _pack(states: np.ndarray, word: type[np.unsignedinteger[Any]]) -> np.ndarray:
+    """Lattice states (yaws, nx, ny) as one ``word`` per cell (nx, ny): bit k is heading k."""
+    weights = word(1) << np.arange(states.shape[0], dtype=word)
+    packed: np.ndarray = np.bitwise_or.reduce(np.where(states, weights[:, None, None], word(0)), axis=0)
+    return packed
+
+
+def _grow(front: np.ndarray, yaws: int) -> np.ndarray:
+    """The states one move of :data:`_MOVES` from ``front`` (packed, :func:`_pack`): the 8 neighbouring
+    cells with the same heading, and the same cell one heading either way (cyclic over ``yaws``)."""
+    plane = front.copy()
+    plane[1:, :] |= front[:-1, :]
+    plane[:-1, :] |= front[1:, :]
+    out = plane.copy()
+    out[:, 1:] |= plane[:, :-1]
+    out[:, :-1] |= plane[:, 1:]
+    word = front.dtype.type
+    one, top = word(1), word(yaws - 1)
+    up, down = (front << one) | (front >> top), (front >> one) | (front << top)  # k -> k + 1 and k -> k - 1
+    if yaws < 8 * front.dtype.itemsize:  # bits above the headings: keep them clear
+        mask = (one << word(yaws)) - one
+        up &= mask
+        down &= mask
+    out |= up
+    out |= down
+    return out

@@ -231,3 +231,69 @@ def test_a_path_planned_with_a_clearance_test_keeps_clear_between_its_states() -
     )
     assert res.status is MotionStatus.SOLVED
     assert max(deepest_between(a, b, overlap, 21) for a, b in zip(res.path, res.path[1:])) <= SLACK + 1e-6
+
+
+def _bfs_distance(free: np.ndarray, goals: list[tuple[int, int, int]], start: tuple[int, int, int]) -> int | None:
+    """Moves from ``start`` to the nearest goal over free states, by a plain breadth-first search (the
+    reference the packed search of ``LatticePlanner._wavefront`` is checked against)."""
+    from collections import deque
+
+    from mrgc.geometry.lattice import _MOVES
+
+    yaws, nx, ny = free.shape
+    dist = dict.fromkeys(goals, 0)
+    queue = deque(goals)
+    while queue:
+        k, i, j = queue.popleft()
+        for dk, di, dj in _MOVES:
+            n = ((k + dk) % yaws, i + di, j + dj)
+            if 0 <= n[1] < nx and 0 <= n[2] < ny and free[n] and n not in dist:
+                dist[n] = dist[(k, i, j)] + 1
+                queue.append(n)
+    return dist.get(start)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    yaws=st.sampled_from([1, 3, 8, 13, 32, 64]),
+    nx=st.integers(1, 14),
+    ny=st.integers(1, 14),
+    density=st.floats(0.0, 0.6),
+    seed=st.integers(0, 2**32 - 1),
+)
+def test_the_wavefront_finds_a_fewest_moves_path_over_free_states(
+    yaws: int, nx: int, ny: int, density: float, seed: int
+) -> None:
+    """The lattice search (headings packed into the bits of a word) answers a path of lattice moves over
+    free states from a start to a goal with as few moves as a plain breadth-first search finds, and None
+    exactly when none connects; with 1 to 64 headings."""
+    from mrgc.geometry.lattice import _MOVES
+
+    rng = np.random.default_rng(seed)
+    free = rng.random((yaws, nx, ny)) >= density
+    cells = [tuple(int(v) for v in c) for c in np.argwhere(free)]
+    if not cells:
+        return
+    goals = [cells[i] for i in rng.choice(len(cells), size=min(2, len(cells)), replace=False)]
+    starts = [cells[i] for i in rng.choice(len(cells), size=min(2, len(cells)), replace=False)]
+    lattice = LatticePlanner((0.0, float(nx), 0.0, float(ny)), cell=1.0, yaws=yaws)
+    assert (lattice.yaws, lattice.nx, lattice.ny) == (yaws, nx, ny)
+    path = lattice._wavefront(free, goals, starts)
+    best = [d for d in (_bfs_distance(free, goals, s) for s in starts) if d is not None]
+    event("connected" if best else "not connected")
+    if not best:
+        assert path is None
+        return
+    assert path is not None and path[0] in starts and path[-1] in goals
+    assert len(path) - 1 == min(best)
+    moves = {((dk % yaws), di, dj) for dk, di, dj in _MOVES}
+    for a, b in zip(path, path[1:]):
+        assert free[b] and ((b[0] - a[0]) % yaws, b[1] - a[1], b[2] - a[2]) in moves
+
+
+def test_a_lattice_has_at_most_64_headings() -> None:
+    """The search packs a cell's headings into one 64-bit word: more is a usage error."""
+    import pytest
+
+    with pytest.raises(ValueError, match="1 to 64 headings"):
+        LatticePlanner(BOUNDS, yaws=65)

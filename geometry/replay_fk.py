@@ -194,13 +194,23 @@ def pack(spheres: list[tuple[np.ndarray, np.ndarray]], links: list[int]) -> tupl
     return np.array(index, dtype=int), np.array(local).reshape(-1, 3), np.array(radius), np.array(first, dtype=int)
 
 
-def axis_reach(chain: ArmChain, rot: np.ndarray, pos: np.ndarray, packed: tuple[np.ndarray, ...]) -> np.ndarray:
+def centres(rot: np.ndarray, pos: np.ndarray, packed: tuple[np.ndarray, ...]) -> np.ndarray:
+    """The world centres (T, spheres, 3) of packed motion spheres (:func:`pack`) at :meth:`ArmChain.frames`'
+    output."""
+    links, local = packed[0], packed[1]
+    out: np.ndarray = pos[:, links] + np.einsum("tkij,kj->tki", rot[:, links], local)
+    return out
+
+
+def axis_reach(
+    chain: ArmChain, rot: np.ndarray, pos: np.ndarray, packed: tuple[np.ndarray, ...], world: np.ndarray | None = None
+) -> np.ndarray:
     """The largest distance (T, links, dof) of each packed link's motion spheres (:func:`pack`) from each
-    chain joint's axis, at :meth:`ArmChain.frames`' output: an upper bound of the distance of every point
-    of the link from the axis."""
-    links, local, radius, first = packed
+    chain joint's axis, at :meth:`ArmChain.frames`' output (``world``: their :func:`centres`, when known): an
+    upper bound of the distance of every point of the link from the axis."""
+    radius, first = packed[2], packed[3]
     point, direction = chain.axes(rot, pos)  # (T, dof, 3)
-    world = pos[:, links] + np.einsum("tkij,kj->tki", rot[:, links], local)  # (T, spheres, 3)
+    world = centres(rot, pos, packed) if world is None else world  # (T, spheres, 3)
     rel = world[:, :, None, :] - point[:, None, :, :]  # (T, spheres, dof, 3)
     u = direction[:, None, :, :]
     cx = rel[..., 1] * u[..., 2] - rel[..., 2] * u[..., 1]

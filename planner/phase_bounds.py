@@ -20,8 +20,9 @@ from typing import TYPE_CHECKING, Any, Callable
 import numpy as np
 
 from mrgc.geometry.conventions import wrap_angle
-from mrgc.geometry.replay_fk import ArmChain, axis_reach, pack
+from mrgc.geometry.replay_fk import SPHERE_PAD, ArmChain, axis_reach, centres, pack
 from mrgc.geometry.scene import half_extents
+from mrgc.language.model import Box, Shape
 from mrgc.planner.sweep import Pair
 
 if TYPE_CHECKING:
@@ -155,13 +156,11 @@ class PhaseBounds(Spheres):
                 self.carried[part.track] = (e, offsets[part.track])
                 if not self.planar[part.track]:
                     self.motion[part.track].append(
-                        (
-                            e,
-                            self.ee[part.track],
-                            offsets[part.track][:3, 3][None].copy(),
-                            np.array([float(rp.radius[o])]),
-                        )
+                        (e, self.ee[part.track], *_held_spheres(rp.shapes[o], offsets[part.track], float(rp.radius[o])))
                     )
+        for i, motion in self.motion.items():
+            self.packed[i] = (np.array([m[0] for m in motion]), pack([m[2:] for m in motion], [m[1] for m in motion]))
+        self.faces = self._face_pairs()
         self.revolute = np.zeros(self.rows.shape[1], dtype=bool)
         for i, tr in enumerate(ph.tracks):
             if not self.planar[i]:
@@ -174,6 +173,7 @@ class PhaseBounds(Spheres):
         t = np.asarray(times, dtype=float)
         centre = np.repeat(self.centre[None], len(t), axis=0)
         rate = np.repeat(self.rows[None], len(t), axis=0)
+        spheres: dict[int, np.ndarray] = {}  # arm track -> its motion spheres' centres (T, spheres, 3)
         for i, tr in enumerate(self.tracks):
             q = _configs_at(tr.configs, t, self.planar[i])
             if self.planar[i]:
@@ -184,8 +184,14 @@ class PhaseBounds(Spheres):
             elems = np.array([e for e, _ in self.links[i]])
             links = np.array([link + 1 for _, link in self.links[i]])
             centre[:, elems] = pos[:, links] + np.einsum("tlij,lj->tli", rot[:, links], chain.com[links])
-            self._arm_rates(i, rot, pos, centre, rate)
-        return self._bound(centre) - FK_PAD, rate
+            spheres[i] = self._arm_rates(i, rot, pos, centre, rate)
+        lb = self._bound(centre) - FK_PAD
+        for i, world in spheres.items():
+            for box, subs, local in self.faces.get(i, ()):
+                lb[:, subs] = np.maximum(
+                    lb[:, subs], self._face_bound(box, world, self.packed[i][1])[:, local] - FK_PAD
+                )
+        return lb, rate
 
     def _planar(self, i: int, q: np.ndarray, centre: np.ndarray) -> None:
         """A planar track's footprint and carried object at configurations ``q`` (T, 3)."""
@@ -199,9 +205,10 @@ class PhaseBounds(Spheres):
             ox, oy, oz = off[:3, 3]
             centre[:, e] = np.stack([x + c * ox - s * oy, y + s * ox + c * oy, np.full(len(q), oz)], axis=1)
 
-    def _arm_rates(self, i: int, rot: np.ndarray, pos: np.ndarray, centre: np.ndarray, rate: np.ndarray) -> None:
+    def _arm_rates(self, i: int, rot: np.ndarray, pos: np.ndarray, centre: np.ndarray, rate: np.ndarray) -> np.ndarray:
         """An arm track's carried object's centre, and its elements' rates: the largest distance of their
-        motion spheres from each revolute joint's axis (at most the global rate)."""
+        motion spheres from each revolute joint's axis (at most the global rate).  Returns the motion spheres'
+        centres (T, spheres, 3)."""
         chain = self.chains[i]
         at = self.offset[i]
         cols = slice(at, at + len(chain.child))
@@ -209,13 +216,30 @@ class PhaseBounds(Spheres):
             e, off = self.carried[i]
             ee = self.ee[i] + 1
             centre[:, e] = pos[:, ee] + rot[:, ee] @ off[:3, 3]
-        if i not in self.packed:
-            motion = self.motion[i]
-            self.packed[i] = (np.array([m[0] for m in motion]), pack([m[2:] for m in motion], [m[1] for m in motion]))
         elems, packed = self.packed[i]
-        tight = axis_reach(chain, rot, pos, packed) + FK_PAD  # (T, elements, dof)
+        world = centres(rot, pos, packed)
+        tight = axis_reach(chain, rot, pos, packed, world) + FK_PAD  # (T, elements, dof)
         g = self.rows[elems][:, cols]
         rate[:, elems, cols] = np.where(self.revolute[cols], np.minimum(g[None], tight), g[None])
+        return world
+
+    def _face_pairs(self) -> dict[int, list[tuple[int, np.ndarray, np.ndarray]]]:
+        """For each arm track: the boxes that stand still which its elements (links, carried object) are
+        paired with, each with those sub-pairs and the positions of their elements in the track's packed
+        elements (:meth:`_face_bound`)."""
+        out: dict[int, list[tuple[int, np.ndarray, np.ndarray]]] = {}
+        for i, (elems, _) in self.packed.items():
+            where = {int(e): k for k, e in enumerate(elems.tolist())}
+            subs = np.flatnonzero(self.box[self.b] & np.isin(self.a, elems))
+            for box in np.unique(self.b[subs]).tolist():
+                mine = subs[self.b[subs] == box]
+                local = np.array([where[int(e)] for e in self.a[mine]], dtype=int)
+                out.setdefault(i, []).append((int(box), mine, local))
+        return out
+
+    def _face_bound(self, box: int, world: np.ndarray, packed: tuple[np.ndarray, ...]) -> np.ndarray:
+        """:func:`face_bound` of box element ``box`` and packed motion spheres centred at ``world``."""
+        return face_bound(self.centre[box], self.rot[box], self.half[box], world, packed[2], packed[3])
 
 
 def _configs_at(configs: np.ndarray, t: np.ndarray, planar: bool) -> np.ndarray:
@@ -232,4 +256,30 @@ def _configs_at(configs: np.ndarray, t: np.ndarray, planar: bool) -> np.ndarray:
         d = d.copy()
         d[:, 2] = wrap_angle(d[:, 2])
     out: np.ndarray = configs[j] + u * d
+    return out
+
+
+def _held_spheres(shape: Shape, offset: np.ndarray, radius: float) -> tuple[np.ndarray, np.ndarray]:
+    """Motion spheres of a held object in its robot's end-effector frame (``offset``: the object's frame
+    there): a box's 8 corners (its hull's vertices), otherwise one sphere of ``radius`` about its frame."""
+    if isinstance(shape, Box):
+        h = (shape.sx / 2, shape.sy / 2, shape.sz / 2)
+        corners = np.array([[x * h[0], y * h[1], z * h[2], 1.0] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)])
+        return (corners @ offset.T)[:, :3], np.full(8, SPHERE_PAD)
+    return offset[:3, 3][None].copy(), np.array([radius])
+
+
+def face_bound(
+    centre: np.ndarray, rot: np.ndarray, half: np.ndarray, world: np.ndarray, radius: np.ndarray, first: np.ndarray
+) -> np.ndarray:
+    """A lower bound (T, elements) of the signed distance of each element from a box (``centre`` (3,),
+    ``rot`` (3, 3), ``half`` extents (3,)): the largest over the box's six face planes of the least signed
+    distance of the element's motion spheres (centres ``world`` (T, spheres, 3), ``radius`` (spheres,), each
+    element's first sphere at ``first``) from the plane.  Sound for the element's convex hull: a point's
+    signed distance from a box is at least its distance from each face plane (inside: exactly the largest),
+    the least plane distance over a convex hull is at a vertex, which a motion sphere holds, and for two
+    convex shapes that overlap, the overlap along a face normal is at least the penetration depth."""
+    local = np.einsum("tsj,ji->tsi", world - centre, rot)  # in the box's frame
+    faces = np.concatenate([local - half, -local - half], axis=2) - radius[None, :, None]  # (T, spheres, 6)
+    out: np.ndarray = np.minimum.reduceat(faces, first, axis=1).max(axis=2)
     return out

@@ -15,10 +15,11 @@ from support import ROOT
 from mrgc.api import load_problem
 from mrgc.geometry.bullet import pose_of
 from mrgc.geometry.replay_bounds import arm_bounds
-from mrgc.geometry.replay_fk import ArmChain, axis_reach, motion_spheres, pack
+from mrgc.geometry.replay_fk import ArmChain, axis_reach, centres, motion_spheres, pack
 from mrgc.geometry.replay_world import ReplayScene
-from mrgc.geometry.scene import scene_from_problem
+from mrgc.geometry.scene import half_extents, scene_from_problem
 from mrgc.planner.certify import Certifier, Phase, interval_rate
+from mrgc.planner.phase_bounds import face_bound
 from mrgc.planner.sweep import CAP, Pair
 
 
@@ -168,3 +169,32 @@ def test_a_certified_motion_keeps_within_the_tolerance(gap: float, lower: float)
         xs = np.linspace(-1.0, 1.0, 20001)
         d = np.hypot(xs, gap) if gap > 0 else np.abs(xs) + gap
         assert d.min() >= -1e-3
+
+
+@settings(max_examples=20, deadline=None)
+@given(st.integers(0, 2**31 - 1))
+def test_the_face_bound_never_exceeds_pybullets_distance(panda: Any, seed: int) -> None:
+    """The lower bound of a link's distance from a box that the box's face planes give (its motion spheres
+    against each face: :func:`~mrgc.planner.phase_bounds.face_bound`) is never more than pybullet's signed
+    distance, at random configurations, for every link and every box of pa5 (the table and five boxes),
+    overlapping ones included."""
+    rs, bounds, home = panda
+    r = rs.robots["r1"]
+    chain = ArmChain(rs, "r1")
+    links = list(bounds.links)
+    packed = pack(motion_spheres(rs, "r1", bounds, chain), links)
+    qs = np.random.default_rng(seed).uniform(r.lower, r.upper, (3, len(r.joints)))
+    rot, pos = chain.frames(qs)
+    world = centres(rot, pos, packed)
+    scene = scene_from_problem(load_problem(str(ROOT / "domains" / "packaging" / "pa5.mrg")))
+    boxes = {b.name: half_extents(b.shape) for b in (*scene.fixed, *scene.movable)}
+    for k, q in enumerate(qs):
+        rs.set_config("r1", q)
+        for name, half in boxes.items():
+            pos_b, rot_b = rs.body_frame(name)
+            lb = face_bound(pos_b, rot_b, half, world[k : k + 1], packed[2], packed[3])[0]
+            got = rs.link_distances("r1", name, 10.0)
+            for i, link in enumerate(links):
+                if (link, -1) in got:
+                    assert lb[i] <= got[(link, -1)] + 1e-6, (name, r.links[link], lb[i], got[(link, -1)])
+    rs.set_config("r1", home)

@@ -20,6 +20,7 @@ from mrgc.geometry.fk import ee_pose, fk
 from mrgc.geometry.ik import solve_ik_many
 from mrgc.geometry.ik_analytic import panda_chain
 from mrgc.geometry.kinematics import gripper_frames, load_robot_model
+from mrgc.geometry.tcp import _derive
 from mrgc.testing.pybullet_reference import pybullet_fk
 
 XARM = "xarm/xarm6_with_gripper.urdf"
@@ -158,6 +159,8 @@ def test_the_xarm_is_modelled_from_its_urdf() -> None:
     gripper = [link for link in model.links if link.finger]
     assert len(gripper) == 6 and sum(link.mimic < 0 for link in gripper) == 1
     assert [model.links[k].name for k in model.fingertips] == ["left_finger", "right_finger"]
+    derived = _derive(model.urdf, model.end_effector, ())
+    assert derived is not None and derived.text() == "(0 0 0.1621 0)" and "left_finger" in derived.source
     assert model.opening_table is not None
     values, gaps = model.opening_table
     assert np.all(np.diff(gaps) < 0) and 0.085 < gaps[0] < 0.095  # 0 is open

@@ -55,7 +55,7 @@ def arm_diagnostics(problem: Problem) -> list[Diagnostic]:
     """W274, W275 and W276 (module docstring) for the fixed-base robots of ``problem``, in declaration
     order; none for a symbolic problem or when a robot's model cannot be loaded (E400/E401 are reported
     where the model is needed)."""
-    if problem.symbolic:
+    if problem.symbolic or not any(k.base != "planar" for k in problem.domain.robot_kinds):
         return []
     return list(_cached(problem))
 

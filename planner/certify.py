@@ -38,7 +38,7 @@ import numpy as np
 from mrgc.planner.sweep import CAP, MIN_BUDGET, Pair
 
 FAR = 0.02  # m: an end whose lower bound leaves less budget than this is asked of pybullet
-MANY = 8  # an interval that lower bounds alone would cut in more pieces than this asks pybullet at its ends
+MANY = 32  # an interval that lower bounds alone would cut in more pieces than this asks pybullet at its ends
 SHARE = 0.6  # an interval is cut in the power of 2 next above this share of the pieces its ends' budgets need
 MOST = 64  # pieces an interval is cut in at once, at most
 GRID = 1 << 36  # dyadic steps of a stretch of constant speeds: times are stretch start + width * m / GRID

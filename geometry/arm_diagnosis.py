@@ -113,7 +113,7 @@ def _everywhere(arm: Arm, world: CollisionWorld) -> tuple[str, str] | None:
             low = _lowest(link.points, transforms[c, i])
             return "W274", (
                 f"every configuration of {arm.name} ({len(qs)} drawn within its joint limits) collides with "
-                f"fixed object '{obj}': link '{link.name}' {_how(depth)} (its lowest point at z = {low:.3g}); "
+                f"fixed object '{obj}': link '{link.name}' {_how(depth)} (its lowest point at z = {_z(low)}); "
                 f"move the robot's :base or the object"
             )
     return None
@@ -246,3 +246,9 @@ def reasons(diagnostics: Iterable[Diagnostic]) -> list[str]:
         for d in diagnostics
         if d.code in CODES
     ]
+
+
+def _z(v: float) -> str:
+    """A height in metres to the millimetre, without a negative zero."""
+    text = f"{v:.3f}".rstrip("0").rstrip(".")
+    return "0" if text in ("-0", "0", "") else text

@@ -495,10 +495,11 @@ def add_planner_options(p: argparse.ArgumentParser) -> None:
             p.add_argument(option.flag, dest=option.name, action="store_true", default=argparse.SUPPRESS, help=text)
             continue
         parse: Callable[[str], Any] = str
+        low, high = option.bounds  # unless mrgc.limits.BOUNDS has a row for the flag
         if option.kind == "count":
-            parse = count(option.flag)
+            parse = count(option.flag, int(low), int(high))
         elif option.kind == "number":
-            parse = number(option.flag)
+            parse = number(option.flag, low, high)
         p.add_argument(
             option.flag,
             dest=option.name,

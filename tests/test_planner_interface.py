@@ -1,0 +1,82 @@
+"""The planner interface (planner/method.py, harness.py, registry.py): a method is a class and one registry
+line; the harness gives it phase 1, the referee, statuses, summary and statistics; ``mrgc plan`` takes the
+options it declares (typed, bounded) and refuses them for the other methods."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import pytest
+from support import ROOT
+
+from mrgc import cli
+from mrgc.planner import registry
+from mrgc.planner.method import Context, Option, Planner, Result
+from mrgc.planner.outcome import PlanStatus
+from mrgc.planner.search import planned_steps
+
+CHAIN = str(ROOT / "domains" / "symbolic" / "chain-3.mrg")
+
+
+class Toy(Planner):
+    """Moves the goal objects one by one, each with its first action nothing obstructs (``--refuse``: finds
+    nothing)."""
+
+    name = "toy"
+    title = "a test method"
+    options = (
+        Option("steps_cap", "count", 9, "at most this many steps", metavar="N"),
+        Option("refuse", "flag", False, "find nothing"),
+    )
+    exhausted = "the toy found nothing"
+
+    def solve(self, context: Context, deadline: float) -> Result:
+        from mrgc.compiler.task_graph import actions_for
+
+        if context.options["refuse"]:
+            return Result(PlanStatus.EXHAUSTED, stats={"toy_steps": 0})
+        base = context.base
+
+        def free(o: str) -> Any:
+            return next(a for a in actions_for(base, o) if not base.occludes_pick.get((o, a.pick_grasp, a.pick_robot)))
+
+        steps = [planned_steps((free(o),))[0] for o in context.goals]
+        steps = steps[: context.options["steps_cap"]]
+        failure = context.referee(steps)
+        return Result(PlanStatus.SOLVED if failure is None else PlanStatus.EXHAUSTED, steps if not failure else None)
+
+
+@pytest.fixture()
+def toy(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setitem(registry.PLANNERS, "toy", f"{__name__}:Toy")
+
+
+def test_a_new_method_is_a_class_and_a_registry_line(toy: None, tmp_path: Path) -> None:
+    out = tmp_path / "plan.json"
+    assert cli.main(["plan", CHAIN, "--planner", "toy", "--steps-cap", "3", "-o", str(out)]) == 0
+    doc = json.loads(out.read_text())
+    assert doc["status"] == "solved" and doc["stats"]["planner"] == "toy" and doc["validation"]["valid"]
+    assert doc["backend"] == "none" and doc["why"]["summary"] == "solved"
+    assert cli.main(["validate", CHAIN, str(out)]) == 0
+
+
+def test_the_harness_gives_statuses_summaries_and_statistics(toy: None, tmp_path: Path, capsys: Any) -> None:
+    out = tmp_path / "plan.json"
+    assert cli.main(["plan", CHAIN, "--planner", "toy", "--refuse", "-o", str(out)]) == 5  # exhausted
+    doc = json.loads(out.read_text())
+    assert doc["status"] == "exhausted" and doc["why"]["summary"] == "the toy found nothing"
+    assert doc["stats"]["toy_steps"] == 0 and {"robots", "facts", "seconds"} <= set(doc["stats"])
+
+
+def test_declared_options_are_typed_and_belong_to_their_method(toy: None, capsys: Any) -> None:
+    assert cli.main(["plan", CHAIN, "--planner", "toy", "--steps-cap", "many"]) == 2  # a count
+    assert cli.main(["plan", CHAIN, "--planner", "mcts", "--refuse"]) == 2  # the toy's option
+    assert cli.main(["plan", CHAIN, "--planner", "toy", "--anytime"]) == 2  # mcts' option
+    err = capsys.readouterr().err
+    assert "--refuse is not an option of the mcts planner" in err
+    assert "--anytime is not an option of the toy planner" in err and "Traceback" not in err
+    assert cli.main(["plan", "--help"]) == 0
+    shown = capsys.readouterr().out
+    assert "--steps-cap N" in shown and "(toy; default 9)" in shown and "--refuse" in shown

@@ -120,8 +120,9 @@ class TaskPlanner:
     def next(self, deadline: float) -> TaskPlan | None:
         """The next task plan: the optimum of the smallest horizon with one left (None: no horizon up to the
         limit has one).  Raises :class:`DeadlineReached` when z3 ran out of time."""
-        if not self.graph.must_move:
-            return TaskPlan(Skeleton(()), [])
+        if not self.graph.must_move:  # nothing to move: the empty plan, once
+            self.horizon, done = self.limit + 1, self.horizon > self.limit
+            return None if done else TaskPlan(Skeleton(()), [])
         while self.horizon <= self.limit:
             if self.solver is None:
                 self._load()

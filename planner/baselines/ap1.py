@@ -340,9 +340,12 @@ class Ap1(Planner):
         steps = SymbolicSteps(base) if context.problem.symbolic else GeometricSteps(context)
         search = Ap1Search(steps, base, accept, deadline, why, one_handover=base.handover_capacity == 1)
         stamp = context.started
-        found, ended = search.run(
-            context.goals, context.seed, lambda line: context.log(f"[t={time.perf_counter() - stamp:.1f}s] {line}")
-        )
+        try:  # interrupted: the statistics of the search so far are kept
+            found, ended = search.run(
+                context.goals, context.seed, lambda line: context.log(f"[t={time.perf_counter() - stamp:.1f}s] {line}")
+            )
+        except KeyboardInterrupt:
+            found, ended = None, "interrupted"
         stats: dict[str, Any] = {k: (round(v, 4) if isinstance(v, float) else int(v)) for k, v in search.stats.items()}
         if isinstance(steps, GeometricSteps):
             stats["geometric_queries"] = steps.grounder.queries

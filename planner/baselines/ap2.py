@@ -317,6 +317,8 @@ class Ap2(Planner):
             status = PlanStatus.SOLVED if found is not None else PlanStatus.EXHAUSTED
         except DeadlineReached:
             found, status = None, PlanStatus.TIME_LIMIT
+        except KeyboardInterrupt:  # the statistics of the search so far are kept
+            found, status = None, PlanStatus.INTERRUPTED
         stats: dict[str, Any] = {k: round(v, 4) if isinstance(v, float) else int(v) for k, v in tasks.stats.items()}
         stats.update(scheduler.stats, task_plans=search.plans)
         if isinstance(steps, ForwardSteps):

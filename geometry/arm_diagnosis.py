@@ -66,13 +66,13 @@ def _cached(problem: Problem) -> tuple[Diagnostic, ...]:
     from mrgc.geometry.collision import scene_world
     from mrgc.geometry.scene import scene_from_problem
 
-    try:
+    try:  # a model or a mesh that cannot be loaded is reported where it is needed, not as a diagnosis here
         scene = scene_from_problem(problem)
         arms = [Arm(spec) for spec in scene.robots if spec.kind.base != "planar"]
+        world = scene_world(scene)
     except InputError:
         return ()
     spans = {r.name: r.span for r in problem.robots}
-    world = scene_world(scene)
     out: list[Diagnostic] = []
     for arm in arms:
         found = _everywhere(arm, world) or _home(arm, world)

@@ -63,6 +63,10 @@ class Phase:
     bounds: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
     set_state: Callable[[float], None]
     query: Callable[[int], dict[tuple[int, int], float]]
+    #: two links of one arm: the first joint between them (column; -1: none or not such a pair) and the
+    #: upstream link's largest distance from that joint's axis, which is fixed in its frame (see _reach)
+    first: np.ndarray | None = None
+    first_rate: np.ndarray | None = None
 
 
 def interval_rate(rows: np.ndarray, start: np.ndarray, end: np.ndarray, dq: np.ndarray) -> np.ndarray:
@@ -203,14 +207,21 @@ class Certifier:
         """How far the two sides of sub-pairs ``js`` can move together over their intervals (rows ``i0`` to
         ``i1``, joint motions ``dq``): each side's rate at the ends (its points' largest distance from each
         joint's axis), grown by what the joints beyond each joint can move it over the interval, never above
-        its global rate."""
+        its global rate.  Two links A (upstream) and B of one arm, with the chain joints c1 < c2 < ... between
+        them: seen from the link that joint c1 turns, A turns about c1's axis, fixed in A's frame, and B moves
+        by c2, ...; so c1's rate may be A's points' largest distance from that axis instead of B's, whichever
+        is less (:attr:`Phase.first_rate`)."""
         ends, sides, rows = self.ph.ends[js], self.ph.sides[js], self.ph.rows
-        total = np.zeros(len(js))
+        combined = np.zeros(dq.shape)
         for side in (0, 1):
             e = ends[:, side]
-            rate = interval_rate(rows[e], self.rate[i0, e], self.rate[i1, e], dq)
-            total += (sides[:, side] * rate * dq).sum(axis=1)
-        return total
+            combined += sides[:, side] * interval_rate(rows[e], self.rate[i0, e], self.rate[i1, e], dq)
+        if self.ph.first is not None and self.ph.first_rate is not None:
+            first = self.ph.first[js]
+            k = np.flatnonzero(first >= 0)
+            combined[k, first[k]] = np.minimum(combined[k, first[k]], self.ph.first_rate[js[k]])
+        out: np.ndarray = (combined * dq).sum(axis=1)
+        return out
 
     def _ask(self, rows: np.ndarray, subs: np.ndarray) -> None:
         """Ask pybullet for the pairs of sub-pairs ``subs`` at time rows ``rows`` (each time set once)."""

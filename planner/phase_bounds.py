@@ -161,6 +161,7 @@ class PhaseBounds(Spheres):
         for i, motion in self.motion.items():
             self.packed[i] = (np.array([m[0] for m in motion]), pack([m[2:] for m in motion], [m[1] for m in motion]))
         self.faces = self._face_pairs()
+        self.still: dict[int, np.ndarray] = {}  # arm track -> its elements' distances from each axis, at its start
         self.revolute = np.zeros(self.rows.shape[1], dtype=bool)
         for i, tr in enumerate(ph.tracks):
             if not self.planar[i]:
@@ -222,6 +223,27 @@ class PhaseBounds(Spheres):
         g = self.rows[elems][:, cols]
         rate[:, elems, cols] = np.where(self.revolute[cols], np.minimum(g[None], tight), g[None])
         return world
+
+    def first_joint(self, upstream: int, column: int) -> float:
+        """The largest distance of element ``upstream`` (a link of a moving arm) from the axis of chain joint
+        ``column`` (of the same arm) when that axis is fixed in the element's frame (the joint hangs on the
+        link or on links bolted to it: no chain joint between), else inf."""
+        for i, (elems, packed) in self.packed.items():
+            at = self.offset[i]
+            if upstream not in elems.tolist() or not at <= column < at + len(self.chains[i].child):
+                continue
+            chain, k = self.chains[i], elems.tolist().index(upstream)
+            link = int(packed[0][packed[3][k]])  # the element's link (index + 1)
+            parent = chain.joints[int(chain.child[column - at]) - 1].parent
+            while parent != link and parent > 0 and chain.joints[parent - 1].column < 0:
+                parent = chain.joints[parent - 1].parent
+            if parent != link:
+                return float("inf")
+            if i not in self.still:
+                rot, pos = chain.frames(np.asarray(self.tracks[i].configs[:1], dtype=float))
+                self.still[i] = axis_reach(chain, rot, pos, packed)[0]
+            return float(self.still[i][k, column - at]) + FK_PAD
+        return float("inf")
 
     def _face_pairs(self) -> dict[int, list[tuple[int, np.ndarray, np.ndarray]]]:
         """For each arm track: the boxes that stand still which its elements (links, carried object) are

@@ -591,6 +591,14 @@ class _Replayer(ActionReader):
         side_b = np.where(same[:, None], gb & ~ga, True)
         bp = ph._bp
         speeds = ph.all_speeds()
+        first = np.full(len(same), -1)
+        first_rate = np.full(len(same), np.inf)
+        for j in np.flatnonzero(same & (side_a.any(axis=1) != side_b.any(axis=1))).tolist():
+            down = 1 if side_b[j].any() else 0  # the side the joints between them move
+            col = int(np.flatnonzero((side_b if down else side_a)[j])[0])
+            rate = bounds.first_joint(int(bounds.ends[j, 1 - down]), col)
+            if np.isfinite(rate):
+                first[j], first_rate[j] = col, rate
         phase = Phase(
             bp,
             speeds,
@@ -601,6 +609,8 @@ class _Replayer(ActionReader):
             bounds.at,
             set_state,
             lambda p: probes[p](),
+            first,
+            first_rate,
         )
         return Certifier(phase, CONTACT_TOL, MAX_SAMPLES).run()
 

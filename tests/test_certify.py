@@ -198,3 +198,38 @@ def test_the_face_bound_never_exceeds_pybullets_distance(panda: Any, seed: int) 
                 if (link, -1) in got:
                     assert lb[i] <= got[(link, -1)] + 1e-6, (name, r.links[link], lb[i], got[(link, -1)])
     rs.set_config("r1", home)
+
+
+@settings(max_examples=15, deadline=None)
+@given(st.integers(0, 2**31 - 1))
+def test_a_link_is_no_farther_from_the_joint_it_carries_than_its_bound(panda: Any, seed: int) -> None:
+    """The certifier's first-joint rate (planner/certify.py, ``_reach``): a link's largest distance from the
+    axis of a chain joint that hangs on it, computed once from its motion spheres at one configuration, is at
+    least the distance of each of its collision vertices from that axis as pybullet places them at random
+    configurations (the axis is fixed in the link's frame, so one configuration serves all)."""
+    rs, bounds, home = panda
+    r = rs.robots["r1"]
+    chain = ArmChain(rs, "r1")
+    links = list(bounds.links)
+    packed = pack(motion_spheres(rs, "r1", bounds, chain), links)
+    rot, pos = chain.frames(home[None])
+    once = axis_reach(chain, rot, pos, packed)[0]  # (links, dof)
+    carried = {
+        (k, column): float(once[k, column])
+        for k, link in enumerate(links)
+        for column, joint in enumerate(r.joints)
+        if chain.joints[joint].parent == link + 1
+    }
+    assert len(carried) == 7  # link0 carries joint 1, ..., link6 joint 7
+    pts = _link_points(rs, bounds.links)
+    for q in np.random.default_rng(seed).uniform(r.lower, r.upper, (3, len(r.joints))):
+        rs.set_config("r1", q)
+        for (k, column), bound in carried.items():
+            joint = r.joints[column]
+            s = rs.pb.getLinkState(r.body, joint, computeForwardKinematics=True, physicsClientId=rs.cid)
+            axis = pose_of(s[4], s[5])[:3, :3] @ chain.joints[joint].axis
+            f = _frame(rs, links[k])
+            rel = pts[links[k]] @ f[:3, :3].T + f[:3, 3] - np.array(s[4])
+            off = np.linalg.norm(np.cross(rel, axis), axis=1).max()
+            assert off <= bound + 1e-6, (r.links[links[k]], column, off, bound)
+    rs.set_config("r1", home)

@@ -438,7 +438,26 @@ def posed_collide(a: Posed, b: Posed, tolerance: float = TOLERANCE) -> bool:
     if len(a) * len(b) <= DIRECT_PAIRS:
         i, j = overlaps(a, b)
         return bool(_exact(a, b, i, j, tolerance, stop=True))
+    if len(a) <= GROUP:  # a probe against a large set (one configuration against a swept volume)
+        i, j = _near(a, b)
+        return bool(_exact(a, b, i, j, tolerance, stop=True))
+    if len(b) <= GROUP:
+        j, i = _near(b, a)
+        return bool(_exact(a, b, i, j, tolerance, stop=True))
     return any(_exact(a, b, i, j, tolerance, stop=True) for i, j in _chunks(a, b))
+
+
+def _near(small: Posed, large: Posed) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`overlaps` of a few pieces and a large set (more than :data:`GROUP` pieces): the large set's
+    groups, then its pieces, that meet the box around all of ``small`` first; then the pairs."""
+    lo, hi = small.lo.min(axis=0), small.hi.max(axis=0)
+    glo, ghi = large.coarse()
+    groups = np.flatnonzero(np.all(glo <= hi, axis=1) & np.all(lo <= ghi, axis=1))
+    j = (groups[:, None] * GROUP + np.arange(GROUP)[None, :]).ravel()
+    j = j[j < len(large)]
+    j = j[np.all(large.lo[j] <= hi, axis=1) & np.all(lo <= large.hi[j], axis=1)]
+    i, k = _meet(small.lo, small.hi, large.lo[j], large.hi[j])
+    return i, j[k]
 
 
 def pieces_collide(a: Probe, b: Probe, tolerance: float = TOLERANCE) -> bool:

@@ -75,6 +75,9 @@ def _cached(problem: Problem) -> tuple[Diagnostic, ...]:
     spans = {r.name: r.span for r in problem.robots}
     out: list[Diagnostic] = []
     for arm in arms:
+        if arm.model.dof == 0:  # no joint between the root and the end effector: nothing can move
+            out.append(Diagnostic("W276", _no_chain(arm), spans.get(arm.name), severity="warning"))
+            continue
         found = _everywhere(arm, world) or _home(arm, world)
         if found is not None:
             out.append(Diagnostic(found[0], found[1], spans.get(arm.name), severity="warning"))
@@ -82,6 +85,14 @@ def _cached(problem: Problem) -> tuple[Diagnostic, ...]:
         if ik is not None:
             out.append(Diagnostic("W276", ik, spans.get(arm.name), severity="warning"))
     return tuple(out)
+
+
+def _no_chain(arm: Arm) -> str:
+    """W276 for an arm whose end-effector link is its root or fixed to it."""
+    return (
+        f"IK for {arm.name} has no joint to move: is :end-effector right? '{arm.model.end_effector}' is fixed to "
+        f"the root link '{arm.model.links[0].name}' (a chain of 0 joints)"
+    )
 
 
 def _samples(arm: Arm) -> np.ndarray:

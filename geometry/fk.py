@@ -174,7 +174,7 @@ def fk(model: RobotModel, q: np.ndarray, base: BasePose = None, fingers: float |
     q = _as_q(model, q)
     p = plan(model)
     batch = q.shape[:-1]
-    flat = q.reshape(-1, model.dof)
+    flat = q.reshape(int(np.prod(batch)), model.dof)  # (a chain of 0 joints too)
     if p.all_rev:
         local = p.ob + np.sin(flat)[..., None, None] * p.a - np.cos(flat)[..., None, None] * p.b  # (N, dof, 4, 4)
     else:

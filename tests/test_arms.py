@@ -240,3 +240,15 @@ def test_an_arm_sunk_into_the_table_says_why(tmp_path: Path) -> None:
     assert span is not None and span.line == text[: text.index("(a1 :kind")].count("\n") + 1
     assert warnings[0].message.startswith("every configuration of a1 (64 drawn within its joint limits) collides")
     assert "fixed object 'table': link 'link1' is 5.6 mm inside it" in warnings[0].message
+
+
+def test_an_end_effector_fixed_to_the_root_says_so(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """:end-effector 'link_base' (fixed to the root, a chain of 0 joints): one W276 per robot, no internal
+    error."""
+    text = docs_example().replace('"xarm_gripper_base_link"', '"link_base" :tcp (0 0 0 0)')
+    text = re.sub(r" *:home \([^)]*\)[^\n]*\n", "", text)
+    path = tmp_path / "rooted.mrg"
+    path.write_text(text, encoding="utf-8")
+    code, _, err = run_cli(capsys, "check", path)
+    assert code == 0 and err.count("warning[W276]: IK for a") == 2
+    assert "'link_base' is fixed to the root link 'world' (a chain of 0 joints)" in err

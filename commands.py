@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, Any, Callable, Sequence
 from mrgc import __version__
 from mrgc.errors import Diagnostic, InputError
 from mrgc.exits import ExitCode
-from mrgc.limits import count, number
+from mrgc.limits import BOUNDS, count, number
 
 if TYPE_CHECKING:
     from mrgc.language.loader import MrgFile
@@ -495,7 +495,7 @@ def add_planner_options(p: argparse.ArgumentParser) -> None:
             p.add_argument(option.flag, dest=option.name, action="store_true", default=argparse.SUPPRESS, help=text)
             continue
         parse: Callable[[str], Any] = str
-        low, high = option.bounds  # unless mrgc.limits.BOUNDS has a row for the flag
+        low, high = BOUNDS.get(option.flag, option.bounds)  # mrgc.limits.BOUNDS' row for the flag first
         if option.kind == "count":
             parse = count(option.flag, int(low), int(high))
         elif option.kind == "number":

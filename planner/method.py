@@ -37,9 +37,9 @@ KINDS = ("count", "number", "text", "flag")
 class Option:
     """An option a method declares: its keyword ``name`` (``max_makespan``; on the command line
     ``--max-makespan``, one letter ``-c``), value ``kind`` (:data:`KINDS`), ``default``, ``help``; ``choices``
-    restricts a text; ``bounds`` a number's least and largest value on the command line (default: the
-    flag's row of ``mrgc.limits.BOUNDS``, else 0 to 1,000,000); ``cli`` False keeps it out of the command
-    line (Python API only)."""
+    restricts a text; ``bounds`` a number's least and largest value on the command line when
+    ``mrgc.limits.BOUNDS`` has no row for the flag (a row there bounds the flag alike for every method that
+    declares it); ``cli`` False keeps it out of the command line (Python API only)."""
 
     name: str
     kind: str

@@ -305,7 +305,9 @@ def test_an_obstacle_with_no_reachable_place_in_its_region_is_parked_in_another(
 
     path = ROOT / "tests" / "data" / "park-packaging.mrg"
     problem = parse_file(path).problem()
-    plan = plan_problem(problem, str(path), file_sha256(str(path)), mrgc.__version__, seed=0, time_limit=600)
+    # a ceiling, not a budget: the search (16 groundings, ~220 s of CPU) is the same whatever the load, and on a
+    # 2-core machine running the suite's other tests beside it, it has needed up to 615 s of wall time
+    plan = plan_problem(problem, str(path), file_sha256(str(path)), mrgc.__version__, seed=0, time_limit=1800)
     assert plan.status == "solved", plan.summary()
     parked = {a.region for step in plan.steps for a in step if a.object not in problem.goal_regions} - {"start"}
     assert "bin-b" in parked  # nobody's goal, tried first; goal bins after it, keeping room for their goals

@@ -15,8 +15,9 @@ without depending on each other.  The validator stays independent of the planner
   robot's footprint, and for the objects such a robot puts down (1 mm).
 - **Placements** inside a region are tried on a lattice, centre first (:func:`lattice_offsets`).
 - **Pose error** between two poses is a position distance and a rotation angle (:func:`pose_error`).
-- **Resolution.**  Motions are checked at :func:`refine`'s resolution (the validator's), and an approach is
-  :data:`APPROACH_SAMPLES` configurations from the pre-grasp to the grasp.
+- **Resolution.**  Motions are checked at :func:`refine`'s resolution (the validator's), paths are written
+  :data:`PATH_RESOLUTION` apart, and an approach is :data:`APPROACH_SAMPLES` configurations from the
+  pre-grasp to the grasp.
 - **Seeds** derive from the query (:func:`seed_for`): the same queries give the same answers in any
   process.
 """
@@ -40,6 +41,10 @@ ARM_PLACE_LIFT = 6e-3
 PLANAR_LIFT = 1e-3
 #: configurations sampled from the pre-grasp to the grasp (an approach's swept volume)
 APPROACH_SAMPLES = 5
+#: largest step (m of translation, rad of turn) between checked states of a planar path, and largest joint
+#: motion (rad) between the configurations of an arm's transfer: the validator's (plans say it in their
+#: motion model, :func:`mrgc.planner.plan.planner_motion_model`)
+PATH_RESOLUTION = 0.01
 
 
 # ----------------------------------------------------------------------------------------- angles, frames

@@ -37,7 +37,15 @@ import numpy as np
 
 from mrgc.geometry.arm import Arm
 from mrgc.geometry.collision import CollisionShape, Posed, collision_shape, posed_collide, scene_world
-from mrgc.geometry.conventions import APPROACH_SAMPLES, ARM_PLACE_LIFT, lattice_offsets, se2, seed_for, to_se2
+from mrgc.geometry.conventions import (
+    APPROACH_SAMPLES,
+    ARM_PLACE_LIFT,
+    PATH_RESOLUTION,
+    lattice_offsets,
+    se2,
+    seed_for,
+    to_se2,
+)
 from mrgc.geometry.grasps import APPROACH, finger_opening, fits, grasp_transform, pregrasp_transform
 from mrgc.geometry.ik import solve_ik_many
 from mrgc.geometry.lattice import Body, LatticePlanner, box_corners
@@ -52,9 +60,6 @@ Volume = list[tuple[CollisionShape, np.ndarray]]  # shapes at world transforms
 #: a volume as the queries read it (what other robots sweep meanwhile, ``busy``): any sequence of pieces
 Pieces = Sequence[tuple[CollisionShape, np.ndarray]]
 
-#: largest step (m of translation, rad of turn) between checked states of a planar path, and largest joint
-#: motion (rad) between the configurations of an arm's transfer: the validator's
-PATH_RESOLUTION = 0.01
 #: how far a transfer raises the tool straight up before it moves off (m): the approach's back-off, or more
 #: when taller objects stand around the one picked (see :meth:`Grounder.lift_height`), up to MAX_LIFT
 TRANSFER_LIFT = 0.08

@@ -8,7 +8,7 @@ the footprint (and the carried object) at every state of the dense path.  For ro
 
 - ``reachable-pick M g R`` (g a side grasp): the footprint at the pick base pose is free of fixed objects
   and a base path leads there from R's start pose, avoiding the fixed objects and M itself (R cannot drive
-  through the object it is about to pick; the pick pose keeps :data:`~mrgc.geometry.planar.CLEARANCE`
+  through the object it is about to pick; the pick pose keeps :data:`~mrgc.geometry.planar_grasps.CLEARANCE`
   from it).  The path is planned first avoiding every movable object too, and only if that fails with
   respect to the fixed objects (and M) alone — the paper's "collision-free, if possible".
 - ``occludes-pick M1 M g R``: M1 is hit by the footprint along the chosen pick path.  When the chosen path
@@ -48,7 +48,8 @@ import numpy as np
 from mrgc.geometry.collision import CollisionShape, CollisionWorld, collision_shape, scene_world
 from mrgc.geometry.facts import RobotFacts
 from mrgc.geometry.lattice import LatticePlanner
-from mrgc.geometry.planar import DiscGrid, PlanarRobot, placements, planar_grasp, scene_bounds
+from mrgc.geometry.planar import DiscGrid, PlanarRobot, placements, scene_bounds
+from mrgc.geometry.planar_grasps import planar_grasp
 from mrgc.geometry.scene import Body, SceneSpec, inside
 from mrgc.language.model import Fact
 

@@ -14,7 +14,7 @@ The model (docs/geometry.md, "Planar robots"):
   ``side-x-``, ``side-y+``, ``side-y-``.  ``top`` (and any grasp name this layer does not know) is not
   available to planar robots: it yields no fact.
 - **Pick base pose.**  To pick object M with grasp g the robot stands facing M's g face with its front at
-  :data:`CLEARANCE` from that face: the base origin is at distance
+  :data:`~mrgc.geometry.planar_grasps.CLEARANCE` from that face: the base origin is at distance
   ``d = footprint half length (x) + CLEARANCE + M's half extent along the face normal`` from M's centre,
   along the face normal, yawed to face M.  The footprint at the pick pose therefore never touches M.
 - **Carrying.**  After the pick, M rides at the kind's ``:carry`` pose relative to the base frame (the pose
@@ -42,32 +42,17 @@ from functools import cached_property
 import numpy as np
 
 from mrgc.geometry.collision import CollisionShape, ConvexHull, collision_shape
-from mrgc.geometry.conventions import PLANAR_LIFT, lattice_offsets, se2, to_se2, wrap_angle, yaw_of
+from mrgc.geometry.conventions import PLANAR_LIFT, lattice_offsets, se2, to_se2, yaw_of
 from mrgc.geometry.lattice import box_corners
+from mrgc.geometry.planar_grasps import carry_transform, grasp_base
 from mrgc.geometry.scene import Body, RobotSpec, SceneSpec, half_extents, inside, outline
-from mrgc.geometry.transforms import from_pose, rot_z, translation
-from mrgc.language.model import Box, Cylinder, RobotKind, Shape
+from mrgc.geometry.transforms import rot_z, translation
+from mrgc.language.model import Box, Cylinder, Shape
 
-#: gap between the robot's front and the face of the object it picks or places (m)
-CLEARANCE = 0.05
 #: placements tried per region: a GRID × GRID lattice, centre first (each at four yaws)
 PLACEMENT_GRID = 5
 #: placement yaws tried, relative to the object's current yaw (degrees)
 PLACEMENT_YAWS = (0.0, 90.0, 180.0, 270.0)
-
-#: grasp -> (outward normal of the grasped face in the object frame, yaw of the object in the base frame
-#: while carried, degrees): the grasped face always faces the robot (the base's -x)
-PLANAR_GRASPS: dict[str, tuple[tuple[float, float], float]] = {
-    "side-x+": ((1.0, 0.0), 180.0),
-    "side-x-": ((-1.0, 0.0), 0.0),
-    "side-y+": ((0.0, 1.0), 90.0),
-    "side-y-": ((0.0, -1.0), -90.0),
-}
-
-
-def planar_grasp(grasp: str) -> bool:
-    """Can a planar robot use ``grasp`` (a side grasp)?"""
-    return grasp in PLANAR_GRASPS
 
 
 def is_planar(spec: RobotSpec) -> bool:
@@ -157,37 +142,6 @@ def grown(shape: CollisionShape, margin: float) -> CollisionShape:
             out = collision_shape(ConvexHull(box_corners(shape, (margin, margin, 0.0))))
         _GROWN[key] = out
     return out
-
-
-def _footprint_half(kind: RobotKind) -> np.ndarray:
-    return half_extents(kind.footprint) if kind.footprint is not None else np.zeros(3)
-
-
-def carry_transform(kind: RobotKind, shape: Shape, grasp: str) -> np.ndarray:
-    """Pose of an object (of ``shape``) that a planar robot of ``kind`` carries, held with ``grasp``,
-    relative to its base frame: the kind's ``:carry`` pose, or on top of the footprint; the grasped face
-    towards the robot."""
-    face = rot_z(math.radians(PLANAR_GRASPS[grasp][1]))
-    on: np.ndarray = (
-        from_pose(kind.carry)
-        if kind.carry is not None
-        else translation(
-            0.0, 0.0, 2 * float(_footprint_half(kind)[2]) + 2 * PLANAR_LIFT + float(half_extents(shape)[2])
-        )
-    )
-    carried: np.ndarray = on @ face
-    return carried
-
-
-def grasp_base(kind: RobotKind, pose: np.ndarray, shape: Shape, grasp: str) -> np.ndarray:
-    """The base pose ``(x, y, yaw)`` from which a planar robot of ``kind`` picks (or places) an object of
-    ``shape`` at ``pose`` with ``grasp``: facing the grasped face, its front :data:`CLEARANCE` from it."""
-    nx, ny = PLANAR_GRASPS[grasp][0]
-    n = pose[:2, :2] @ np.array([nx, ny])
-    n = n / max(float(np.linalg.norm(n)), 1e-12)
-    d = float(_footprint_half(kind)[0]) + CLEARANCE + float(np.abs([nx, ny]) @ half_extents(shape)[:2])
-    x, y = float(pose[0, 3] + d * n[0]), float(pose[1, 3] + d * n[1])
-    return np.array([x, y, wrap_angle(math.atan2(-n[1], -n[0]))])
 
 
 def scene_bounds(scene: SceneSpec, margin: float) -> tuple[float, float, float, float]:

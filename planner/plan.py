@@ -79,9 +79,8 @@ def planner_motion_model(arms: str = "configurations") -> MotionModel:
     """The motion model of the plans ``mrgc plan`` writes: approaches of the geometry layer's
     ``APPROACH_SAMPLES`` configurations backed off by the grasp specification's ``APPROACH``, planar paths
     checked every ``PATH_RESOLUTION``."""
-    from mrgc.geometry.conventions import APPROACH_SAMPLES
+    from mrgc.geometry.conventions import APPROACH_SAMPLES, PATH_RESOLUTION
     from mrgc.geometry.grasps import APPROACH
-    from mrgc.geometry.grounding import PATH_RESOLUTION
 
     return MotionModel(arms, "paths", APPROACH_SAMPLES, APPROACH, PATH_RESOLUTION)
 

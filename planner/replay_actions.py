@@ -5,7 +5,7 @@ that needs no sweep (configurations, joint limits, grasps, approaches, handovers
 (numpy arrays, the motion of each phase) and reports what is wrong with it; :mod:`mrgc.planner.replay`
 sweeps the motions.  Forward kinematics are pybullet's (:class:`~mrgc.geometry.replay_world.ReplayScene`), grasp
 frames come from their specification (:mod:`mrgc.geometry.grasps`), the planar model from
-:mod:`mrgc.geometry.planar`'s docstring; nothing comes from the planner's search or grounding.
+:mod:`mrgc.geometry.planar_grasps`; nothing comes from the planner's search or grounding.
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ import numpy as np
 
 from mrgc.geometry.conventions import pose_error, wrap_angle, yaw_of
 from mrgc.geometry.grasps import APPROACH, finger_opening, fits, grasp_transform, pregrasp_transform
-from mrgc.geometry.planar import PLANAR_GRASPS, carry_transform, grasp_base
+from mrgc.geometry.planar_grasps import PLANAR_GRASPS, carry_transform, grasp_base
 from mrgc.geometry.replay_world import ReplayScene
 from mrgc.geometry.scene import SceneSpec
 from mrgc.geometry.transforms import from_pose, inverse

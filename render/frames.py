@@ -391,7 +391,7 @@ def _names_misfit(world: World, a: Mapping[str, Any]) -> str | None:
         if not world.robots[r].planar and g not in world.scene.grasp_specs:
             return f"grasp {g!r} has no geometry in the problem's domain"
         if world.robots[r].planar:
-            from mrgc.geometry.planar import planar_grasp
+            from mrgc.geometry.planar_grasps import planar_grasp
 
             if not planar_grasp(g):
                 return f"planar robot {r} cannot use grasp {g!r}"

@@ -853,7 +853,7 @@ def between_samples(plan: dict[str, Any], step: int, wall: str = "divider-s") ->
     act["paths"]["to-place"] = [[float(v) for v in q] for q in new]
     k = len(back) - 1  # A's index; B follows
     # measured: the cart (and the box it carries) against the wall at A, B and between them
-    from mrgc.geometry.planar import carry_transform
+    from mrgc.geometry.planar_grasps import carry_transform
 
     carry = carry_transform(w.scene.robot(robot).kind, w.scene.body(obj).shape, act["place_grasp"])
     place_objects(w, poses_before(w, plan, step), obj)

@@ -14,7 +14,8 @@ from support import ROOT
 
 from mrgc import parse_file, parse_string
 from mrgc.geometry.path_predicates import PlanarEvaluator
-from mrgc.geometry.planar import CLEARANCE, DiscGrid, PlanarRobot, placements, scene_bounds
+from mrgc.geometry.planar import DiscGrid, PlanarRobot, placements, scene_bounds
+from mrgc.geometry.planar_grasps import CLEARANCE
 from mrgc.geometry.scene import SceneSpec, inside, scene_from_problem
 from mrgc.language.model import Fact, Problem
 from mrgc.planner.skeletons import compile_problem

@@ -13,8 +13,8 @@ from mrgc import parse_file
 from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action
 from mrgc.geometry.collision import CollisionShape, CollisionWorld
-from mrgc.geometry.conventions import to_se2
-from mrgc.geometry.grounding import PATH_RESOLUTION, PHASES, Grounder, GroundStatus, Stance, joint_line, stance
+from mrgc.geometry.conventions import PATH_RESOLUTION, to_se2
+from mrgc.geometry.grounding import PHASES, Grounder, GroundStatus, Stance, joint_line, stance
 from mrgc.geometry.scene import inside, scene_from_problem
 from mrgc.geometry.transforms import translation
 from mrgc.planner.ground import Outcome, ReverseGrounder

@@ -256,6 +256,23 @@ def test_import_rules(path: Path) -> None:
         )
 
 
+def test_nothing_of_the_planner_is_reachable_from_the_validator() -> None:
+    """The validator's independence, transitively: following every import (in functions and
+    ``TYPE_CHECKING`` blocks too) from each of its modules reaches none of the planner's search and grounding,
+    coal or the numpy kinematics (a module it imports may not pull them in either)."""
+    seen: dict[str, list[str]] = {}  # module -> the import chain that reached it
+    todo = [(module_name(Path(rel)), [rel]) for rel in VALIDATOR]
+    while todo:
+        module, chain = todo.pop()
+        if module in seen:
+            continue
+        seen[module] = chain
+        for nxt in sorted(mrgc_imports(MODULES[module]) - {module}):
+            todo.append((nxt, [*chain, nxt]))
+    reached = {m: seen[m] for m in sorted(set(seen) & NOT_FOR_THE_VALIDATOR)}
+    assert not reached, "the validator reaches " + "; ".join(" -> ".join(c) for c in reached.values())
+
+
 def test_no_module_imports_itself_through_others() -> None:
     """No import cycle between modules, counting every import (in functions and TYPE_CHECKING blocks too)."""
     assert import_cycles() == []

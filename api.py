@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Callable, Iterable, Mapping, Sequence, Union
 
 from mrgc.errors import Diagnostic, InputError
+from mrgc.planner.defaults import DEFAULT_BACKEND, DEFAULT_ENCODING, DEFAULT_PLANNER, DEFAULT_TIME_LIMIT
 
 if TYPE_CHECKING:
     from mrgc.backends.base import Backend
@@ -35,9 +36,6 @@ ProblemSource = Union["Problem", str, "os.PathLike[str]"]
 #: a backend as the API takes it: a registered name (``mrgc backends``) or a Backend subclass (a plug-in
 #: under test, not registered)
 BackendSpec = Union[str, "type[Backend]"]
-
-DEFAULT_BACKEND = "cpsat"
-DEFAULT_ENCODING = "time-of-move"
 
 
 # ---------------------------------------------------------------- reading problems
@@ -269,11 +267,11 @@ def plan(
     source: ProblemSource,
     *,
     name: str | None = None,
-    planner: str = "mcts",
+    planner: str = DEFAULT_PLANNER,
     backend: str | None = None,
     encoding: str | None = None,
     seed: int = 0,
-    time_limit: float = 60.0,
+    time_limit: float = DEFAULT_TIME_LIMIT,
     log: Callable[[str], None] | None = None,
     allow_outside: Sequence[str] = (),
     facts: Iterable["Fact"] | None = None,

@@ -20,6 +20,7 @@ from mrgc import __version__
 from mrgc.errors import Diagnostic, InputError
 from mrgc.exits import ExitCode
 from mrgc.limits import BOUNDS, count, number
+from mrgc.planner.defaults import DEFAULT_BACKEND, DEFAULT_ENCODING, DEFAULT_PLANNER, DEFAULT_TIME_LIMIT
 
 if TYPE_CHECKING:
     from mrgc.language.loader import MrgFile
@@ -602,9 +603,15 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("compile", help="build the task graph and generate task skeletons with a solver backend")
     p.add_argument("file", metavar="FILE")
     p.add_argument("--problem", help="which problem of the file (default: its only one)")
-    p.add_argument("--backend", default="cpsat", help="mip | smt | pysmt | cpsat (default cpsat; see mrgc backends)")
     p.add_argument(
-        "--encoding", default="time-of-move", help="paper | disaggregated | time-of-move (default time-of-move)"
+        "--backend",
+        default=DEFAULT_BACKEND,
+        help=f"mip | smt | pysmt | cpsat (default {DEFAULT_BACKEND}; see mrgc backends)",
+    )
+    p.add_argument(
+        "--encoding",
+        default=DEFAULT_ENCODING,
+        help=f"paper | disaggregated | time-of-move (default {DEFAULT_ENCODING})",
     )
     p.add_argument(
         "--skeletons", type=count("--skeletons"), default=1, metavar="K", help="how many skeletons (default 1)"
@@ -646,14 +653,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", metavar="PLAN", help="write the plan JSON here (default: standard output)")
     p.add_argument(
         "--planner",
-        default="mcts",
+        default=DEFAULT_PLANNER,
         metavar="NAME",
-        help=f"the planning method: {' | '.join(PLANNERS)} (default mcts, the paper's; the baselines: "
+        help=f"the planning method: {' | '.join(PLANNERS)} (default {DEFAULT_PLANNER}, the paper's; the baselines: "
         "docs/baselines.md)",
     )
     add_seed(p)
     add_no_cache(p)
-    p.add_argument("--time-limit", type=number("--time-limit", positive=True), default=60.0, metavar="S")
+    p.add_argument("--time-limit", type=number("--time-limit", positive=True), default=DEFAULT_TIME_LIMIT, metavar="S")
     p.add_argument(
         "--motions",
         choices=["configurations", "full"],

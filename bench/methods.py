@@ -17,7 +17,7 @@ from typing import Any
 
 from mrgc.bench.study import E_STUDY_SCHEMA, Method, Study
 from mrgc.errors import Diagnostic
-from mrgc.planner.registry import DEFAULT_PLANNER
+from mrgc.planner.defaults import DEFAULT_PLANNER
 
 #: options the runner sets itself; a method may not give them in ``options``
 RESERVED = {

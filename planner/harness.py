@@ -17,6 +17,7 @@ import time
 from typing import TYPE_CHECKING, Any
 
 from mrgc.errors import Diagnostic, InputError
+from mrgc.planner.defaults import DEFAULT_TIME_LIMIT
 from mrgc.planner.method import Context, Log, Planner, Result
 from mrgc.planner.outcome import PlanStatus, Why
 
@@ -47,7 +48,7 @@ def run(
     sha256: str,
     version: str,
     seed: int = 0,
-    time_limit: float = 60.0,
+    time_limit: float = DEFAULT_TIME_LIMIT,
     log: Log | None = None,
     motions: str = "configurations",
     started: float | None = None,

@@ -21,6 +21,7 @@ import importlib
 from typing import TYPE_CHECKING, Any
 
 from mrgc.errors import Diagnostic, InputError
+from mrgc.planner.defaults import DEFAULT_PLANNER
 
 if TYPE_CHECKING:
     from mrgc.language.model import Problem
@@ -33,8 +34,6 @@ PLANNERS: dict[str, str] = {
     "ap1": "mrgc.planner.baselines.ap1:Ap1",
     "ap2": "mrgc.planner.baselines.ap2:Ap2",
 }
-
-DEFAULT_PLANNER = "mcts"
 
 
 def planner_class(name: str) -> type[Planner]:

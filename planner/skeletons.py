@@ -23,9 +23,7 @@ from mrgc.compiler.task_graph import TaskGraph, build_task_graph
 from mrgc.errors import Diagnostic, InputError
 from mrgc.exits import ExitCode
 from mrgc.language.model import Fact, Problem
-
-DEFAULT_BACKEND = "cpsat"
-DEFAULT_ENCODING = "time-of-move"
+from mrgc.planner.defaults import DEFAULT_BACKEND, DEFAULT_ENCODING
 
 
 class CompileStatus(enum.StrEnum):

@@ -15,6 +15,7 @@ from typing import Any, Iterator
 
 from mrgc.errors import Diagnostic, InputError
 from mrgc.exits import ExitCode
+from mrgc.planner.defaults import DEFAULT_BACKEND, DEFAULT_ENCODING
 
 MAX_SIDE = 4096  # pixels
 DEFAULT_SIZE = "400x300"
@@ -78,8 +79,12 @@ def add_commands(sub: Any) -> None:
         action="store_true",
         help="draw every action of a large graph (more than 24 actions; by default only a skeleton's)",
     )
-    p.add_argument("--backend", default="cpsat", help="backend generating skeletons for --skeleton (default cpsat)")
-    p.add_argument("--encoding", default="time-of-move")
+    p.add_argument(
+        "--backend",
+        default=DEFAULT_BACKEND,
+        help=f"backend generating skeletons for --skeleton (default {DEFAULT_BACKEND})",
+    )
+    p.add_argument("--encoding", default=DEFAULT_ENCODING)
     p.add_argument("--seed", type=int, default=0)
     add_no_cache(p)
     p.set_defaults(func=cmd_graph)

@@ -19,6 +19,7 @@ from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action, TaskGraph
 from mrgc.errors import MissingBackendError, MrgcError
 from mrgc.language.model import Problem
+from mrgc.planner.defaults import DEFAULT_BACKEND, DEFAULT_ENCODING
 
 FORMATS = (".dot", ".svg", ".png")
 MUST_MOVE = "#e41a1c"  # red, as the paper's M* nodes
@@ -145,8 +146,8 @@ def _action_node(a: Action, i: int, step_of: dict[Action, int]) -> str:
 def task_graph_dot(
     problem: Problem,
     skeleton: int | None = None,
-    backend: str = "cpsat",
-    encoding: str = "time-of-move",
+    backend: str = DEFAULT_BACKEND,
+    encoding: str = DEFAULT_ENCODING,
     seed: int = 0,
     full: bool = False,
 ) -> tuple[str, str]:

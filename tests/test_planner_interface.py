@@ -80,3 +80,31 @@ def test_declared_options_are_typed_and_belong_to_their_method(toy: None, capsys
     assert cli.main(["plan", "--help"]) == 0
     shown = capsys.readouterr().out
     assert "--steps-cap N" in shown and "(toy; default 9)" in shown and "--refuse" in shown
+
+
+def test_the_defaults_have_one_home() -> None:
+    """The planning method, backend, encoding and time limit used when nothing is given are
+    planner/defaults.py's, wherever they are read: the API, both commands' parsers, the paper's method's
+    declared options."""
+    import inspect
+
+    import mrgc.api as api
+    from mrgc.commands import build_parser
+    from mrgc.planner import defaults
+    from mrgc.planner.search import Mcts
+
+    plan = inspect.signature(api.plan).parameters
+    assert plan["planner"].default == defaults.DEFAULT_PLANNER
+    assert plan["time_limit"].default == defaults.DEFAULT_TIME_LIMIT
+    compile_ = inspect.signature(api.compile).parameters
+    assert (compile_["backend"].default, compile_["encoding"].default) == (
+        defaults.DEFAULT_BACKEND,
+        defaults.DEFAULT_ENCODING,
+    )
+    parser = build_parser()
+    planned = parser.parse_args(["plan", CHAIN])
+    assert (planned.planner, planned.time_limit) == (defaults.DEFAULT_PLANNER, defaults.DEFAULT_TIME_LIMIT)
+    compiled = parser.parse_args(["compile", CHAIN])
+    assert (compiled.backend, compiled.encoding) == (defaults.DEFAULT_BACKEND, defaults.DEFAULT_ENCODING)
+    declared = {o.name: o.default for o in Mcts.options}
+    assert (declared["backend"], declared["encoding"]) == (defaults.DEFAULT_BACKEND, defaults.DEFAULT_ENCODING)

@@ -345,6 +345,20 @@ def _progress(message: str) -> "contextlib.AbstractContextManager[object]":
     return Console(stderr=True).status(message)
 
 
+#: the timing and counting statistics ``mrgc plan -v`` prints, each when the method recorded it (mcts: skeletons,
+#: grounding, nodes; ap1: grounding, nodes; ap2: task plans, grounding)
+_SECONDS = (("skeleton_seconds", "skeletons"), ("task_seconds", "task plans"), ("grounding_seconds", "grounding"))
+_COUNTS = (("skeletons", "skeletons"), ("task_plans", "task plans"), ("groundings", "grounded"), ("nodes", "nodes"))
+
+
+def _timing_line(st: dict[str, Any]) -> str:
+    """``mrgc plan``'s line of times and counts, from the statistics the planning method recorded."""
+    times = [f"facts {st.get('facts_seconds', 0):.2f} s"]
+    times += [f"{label} {st[key]:.2f} s" for key, label in _SECONDS if key in st]
+    counts = [f"{st[key]} {label}" for key, label in _COUNTS if key in st]
+    return f"  {st.get('seconds', 0):.2f} s: {', '.join(times)}" + (f"; {', '.join(counts)}" if counts else "")
+
+
 def cmd_plan(args: argparse.Namespace) -> int:
     """``mrgc plan``: plan end to end and write the plan; the exit code is the plan's status's."""
     from mrgc import api, signals
@@ -381,13 +395,7 @@ def cmd_plan(args: argparse.Namespace) -> int:
         print(f"mrgc: {signals.describe()}; no plan file written. The search so far:", file=out)
     for line in plan.summary():
         print(line, file=out)
-    st = plan.stats
-    print(
-        f"  {st.get('seconds', 0):.2f} s: facts {st.get('facts_seconds', 0):.2f} s, skeletons "
-        f"{st.get('skeleton_seconds', 0):.2f} s, grounding {st.get('grounding_seconds', 0):.2f} s; "
-        f"{st.get('skeletons', 0)} skeletons, {st.get('groundings', 0)} grounded, {st.get('nodes', 0)} nodes",
-        file=out,
-    )
+    print(_timing_line(plan.stats), file=out)
     if plan.validation:
         print(
             f"  validated: {plan.validation['plans_checked']} complete plan(s) replayed by the validator, "

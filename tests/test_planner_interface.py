@@ -108,3 +108,19 @@ def test_the_defaults_have_one_home() -> None:
     assert (compiled.backend, compiled.encoding) == (defaults.DEFAULT_BACKEND, defaults.DEFAULT_ENCODING)
     declared = {o.name: o.default for o in Mcts.options}
     assert (declared["backend"], declared["encoding"]) == (defaults.DEFAULT_BACKEND, defaults.DEFAULT_ENCODING)
+
+
+def test_the_verbose_timing_line_shows_what_the_method_recorded() -> None:
+    """``mrgc plan -v``'s line of times and counts: mcts' statistics as before, another method's own (Ap2's
+    task plans), nothing a method did not record shown as zero."""
+    from mrgc.commands import _timing_line
+
+    mcts = {"seconds": 3.2, "facts_seconds": 1.1, "skeleton_seconds": 0.2, "grounding_seconds": 1.1}
+    mcts |= {"skeletons": 5, "groundings": 1, "nodes": 1}
+    assert (
+        _timing_line(mcts)
+        == "  3.20 s: facts 1.10 s, skeletons 0.20 s, grounding 1.10 s; 5 skeletons, 1 grounded, 1 nodes"
+    )
+    ap2 = {"seconds": 2.8, "facts_seconds": 0.8, "task_seconds": 0.02, "task_plans": 1, "groundings": 2}
+    assert _timing_line(ap2) == "  2.80 s: facts 0.80 s, task plans 0.02 s; 1 task plans, 2 grounded"
+    assert _timing_line({"seconds": 0.1, "facts_seconds": 0.0}) == "  0.10 s: facts 0.00 s"

@@ -299,9 +299,9 @@ def plan(
 
     from mrgc import __version__
     from mrgc.language.digest import problem_digest
+    from mrgc.planfile.format import file_sha256
     from mrgc.planner.baselines import plan_with
     from mrgc.planner.outcome import PlanStatus
-    from mrgc.planner.plan import file_sha256
 
     started = time.perf_counter()  # the time limit covers the layout checks, which load the robots' models
     problem, path = _resolve(source, name, allow_outside)
@@ -344,7 +344,7 @@ def validate(
     cannot be used at all raises InputError (E500-E504).  A file holding several problems is read for the
     one the plan names (unless ``name`` says otherwise).  The plan must be for the same problem contents:
     the file it was made from or its facts file are both accepted."""
-    from mrgc.planner.validate import load_plan
+    from mrgc.planfile.reader import load_plan
     from mrgc.planner.validate import validate as run
 
     doc: Any = plan

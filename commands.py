@@ -412,7 +412,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
     import json
 
     from mrgc.api import validate
-    from mrgc.planner.validate import load_plan
+    from mrgc.planfile.reader import load_plan
 
     report = validate(
         args.file, load_plan(args.plan), name=args.problem, allow_outside=getattr(args, "allow_outside", None) or ()

@@ -26,7 +26,8 @@ from pathlib import Path
 
 def main() -> None:
     from mrgc.language.loader import parse_file
-    from mrgc.planner.validate import load_plan, validate
+    from mrgc.planfile.reader import load_plan
+    from mrgc.planner.validate import validate
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("pairs", nargs="+", help="PROBLEM.mrg PLAN.json pairs")

@@ -31,8 +31,8 @@ from mrgc.geometry.conventions import refine, to_se2
 from mrgc.geometry.grounding import BUSY, PHASES, SELF, Answer, Grounder, GroundStatus, Stance, Volume
 from mrgc.geometry.relays import spot_region
 from mrgc.language.model import Box
+from mrgc.planfile.format import PlannedAction
 from mrgc.planner.outcome import DeadlineReached, Failure
-from mrgc.planner.plan import PlannedAction
 
 PLACEMENT_TRIES = 6  # placements sampled per place before the step gives up
 #: more placements an arm may try when they are out of its reach (a bin at the edge of the arm's reach:

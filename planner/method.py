@@ -23,7 +23,7 @@ from mrgc.planner.outcome import Failure, PlanStatus, Why
 if TYPE_CHECKING:
     from mrgc.compiler.facts import FactBase
     from mrgc.language.model import Fact, Problem
-    from mrgc.planner.plan import PlannedAction
+    from mrgc.planfile.format import PlannedAction
 
 #: a search log line sink (``mrgc plan --verbose`` prints them)
 Log = Callable[[str], None]

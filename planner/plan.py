@@ -1,78 +1,20 @@
-"""Plans: the planner's output, as versioned JSON (schema ``docs/plan.schema.json``).
+"""Plans: the planner's output, written as versioned JSON in the plan format of :mod:`mrgc.planfile`.
 
-A plan is a sequence of steps; in each step every robot performs at most one action (a pick-and-place, a
-handover-and-place occupying two robots) or waits.  Geometric plans carry the placement pose of every
-moved object and the robots' configurations: for an arm, the approach configurations of its pick and of
-its place (pre-grasp first), and at a handover both robots' exchange configurations; for a planar robot,
-its SE(2) paths.  Symbolic plans carry no geometry.
-
-A geometric plan states its :class:`MotionModel`: which motions it holds, and so which motions the
-validator requires and how it reads a motion the plan leaves out (docs/validator.md).  This module writes
-plans; :mod:`mrgc.planner.plan_reader` reads them back (limits, JSON Schema, typed actions).
+A :class:`Plan` is the record of one planning run: the steps of :class:`~mrgc.planfile.format.PlannedAction`
+s it found (the plan format's one action type), how the run ended (status, why), the validator's verdict on
+it and the statistics; :meth:`Plan.dumps` writes it.  :func:`planner_motion_model` is the motion model of
+the plans ``mrgc plan`` writes.  :mod:`mrgc.planfile.reader` reads plans back (limits, JSON Schema, typed
+actions).
 """
 
 from __future__ import annotations
 
-import hashlib
 import json
 from dataclasses import dataclass, field, replace
 from typing import Any
 
+from mrgc.planfile.format import SCHEMA, MotionModel, PlannedAction
 from mrgc.planner.outcome import PlanStatus, Why
-
-SCHEMA = "mrgc-plan/1"
-
-#: ``motion_model.arms`` -> what an arm's motions in the plan are
-ARM_MODELS: dict[str, str] = {
-    "configurations": "the paper's packaging model: pick and place approaches (pre-grasp to grasp) and the "
-    "handover configurations; a transfer holding the object is a straight joint-space move "
-    "unless the plan gives its path; empty-handed transit is not modelled",
-    "full": "every motion is a path: to-pick, to-handover, taker-to-handover, to-place, home, giver-home, "
-    "besides the approaches and handover configurations",
-}
-#: ``motion_model.planar`` -> what a planar robot's motions in the plan are
-PLANAR_MODELS: dict[str, str] = {
-    "paths": "every motion is an SE(2) path: to-pick, to-place, home",
-}
-
-
-@dataclass(frozen=True)
-class MotionModel:
-    """Which motions a geometric plan holds.
-
-    ``arms`` and ``planar`` name entries of :data:`ARM_MODELS` and :data:`PLANAR_MODELS`;
-    ``approach_configurations`` is how many configurations each pick and place approach holds (pre-grasp
-    first, grasp last, in joint space), ``approach_back_off`` how far (m) the pre-grasp stands back from the
-    grasp along the approach axis; ``resolution`` the largest motion (rad per joint; m or rad for a planar
-    base) between two states at which the planner checked its motions.
-    """
-
-    arms: str = "configurations"
-    planar: str = "paths"
-    approach_configurations: int = 5
-    approach_back_off: float = 0.08
-    resolution: float = 0.01
-
-    def to_json(self) -> dict[str, Any]:
-        """The motion model as the plan's ``motion_model``."""
-        return {
-            "arms": self.arms,
-            "planar": self.planar,
-            "approach": {"configurations": self.approach_configurations, "back_off": self.approach_back_off},
-            "resolution": self.resolution,
-        }
-
-    @classmethod
-    def from_json(cls, data: dict[str, Any]) -> "MotionModel":
-        """The model of a schema-checked ``motion_model`` object."""
-        approach = data["approach"]
-        return cls(
-            data["arms"],
-            data["planar"],
-            approach["configurations"],
-            float(approach["back_off"]),
-            float(data["resolution"]),
-        )
 
 
 def planner_motion_model(arms: str = "configurations") -> MotionModel:
@@ -83,57 +25,6 @@ def planner_motion_model(arms: str = "configurations") -> MotionModel:
     from mrgc.geometry.grasps import APPROACH
 
     return MotionModel(arms, "paths", APPROACH_SAMPLES, APPROACH, PATH_RESOLUTION)
-
-
-@dataclass
-class PlannedAction:
-    """One action of one step; ``configs`` maps a phase (``pick``, ``place``, ``handover``) to configurations."""
-
-    object: str
-    region: str
-    pick_robot: str
-    place_robot: str
-    pick_grasp: str
-    place_grasp: str
-    place_pose: list[list[float]] | None = None  # 4×4, world frame
-    handover_point: str | None = None
-    configs: dict[str, list[list[float]]] = field(default_factory=dict)
-    paths: dict[str, list[list[float]]] = field(default_factory=dict)
-    #: the object is only set down in ``region`` on its way (a relay, beyond the paper: ``enable-relay``);
-    #: a later action, the onward move, takes it from there to its goal
-    relay: bool = False
-
-    @property
-    def kind(self) -> str:
-        """``pick-place`` (one robot) or ``handover`` (two)."""
-        return "handover" if self.pick_robot != self.place_robot else "pick-place"
-
-    def robots(self) -> list[str]:
-        """The robots of the action (one, or the giver and the taker)."""
-        return [self.pick_robot] if self.pick_robot == self.place_robot else [self.pick_robot, self.place_robot]
-
-    def to_json(self) -> dict[str, Any]:
-        """The action as the plan's JSON holds it."""
-        out: dict[str, Any] = {
-            "kind": self.kind,
-            "object": self.object,
-            "region": self.region,
-            "pick_robot": self.pick_robot,
-            "place_robot": self.place_robot,
-            "pick_grasp": self.pick_grasp,
-            "place_grasp": self.place_grasp,
-        }
-        if self.place_pose is not None:
-            out["place_pose"] = self.place_pose
-        if self.handover_point is not None:
-            out["handover_point"] = self.handover_point
-        if self.relay:
-            out["relay"] = True
-        if self.configs:
-            out["configs"] = self.configs
-        if self.paths:
-            out["paths"] = self.paths
-        return out
 
 
 @dataclass
@@ -234,13 +125,7 @@ class Plan:
             )
         ]
         for i, step in enumerate(self.steps, 1):
-            parts = []
-            for a in step:
-                who = a.pick_robot if a.kind == "pick-place" else f"{a.pick_robot}->{a.place_robot}"
-                grasp = a.pick_grasp if a.kind == "pick-place" else f"{a.pick_grasp}->{a.place_grasp}"
-                verb = "sets down" if a.relay else "moves"
-                parts.append(f"{who} {verb} {a.object} {'in' if a.relay else 'to'} {a.region} ({grasp})")
-            lines.append(f"  step {i}: " + "; ".join(parts))
+            lines.append(f"  step {i}: " + "; ".join(a.describe() for a in step))
         if self.why is not None and self.status is not PlanStatus.SOLVED:
             lines += self.why.lines()
         return lines
@@ -251,9 +136,3 @@ def moved_text(steps: list[list[str]]) -> str:
     objects, moves = len({o for step in steps for o in step}), sum(len(step) for step in steps)
     text = f"{objects} object{'s' * (objects != 1)} moved"
     return text + (f" in {moves} moves" if moves != objects else "")
-
-
-def file_sha256(path: str) -> str:
-    """The sha256 of the file's bytes (hex)."""
-    with open(path, "rb") as fh:
-        return hashlib.sha256(fh.read()).hexdigest()

@@ -17,7 +17,8 @@ from mrgc.planner.outcome import Failure, Why
 
 if TYPE_CHECKING:
     from mrgc.language.model import Problem
-    from mrgc.planner.plan import Plan, PlannedAction
+    from mrgc.planfile.format import PlannedAction
+    from mrgc.planner.plan import Plan
 
 
 class Referee:

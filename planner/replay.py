@@ -82,10 +82,9 @@ from mrgc.geometry.replay_world import ReplayScene
 from mrgc.geometry.scene import SceneSpec, inside, outline, scene_from_problem
 from mrgc.geometry.transforms import translation
 from mrgc.language.model import Problem
+from mrgc.planfile.format import MotionModel, PlannedAction
 from mrgc.planner.certify import Certifier, Phase
 from mrgc.planner.phase_bounds import PhaseBounds
-from mrgc.planner.plan import MotionModel
-from mrgc.planner.plan_reader import Action
 from mrgc.planner.replay_actions import PATH_PHASES, ActionGeometry, ActionReader
 from mrgc.planner.sampling import config_at, deltas, sample_count, where
 from mrgc.planner.stability import stability
@@ -300,7 +299,7 @@ class _Stop(Exception):
 def replay(
     problem: Problem,
     model: MotionModel,
-    steps: Sequence[Sequence[Action]],
+    steps: Sequence[Sequence[PlannedAction]],
     usable: set[int],
     stats: dict[str, Any],
     first_only: bool = False,

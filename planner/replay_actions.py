@@ -1,7 +1,7 @@
 """The validator's reading of one action's geometry: what the motion model requires of it, and every check
 that needs no sweep (configurations, joint limits, grasps, approaches, handovers, path ends).
 
-:class:`ActionReader` turns a typed :class:`~mrgc.planner.plan_reader.Action` into an :class:`ActionGeometry`
+:class:`ActionReader` turns a typed :class:`~mrgc.planfile.format.PlannedAction` into an :class:`ActionGeometry`
 (numpy arrays, the motion of each phase) and reports what is wrong with it; :mod:`mrgc.planner.replay`
 sweeps the motions.  Forward kinematics are pybullet's (:class:`~mrgc.geometry.replay_world.ReplayScene`), grasp
 frames come from their specification (:mod:`mrgc.geometry.grasps`), the planar model from
@@ -21,8 +21,7 @@ from mrgc.geometry.planar_grasps import PLANAR_GRASPS, carry_transform, grasp_ba
 from mrgc.geometry.replay_world import ReplayScene
 from mrgc.geometry.scene import SceneSpec
 from mrgc.geometry.transforms import from_pose, inverse
-from mrgc.planner.plan import MotionModel
-from mrgc.planner.plan_reader import Action
+from mrgc.planfile.format import MotionModel, PlannedAction
 from mrgc.planner.violation import Violation, number
 
 POS_TOL = 1e-3  # m: tool vs grasp, handover position, path continuity of planar bases
@@ -72,7 +71,7 @@ class ActionGeometry:
     can run (everything it needs is present and well formed)."""
 
     step: int
-    action: Action
+    action: PlannedAction
     place_pose: np.ndarray | None = None
     configs: dict[str, np.ndarray] = field(default_factory=dict)
     paths: dict[str, np.ndarray] = field(default_factory=dict)
@@ -193,7 +192,7 @@ class ActionReader:
             )
 
     # ------------------------------------------------------------------ reading one action
-    def parse(self, t: int, a: Action) -> ActionGeometry:
+    def parse(self, t: int, a: PlannedAction) -> ActionGeometry:
         """``a`` (whose names resolve) with its geometry read and checked; ``geometry`` False when the sweep
         cannot run on it."""
         act = ActionGeometry(t, a)

@@ -23,11 +23,12 @@ from mrgc.compiler.facts import FactBase
 from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action, TaskGraph
 from mrgc.language.model import Problem
+from mrgc.planfile.format import PlannedAction
 from mrgc.planner.defaults import DEFAULT_BACKEND, DEFAULT_ENCODING
 from mrgc.planner.deferral import Deferrals, describe
 from mrgc.planner.method import HORIZON_LIMIT, Context, Option, Planner, Result
 from mrgc.planner.outcome import BlockingCycle, PlanStatus, Why
-from mrgc.planner.plan import Plan, PlannedAction
+from mrgc.planner.plan import Plan
 from mrgc.planner.skeletons import SkeletonSource
 
 if TYPE_CHECKING:  # the geometric modules load numpy and coal: a symbolic problem never imports them

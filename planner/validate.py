@@ -2,7 +2,7 @@
 
 It shares no code with the planner's search or grounding (:mod:`mrgc.planner.ground`,
 :mod:`mrgc.planner.mcts`, :mod:`mrgc.geometry.grounding`, :mod:`mrgc.geometry.predicates`, coal): it reads
-the plan through :mod:`mrgc.planner.plan_reader` (limits, JSON Schema, typed actions), re-derives what each
+the plan through :mod:`mrgc.planfile.reader` (limits, JSON Schema, typed actions), re-derives what each
 action means from the problem and the model's specifications (grasp frames of :mod:`mrgc.geometry.grasps`,
 the planar-robot model of :mod:`mrgc.geometry.planar`, ``inside`` of :mod:`mrgc.geometry.scene`), and
 replays geometric plans in pybullet (:mod:`mrgc.planner.replay`).
@@ -51,37 +51,9 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from mrgc.language.model import Problem
-from mrgc.planner.plan import file_sha256
-from mrgc.planner.plan_reader import (
-    E_JSON,
-    E_LIMIT,
-    E_READ,
-    E_SCHEMA,
-    E_VERSION,
-    Action,
-    PlanFile,
-    Step,
-    check_schema,
-    load_plan,
-    read_plan,
-    schema_errors,
-)
+from mrgc.planfile.format import PlanFile, PlannedAction, Step, file_sha256
+from mrgc.planfile.reader import read_plan
 from mrgc.planner.violation import Violation
-
-#: the reader's entry points and :class:`Violation` are re-exported here, where the CLI and the tests import them
-__all__ = [
-    "E_JSON",
-    "E_LIMIT",
-    "E_READ",
-    "E_SCHEMA",
-    "E_VERSION",
-    "ValidationReport",
-    "Violation",
-    "check_schema",
-    "load_plan",
-    "schema_errors",
-    "validate",
-]
 
 
 @dataclass
@@ -118,7 +90,7 @@ def validate(
     problem: Problem, plan: Any, problem_path: str | None = None, first_only: bool = False
 ) -> ValidationReport:
     """Check ``plan`` against ``problem``, read from ``problem_path`` (whose sha256 must match the plan's;
-    None skips that comparison).  ``plan`` is a :class:`~mrgc.planner.plan_reader.PlanFile`, parsed plan
+    None skips that comparison).  ``plan`` is a :class:`~mrgc.planfile.reader.PlanFile`, parsed plan
     JSON (as :func:`load_plan` returns it) or a :class:`~mrgc.planner.plan.Plan`; InputError when it breaks
     the schema.  ``first_only``: the geometric replay stops at the first phase that finds a violation (the
     verdict is the same; the report lists fewer violations), for a referee inside a search."""
@@ -264,7 +236,7 @@ def _names(problem: Problem, plan: PlanFile, out: list[Violation]) -> set[int]:
     return usable
 
 
-def _unknown_names(problem: Problem, names: _Names, a: Action) -> list[str]:
+def _unknown_names(problem: Problem, names: _Names, a: PlannedAction) -> list[str]:
     """What of action ``a`` names nothing the problem declares (or a grasp its object does not allow)."""
     bad = []
     obj = a.object
@@ -287,7 +259,7 @@ def _unknown_names(problem: Problem, names: _Names, a: Action) -> list[str]:
     return bad
 
 
-def _kind(t: int, a: Action, out: list[Violation]) -> None:
+def _kind(t: int, a: PlannedAction, out: list[Violation]) -> None:
     """The action's ``kind`` matches its robots, and a pick-and-place keeps its grasp ``[action]``."""
     kind = "handover" if a.handover else "pick-place"
     if a.kind != kind:
@@ -313,14 +285,14 @@ class _Relays:
     """The relay moves of a plan paired with their onward moves (ids of actions): ``onward`` relay -> the
     object's next move, at a later step and not a relay itself; ``relay_of`` the reverse."""
 
-    onward: dict[int, Action] = field(default_factory=dict)
-    relay_of: dict[int, Action] = field(default_factory=dict)
+    onward: dict[int, PlannedAction] = field(default_factory=dict)
+    relay_of: dict[int, PlannedAction] = field(default_factory=dict)
 
 
 def _structure(problem: Problem, plan: PlanFile, usable: set[int], out: list[Violation]) -> _Relays:
     """The structural checks (module docstring): how often objects move ``[moved-twice]``, ``[relay]``,
     relay moves ``[region]``, robots ``[robot-busy]``, ``[waiting]``; the relay moves and their onward moves."""
-    history: dict[str, list[tuple[int, Action]]] = {}
+    history: dict[str, list[tuple[int, PlannedAction]]] = {}
     relays = _Relays()
     robots = [r.name for r in problem.robots]
     for t, s in enumerate(plan.steps, 1):
@@ -371,7 +343,7 @@ def _robots(t: int, s: Step, robots: list[str], out: list[Violation]) -> None:
             out.append(Violation(t, r, "waiting", f"{r} is in no action of the step and not listed as waiting"))
 
 
-def _moved_again(t: int, a: Action, before: list[tuple[int, Action]]) -> str:
+def _moved_again(t: int, a: PlannedAction, before: list[tuple[int, PlannedAction]]) -> str:
     """Why moving ``a.object`` at step ``t`` after its moves ``before`` breaks "each object moves at most
     once, or twice when the first move is a relay move and the second, at a later step, is not" ("" if it
     does not)."""
@@ -393,7 +365,7 @@ def _moved_again(t: int, a: Action, before: list[tuple[int, Action]]) -> str:
     return ""
 
 
-def _relay_region(problem: Problem, t: int, a: Action, out: list[Violation]) -> None:
+def _relay_region(problem: Problem, t: int, a: PlannedAction, out: list[Violation]) -> None:
     """A relay move is a pick-and-place of a goal object into a region that is not its goal ``[region]``."""
     o, goal = a.object, problem.goal_regions.get(a.object)
     if a.handover:
@@ -423,7 +395,7 @@ Facts = set[tuple[str, tuple[str, ...]]]
 
 
 def _symbolic(
-    problem: Problem, steps: list[tuple[Action, ...]], usable: set[int], relays: _Relays, out: list[Violation]
+    problem: Problem, steps: list[tuple[PlannedAction, ...]], usable: set[int], relays: _Relays, out: list[Violation]
 ) -> None:
     """The checks of a symbolic plan against the problem's facts (module docstring)."""
     facts = {(f.predicate, f.args) for f in problem.init}
@@ -443,7 +415,9 @@ def _symbolic(
             _obstacles_moved(facts, moved_at, t, a, out, pick=id(a) not in relays.relay_of, place=not a.relay)
 
 
-def _relay_supported(facts: Facts, t: int, a: Action, onward: Action | None, out: list[Violation]) -> None:
+def _relay_supported(
+    facts: Facts, t: int, a: PlannedAction, onward: PlannedAction | None, out: list[Violation]
+) -> None:
     """A relay move needs ``reachable-pick`` and the ``enable-relay`` fact naming the robot and grasp that
     pick the object up again in its onward move ``[unsupported]``."""
     o, re_, r1, g1 = a.object, a.region, a.pick_robot, a.pick_grasp
@@ -457,7 +431,7 @@ def _relay_supported(facts: Facts, t: int, a: Action, onward: Action | None, out
             out.append(Violation(t, o, "unsupported", f"no fact ({pred} {' '.join(args)}) supports '{a.describe()}'"))
 
 
-def _supported(problem: Problem, facts: Facts, t: int, a: Action, onward: bool, out: list[Violation]) -> None:
+def _supported(problem: Problem, facts: Facts, t: int, a: PlannedAction, onward: bool, out: list[Violation]) -> None:
     """Facts support action ``a`` ``[unsupported]`` (an ``onward`` move picks where a relay move set the
     object down: its relay fact covers the pick); only goal objects are handed over, and an object goes
     only to its goal region or, outside the goal, within its own region ``[region]``."""
@@ -489,7 +463,7 @@ def _supported(problem: Problem, facts: Facts, t: int, a: Action, onward: bool, 
 
 
 def _obstacles_moved(
-    facts: Facts, moved_at: dict[str, int], t: int, a: Action, out: list[Violation], pick: bool, place: bool
+    facts: Facts, moved_at: dict[str, int], t: int, a: PlannedAction, out: list[Violation], pick: bool, place: bool
 ) -> None:
     """Every ``occludes-pick`` obstacle of action ``a`` moves at a strictly earlier step, every
     ``occludes-goal-place`` obstacle no later ``[pick-obstacle]``, ``[place-obstacle]``; ``pick``/``place``:

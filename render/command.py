@@ -155,8 +155,8 @@ def cmd_render(args: argparse.Namespace) -> int:
     plan = None
     name = args.problem
     if args.plan is not None:
+        from mrgc.planfile.reader import load_plan
         from mrgc.planner.outcome import not_solved
-        from mrgc.planner.validate import load_plan
 
         plan = load_plan(args.plan)
         unsolved = not_solved(args.plan, plan)

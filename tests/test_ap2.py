@@ -16,9 +16,9 @@ from support import ROOT
 from mrgc import cli, parse_file
 from mrgc.compiler.facts import FactBase
 from mrgc.compiler.task_graph import Action, build_task_graph
+from mrgc.planfile.format import PlannedAction
 from mrgc.planner.baselines.ap2 import Scheduler, TaskPlanner, without_relays
 from mrgc.planner.outcome import Failure
-from mrgc.planner.plan import PlannedAction
 from mrgc.planner.skeletons import must_move
 from mrgc.testing import oracle
 from mrgc.testing.strategies import SymbolicCase, symbolic_problems

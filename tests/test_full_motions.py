@@ -7,7 +7,7 @@ import pytest
 from support import ROOT
 
 from mrgc import __version__, parse_file
-from mrgc.planner.plan import file_sha256
+from mrgc.planfile.format import file_sha256
 from mrgc.planner.search import plan_problem
 from mrgc.planner.validate import validate
 

@@ -299,7 +299,7 @@ def test_an_obstacle_with_no_reachable_place_in_its_region_is_parked_in_another(
     the later steps' sweeps are kept clear no free place there is within its reach (~100 skeletons failed
     with "place by r2: no inverse kinematics" before).  Obstacles are parked in bin-b, a region nobody's
     goal that r2 reaches (then goal bins with room left for their goals); the plan is valid."""
-    from mrgc.planner.plan import file_sha256
+    from mrgc.planfile.format import file_sha256
     from mrgc.planner.search import plan_problem
     from mrgc.planner.validate import validate
 

@@ -50,7 +50,8 @@ ONLY_IMPORTS: dict[str, set[str]] = {
 VALIDATOR = [
     "planner/validate.py",
     "planner/violation.py",
-    "planner/plan_reader.py",
+    "planfile/reader.py",
+    "planfile/format.py",
     "planner/replay.py",
     "planner/replay_actions.py",
     "planner/sampling.py",
@@ -96,7 +97,7 @@ HEAVY = {
     "matplotlib": "render/gantt.py",
     "viser": "render/html.py",
     "ray": "bench/ray_executor.py",
-    "jsonschema": "planner/plan_reader.py",
+    "jsonschema": "planfile/reader.py",
     "geofikpy": "geometry/ik_analytic.py",
 }
 #: heavy libraries a second module may import too: pybullet's renderer draws the pictures

@@ -21,9 +21,9 @@ from mrgc import __version__, cli, parse_file
 from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action
 from mrgc.geometry.grounding import BUSY, Answer, GroundStatus, Stance
+from mrgc.planfile.format import PlannedAction, file_sha256
 from mrgc.planner.ground import GroundedStep, Outcome, ReverseGrounder
 from mrgc.planner.outcome import EXIT_CODES, PlanStatus
-from mrgc.planner.plan import PlannedAction, file_sha256
 from mrgc.planner.search import plan_problem
 
 PA3 = (ROOT / "domains" / "packaging" / "pa3-handover.mrg").read_text(encoding="utf-8")

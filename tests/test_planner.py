@@ -11,9 +11,9 @@ from support import ROOT
 from mrgc import __version__, cli, parse_file
 from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action
+from mrgc.planfile.format import PlannedAction, file_sha256
 from mrgc.planner.ground import GroundedStep, Grounding, Outcome
 from mrgc.planner.mcts import MCTS
-from mrgc.planner.plan import PlannedAction, file_sha256
 from mrgc.planner.search import plan_problem
 from mrgc.planner.validate import validate
 

@@ -20,9 +20,9 @@ from mrgc.geometry.relays import STAGING, staging, stranded
 from mrgc.geometry.scene import scene_from_problem
 from mrgc.language.loader import parse_file, parse_string
 from mrgc.language.model import Problem
+from mrgc.planfile.format import file_sha256
 from mrgc.planner.outcome import PlanStatus
 from mrgc.planner.phase1 import compute_problem_facts
-from mrgc.planner.plan import file_sha256
 from mrgc.planner.search import plan_problem
 from mrgc.planner.validate import validate
 from mrgc.testing.oracle import graph_signature, reference_task_graph

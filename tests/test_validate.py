@@ -29,9 +29,9 @@ from mrgc.geometry.grounding import Grounder
 from mrgc.geometry.ik import solve_ik_many
 from mrgc.geometry.transforms import translation
 from mrgc.language.loader import parse_file
-from mrgc.planner.plan import PlannedAction
-from mrgc.planner.plan_reader import read_plan
-from mrgc.planner.validate import ValidationReport, load_plan, validate
+from mrgc.planfile.format import PlannedAction
+from mrgc.planfile.reader import load_plan, read_plan
+from mrgc.planner.validate import ValidationReport, validate
 
 ROOT = vp.ROOT
 PA3 = vp.PA3
@@ -614,7 +614,7 @@ def test_the_validator_imports_no_planner_search_or_grounding() -> None:
         "mrgc.geometry.arm",
         "mrgc.compiler",
     }
-    for name in ("validate.py", "replay.py", "replay_actions.py", "sampling.py", "plan_reader.py"):
+    for name in ("validate.py", "replay.py", "replay_actions.py", "sampling.py", "../planfile/reader.py"):
         tree = ast.parse((ROOT / "planner" / name).read_text(encoding="utf-8"))
         for node in ast.walk(tree):
             if isinstance(node, ast.ImportFrom) and node.module:

@@ -22,7 +22,8 @@ from support import ROOT
 from mrgc.geometry.grasps import grasp_transform, pregrasp_transform
 from mrgc.geometry.transforms import translation
 from mrgc.language.loader import parse_file
-from mrgc.planner.plan import Plan, PlannedAction, file_sha256
+from mrgc.planfile.format import PlannedAction, file_sha256
+from mrgc.planner.plan import Plan
 
 if TYPE_CHECKING:  # the grounding service (coal, IK) loads only when a plan is built
     from mrgc.geometry.grounding import Grounder

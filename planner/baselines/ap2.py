@@ -52,7 +52,7 @@ if TYPE_CHECKING:
     from mrgc.compiler.facts import FactBase
     from mrgc.compiler.ir import Row, Solver
     from mrgc.language.model import Problem
-    from mrgc.planner.plan import PlannedAction
+    from mrgc.planfile.format import PlannedAction
 
 #: alternate robot assignments the scheduler grounds per failing step before the task planner is asked again
 REASSIGNMENTS = 8

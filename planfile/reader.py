@@ -1,7 +1,8 @@
-"""Reading plans: the one strict way from a plan file (or a :class:`~mrgc.planner.plan.Plan`) to typed values.
+"""Reading plans: the one strict way from a plan file (or a written plan) to typed values.
 
-:mod:`mrgc.planner.plan` writes plans; this module reads them back, in four stages, each with its own
-error (an :class:`~mrgc.errors.InputError`, exit code 2; codes in docs/errors.md):
+The planner (:mod:`mrgc.planner.plan`) writes plans with the types of :mod:`mrgc.planfile.format`; this
+module reads them back, in four stages, each with its own error (an :class:`~mrgc.errors.InputError`, exit
+code 2; codes in docs/errors.md):
 
 1. **Limits, before parsing** (E504): at most :data:`MAX_BYTES`; brackets nested at most :data:`MAX_DEPTH`
    deep (counted on the text, outside strings, so a plan nested 100,000 deep never reaches the JSON
@@ -12,10 +13,11 @@ error (an :class:`~mrgc.errors.InputError`, exit code 2; codes in docs/errors.md
    Schema validator (``jsonschema``, Draft 2020-12): required fields, types, enums, sizes, and no unknown
    field anywhere but in ``stats``.  A field the schema does not know may carry meaning this reader cannot
    check, so it is bad input, like a missing one (docs/validator.md).
-4. **Typed values**: frozen dataclasses (:class:`PlanFile`, :class:`Step`, :class:`Action`, the
-   :class:`~mrgc.planner.plan.MotionModel`), configurations as tuples of floats.  The validator works on
-   these only.  Names are not resolved here: whether a robot, object, region, grasp or handover point
-   exists is a question about the problem, answered by the validator (``[unknown-name]`` violations).
+4. **Typed values**: :class:`~mrgc.planfile.format.PlanFile`, its :class:`~mrgc.planfile.format.Step` s
+   and :class:`~mrgc.planfile.format.PlannedAction` s, the
+   :class:`~mrgc.planfile.format.MotionModel`.  The validator works on these only.  Names are not resolved
+   here: whether a robot, object, region, grasp or handover point exists is a question about the problem,
+   answered by the validator (``[unknown-name]`` violations).
 """
 
 from __future__ import annotations
@@ -25,14 +27,13 @@ import math
 import os
 import re
 import stat
-from dataclasses import dataclass, field
 from functools import lru_cache
 from itertools import islice
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any
 
 from mrgc.errors import Diagnostic, InputError, Span
-from mrgc.planner.plan import SCHEMA, MotionModel
+from mrgc.planfile.format import SCHEMA, MotionModel, PlanFile, PlannedAction, Step
 
 #: diagnostic codes of unusable plan files
 E_READ, E_JSON, E_SCHEMA, E_VERSION, E_LIMIT = "E500", "E501", "E502", "E503", "E504"
@@ -41,76 +42,6 @@ SCHEMA_FILE = Path(__file__).resolve().parent.parent / "docs" / "plan.schema.jso
 MAX_BYTES = 32 * 2**20  # a plan file larger than this is refused unread
 MAX_DEPTH = 32  # brackets nested deeper than this (a plan needs 8; its stats a few more)
 MAX_INTEGER_DIGITS = 20  # an integer literal longer than this (|n| < 1e20) is refused
-
-Config = tuple[float, ...]
-Motion = tuple[Config, ...]
-Matrix = tuple[tuple[float, ...], ...]
-
-
-@dataclass(frozen=True)
-class Action:
-    """One action of a step as the plan states it (see docs/plan.schema.json for each field's meaning)."""
-
-    kind: str
-    object: str
-    region: str
-    pick_robot: str
-    place_robot: str
-    pick_grasp: str
-    place_grasp: str
-    place_pose: Matrix | None = None
-    handover_point: str | None = None
-    configs: Mapping[str, Motion] = field(default_factory=dict)  # phase -> configurations
-    paths: Mapping[str, Motion] = field(default_factory=dict)  # path name -> configurations
-    relay: bool = False  # a relay move: the object is only set down in ``region`` on its way
-
-    @property
-    def handover(self) -> bool:
-        """Two robots: the object changes hands at ``handover_point``."""
-        return self.pick_robot != self.place_robot
-
-    def robots(self) -> tuple[str, ...]:
-        """The robots of the action (one, or the giver and the taker)."""
-        return (self.pick_robot,) if not self.handover else (self.pick_robot, self.place_robot)
-
-    def describe(self) -> str:
-        """``r1 moves o1 to bin (top)`` / ``r1->r2 moves o1 to bin (top->side-x+)`` / a relay move ``r1 sets
-        down o1 in start (top)``."""
-        who, grasp = self.pick_robot, self.pick_grasp
-        if self.handover:
-            who, grasp = f"{who}->{self.place_robot}", f"{grasp}->{self.place_grasp}"
-        what = f"sets down {self.object} in" if self.relay else f"moves {self.object} to"
-        return f"{who} {what} {self.region} ({grasp})"
-
-
-@dataclass(frozen=True)
-class Step:
-    """One step: its stated index, its actions and the robots it says wait."""
-
-    index: int
-    actions: tuple[Action, ...]
-    waiting: tuple[str, ...]
-
-
-@dataclass(frozen=True)
-class PlanFile:
-    """A plan as read: the header fields, the steps, and (geometric plans) the motion model."""
-
-    schema: str
-    mrgc_version: str
-    problem: str
-    problem_file: str
-    problem_sha256: str
-    backend: str
-    encoding: str
-    seed: int
-    status: str
-    symbolic: bool
-    makespan: int | None
-    motion_cost: int | None
-    steps: tuple[Step, ...]
-    motion_model: MotionModel | None = None
-    problem_digest: str | None = None
 
 
 # ------------------------------------------------------------------------------------------ reading
@@ -436,8 +367,9 @@ def _describe(e: Any) -> str:
 
 # ------------------------------------------------------------------------------------- typed values
 def read_plan(data: Any, where: str = "plan") -> PlanFile:
-    """Typed values of a plan: ``data`` is parsed plan JSON (checked here against the schema) or a
-    :class:`~mrgc.planner.plan.Plan` (InputError E502/E503 when it breaks the schema)."""
+    """Typed values of a plan: ``data`` is parsed plan JSON (checked here against the schema) or a written
+    plan (:class:`~mrgc.planner.plan.Plan`, anything with ``to_json``; InputError E502/E503 when it breaks
+    the schema)."""
     if isinstance(data, PlanFile):
         return data
     if not isinstance(data, dict) and hasattr(data, "to_json"):
@@ -466,23 +398,23 @@ def read_plan(data: Any, where: str = "plan") -> PlanFile:
     )
 
 
-def _motion(qs: list[list[float]]) -> Motion:
-    return tuple(tuple(float(v) for v in q) for q in qs)
+def _configurations(qs: list[list[float]]) -> list[list[float]]:
+    return [[float(v) for v in q] for q in qs]
 
 
-def _action(a: dict[str, Any]) -> Action:
+def _action(a: dict[str, Any]) -> PlannedAction:
     pose = a.get("place_pose")
-    return Action(
-        a["kind"],
+    return PlannedAction(
         a["object"],
         a["region"],
         a["pick_robot"],
         a["place_robot"],
         a["pick_grasp"],
         a["place_grasp"],
-        None if pose is None else _motion(pose),
+        None if pose is None else _configurations(pose),
         a.get("handover_point"),
-        {k: _motion(v) for k, v in a.get("configs", {}).items()},
-        {k: _motion(v) for k, v in a.get("paths", {}).items()},
+        {k: _configurations(v) for k, v in a.get("configs", {}).items()},
+        {k: _configurations(v) for k, v in a.get("paths", {}).items()},
         bool(a.get("relay", False)),
+        stated_kind=a["kind"],
     )

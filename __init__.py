@@ -55,7 +55,7 @@ _LAZY: dict[str, str] = {
     "Skeleton": "mrgc.compiler.skeleton:Skeleton",
     "Plan": "mrgc.planner.plan:Plan",
     "PlanStatus": "mrgc.planner.outcome:PlanStatus",
-    "ValidationReport": "mrgc.planner.validate:ValidationReport",
+    "ValidationReport": "mrgc.validator.validate:ValidationReport",
     "FactsResult": "mrgc.geometry.facts:FactsResult",
     "Backend": "mrgc.backends.base:Backend",
     "BackendInfo": "mrgc.backends.base:BackendInfo",
@@ -92,7 +92,7 @@ if TYPE_CHECKING:
     from mrgc.planner.plan import Plan
     from mrgc.planner.skeletons import CompileResult, CompileStatus
     from mrgc.planner.summary import FactsSummary
-    from mrgc.planner.validate import ValidationReport
+    from mrgc.validator.validate import ValidationReport
 
 
 def __getattr__(name: str) -> Any:

@@ -29,7 +29,7 @@ if TYPE_CHECKING:
     from mrgc.planner.plan import Plan
     from mrgc.planner.skeletons import CompileResult
     from mrgc.planner.summary import FactsSummary
-    from mrgc.planner.validate import ValidationReport
+    from mrgc.validator.validate import ValidationReport
 
 #: a problem as the API takes it: checked, or the path of its ``.mrg`` file
 ProblemSource = Union["Problem", str, "os.PathLike[str]"]
@@ -339,13 +339,13 @@ def validate(
     allow_outside: Sequence[str] = (),
 ) -> "ValidationReport":
     """Independently re-check ``plan`` (a :class:`~mrgc.planner.plan.Plan`, parsed plan JSON, or the path of
-    a plan file) against a problem: a :class:`~mrgc.planner.validate.ValidationReport` whose ``ok`` is the
+    a plan file) against a problem: a :class:`~mrgc.validator.validate.ValidationReport` whose ``ok`` is the
     verdict and whose ``violations`` list every way the plan fails (docs/validator.md).  A plan file that
     cannot be used at all raises InputError (E500-E504).  A file holding several problems is read for the
     one the plan names (unless ``name`` says otherwise).  The plan must be for the same problem contents:
     the file it was made from or its facts file are both accepted."""
     from mrgc.planfile.reader import load_plan
-    from mrgc.planner.validate import validate as run
+    from mrgc.validator.validate import validate as run
 
     doc: Any = plan
     if isinstance(plan, (str, os.PathLike)):

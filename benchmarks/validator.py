@@ -27,7 +27,7 @@ from pathlib import Path
 def main() -> None:
     from mrgc.language.loader import parse_file
     from mrgc.planfile.reader import load_plan
-    from mrgc.planner.validate import validate
+    from mrgc.validator.validate import validate
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("pairs", nargs="+", help="PROBLEM.mrg PLAN.json pairs")

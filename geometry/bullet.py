@@ -7,7 +7,7 @@ happens on first use.  Two kinds of client:
   validity checks (:func:`check_urdf`) and the kinematics references of :mod:`mrgc.testing.pybullet_reference`
   (URDFs loaded once each: :func:`shared_body`);
 - private DIRECT clients (:func:`private_client`), one per world of its own: the validator's
-  :class:`~mrgc.geometry.replay_world.ReplayScene`.
+  :class:`~mrgc.validator.world.ReplayScene`.
 
 Frames: a link's frame is its URDF link frame (pybullet's ``worldLinkFrame``, not its centre of mass);
 :func:`pose_of` turns pybullet's (position, quaternion) into a 4×4 transform.

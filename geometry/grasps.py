@@ -17,7 +17,7 @@ close along, ``depth`` and ``offset``.  The conventions (docs/geometry.md, "Gras
   that opening while it approaches the object and while it holds it, fully open otherwise (callers pass
   the opening to :meth:`~mrgc.geometry.arm.Arm.link_transforms` / ``ReplayScene.set_fingers``).
 
-Phase 1 (geometry/predicates.py), grounding (geometry/grounding.py) and the validator (planner/replay.py)
+Phase 1 (geometry/predicates.py), grounding (geometry/grounding.py) and the validator (validator/replay.py)
 read grasps only through this module.  The built-in names' specs are data of the language
 (:data:`~mrgc.language.model.BUILTIN_GRASPS`), so the checker knows them without the geometry layer.
 """

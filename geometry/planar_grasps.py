@@ -1,7 +1,7 @@
 """The planar grasp convention (docs/geometry.md, "Planar robots"; :mod:`mrgc.geometry.planar`'s docstring):
 which faces a planar robot grasps, where it stands to pick or place, and where the object rides while
 carried.  Its one home, read by the planner's model (:mod:`mrgc.geometry.planar`) and by the validator's
-replay (:mod:`mrgc.planner.replay_actions`), which must not import the planner's collision kernel or lattice.
+replay (:mod:`mrgc.validator.actions`), which must not import the planner's collision kernel or lattice.
 """
 
 from __future__ import annotations

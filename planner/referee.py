@@ -32,7 +32,7 @@ class Referee:
 
     def __call__(self, steps: list[list[PlannedAction]]) -> Failure | None:
         """None when the validator accepts the complete plan ``steps``, else the failure it names."""
-        from mrgc.planner.validate import validate
+        from mrgc.validator.validate import validate
 
         t0 = time.perf_counter()
         robots = [r.name for r in self.problem.robots]

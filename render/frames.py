@@ -1,6 +1,6 @@
 """A plan as motion: its steps cut into timed phases, and frames sampled from them.
 
-The replay follows the validator's execution model (:mod:`mrgc.planner.replay`), so a picture shows what
+The replay follows the validator's execution model (:mod:`mrgc.validator.replay`), so a picture shows what
 was checked.  Every robot starts a step at home.  A step runs in phases, each present only when some action
 of the step has a motion in it (:data:`PHASES`):
 
@@ -348,7 +348,7 @@ def _parse(world: World, a: Mapping[str, Any], t: int, source: str) -> _Act:
                 f"{world.robots[robot].home.size} values ({robot})"
             )
         configs[name] = arr
-    from mrgc.planner.replay_actions import PATH_PHASES
+    from mrgc.validator.actions import PATH_PHASES
 
     paths: dict[str, np.ndarray] = {}
     for name, qs in (a.get("paths") or {}).items():

@@ -17,7 +17,7 @@ that breaks it in one of issue 21's ways, the edit computed from the geometry, w
    each clear, the straight motion between them cutting into the divider;
 8. :func:`digest_changed` and :func:`huge_joint_value`.
 
-What a plan means is planner/replay.py's execution model (docs/validator.md): every robot stands where its
+What a plan means is validator/replay.py's execution model (docs/validator.md): every robot stands where its
 last motion left it, and a giver withdraws home (``giver-home``) before its taker carries the object on.
 Everything geometric is measured in a pybullet world of its own (:class:`World`; the planner's geometry
 modules give grasp frames, the planar carry pose and IK: tests may use them, the validator may not), never
@@ -345,7 +345,7 @@ def held_transform(w: World, act: dict[str, Any], robot: str) -> tuple[np.ndarra
     return tf.inverse(grasp_transform(grasp, shape)), finger_opening(grasp, shape)
 
 
-#: the phases of a step in the order they run (planner/replay.py's execution model: a giver withdraws home,
+#: the phases of a step in the order they run (validator/replay.py's execution model: a giver withdraws home,
 #: its taker standing at the exchange, before the taker carries the object on)
 PHASES = ("to-pick", "pick", "to-handover", "handover", "giver-home", "to-place", "place", "home")
 
@@ -364,7 +364,7 @@ class Track:
 
 
 def step_phases(w: World, plan: dict[str, Any], step: int) -> Iterator[tuple[str, list[Track], dict[str, Track]]]:
-    """The phases of ``step``'s arm actions as planner/replay.py runs them: (phase, the tracks that move, every
+    """The phases of ``step``'s arm actions as validator/replay.py runs them: (phase, the tracks that move, every
     other arm standing as a one-configuration track, holding what it holds).  Every arm starts at home; a
     transit without a path is a jump at the end of its phase; a holding transfer without a path is the straight
     joint-space move; a pick-and-place arm stands at its grasp while the step's handovers run."""
@@ -482,7 +482,7 @@ def at_time(t: Track, s: float) -> np.ndarray:
 
 # ------------------------------------------------------------------------------------- the audit
 def audit(plan: dict[str, Any]) -> dict[str, tuple[float, str]]:
-    """What issue 21's new checks ask of a plan's arms, replayed as planner/replay.py's execution model has
+    """What issue 21's new checks ask of a plan's arms, replayed as validator/replay.py's execution model has
     it (:func:`step_phases`) and measured: the least distance found (m, negative: a penetration) and where,
     for ``self`` (two links of one moving arm whose tree path crosses two or more chain joints), ``held``
     (an object against every link but the fingers of the arm or arms holding it) and ``robots`` (a moving
@@ -742,7 +742,7 @@ def giver_into_taker(plan: dict[str, Any], step: int, push: float = 0.06) -> Doc
     """Class 4 (``--motions full``, a handover): the giver's ``giver-home`` path first pushes its open hand
     ``push`` m further along its approach axis, into the object its taker holds, and back: configurations 2
     and 3 of the path become the pushed configuration (IK) and the exchange configuration again.  In the
-    giver-home phase the taker stands at its exchange configuration holding the object (planner/replay.py's
+    giver-home phase the taker stands at its exchange configuration holding the object (validator/replay.py's
     execution model; before it, the validator ran giver-home beside the taker's home path, the object
     already placed, and found nothing there)."""
     plan = copy.deepcopy(plan)

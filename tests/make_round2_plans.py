@@ -13,12 +13,12 @@ is checked twice:
   and the validator may not yet: no two links of an arm whose tree path crosses two or more chain joints
   (fingers and fixed joints do not count) closer than 0, the held object clear of every link of its holding
   arm but the fingers, every arm clear of every other arm and what it holds, moving or standing as
-  planner/replay.py's execution model has them (a giver withdraws home while its taker stands at the
+  validator/replay.py's execution model has them (a giver withdraws home while its taker stands at the
   exchange holding the object), at every configuration and at most 0.01 rad between checked ones.
 
 A plan that fails either is not stored (exit 1).  The seeds, and why: the planner these files were made
 with keeps each arm clear of itself and plans a giver's withdrawal before its taker moves on (as
-planner/replay.py replays a plan); the planner of commit 6e003bf did neither, and none of the seeds it was
+validator/replay.py replays a plan); the planner of commit 6e003bf did neither, and none of the seeds it was
 tried with gave a clean ``pa5-full`` or ``pa10``:
 
 - ``pa5`` (default motion model: approaches, exchanges and transfers; a handover of o5 from r1 to r2 in

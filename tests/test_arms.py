@@ -178,8 +178,8 @@ def test_the_xarm_is_modelled_from_its_urdf() -> None:
 
 def test_the_validator_exempts_the_whole_mount() -> None:
     """pybullet's joint info gives the validator the same mount: its base link -1 and link_base (joint 0)."""
-    from mrgc.geometry.replay_world import ReplayScene
     from mrgc.geometry.scene import scene_from_problem
+    from mrgc.validator.world import ReplayScene
 
     problem = mrgc.parse_file(ROOT / "tests" / "golden" / "errors" / "W274.mrg").problem()
     with ReplayScene(scene_from_problem(problem)) as rs:

@@ -22,8 +22,8 @@ from mrgc.language.model import Problem
 from mrgc.planner.baselines import PLANNERS, plan_with
 from mrgc.planner.outcome import PlanStatus
 from mrgc.planner.plan import Plan
-from mrgc.planner.validate import validate
 from mrgc.testing import oracle
+from mrgc.validator.validate import validate
 
 SYMBOLIC = ROOT / "domains" / "symbolic"
 PLACE_OBSTACLE = ROOT / "domains" / "packaging" / "pa3-place-obstacle.mrg"

@@ -1,6 +1,6 @@
 """The validator's fast path (issue 21, item 8): its own numpy kinematics equal pybullet's, the motion bounds it
 derives from them hold over whole intervals, and the certifier proves clear only what is clear
-(geometry/replay_fk.py, planner/certify.py, planner/phase_bounds.py)."""
+(validator/fk.py, validator/certify.py, validator/phase_bounds.py)."""
 
 from __future__ import annotations
 
@@ -14,13 +14,13 @@ from support import ROOT
 
 from mrgc.api import load_problem
 from mrgc.geometry.bullet import pose_of
-from mrgc.geometry.replay_bounds import arm_bounds
-from mrgc.geometry.replay_fk import ArmChain, axis_reach, centres, motion_spheres, pack
-from mrgc.geometry.replay_world import ReplayScene
 from mrgc.geometry.scene import half_extents, scene_from_problem
-from mrgc.planner.certify import Certifier, Phase, interval_rate
-from mrgc.planner.phase_bounds import face_bound
-from mrgc.planner.sweep import CAP, Pair
+from mrgc.validator.bounds import arm_bounds
+from mrgc.validator.certify import Certifier, Phase, interval_rate
+from mrgc.validator.fk import ArmChain, axis_reach, centres, motion_spheres, pack
+from mrgc.validator.phase_bounds import face_bound
+from mrgc.validator.sweep import CAP, Pair
+from mrgc.validator.world import ReplayScene
 
 
 @pytest.fixture(scope="module")
@@ -82,7 +82,7 @@ def _link_points(rs: ReplayScene, links: tuple[int, ...]) -> dict[int, np.ndarra
 def test_the_interval_bound_holds_over_the_whole_segment(panda: Any, seed: int, scale: float) -> None:
     """The certifier's motion bound over a straight joint-space segment q0 -> q1, built from each link's
     distance from each joint's axis at the two ends only (motion spheres, grown by what the joints beyond
-    move the link: :func:`~mrgc.planner.certify.interval_rate`), is at least the largest displacement of any
+    move the link: :func:`~mrgc.validator.certify.interval_rate`), is at least the largest displacement of any
     collision vertex of the link from where it starts, measured by pybullet at 41 configurations along the
     segment; and never above the global bound."""
     rs, bounds, home = panda
@@ -175,7 +175,7 @@ def test_a_certified_motion_keeps_within_the_tolerance(gap: float, lower: float)
 @given(st.integers(0, 2**31 - 1))
 def test_the_face_bound_never_exceeds_pybullets_distance(panda: Any, seed: int) -> None:
     """The lower bound of a link's distance from a box that the box's face planes give (its motion spheres
-    against each face: :func:`~mrgc.planner.phase_bounds.face_bound`) is never more than pybullet's signed
+    against each face: :func:`~mrgc.validator.phase_bounds.face_bound`) is never more than pybullet's signed
     distance, at random configurations, for every link and every box of pa5 (the table and five boxes),
     overlapping ones included."""
     rs, bounds, home = panda
@@ -203,7 +203,7 @@ def test_the_face_bound_never_exceeds_pybullets_distance(panda: Any, seed: int) 
 @settings(max_examples=15, deadline=None)
 @given(st.integers(0, 2**31 - 1))
 def test_a_link_is_no_farther_from_the_joint_it_carries_than_its_bound(panda: Any, seed: int) -> None:
-    """The certifier's first-joint rate (planner/certify.py, ``_reach``): a link's largest distance from the
+    """The certifier's first-joint rate (validator/certify.py, ``_reach``): a link's largest distance from the
     axis of a chain joint that hangs on it, computed once from its motion spheres at one configuration, is at
     least the distance of each of its collision vertices from that axis as pybullet places them at random
     configurations (the axis is fixed in the link's frame, so one configuration serves all)."""

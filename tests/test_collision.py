@@ -19,10 +19,10 @@ from mrgc.errors import InputError
 from mrgc.geometry.arm import Arm
 from mrgc.geometry.collision import TOLERANCE, CollisionWorld, ConvexHull, collision_shape
 from mrgc.geometry.ik import solve_ik_many
-from mrgc.geometry.replay_world import ReplayScene
 from mrgc.geometry.scene import SceneSpec, scene_from_problem
 from mrgc.geometry.transforms import rot_z, rpy_matrix, translation
 from mrgc.language.model import Box, Cylinder, Mesh, Sphere
+from mrgc.validator.world import ReplayScene
 
 
 def at(x: float, y: float = 0.0, z: float = 0.0, yaw: float = 0.0) -> np.ndarray:

@@ -9,7 +9,7 @@ from support import ROOT
 from mrgc import __version__, parse_file
 from mrgc.planfile.format import file_sha256
 from mrgc.planner.search import plan_problem
-from mrgc.planner.validate import validate
+from mrgc.validator.validate import validate
 
 HANDOVER = ROOT / "domains" / "packaging" / "pa3-handover.mrg"
 

@@ -15,7 +15,7 @@ from mrgc.planfile.format import PlannedAction, file_sha256
 from mrgc.planner.ground import GroundedStep, Grounding, Outcome
 from mrgc.planner.mcts import MCTS
 from mrgc.planner.search import plan_problem
-from mrgc.planner.validate import validate
+from mrgc.validator.validate import validate
 
 GEOMETRIC = sorted((ROOT / "domains" / "packaging").glob("pa*.mrg")) + sorted(
     (ROOT / "domains" / "box-moving").glob("bo*.mrg")

@@ -24,8 +24,8 @@ from mrgc.planfile.format import file_sha256
 from mrgc.planner.outcome import PlanStatus
 from mrgc.planner.phase1 import compute_problem_facts
 from mrgc.planner.search import plan_problem
-from mrgc.planner.validate import validate
 from mrgc.testing.oracle import graph_signature, reference_task_graph
+from mrgc.validator.validate import validate
 
 SYMBOLIC = ROOT / "tests" / "data" / "relay.mrg"
 GENERATED = ROOT / "tests" / "data" / "relay-packaging.mrg"

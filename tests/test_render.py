@@ -399,7 +399,7 @@ def test_planar_yaw_turns_the_short_way(a: float, b: float) -> None:
 
 
 def test_phases_are_the_validators() -> None:
-    from mrgc.planner.replay import PATH_PHASES
+    from mrgc.validator.replay import PATH_PHASES
 
     assert set(PATH_PHASES) <= {"to-pick", "to-handover", "taker-to-handover", "to-place", "home", "giver-home"}
     assert PHASES == ("to-pick", "pick", "to-handover", "handover", "to-place", "place", "home")

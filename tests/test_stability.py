@@ -1,4 +1,4 @@
-"""Stable placements (planner/stability.py) and upright cart placements (issue 21, items 6 and 7).
+"""Stable placements (validator/stability.py) and upright cart placements (issue 21, items 6 and 7).
 
 The support polygon is checked against closed forms: boxes on boxes (centred, shifted past the edge, bridged
 over two supports, yawed), boxes on region floors, cylinders, spheres and meshes; tilted and floating objects
@@ -23,7 +23,7 @@ from support import run_cli
 
 from mrgc.geometry.transforms import from_xyz_rpy, rot_z, translation
 from mrgc.language.model import Box, Cylinder, Mesh, Sphere
-from mrgc.planner.stability import (
+from mrgc.validator.stability import (
     CIRCLE_POINTS,
     FLAT_TOL,
     MARGIN,

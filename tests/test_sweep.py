@@ -1,5 +1,5 @@
 """The validator's continuous check: motion bounds that hold, self-collision pairs derived from the URDF, and a
-sweep that finds what passes between two samples (planner/sweep.py, geometry/replay_bounds.py)."""
+sweep that finds what passes between two samples (validator/sweep.py, validator/bounds.py)."""
 
 from __future__ import annotations
 
@@ -12,10 +12,10 @@ from hypothesis import strategies as st
 from support import ROOT
 
 from mrgc.api import load_problem
-from mrgc.geometry.replay_bounds import ArmBounds, arm_bounds
-from mrgc.geometry.replay_world import ReplayScene
 from mrgc.geometry.scene import scene_from_problem
-from mrgc.planner.sweep import CAP, Pair, Sweep
+from mrgc.validator.bounds import ArmBounds, arm_bounds
+from mrgc.validator.sweep import CAP, Pair, Sweep
+from mrgc.validator.world import ReplayScene
 
 PA5 = str(ROOT / "domains" / "packaging" / "pa5.mrg")
 

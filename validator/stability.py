@@ -13,7 +13,7 @@ a mesh's lowest vertices, a sphere's lowest point (a point contact).  A *support
 object whose *top face* (the same construction at its highest point), or a region whose *floor* (its
 lowest face: a region's floor is a surface whatever lies under it, as for ``[floating]``), lies within
 :data:`SUPPORT_TOL` of the object's lowest point, above or below (what lies within that distance under the
-object counts as touching, as in :mod:`mrgc.planner.replay`; an object sunk into its supporter is still held
+object counts as touching, as in :mod:`mrgc.validator.replay`; an object sunk into its supporter is still held
 up by it, and the sinking is a collision reported on its own), and whose face overlaps the object's lowest
 face in the horizontal plane.  Its *contact patch* is that overlap (two convex polygons clipped, or a point
 or an edge where either is one), and the *support polygon* is the convex hull of every patch: a bridge

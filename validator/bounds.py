@@ -1,6 +1,6 @@
 """What the validator derives from a robot's URDF, as pybullet loads it: self-collision pairs and motion bounds.
 
-Both are computed once per robot of a :class:`~mrgc.geometry.replay_world.ReplayScene` from the loaded body
+Both are computed once per robot of a :class:`~mrgc.validator.world.ReplayScene` from the loaded body
 (its joint tree, joint types and link frames); nothing here comes from the planner's kinematics.
 
 **Self-collision pairs.**  Two links of one arm that carry collision shapes are *exempt* from the
@@ -12,7 +12,7 @@ fingers, finger and finger) never move against each other in a plan, and neighbo
 No pair is dropped because it "cannot meet": that would be a sampled claim, and the sweep's bounds already
 make far pairs cheap (a pair 30 cm apart is re-checked only after its links could have moved 30 cm).
 
-**Motion bounds** (the continuous check of :mod:`mrgc.planner.sweep`).  When joint ``j`` turns by ``dq``,
+**Motion bounds** (the continuous check of :mod:`mrgc.validator.sweep`).  When joint ``j`` turns by ``dq``,
 no point of a link it moves travels farther than ``|dq|`` times the point's distance from the joint's axis;
 along a straight joint-space motion every point of link ``k`` travels at most ``sum_j |dq_j| R[j, k]``
 (Schwarzer, Saha and Latombe's bound for path segments).  ``R[j, k]`` is bounded here by the chain length
@@ -35,7 +35,7 @@ import numpy as np
 from mrgc.geometry.bullet import pose_of
 
 if TYPE_CHECKING:
-    from mrgc.geometry.replay_world import ReplayScene
+    from mrgc.validator.world import ReplayScene
 
 #: configurations (home and these many more, drawn with a fixed seed within the limits) whose bounding boxes
 #: bound each link's radius: the smallest bound is kept (each is a true upper bound)
@@ -221,7 +221,7 @@ def _spheres(
     rs: ReplayScene, robot: str, links: tuple[int, ...], verts: dict[int, np.ndarray], home: np.ndarray
 ) -> np.ndarray:
     """The radius of a sphere about each link's centre of mass (as pybullet places it:
-    :meth:`~mrgc.geometry.replay_world.ReplayScene.link_centres`) holding its collision shapes: the smallest
+    :meth:`~mrgc.validator.world.ReplayScene.link_centres`) holding its collision shapes: the smallest
     of (a) the farthest of the link's collision vertices (+ :data:`RADIUS_PAD`), where every shape of the
     link is a mesh (pybullet's shape is the hull of those vertices), and (b) at home and
     :data:`RADIUS_CONFIGS` more configurations, the farthest corner of pybullet's bounding box of the link

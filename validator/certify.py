@@ -1,10 +1,10 @@
 """Certifying a phase free of collisions, fast: bounds at many times at once, pybullet only where they fail.
 
-The sweep of :mod:`mrgc.planner.sweep` walks a phase's time forward one checked time after another, setting
+The sweep of :mod:`mrgc.validator.sweep` walks a phase's time forward one checked time after another, setting
 the pybullet world at each.  Most phases of a valid plan have nothing to report, and this module proves
 that for a whole phase with far fewer pybullet calls; a phase it cannot prove clear (an overlap, or a pair
-within :data:`~mrgc.planner.sweep.MIN_BUDGET` of the tolerance, or too many times needed) is then swept by
-:mod:`mrgc.planner.sweep`, which finds and reports what is there.  So violations still come from the sweep
+within :data:`~mrgc.validator.sweep.MIN_BUDGET` of the tolerance, or too many times needed) is then swept by
+:mod:`mrgc.validator.sweep`, which finds and reports what is there.  So violations still come from the sweep
 and pybullet's distances alone; this module only decides that there is none.
 
 **Certifying an interval.**  For a sub-pair (two links, a link and an object, ...) and an interval
@@ -17,12 +17,12 @@ from the joint's axis over the interval; a motion of ``x`` of it over ``[t0, s]`
 collision tolerance, plus the pair's slack there).  Two-sided, an interval may be about twice as long as a
 conservative-advancement step from one end.
 
-**Where the bounds come from** (the phase's ``bounds``, :class:`~mrgc.planner.phase_bounds.PhaseBounds`):
-at any times, the validator's numpy kinematics (:mod:`mrgc.geometry.replay_fk`) give lower bounds on every
+**Where the bounds come from** (the phase's ``bounds``, :class:`~mrgc.validator.phase_bounds.PhaseBounds`):
+at any times, the validator's numpy kinematics (:mod:`mrgc.validator.fk`) give lower bounds on every
 sub-pair's distance (spheres about links, boxes about objects that stand still) and, per link, its largest
 distance from each joint's axis (motion spheres); over an interval the latter grows at most by what the
 joints beyond that joint move it, so ``D`` is bounded from the interval's ends, never above the global bound
-of :mod:`mrgc.geometry.replay_bounds`.  Where a lower bound is weak (under :data:`FAR` of budget, or the
+of :mod:`mrgc.validator.bounds`.  Where a lower bound is weak (under :data:`FAR` of budget, or the
 interval would need many pieces), pybullet is asked for the pair's distances at that time (the world set
 there once for every pair asked then); an interval still not certified is cut in 2^k equal pieces (times
 on a dyadic grid of its stretch, so that pairs share them) and the pieces are certified in turn.
@@ -35,7 +35,7 @@ from typing import Callable, Sequence
 
 import numpy as np
 
-from mrgc.planner.sweep import CAP, MIN_BUDGET, Pair
+from mrgc.validator.sweep import CAP, MIN_BUDGET, Pair
 
 FAR = 0.02  # m: an end whose lower bound leaves less budget than this is asked of pybullet
 MANY = 32  # an interval that lower bounds alone would cut in more pieces than this asks pybullet at its ends

@@ -1,5 +1,5 @@
-"""A way a plan fails, as the validator reports it (shared by :mod:`mrgc.planner.validate` and the
-geometric replay, :mod:`mrgc.planner.replay`)."""
+"""A way a plan fails, as the validator reports it (shared by :mod:`mrgc.validator.validate` and the
+geometric replay, :mod:`mrgc.validator.replay`)."""
 
 from __future__ import annotations
 

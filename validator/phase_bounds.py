@@ -1,16 +1,16 @@
 """Bounds of a phase's pairs without pybullet's distance queries: lower bounds on distances, motion rates.
 
 Every robot link is held by a sphere about its centre of mass
-(:attr:`~mrgc.geometry.replay_bounds.ArmBounds.spheres`), a planar robot's footprint and a carried object
+(:attr:`~mrgc.validator.bounds.ArmBounds.spheres`), a planar robot's footprint and a carried object
 by one about its frame, every object that stands still in the phase by its bounding box; two spheres are at
 least the distance of their centres less both radii apart, a sphere and a box the distance of the centre
 from the box less the radius.
 
 :class:`Spheres` reads the positions from pybullet at the state the world is set to (the sweep's
-:attr:`~mrgc.planner.sweep.Sweep.bound`); :class:`PhaseBounds` computes them for many times at once with
-the validator's numpy kinematics (:mod:`mrgc.geometry.replay_fk`), and with them each element's motion
+:attr:`~mrgc.validator.sweep.Sweep.bound`); :class:`PhaseBounds` computes them for many times at once with
+the validator's numpy kinematics (:mod:`mrgc.validator.fk`), and with them each element's motion
 rate at those times (its points' largest distance from each joint's axis, from its motion spheres, at most
-its global rate), for the certifier (:mod:`mrgc.planner.certify`).
+its global rate), for the certifier (:mod:`mrgc.validator.certify`).
 """
 
 from __future__ import annotations
@@ -20,13 +20,13 @@ from typing import TYPE_CHECKING, Any, Callable
 import numpy as np
 
 from mrgc.geometry.conventions import wrap_angle
-from mrgc.geometry.replay_fk import SPHERE_PAD, ArmChain, axis_reach, centres, pack
 from mrgc.geometry.scene import half_extents
 from mrgc.language.model import Box, Shape
-from mrgc.planner.sweep import Pair
+from mrgc.validator.fk import SPHERE_PAD, ArmChain, axis_reach, centres, pack
+from mrgc.validator.sweep import Pair
 
 if TYPE_CHECKING:
-    from mrgc.geometry.replay_world import ReplayScene
+    from mrgc.validator.world import ReplayScene
 
 FK_PAD = 1e-5  # m: the numpy kinematics against pybullet's single-precision frames (measured 3e-7)
 
@@ -115,10 +115,10 @@ class Spheres:
 
 class PhaseBounds(Spheres):
     """:class:`Spheres` for many times at once from the numpy kinematics, and each element's motion rate
-    (module docstring; the certifier's :attr:`~mrgc.planner.certify.Phase.bounds`).  ``offsets``: for each
+    (module docstring; the certifier's :attr:`~mrgc.validator.certify.Phase.bounds`).  ``offsets``: for each
     track that carries an object, the object's frame in its robot's end-effector frame (a planar robot's:
-    its base frame); ``chains(robot)``: an arm's :class:`~mrgc.geometry.replay_fk.ArmChain` with its fingers
-    as they are now, and its links' motion spheres (:func:`~mrgc.geometry.replay_fk.motion_spheres`)."""
+    its base frame); ``chains(robot)``: an arm's :class:`~mrgc.validator.fk.ArmChain` with its fingers
+    as they are now, and its links' motion spheres (:func:`~mrgc.validator.fk.motion_spheres`)."""
 
     def __init__(
         self,
@@ -265,7 +265,7 @@ class PhaseBounds(Spheres):
 
 
 def _configs_at(configs: np.ndarray, t: np.ndarray, planar: bool) -> np.ndarray:
-    """Configurations (T, dof) of a motion at times ``t`` (:func:`mrgc.planner.sampling.config_at`, many at
+    """Configurations (T, dof) of a motion at times ``t`` (:func:`mrgc.validator.sampling.config_at`, many at
     once)."""
     m = len(configs)
     if m == 1:

@@ -1,11 +1,11 @@
 """Continuous collision checking of one phase of a replay: nothing passes between two checked samples.
 
 A phase is a set of motions that share the time ``s`` in [0, 1], each linear between its configurations
-(:mod:`mrgc.planner.sampling`).  The bodies it moves are checked pairwise; each *pair* (a robot against an
+(:mod:`mrgc.validator.sampling`).  The bodies it moves are checked pairwise; each *pair* (a robot against an
 object, a robot against itself at two links, a held object against another robot ...) is made of
 *sub-pairs*, one for each two links whose distance pybullet reports.  Between two breakpoints (where some
 motion passes one of its configurations) every joint moves at a constant speed, so every point of a link
-moves at most at a constant *rate* (:mod:`mrgc.geometry.replay_bounds`): the rate of a sub-pair is the sum
+moves at most at a constant *rate* (:mod:`mrgc.validator.bounds`): the rate of a sub-pair is the sum
 of its two sides' rates (for two links of one arm, only the joints that move one of them and not the
 other count).
 

@@ -1,6 +1,6 @@
 """The validator's own forward kinematics: an arm's link frames for many configurations at once, in numpy.
 
-Derived from the arm's body as pybullet loaded it (:class:`~mrgc.geometry.replay_world.ReplayScene`), not
+Derived from the arm's body as pybullet loaded it (:class:`~mrgc.validator.world.ReplayScene`), not
 from the planner's kinematics (:mod:`mrgc.geometry.fk`): at the configuration the body stands in, each
 link's frame (pybullet's ``worldLinkFrame``), its parent's and its joint's axis and value give the joint's
 constant origin ``O_j = T_parent^-1 T_j J(v_j)^-1``, and then ``T_j(q) = T_parent(q) O_j J(q_j)`` for every
@@ -8,8 +8,8 @@ configuration (``J``: the turn about, or the slide along, the joint's axis; a jo
 chain, a finger, keeps the value it has when the chain is derived).  A test checks the frames against
 pybullet's at random configurations.
 
-What the sweep asks of it (:mod:`mrgc.planner.certify`): where each link's centre of mass is (the centres
-of the spheres that hold the links, :attr:`~mrgc.geometry.replay_bounds.ArmBounds.spheres`), and how far
+What the sweep asks of it (:mod:`mrgc.validator.certify`): where each link's centre of mass is (the centres
+of the spheres that hold the links, :attr:`~mrgc.validator.bounds.ArmBounds.spheres`), and how far
 each link's points are from each chain joint's axis, bounded by *motion spheres*: a few spheres per link,
 fixed in the link's frame, that hold every collision vertex of the link (a point's distance from an axis is
 convex, so its largest over the link's convex hull is at a vertex) or, for a link without its vertices, the
@@ -27,8 +27,8 @@ import numpy as np
 from mrgc.geometry.bullet import pose_of
 
 if TYPE_CHECKING:
-    from mrgc.geometry.replay_bounds import ArmBounds
-    from mrgc.geometry.replay_world import ReplayScene
+    from mrgc.validator.bounds import ArmBounds
+    from mrgc.validator.world import ReplayScene
 
 #: motion spheres per link at most (the vertices split in slices along their longest spread)
 MOTION_SPHERES = 4
@@ -150,7 +150,7 @@ def motion_spheres(
     """For each link of ``bounds.links`` (in that order): centres (k, 3) in the link's frame and radii (k,)
     of the spheres that hold its points (module docstring): the collision vertices of a link whose shapes are
     all meshes, in up to :data:`MOTION_SPHERES` slices along their longest spread; otherwise the sphere about
-    its centre of mass (:attr:`~mrgc.geometry.replay_bounds.ArmBounds.spheres`; ``chain``: the arm's
+    its centre of mass (:attr:`~mrgc.validator.bounds.ArmBounds.spheres`; ``chain``: the arm's
     :class:`ArmChain`, derived when not given)."""
     r = rs.robots[robot]
     model = rs.models.get(robot)

@@ -1,12 +1,12 @@
 """Geometric plan replay for the validator: every step re-run in pybullet, checked continuously.
 
 Nothing here comes from the planner's search or grounding: configurations are read from the plan, forward
-kinematics and signed distances are pybullet's (:class:`mrgc.geometry.replay_world.ReplayScene`: the robots'
+kinematics and signed distances are pybullet's (:class:`mrgc.validator.world.ReplayScene`: the robots'
 URDF collision meshes, the objects as pybullet shapes), motion bounds and self-collision pairs are derived
-from the URDFs as pybullet loads them (:mod:`mrgc.geometry.replay_bounds`), grasp frames come from their
+from the URDFs as pybullet loads them (:mod:`mrgc.validator.bounds`), grasp frames come from their
 specification (:mod:`mrgc.geometry.grasps`), the planar-robot model from :mod:`mrgc.geometry.planar`'s
-docstring.  Each action's geometry is read and checked by :mod:`mrgc.planner.replay_actions`; this module
-sweeps it (:mod:`mrgc.planner.sweep`).
+docstring.  Each action's geometry is read and checked by :mod:`mrgc.validator.actions`; this module
+sweeps it (:mod:`mrgc.validator.sweep`).
 
 **Execution model** (what a plan means; the checks follow it).  Every robot starts each step at home (its
 kind's ``:home``; a planar robot at its ``:base`` pose).  Between its own motions a robot stands where its
@@ -37,20 +37,20 @@ move between the configurations it connects, checked like a path; an empty-hande
 not modelled: the robot stands where it was until the end of the transit's phase and is at its destination
 from then on (a giver is home after phase 5, a placer after phase 8).  Motions of different robots in one
 phase are paired by index: they share the phase's time ``s`` in [0, 1], each linear between its
-configurations (:mod:`mrgc.planner.sampling`).
+configurations (:mod:`mrgc.validator.sampling`).
 
-**Checks** (codes in brackets; tolerances as module constants here and in :mod:`~mrgc.planner.replay_actions`):
+**Checks** (codes in brackets; tolerances as module constants here and in :mod:`~mrgc.validator.actions`):
 
-- what :mod:`~mrgc.planner.replay_actions` checks per action: ``[motion-model]``, ``[missing]``,
+- what :mod:`~mrgc.validator.actions` checks per action: ``[motion-model]``, ``[missing]``,
   ``[config]``, ``[joint-limits]``, ``[pose]``, ``[grasp]``, ``[approach]`` (including the tool's pose along
   the pick's and place's contact segment), ``[handover]``, ``[path]``;
-- **continuously** through every phase (:mod:`mrgc.planner.sweep`: conservative advancement on bounds of
+- **continuously** through every phase (:mod:`mrgc.validator.sweep`: conservative advancement on bounds of
   how far any point of a link, footprint or held object can move; nothing passes between two checked
   samples), no overlap deeper than :data:`CONTACT_TOL` of: a moving robot with the fixed objects (except an
-  arm's base link, see :class:`~mrgc.geometry.replay_world.ReplayScene`), the objects present, the other
+  arm's base link, see :class:`~mrgc.validator.world.ReplayScene`), the objects present, the other
   robots moving or standing and what they hold ``[collision-robot-fixed]``, ``[collision-robot-robot]``,
   ``[collision-robot-object]``; an arm with itself, every pair of links more than one chain joint apart
-  (:mod:`mrgc.geometry.replay_bounds`) ``[collision-self]``; a held object with the fixed objects, the
+  (:mod:`mrgc.validator.bounds`) ``[collision-self]``; a held object with the fixed objects, the
   other objects and robots, and every link of the arm or arms holding it but their fingers
   ``[collision-object-fixed]``, ``[collision-object-object]``, ``[collision-self-held]``.  The object a robot
   picks may touch only its gripper (hand and fingers), only in the *contact segment* of its pick
@@ -76,20 +76,20 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from mrgc.geometry.replay_bounds import ArmBounds, arm_bounds, planar_radius
-from mrgc.geometry.replay_fk import ArmChain, motion_spheres
-from mrgc.geometry.replay_world import ReplayScene
 from mrgc.geometry.scene import SceneSpec, inside, outline, scene_from_problem
 from mrgc.geometry.transforms import translation
 from mrgc.language.model import Problem
 from mrgc.planfile.format import MotionModel, PlannedAction
-from mrgc.planner.certify import Certifier, Phase
-from mrgc.planner.phase_bounds import PhaseBounds
-from mrgc.planner.replay_actions import PATH_PHASES, ActionGeometry, ActionReader
-from mrgc.planner.sampling import config_at, deltas, sample_count, where
-from mrgc.planner.stability import stability
-from mrgc.planner.sweep import CAP, Pair, Sweep
-from mrgc.planner.violation import Violation
+from mrgc.validator.actions import PATH_PHASES, ActionGeometry, ActionReader
+from mrgc.validator.bounds import ArmBounds, arm_bounds, planar_radius
+from mrgc.validator.certify import Certifier, Phase
+from mrgc.validator.fk import ArmChain, motion_spheres
+from mrgc.validator.phase_bounds import PhaseBounds
+from mrgc.validator.sampling import config_at, deltas, sample_count, where
+from mrgc.validator.stability import stability
+from mrgc.validator.sweep import CAP, Pair, Sweep
+from mrgc.validator.violation import Violation
+from mrgc.validator.world import ReplayScene
 
 RESOLUTION = 0.01  # largest joint (rad) or planar base (m, rad) motion between samples
 MIN_RESOLUTION = 1e-3  # a plan's finer resolution is followed down to this
@@ -142,7 +142,7 @@ class _StepState:
 
 
 class _PairList:
-    """The pairs of a phase as they are added: :class:`~mrgc.planner.sweep.Pair` (sub-pairs and rates) and
+    """The pairs of a phase as they are added: :class:`~mrgc.validator.sweep.Pair` (sub-pairs and rates) and
     their sides (parts, the link indices of a self pair, the collision kind)."""
 
     def __init__(self) -> None:
@@ -348,7 +348,7 @@ def _world(problem: Problem) -> tuple[SceneSpec, ReplayScene]:
 
 
 def _arm_bounds(rs: ReplayScene, homes: dict[str, np.ndarray]) -> dict[str, ArmBounds]:
-    """Each arm's :class:`~mrgc.geometry.replay_bounds.ArmBounds`, derived once per world (they depend on
+    """Each arm's :class:`~mrgc.validator.bounds.ArmBounds`, derived once per world (they depend on
     the URDF as loaded and on the arm's home only) and kept with it."""
     kept: dict[tuple[int, str], tuple[np.ndarray, ArmBounds]] = _WORLD.setdefault("bounds", {})
     out = {}
@@ -500,7 +500,7 @@ class _Replayer(ActionReader):
 
     # ------------------------------------------------------------------ sweeping a phase
     def _sweep(self, t: int, phase: str, tracks: list[_Track], standing: list[_Track]) -> None:
-        """Check phase ``phase`` of step ``t`` continuously (:mod:`mrgc.planner.sweep`): the ``tracks`` move,
+        """Check phase ``phase`` of step ``t`` continuously (:mod:`mrgc.validator.sweep`): the ``tracks`` move,
         the ``standing`` robots stand (with what they hold)."""
         ph = _PhaseWorld(self, tracks, standing)
         pairs, sides = self._pairs(ph)
@@ -579,7 +579,7 @@ class _Replayer(ActionReader):
         set_state: Callable[[float], None],
         probes: list[Callable[[], dict[tuple[int, int], float]]],
     ) -> bool:
-        """Whether the certifier (:mod:`mrgc.planner.certify`) proves the phase free of overlaps beyond the
+        """Whether the certifier (:mod:`mrgc.validator.certify`) proves the phase free of overlaps beyond the
         tolerance; when it cannot, the sweep checks the phase and reports."""
         rows = bounds.rows
         same = np.concatenate(
@@ -892,7 +892,7 @@ class _Replayer(ActionReader):
         """An object that rests on something rests stably, with the objects that stand on it alone (their
         weight is its weight), and so does every object under it that holds it up alone, down to what
         stands on several supports or on something fixed: the centre of mass over the support polygon of the
-        contacts, with a margin, flat on its lowest face (:mod:`mrgc.planner.stability`) ``[unstable]``;
+        contacts, with a margin, flat on its lowest face (:mod:`mrgc.validator.stability`) ``[unstable]``;
         ``gone``: objects not in the scene now (picked up)."""
         floors = [(r.name, r.shape, r.pose) for r in self.scene.regions]
         bodies = {

@@ -5,7 +5,7 @@ It shares no code with the planner's search or grounding (:mod:`mrgc.planner.gro
 the plan through :mod:`mrgc.planfile.reader` (limits, JSON Schema, typed actions), re-derives what each
 action means from the problem and the model's specifications (grasp frames of :mod:`mrgc.geometry.grasps`,
 the planar-robot model of :mod:`mrgc.geometry.planar`, ``inside`` of :mod:`mrgc.geometry.scene`), and
-replays geometric plans in pybullet (:mod:`mrgc.planner.replay`).
+replays geometric plans in pybullet (:mod:`mrgc.validator.replay`).
 
 Outcomes are values: :func:`validate` returns a :class:`ValidationReport` listing every
 :class:`Violation`, one line each.  A plan *file* that cannot be used at all (unreadable, beyond the
@@ -42,7 +42,7 @@ action moves at a strictly earlier step, every ``occludes-goal-place`` obstacle 
 obstacles only.  The onward move needs what a move into the goal needs except ``reachable-pick`` (the relay
 fact covers picking M where it was set down) and has place obstacles only.  Geometric checks (the motion
 model, motions, collisions, support; an onward move picks M where its relay move placed it) are listed in
-:mod:`mrgc.planner.replay`.
+:mod:`mrgc.validator.replay`.
 """
 
 from __future__ import annotations
@@ -53,7 +53,7 @@ from typing import Any
 from mrgc.language.model import Problem
 from mrgc.planfile.format import PlanFile, PlannedAction, Step, file_sha256
 from mrgc.planfile.reader import read_plan
-from mrgc.planner.violation import Violation
+from mrgc.validator.violation import Violation
 
 
 @dataclass
@@ -90,10 +90,11 @@ def validate(
     problem: Problem, plan: Any, problem_path: str | None = None, first_only: bool = False
 ) -> ValidationReport:
     """Check ``plan`` against ``problem``, read from ``problem_path`` (whose sha256 must match the plan's;
-    None skips that comparison).  ``plan`` is a :class:`~mrgc.planfile.reader.PlanFile`, parsed plan
-    JSON (as :func:`load_plan` returns it) or a :class:`~mrgc.planner.plan.Plan`; InputError when it breaks
-    the schema.  ``first_only``: the geometric replay stops at the first phase that finds a violation (the
-    verdict is the same; the report lists fewer violations), for a referee inside a search."""
+    None skips that comparison).  ``plan`` is a :class:`~mrgc.planfile.format.PlanFile`, parsed plan JSON
+    (as :func:`~mrgc.planfile.reader.load_plan` returns it) or a written plan (:class:`~mrgc.planner.plan.Plan`);
+    InputError when it breaks the schema.  ``first_only``: the geometric replay stops at the first phase that
+    finds a violation (the verdict is the same; the report lists fewer violations), for a referee inside a
+    search."""
     doc = read_plan(plan)
     out: list[Violation] = []
     steps = [s.actions for s in doc.steps]
@@ -126,7 +127,7 @@ def validate(
                     )
                 )
     elif not doc.symbolic and not (first_only and out):  # a symbolic plan carries no geometry to replay
-        from mrgc.planner.replay import replay
+        from mrgc.validator.replay import replay
 
         assert doc.motion_model is not None  # the schema requires it of geometric plans
         out.extend(replay(problem, doc.motion_model, steps, usable, stats, first_only=first_only))

@@ -2,8 +2,8 @@
 that needs no sweep (configurations, joint limits, grasps, approaches, handovers, path ends).
 
 :class:`ActionReader` turns a typed :class:`~mrgc.planfile.format.PlannedAction` into an :class:`ActionGeometry`
-(numpy arrays, the motion of each phase) and reports what is wrong with it; :mod:`mrgc.planner.replay`
-sweeps the motions.  Forward kinematics are pybullet's (:class:`~mrgc.geometry.replay_world.ReplayScene`), grasp
+(numpy arrays, the motion of each phase) and reports what is wrong with it; :mod:`mrgc.validator.replay`
+sweeps the motions.  Forward kinematics are pybullet's (:class:`~mrgc.validator.world.ReplayScene`), grasp
 frames come from their specification (:mod:`mrgc.geometry.grasps`), the planar model from
 :mod:`mrgc.geometry.planar_grasps`; nothing comes from the planner's search or grounding.
 """
@@ -18,11 +18,11 @@ import numpy as np
 from mrgc.geometry.conventions import pose_error, wrap_angle, yaw_of
 from mrgc.geometry.grasps import APPROACH, finger_opening, fits, grasp_transform, pregrasp_transform
 from mrgc.geometry.planar_grasps import PLANAR_GRASPS, carry_transform, grasp_base
-from mrgc.geometry.replay_world import ReplayScene
 from mrgc.geometry.scene import SceneSpec
 from mrgc.geometry.transforms import from_pose, inverse
 from mrgc.planfile.format import MotionModel, PlannedAction
-from mrgc.planner.violation import Violation, number
+from mrgc.validator.violation import Violation, number
+from mrgc.validator.world import ReplayScene
 
 POS_TOL = 1e-3  # m: tool vs grasp, handover position, path continuity of planar bases
 ROT_TOL = 0.01  # rad
@@ -395,7 +395,7 @@ class ActionReader:
                         f"{dr:.3f} rad from where grasp {grasp!r} of {obj} puts it (at "
                         f"{what}; tolerance {POS_TOL * 1e3:g} mm, {ROT_TOL} rad)",
                     )
-                from mrgc.planner.stability import cart_set_down
+                from mrgc.validator.stability import cart_set_down
 
                 # a cart lowers its box, upright, onto the floor it drives on (a pick takes the object as it is)
                 placing = (

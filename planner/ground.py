@@ -26,10 +26,13 @@ import numpy as np
 
 from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action
+from mrgc.geometry.answers import BUSY, SELF, Answer, GroundStatus
 from mrgc.geometry.collision import Posed, paired_collide, pieces_collide
 from mrgc.geometry.conventions import refine, to_se2
-from mrgc.geometry.grounding import BUSY, PHASES, SELF, Answer, Grounder, GroundStatus, Stance, Volume
+from mrgc.geometry.grounding import Grounder
 from mrgc.geometry.relays import spot_region
+from mrgc.geometry.stances import PHASES, Stance
+from mrgc.geometry.step_world import Volume
 from mrgc.language.model import Box
 from mrgc.planfile.format import PlannedAction
 from mrgc.planner.outcome import DeadlineReached, Failure

@@ -78,7 +78,7 @@ def test_reach_failures_count_by_part_other_failures_by_action() -> None:
 def test_the_checks_grounding_writes_are_the_ones_counted_by_part() -> None:
     """The part of a failure is read from the check text that planner/ground.py writes: built here by its own
     formatter, so a reworded message fails this test instead of quietly deferring whole actions."""
-    from mrgc.geometry.grounding import Answer, GroundStatus
+    from mrgc.geometry.answers import Answer, GroundStatus
     from mrgc.planner.ground import _failed
 
     skel = Skeleton(((A3,),))

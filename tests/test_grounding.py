@@ -12,10 +12,13 @@ import mrgc
 from mrgc import parse_file
 from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action
+from mrgc.geometry.answers import GroundStatus
+from mrgc.geometry.arm_paths import joint_line
 from mrgc.geometry.collision import CollisionShape, CollisionWorld
 from mrgc.geometry.conventions import PATH_RESOLUTION, to_se2
-from mrgc.geometry.grounding import PHASES, Grounder, GroundStatus, Stance, joint_line, stance
+from mrgc.geometry.grounding import Grounder
 from mrgc.geometry.scene import inside, scene_from_problem
+from mrgc.geometry.stances import PHASES, Stance, stance
 from mrgc.geometry.transforms import translation
 from mrgc.planner.ground import Outcome, ReverseGrounder
 
@@ -301,7 +304,7 @@ def test_an_obstacle_with_no_reachable_place_in_its_region_is_parked_in_another(
     goal that r2 reaches (then goal bins with room left for their goals); the plan is valid."""
     from mrgc.planfile.format import file_sha256
     from mrgc.planner.search import plan_problem
-    from mrgc.validator.validate import validate
+    from mrgc.planner.validate import validate
 
     path = ROOT / "tests" / "data" / "park-packaging.mrg"
     problem = parse_file(path).problem()
@@ -328,7 +331,7 @@ def test_failures_say_whether_only_what_never_moves_explains_them(pa3: Grounder)
 
 
 def test_the_grounder_knows_where_each_arm_of_the_step_is_in_each_phase(pa3: Grounder) -> None:
-    """The execution model a plan means (docs/validator.md, validator/replay.py), as the grounding reads it:
+    """The execution model a plan means (docs/validator.md, planner/replay.py), as the grounding reads it:
     between its own motions an arm stands where its last motion left it; a missing transit (no path under
     the ``configurations`` model) is a jump at the end of its phase."""
     assert stance("pick-place", "to-handover") is stance("pick-place", "giver-home") is Stance.PICKED
@@ -416,7 +419,7 @@ def test_a_base_path_blocked_only_by_another_robot_of_the_step_says_so() -> None
     """bo-one-doorway, the doorway cleared: r1's drive through the 1 m doorway fails while what r2 sweeps
     meanwhile stands in it, and the answer says so (before, "no path" with nothing named, and the step was
     never split); without r2's sweep the path exists, and a path the scene blocks says nothing of robots."""
-    from mrgc.geometry.grounding import BUSY
+    from mrgc.geometry.answers import BUSY
     from mrgc.geometry.transforms import rot_z
 
     g = Grounder(scene_from_problem(parse_file(DOORWAY).problem()), seed=0)

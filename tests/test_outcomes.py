@@ -20,7 +20,8 @@ from support import ROOT, run_cli
 from mrgc import __version__, cli, parse_file
 from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action
-from mrgc.geometry.grounding import BUSY, Answer, GroundStatus, Stance
+from mrgc.geometry.answers import BUSY, Answer, GroundStatus
+from mrgc.geometry.stances import Stance
 from mrgc.planfile.format import PlannedAction, file_sha256
 from mrgc.planner.ground import GroundedStep, Outcome, ReverseGrounder
 from mrgc.planner.outcome import EXIT_CODES, PlanStatus

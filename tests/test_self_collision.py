@@ -15,10 +15,12 @@ import pytest
 
 from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action
+from mrgc.geometry.answers import SELF, GroundStatus
 from mrgc.geometry.arm import SELF_CLEARANCE, Arm
+from mrgc.geometry.arm_paths import joint_line
 from mrgc.geometry.conventions import refine
 from mrgc.geometry.grasps import finger_opening, grasp_transform, pregrasp_transform
-from mrgc.geometry.grounding import SELF, Grounder, GroundStatus, joint_line
+from mrgc.geometry.grounding import Grounder
 from mrgc.geometry.kinematics import RobotModel, load_robot_model
 from mrgc.geometry.predicates import IK_SEEDS, RobotEvaluator
 from mrgc.geometry.scene import SceneSpec, scene_from_problem

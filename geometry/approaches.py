@@ -1,0 +1,264 @@
+"""Approaches and handovers: an arm's configurations for a grasp of an object at a pose, found by IK.
+
+To pick (or place) an object with a grasp, the arm's tool goes to the grasp pose along the grasp's approach
+axis: the *approach* is the pre-grasp (backed off by :data:`~mrgc.geometry.grasps.APPROACH`) and
+:data:`~mrgc.geometry.conventions.APPROACH_SAMPLES` configurations to the grasp, pre-grasp first, both ends by
+IK from one branch (:meth:`Approaches._approach_configs`).  An approach is kept when, checked at every
+:data:`APPROACH_CHECK` of joint motion, it collides with nothing: not with itself, fixed bodies, the other arms
+where they stand in the phase, the objects to avoid, what the step's other robots sweep meanwhile (``busy``),
+and, at its last configuration, what they do in the later phases it stands there (``after``).  Attempts start
+from home, then from seeded random starts; a pose no start solves is out of reach after :data:`IK_GIVE_UP`.
+A *handover* is both arms at their exchange configurations holding the object at a handover point, not
+colliding with each other (:data:`HANDOVER_PAIRS` rounds of drawing).
+"""
+
+from __future__ import annotations
+
+from typing import Iterable, Mapping
+
+import numpy as np
+
+from mrgc.geometry.answers import BUSY, SELF, Answer, GroundStatus
+from mrgc.geometry.arm import Arm
+from mrgc.geometry.arm_paths import joint_line
+from mrgc.geometry.collision import Posed, posed_collide
+from mrgc.geometry.conventions import APPROACH_SAMPLES, PATH_RESOLUTION, seed_for
+from mrgc.geometry.grasps import APPROACH, fits, grasp_transform, pregrasp_transform
+from mrgc.geometry.ik import solve_ik_many
+from mrgc.geometry.step_world import Pieces, Volume, named_body
+from mrgc.geometry.transforms import translation
+from mrgc.geometry.volumes import Volumes
+
+#: largest joint motion (rad) between the configurations of an approach that are checked: half the
+#: validator's resolution, so that the validator, sampling at other times, does not find the fingers deeper
+#: in a neighbour than the 1 mm it tolerates where the planner found them clear (a 5-sample approach checked
+#: at 4 times its samples let the validator reject whole plans for 1.1 mm finger overlaps)
+APPROACH_CHECK = PATH_RESOLUTION / 2
+#: IK attempts (each with its restarts) after which a pose none of them solved is called out of reach, as
+#: phase 1 does (predicates.IK_SEEDS); attempts that solve it but collide go on to other branches
+IK_GIVE_UP = 3
+#: pairs of exchange configurations tried for a handover before the two arms are said to collide
+HANDOVER_PAIRS = 6
+#: an approach's last segment starts at most this many equal shares of the back-off from the grasp (the
+#: validator allows 2)
+CONTACT_START = 1.5
+
+
+class Approaches(Volumes):
+    """An arm's pick, place and handover configurations (see the module docstring)."""
+
+    def _approach(
+        self,
+        robot: str,
+        obj: str,
+        grasp: str,
+        pose: np.ndarray,
+        key: str,
+        avoid: Iterable[str],
+        attempts: int = 8,
+        approach: bool = True,
+        held: bool = False,
+        busy: Pieces = (),
+        from_home: bool = True,
+        after: Pieces = (),
+    ) -> Answer:
+        spec = self.scene.grasp_specs.get(grasp)
+        arm = self.arm(robot)
+        if spec is None or not fits(spec, self.scene.body(obj).shape, arm.spec.kind):
+            return Answer(GroundStatus.NO_IK)  # no geometry, or the gripper does not open wide enough
+        g_t = grasp_transform(spec, self.scene.body(obj).shape)
+        avoid = tuple(a for a in avoid if a != obj)
+        blockers: set[str] = set()
+        status = GroundStatus.NO_IK
+        moving = self._busy(busy)
+        clash: tuple[str, Volume] | None = None  # the last attempt's collision not with ``avoid``: told at the end
+        phase = key.split(":")[0]  # "pick", "place" or "handover"
+        static = True  # every attempt so far failed on what never moves (IK, fixed bodies, bases)
+        for attempt in range(attempts):
+            seed = seed_for(robot, obj, grasp, key, str(attempt), seed=self.seed)
+            # the first attempt starts from home (the solution nearest it); the others from a start drawn from
+            # their seed, or every attempt would converge to that same solution again
+            start = (
+                arm.home
+                if attempt == 0 and from_home
+                else np.random.default_rng(seed).uniform(arm.model.lower, arm.model.upper)
+            )
+            q = solve_ik_many(arm.model, arm.ee_target(pose @ g_t)[None], seed, q_init=start)[0]
+            if not q.solved or q.q is None:  # (q is None exactly when the solve failed)
+                if q.status.value == "unreachable":
+                    return Answer(GroundStatus.NO_IK, static=True)  # provably out of reach: no other seed helps
+                if attempt + 1 >= IK_GIVE_UP and status is GroundStatus.NO_IK:
+                    return Answer(GroundStatus.NO_IK, static=True)  # no start converged (phase 1 gives up too)
+                continue
+            configs = self._approach_configs(arm, pose @ g_t, q.q, seed) if approach else np.asarray(q.q)[None]
+            if configs is None:
+                continue
+            # checked at every APPROACH_CHECK of joint motion (finer than the validator samples), with the
+            # object in hand when placing
+            dense = joint_line(configs, APPROACH_CHECK)
+            volume = self.free_volume(robot, dense, holding=(obj, grasp) if held else None, grasp=(obj, grasp))
+            if volume is None:  # the arm collides with itself: another branch may not (what never moves)
+                status, clash = GroundStatus.COLLISION, ("self", [])
+                continue
+            self.queries += 1
+            posed = Posed.of(volume)
+            if self._fixed_clash(robot, obj, grasp, configs, posed, held, self._others(robot, phase)):
+                status, clash = GroundStatus.COLLISION, ("fixed", volume)
+                static = static and self._static_clash(robot, obj, posed, held)
+                continue
+            static = False  # this attempt failed (if it did) on what moves
+            hit = self.world.probe_hits(posed, against=avoid) if avoid else set()
+            if hit:
+                blockers |= hit
+                status = GroundStatus.COLLISION
+                continue
+            if (moving is not None and posed_collide(posed, moving)) or (
+                after and self._standing_clash(robot, obj, grasp, configs[-1], after)
+            ):
+                # another robot of the step moves there meanwhile, or moves (or stands) where the arm stands
+                # afterwards: another IK seed
+                status, clash = GroundStatus.COLLISION, ("moving", volume)
+                continue
+            return Answer(GroundStatus.OK, pose=pose, configs=configs)
+        detail = ""
+        if clash is not None and not blockers:
+            detail = self._clash_detail(robot, phase, clash, ignore=() if held else (obj,))
+        return Answer(status, blockers=blockers, detail=detail, static=static)
+
+    def _standing_clash(self, robot: str, obj: str, grasp: str, q: np.ndarray, after: Pieces) -> bool:
+        """Whether ``robot`` standing at ``q`` holding ``obj`` hits ``after``: what the step's other robots do
+        in the later phases it stands there (:meth:`step`).  Held: where it has let the object go, the object
+        is there too then (placed, or held by the taker)."""
+        volume = self.arm_volume(robot, q[None], holding=(obj, grasp))
+        return posed_collide(Posed.of(volume), self._volumes.posed(after))
+
+    def _static_clash(self, robot: str, obj: str, volume: Posed, held: bool) -> bool:
+        """Whether an approach volume hits what never moves: a fixed body or another arm's base link."""
+        bases = tuple(b for b in self._bases if b != f"base:{robot}")
+        return self.world.probe_collides(volume, against=("fixed", *bases), ignore=() if held else (obj,))
+
+    def _fixed_clash(
+        self, robot: str, obj: str, grasp: str, configs: np.ndarray, volume: Posed, held: bool, homes: tuple[str, ...]
+    ) -> bool:
+        """Whether an approach (``configs``, swept as ``volume``) hits a fixed object or an arm at home
+        (``homes``), or, picking, the object it picks before its contact segment (the last one: the validator
+        exempts the picked object there only)."""
+        if self.world.probe_collides(volume, against=("fixed", *homes), ignore=() if held else (obj,)):
+            return True
+        if held or len(configs) < 3:
+            return False
+        early = self.arm_volume(robot, joint_line(configs[:-1], APPROACH_CHECK), grasp=(obj, grasp))
+        return self.world.probe_collides(early, against=(obj,))
+
+    @staticmethod
+    def _approach_configs(arm: Arm, tool: np.ndarray, q: np.ndarray, seed: int) -> np.ndarray | None:
+        """The approach to grasp configuration ``q`` (tool at ``tool``): the pre-grasp by IK from ``q``, then
+        :data:`APPROACH_SAMPLES` configurations to ``q``; None when the pre-grasp has no solution, or when
+        pre-grasp and grasp come from different IK branches and swing the tool off the approach line (the
+        contact segment must start near the grasp: the validator's rule, with a margin)."""
+        pre = solve_ik_many(
+            arm.model, arm.ee_target(tool @ pregrasp_transform(np.eye(4)))[None], seed, q_init=q[None], restarts=2
+        )[0]
+        if not pre.solved or pre.q is None:
+            return None
+        s = np.linspace(0.0, 1.0, APPROACH_SAMPLES)[:, None]
+        configs: np.ndarray = pre.q[None] * (1 - s) + q[None] * s
+        near = arm.tool_world(configs[-2][None])[0][:3, 3]
+        if np.linalg.norm(near - tool[:3, 3]) > CONTACT_START * APPROACH / (APPROACH_SAMPLES - 1):
+            return None
+        return configs
+
+    def _clash_detail(self, robot: str, phase: str, clash: tuple[str, Volume], ignore: tuple[str, ...]) -> str:
+        """Name what a volume collided with besides the avoided objects: fixed bodies, other arms at home
+        (their links are named ``@<arm>:<i>``) or standing still (``~<arm>:<stance>:<i>``), or the other robots
+        of the step."""
+        kind, volume = clash
+        if kind == "moving":
+            return BUSY
+        if kind == "self":
+            return SELF
+        hit = self.world.probe_hits(volume, against=("fixed", *self._others(robot, phase)), ignore=ignore)
+        named = sorted({named_body(h) for h in hit})
+        return "hits " + ", ".join(named) if named else ""
+
+    def pick(
+        self, robot: str, obj: str, grasp: str, avoid: Iterable[str] = (), busy: Pieces = (), after: Pieces = ()
+    ) -> Answer:
+        """Approach configurations for ``robot`` to grasp ``obj`` (at its current pose) with ``grasp``,
+        free of fixed objects, of ``avoid`` and of ``busy`` (what other robots sweep meanwhile), the last one
+        holding the object also free of ``after`` (what they do in the later phases the arm stands there,
+        :meth:`step`); ``blockers`` names the avoided objects that were in the way."""
+        return self._approach(robot, obj, grasp, self.poses[obj], "pick", avoid, busy=busy, after=after)
+
+    def place(
+        self,
+        robot: str,
+        obj: str,
+        grasp: str,
+        pose: np.ndarray,
+        avoid: Iterable[str] = (),
+        busy: Pieces = (),
+        after: Pieces = (),
+    ) -> Answer:
+        """Approach configurations for ``robot`` holding ``obj`` with ``grasp`` to put it at ``pose`` (``busy``
+        and ``after`` as for :meth:`pick`)."""
+        return self._approach(robot, obj, grasp, pose, "place", avoid, held=True, busy=busy, after=after)
+
+    def handover(
+        self,
+        obj: str,
+        point: str,
+        giver: str,
+        g1: str,
+        taker: str,
+        g2: str,
+        avoid: Iterable[str] = (),
+        busy: Pieces = (),
+        after: Mapping[str, Pieces] | None = None,
+    ) -> Answer:
+        """Both arms' configurations holding ``obj`` at handover point ``point`` (configs: giver, taker), free
+        of ``busy`` (what the step's other robots do in the handover phase), each arm's also of ``after[arm]``
+        (what they do in the later phases it stands at its exchange: :meth:`step`)."""
+        pose = translation(*self.scene.handover_points[point])
+        # as in phase 1, a handover is checked at the exchange configurations (no approach).  Each round draws
+        # one more free exchange configuration of each arm (the first from home, the others from seeded
+        # random starts: from home IK finds the same solution every time) and tries it against every
+        # configuration of the other arm drawn so far, until a pair does not collide
+        found: dict[str, list[np.ndarray]] = {giver: [], taker: []}
+        failed = Answer(GroundStatus.COLLISION)
+        worlds: list[Posed] = []  # the taker's configurations, as the kernel reads them
+        later = after or {}
+
+        def exchange(arm: str, grasp: str, attempt: int) -> Answer:
+            key = f"handover:{point}" + (f":{attempt}" if attempt else "")
+            first = attempt == 0
+            return self._approach(
+                arm, obj, grasp, pose, key, avoid, approach=False, busy=busy, from_home=first, after=later.get(arm, ())
+            )
+
+        for attempt in range(HANDOVER_PAIRS):
+            if self.late():
+                return Answer(GroundStatus.TIME_LIMIT)
+            a, b = exchange(giver, g1, attempt), exchange(taker, g2, attempt)
+            if not b.ok:
+                failed = b
+            else:
+                assert b.configs is not None
+                found[taker].append(b.configs[-1])
+                world = Posed.of(self.arm_volume(taker, b.configs[-1:], grasp=(obj, g2)))
+                worlds.append(world)
+                for q in found[giver]:  # the new taker configuration against the giver's earlier ones
+                    if not posed_collide(Posed.of(self.arm_volume(giver, q[None], grasp=(obj, g1))), world):
+                        return Answer(GroundStatus.OK, pose=pose, configs=np.stack([q, b.configs[-1]]))
+            if not a.ok:
+                failed = a
+            else:
+                assert a.configs is not None
+                found[giver].append(a.configs[-1])
+                volume = Posed.of(self.arm_volume(giver, a.configs[-1:], grasp=(obj, g1)))
+                for q, world in zip(found[taker], worlds):  # the new giver configuration against every taker's
+                    if not posed_collide(volume, world):
+                        return Answer(GroundStatus.OK, pose=pose, configs=np.stack([a.configs[-1], q]))
+        if not (found[giver] and found[taker]):  # one arm never got there: why (its last attempt)
+            return Answer(failed.status, blockers=failed.blockers, detail=failed.detail)
+        return Answer(GroundStatus.COLLISION, detail="the two arms collide at every exchange drawn")

@@ -1,0 +1,171 @@
+"""Placements: a collision-free pose of an object inside a region, for the reverse search to put it at.
+
+A placement rests on the region's floor (:data:`~mrgc.geometry.conventions.ARM_PLACE_LIFT` above it), lies
+entirely inside the region (``in-region``), and hits no fixed object, no parked planar robot, none of the
+objects to avoid (at their current poses) and nothing of a given volume (the future volume V_fut of the
+paper's reverse search).  Candidates come in a fixed order: phase 1's 3 x 3 lattice first (so a placement the
+facts relied on is tried first), then seeded random positions at the four yaws; a bin several objects share
+is *packed*, corners and walls first, so that each object leaves the most room to the ones the reverse
+search places after it (:func:`_packing_grid`).  :meth:`Placements.comfortable` ranks candidates by the
+placing arm's reach, :meth:`Placements.crowded_out` asks whether a placement leaves room for the objects
+still to come.
+"""
+
+from __future__ import annotations
+
+from typing import Callable, Iterable, Iterator
+
+import numpy as np
+
+from mrgc.geometry.answers import Answer, GroundStatus
+from mrgc.geometry.collision import Posed, posed_collide
+from mrgc.geometry.conventions import ARM_PLACE_LIFT, lattice_offsets, seed_for
+from mrgc.geometry.grasps import grasp_transform
+from mrgc.geometry.scene import Body as SceneBody
+from mrgc.geometry.scene import half_extents, inside
+from mrgc.geometry.step_world import StepWorld, Volume
+from mrgc.geometry.transforms import rot_z, translation
+from mrgc.language.model import Box
+
+#: the share of an arm's reach bound that :meth:`Placements.comfortable` placements keep within
+COMFORT = 0.85
+
+
+class Placements(StepWorld):
+    """Poses of objects inside regions (see the module docstring)."""
+
+    def placement(
+        self,
+        obj: str,
+        region: str | SceneBody,
+        avoid: Iterable[str] = (),
+        volume: Volume | None = None,
+        samples: int = 200,
+        key: str = "",
+        skip: int = 0,
+        packed: bool = False,
+    ) -> Answer:
+        """A pose of ``obj`` entirely inside ``region`` that hits no fixed object, none of ``avoid`` (at their
+        current poses) and nothing of ``volume``: phase 1's lattice first, then random positions and the four
+        yaws; ``skip`` passes over that many valid candidates (to get another one on a retry).
+
+        ``packed`` (a bin that several objects share): first a grid over the region at the four yaws,
+        corners and walls first, so that each object leaves the largest free space in the middle for the
+        ones placed before it (the reverse search places the last object first); the middle-first lattice
+        scatters them and leaves no room for a third or fourth."""
+        for pose in self.placements(obj, region, avoid, volume, samples, key, packed):
+            if skip == 0:
+                return Answer(GroundStatus.OK, pose=pose)
+            skip -= 1  # the caller wants a different placement than the ones it already tried
+        return Answer(GroundStatus.NO_PLACEMENT)
+
+    def placements(
+        self,
+        obj: str,
+        region: str | SceneBody,
+        avoid: Iterable[str] = (),
+        volume: Volume | None = None,
+        samples: int = 200,
+        key: str = "",
+        packed: bool = False,
+        prefer: Callable[[np.ndarray], float] | None = None,
+    ) -> Iterator[np.ndarray]:
+        """The poses :meth:`placement` would return with ``skip`` 0, 1, 2 ..., in that order, each checked
+        once (asking :meth:`placement` for the k-th checks the first k again).  ``prefer`` (a rank of a pose,
+        e.g. :meth:`comfortable`'s) orders the grid and lattice candidates by rank, keeping their order
+        among equal ranks.  ``region`` is a region's name or a region body (a relay's spot on a fixed object's
+        top: :func:`mrgc.geometry.relays.spot_region`)."""
+        body = self.scene.body(obj)
+        reg = region if isinstance(region, SceneBody) else self.scene.body(region)
+        if not isinstance(reg.shape, Box):
+            return
+        rng = np.random.default_rng(seed_for("placement", obj, reg.name, key, seed=self.seed))
+        h_o, h_r = half_extents(body.shape), half_extents(reg.shape)
+        vol = self._volumes.posed(volume) if volume else None
+        avoid = tuple(a for a in avoid if a != obj)
+        shape = self.shape(obj)
+        # first the 3 × 3 lattice phase 1 uses (so a placement the facts relied on is tried first), then
+        # random positions and the four yaws
+        room = np.maximum(h_r[:2] - h_o[:2], 0) * 0.9
+        fixed: list[tuple[float, float, float]] = [(0.0, a * room[0], b * room[1]) for a, b in lattice_offsets(3)]
+        if packed:
+            fixed = _packing_grid(h_r[:2] - min(h_o[0], h_o[1])) + fixed
+        if prefer is not None:  # accepted ones first in their order, then the others by the preference's rank
+            rank = {
+                c: prefer(reg.pose @ translation(c[1], c[2], -h_r[2] + h_o[2] + ARM_PLACE_LIFT) @ rot_z(c[0]))
+                for c in fixed
+            }
+            fixed = sorted(fixed, key=lambda c: rank[c])  # stable
+        for k in range(len(fixed) + samples):
+            if self.late():
+                return
+            if k < len(fixed):
+                yaw, x, y = fixed[k]
+            else:
+                yaw = (np.pi / 2) * (k % 4)
+                x, y = rng.uniform(-1, 1, 2) * np.maximum(h_r[:2] - min(h_o[0], h_o[1]), 0)
+            pose = reg.pose @ translation(x, y, -h_r[2] + h_o[2] + ARM_PLACE_LIFT) @ rot_z(yaw)
+            if not inside(reg, body.shape, pose):
+                continue
+            probe = [(shape, pose)]
+            self.queries += 1
+            if self.world.probe_collides(probe, against="fixed"):
+                continue
+            if self.parked and self.world.probe_collides(probe, against="robots"):
+                continue
+            if avoid and self.world.probe_collides(probe, against=avoid):
+                continue
+            if vol is not None and posed_collide(Posed.of(probe), vol):
+                continue
+            yield pose
+
+    def crowded_out(
+        self, objs: Iterable[str], region: str, avoid: Iterable[str] = (), volume: Volume | None = None, key: str = ""
+    ) -> str | None:
+        """The first of ``objs`` that has no free pose left in ``region`` (the candidates and checks of a
+        packed :meth:`placements`: fixed objects, ``avoid``, ``volume``), or None when each has one; objects
+        already inside the region are not asked.  The reverse search asks it after grounding a placement
+        into a bin that objects placed *earlier* still have to reach: a placement whose approach and carry
+        sweep the whole bin leaves them none, and every grounding of an earlier step would then fail on it."""
+        avoid, reg = tuple(avoid), self.scene.body(region)
+        for obj in objs:
+            if self.late():
+                return None
+            if inside(reg, self.scene.body(obj).shape, self.poses[obj]):
+                continue
+            if next(self.placements(obj, region, avoid, volume, key=f"room:{key}", packed=True), None) is None:
+                return obj
+        return None
+
+    def comfortable(self, robot: str, obj: str, grasp: str, share: float = COMFORT) -> Callable[[np.ndarray], float]:
+        """A rank of placements of ``obj`` for ``robot`` holding it with ``grasp``: 0 where the end effector
+        lies within ``share`` of the arm's reach bound from the shoulder, else its distance from the shoulder
+        (nearer first).  A bin at the edge of an arm's reach is reachable in its near part only, and IK at
+        its far corners fails after every restart."""
+        arm = self.arm(robot) if not self.is_planar(robot) else None
+        spec = self.scene.grasp_specs.get(grasp)
+        if arm is None or spec is None:
+            return lambda pose: 0.0
+        g_t = grasp_transform(spec, self.scene.body(obj).shape)
+
+        def rank(pose: np.ndarray) -> float:
+            far = float(np.linalg.norm(arm.ee_target(pose @ g_t)[:3, 3] - arm.model.shoulder))
+            return 0.0 if far <= share * arm.model.reach else far
+
+        return rank
+
+
+def _packing_grid(room: np.ndarray, cells: int = 15) -> list[tuple[float, float, float]]:
+    """(yaw, x, y) over ``[-room, room]`` (region frame) on a grid of at most ``cells`` per side (at least 1 cm
+    apart), the four yaws at each point, points nearest a corner first."""
+    room = np.maximum(room, 0.0)
+    axes = [np.linspace(-r, r, max(1, min(cells, int(2 * r / 0.01) + 1))) for r in room]
+    scale = np.maximum(room, 1e-9)
+
+    def level(x: float, y: float) -> float:
+        return float(-round(abs(x) / scale[0] + abs(y) / scale[1], 9))  # numpy's round, as before
+
+    # the points of one level (the four corners, ...) at one yaw before the next yaw: a place that fails
+    # at one corner (out of reach) is tried at the others before another yaw
+    cands = [(level(float(x), float(y)), k, float(x), float(y)) for x in axes[0] for y in axes[1] for k in range(4)]
+    return [(k * np.pi / 2, x, y) for _, k, x, y in sorted(cands)]

@@ -304,7 +304,7 @@ def test_an_obstacle_with_no_reachable_place_in_its_region_is_parked_in_another(
     goal that r2 reaches (then goal bins with room left for their goals); the plan is valid."""
     from mrgc.planfile.format import file_sha256
     from mrgc.planner.search import plan_problem
-    from mrgc.planner.validate import validate
+    from mrgc.validator.validate import validate
 
     path = ROOT / "tests" / "data" / "park-packaging.mrg"
     problem = parse_file(path).problem()
@@ -331,7 +331,7 @@ def test_failures_say_whether_only_what_never_moves_explains_them(pa3: Grounder)
 
 
 def test_the_grounder_knows_where_each_arm_of_the_step_is_in_each_phase(pa3: Grounder) -> None:
-    """The execution model a plan means (docs/validator.md, planner/replay.py), as the grounding reads it:
+    """The execution model a plan means (docs/validator.md, validator/replay.py), as the grounding reads it:
     between its own motions an arm stands where its last motion left it; a missing transit (no path under
     the ``configurations`` model) is a jump at the end of its phase."""
     assert stance("pick-place", "to-handover") is stance("pick-place", "giver-home") is Stance.PICKED

@@ -25,7 +25,8 @@ from mrgc.geometry.collision import Posed, posed_collide
 from mrgc.geometry.conventions import APPROACH_SAMPLES, PATH_RESOLUTION, seed_for
 from mrgc.geometry.grasps import APPROACH, fits, grasp_transform, pregrasp_transform
 from mrgc.geometry.ik import solve_ik_many
-from mrgc.geometry.step_world import Pieces, Volume, named_body
+from mrgc.geometry.robot import Pieces, Volume
+from mrgc.geometry.step_world import named_body
 from mrgc.geometry.transforms import translation
 from mrgc.geometry.volumes import Volumes
 

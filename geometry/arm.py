@@ -9,14 +9,18 @@ whether the arm collides with itself (:meth:`Arm.self_collides`: the link pairs 
 from __future__ import annotations
 
 from functools import cached_property
+from typing import Mapping
 
 import numpy as np
 
 from mrgc.geometry.collision import CollisionShape, ConvexHull, PairCheck, collision_shape
 from mrgc.geometry.fk import ee_pose, fk_world
+from mrgc.geometry.grasps import finger_opening, grasp_transform
 from mrgc.geometry.kinematics import RobotModel, model_for_kind
+from mrgc.geometry.robot import Held, Rest, Volume
 from mrgc.geometry.scene import RobotSpec
 from mrgc.geometry.transforms import from_pose, inverse
+from mrgc.language.model import GraspSpec, Shape
 
 #: how far apart (m) the planner keeps two links of one arm that the self-collision rule does not exempt
 #: (:attr:`RobotModel.self_collision_pairs`).  The validator calls a self-collision a penetration deeper than
@@ -29,7 +33,16 @@ _HULLS: dict[str, dict[int, CollisionShape]] = {}
 
 
 class Arm:
-    """A fixed-base arm of a scene (one per robot; built once per process)."""
+    """A fixed-base arm of a scene (one per robot; built once per process): the ``fixed`` kind of
+    :class:`~mrgc.geometry.robot.Robot`.  Its configurations are joint vectors; it holds an object in its tool
+    frame, its fingers at the grasp's opening; it picks and places along an approach found by IK, and between
+    its motions stands where the execution model puts it."""
+
+    #: its pick and place are approaches found by IK (:attr:`Robot.approaches <mrgc.geometry.robot.Robot.approaches>`)
+    approaches = True
+    #: it stands where the execution model puts it, phase by phase (:attr:`Robot.parks
+    #: <mrgc.geometry.robot.Robot.parks>`)
+    parks = False
 
     def __init__(self, spec: RobotSpec) -> None:
         self.spec = spec
@@ -134,3 +147,51 @@ class Arm:
         return bool(
             np.linalg.norm(local - self.model.shoulder) <= self.model.reach + np.linalg.norm(self.tcp[:3, 3]) + margin
         )
+
+    def comfort(self, tool: np.ndarray, share: float) -> float:
+        """0 when the end effector for world tool pose ``tool`` lies within ``share`` of the reach bound from
+        the shoulder, else its distance from the shoulder (m): the far corners of a bin at the edge of the
+        reach fail IK after every restart."""
+        far = float(np.linalg.norm(self.ee_target(tool)[:3, 3] - self.model.shoulder))
+        return 0.0 if far <= share * self.model.reach else far
+
+    # ------------------------------------------------------------------ volumes (the Robot protocol)
+    def hold(self, shape: Shape, grasp: str, grasps: Mapping[str, GraspSpec]) -> tuple[float | None, np.ndarray]:
+        """The finger opening holding an object of ``shape`` with ``grasp`` and the object's pose in the tool
+        frame (the inverse grasp transform); KeyError for a grasp without geometry."""
+        spec = grasps[grasp]
+        return finger_opening(spec, shape), np.linalg.inv(grasp_transform(spec, shape))
+
+    def volume(
+        self, configs: np.ndarray, held: Held | None = None, opening: float | None = None
+    ) -> tuple[Volume, np.ndarray]:
+        """The probed link hulls at each of ``configs`` (C, dof), the fingers ``opening`` apart (None: fully
+        open), then the held object (shape, pose in the tool frame) at each; and the links' world transforms
+        ((C, L, 4, 4), for :meth:`self_collides_at`)."""
+        configs = np.atleast_2d(configs)
+        shapes, _ = self.probes
+        out: Volume = []
+        transforms = self.link_transforms(configs, opening)
+        for t in transforms:
+            out.extend(zip(shapes, t))
+        if held is not None:
+            shape, in_tool = held
+            for tool in self.tool_world(configs):
+                out.append((shape, tool @ in_tool))
+        return out, transforms
+
+    def volumes(self, configs: np.ndarray, held: Held | None = None, opening: float | None = None) -> list[Volume]:
+        """:meth:`volume` at each of ``configs`` separately (one volume per configuration: a motion's samples,
+        the held object after the links), from one batched forward kinematics."""
+        configs = np.atleast_2d(configs)
+        volume = self.volume(configs, held, opening)[0]
+        links = len(self.probes[0])
+        out = [volume[k * links : (k + 1) * links] for k in range(len(configs))]
+        if held is not None:  # the held object's pieces follow the links' (one per configuration)
+            for k, piece in enumerate(volume[links * len(configs) :]):
+                out[k].append(piece)
+        return out
+
+    def rest(self) -> Rest:
+        """The probed links at home (fingers fully open) and the mount's solid links (:attr:`base_hulls`)."""
+        return Rest(self.volume(self.home[None])[0], self.base_hulls)

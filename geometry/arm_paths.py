@@ -26,8 +26,9 @@ from mrgc.geometry.conventions import PATH_RESOLUTION, seed_for
 from mrgc.geometry.grasps import APPROACH
 from mrgc.geometry.ik import solve_ik_many
 from mrgc.geometry.motion import MAX_CHECKS, plan_joint_path
+from mrgc.geometry.robot import Pieces
 from mrgc.geometry.scene import half_extents
-from mrgc.geometry.step_world import Pieces, fingerprint
+from mrgc.geometry.step_world import fingerprint
 from mrgc.geometry.transforms import translation
 from mrgc.geometry.volumes import Volumes
 
@@ -381,7 +382,7 @@ class ArmPaths(Volumes):
         at each of ``configs``."""
         obj, grasp = held
         h = half_extents(self.scene.body(obj).shape)
-        poses = self.arm(robot).tool_world(configs) @ self._grip(obj, grasp)[1]
+        poses = self.arm(robot).tool_world(configs) @ self._grip(robot, obj, grasp)[1]
         out: np.ndarray = poses[:, 2, 3] - np.abs(poses[:, 2, :3]) @ h
         return out
 

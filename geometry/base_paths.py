@@ -17,8 +17,8 @@ from typing import Hashable, Iterable, Sequence
 import numpy as np
 
 from mrgc.geometry.answers import BUSY, Answer, GroundStatus
-from mrgc.geometry.collision import CollisionShape, Posed, posed_collide
-from mrgc.geometry.conventions import PATH_RESOLUTION, se2
+from mrgc.geometry.collision import CollisionShape, ConvexHull, Posed, posed_collide
+from mrgc.geometry.conventions import PATH_RESOLUTION
 from mrgc.geometry.lattice import Body, LatticePlanner, box_corners
 from mrgc.geometry.motion import MotionStatus
 from mrgc.geometry.planar import DiscGrid, scene_bounds
@@ -79,7 +79,7 @@ class BasePaths(Volumes):
         movers: list[str],
         busy: Sequence[tuple[CollisionShape, np.ndarray]],
     ) -> Answer:
-        others = [name for r, name in self.parked.items() if r != robot]
+        others = [name for r, names in self.parked.items() if r != robot for name in names]
         against = ("fixed", *others, *movers)
         ignore = (holding[0],) if holding else ()
         if robot not in self._grids:
@@ -96,7 +96,7 @@ class BasePaths(Volumes):
         sweep = self._busy(busy)
 
         pr = self.planar(robot)
-        carried = self._carried(robot, holding)
+        carried = self._held(robot, holding)
 
         def clear(q: np.ndarray, margin: float) -> bool:
             self.queries += 1
@@ -116,9 +116,9 @@ class BasePaths(Volumes):
             parts.append((body.shape, pr.carry_transform(body.shape, holding[1])))
         bodies: list[tuple[Hashable, Body, np.ndarray]] = [(b.name, b.shape, b.pose) for b in self.scene.fixed]
         bodies += [((a, self.poses[a].tobytes()), self.scene.body(a).shape, self.poses[a]) for a in movers]
-        for r in others:
-            other = self.planar(r.lstrip("@"))
-            bodies.append((r, other.footprint, se2(*other.start) @ other.lift))
+        for r, names in self.parked.items():  # the other parked robots where they wait
+            if r != robot:
+                bodies += [(name, _body(shape), t) for name, (shape, t) in zip(names, self.robot(r).rest().home)]
         bodies += [(("busy", pts.tobytes()), pts, np.eye(4)) for pts in _swept_hulls(busy)]
         lattice = self._lattices[robot]
         occupied = lattice.occupancy(parts, bodies)
@@ -154,3 +154,9 @@ def _swept_hulls(volume: Sequence[tuple[CollisionShape, np.ndarray]], chunk: int
             flushed.add(id(shape))
     out += [np.concatenate(run) for key, run in runs.items() if len(run) > 1 or key not in flushed]
     return out
+
+
+def _body(shape: CollisionShape) -> Body:
+    """A piece of a parked robot as the lattice reads it: its own geometry (a primitive's or a mesh's outline),
+    a hull by its collision shape."""
+    return shape if isinstance(shape.geometry, ConvexHull) else shape.geometry

@@ -12,12 +12,15 @@ grounds steps) and answers, each job in a module of its own:
   optionally holding an object, remembered: :mod:`mrgc.geometry.arm_paths`;
 - :meth:`~Grounder.base_path`: an SE(2) path for a planar robot, optionally carrying an object:
   :mod:`mrgc.geometry.base_paths`;
-- :meth:`~Grounder.arm_volume` / :meth:`~Grounder.base_volume`: the swept volume of configurations or a path,
-  and :meth:`~Grounder.hits`: which objects a volume overlaps: :mod:`mrgc.geometry.volumes`.
+- :meth:`~Grounder.volumes`: any robot's volume at each configuration of a motion (:meth:`~Grounder.arm_volume`:
+  an arm's, its self-collision checked by :meth:`~Grounder.free_volume`), and :meth:`~Grounder.hits`: which
+  objects a volume overlaps: :mod:`mrgc.geometry.volumes`.
 
-What they share (the scene as moved, the robots at home and where the step's arms stand, the run's deadline,
-the caches) is :class:`~mrgc.geometry.step_world.StepWorld`; what every query answers is
-:mod:`mrgc.geometry.answers`, and the execution model the queries keep to is :mod:`mrgc.geometry.stances`.
+What they share (the scene as moved, the robots -- :meth:`~Grounder.robot`, each a
+:class:`~mrgc.geometry.robot.Robot` of its kind's class, asked, never tested for its kind -- at home and where
+the step's arms stand, the run's deadline, the caches) is :class:`~mrgc.geometry.step_world.StepWorld`; what
+every query answers is :mod:`mrgc.geometry.answers`, and the execution model the queries keep to is
+:mod:`mrgc.geometry.stances`.
 Every answer carries a status; failures are values, never exceptions.  Seeds derive from the query, so the
 same queries in the same order give the same answers.
 """

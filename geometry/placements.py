@@ -21,9 +21,10 @@ from mrgc.geometry.answers import Answer, GroundStatus
 from mrgc.geometry.collision import Posed, posed_collide
 from mrgc.geometry.conventions import ARM_PLACE_LIFT, lattice_offsets, seed_for
 from mrgc.geometry.grasps import grasp_transform
+from mrgc.geometry.robot import Volume
 from mrgc.geometry.scene import Body as SceneBody
 from mrgc.geometry.scene import half_extents, inside
-from mrgc.geometry.step_world import StepWorld, Volume
+from mrgc.geometry.step_world import StepWorld
 from mrgc.geometry.transforms import rot_z, translation
 from mrgc.language.model import Box
 
@@ -138,21 +139,17 @@ class Placements(StepWorld):
         return None
 
     def comfortable(self, robot: str, obj: str, grasp: str, share: float = COMFORT) -> Callable[[np.ndarray], float]:
-        """A rank of placements of ``obj`` for ``robot`` holding it with ``grasp``: 0 where the end effector
-        lies within ``share`` of the arm's reach bound from the shoulder, else its distance from the shoulder
-        (nearer first).  A bin at the edge of an arm's reach is reachable in its near part only, and IK at
-        its far corners fails after every restart."""
-        arm = self.arm(robot) if not self.is_planar(robot) else None
+        """A rank of placements of ``obj`` for ``robot`` holding it with ``grasp``: its :meth:`Robot.comfort
+        <mrgc.geometry.robot.Robot.comfort>` of the tool pose (an arm: 0 where the end effector lies within
+        ``share`` of its reach bound from the shoulder, else its distance from the shoulder, nearer first; a
+        bin at the edge of an arm's reach is reachable in its near part only, and IK at its far corners fails
+        after every restart).  0 everywhere for a grasp without geometry."""
         spec = self.scene.grasp_specs.get(grasp)
-        if arm is None or spec is None:
+        if spec is None:
             return lambda pose: 0.0
+        mover = self.robot(robot)
         g_t = grasp_transform(spec, self.scene.body(obj).shape)
-
-        def rank(pose: np.ndarray) -> float:
-            far = float(np.linalg.norm(arm.ee_target(pose @ g_t)[:3, 3] - arm.model.shoulder))
-            return 0.0 if far <= share * arm.model.reach else far
-
-        return rank
+        return lambda pose: mover.comfort(pose @ g_t, share)
 
 
 def _packing_grid(room: np.ndarray, cells: int = 15) -> list[tuple[float, float, float]]:

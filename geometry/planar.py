@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import math
 from functools import cached_property
+from typing import Mapping
 
 import numpy as np
 
@@ -45,9 +46,10 @@ from mrgc.geometry.collision import CollisionShape, ConvexHull, collision_shape
 from mrgc.geometry.conventions import PLANAR_LIFT, lattice_offsets, se2, to_se2, yaw_of
 from mrgc.geometry.lattice import box_corners
 from mrgc.geometry.planar_grasps import carry_transform, grasp_base
+from mrgc.geometry.robot import Held, Rest, Volume
 from mrgc.geometry.scene import Body, RobotSpec, SceneSpec, half_extents, inside, outline
 from mrgc.geometry.transforms import rot_z, translation
-from mrgc.language.model import Box, Cylinder, Shape
+from mrgc.language.model import Box, Cylinder, GraspSpec, Shape
 
 #: placements tried per region: a GRID × GRID lattice, centre first (each at four yaws)
 PLACEMENT_GRID = 5
@@ -55,13 +57,17 @@ PLACEMENT_GRID = 5
 PLACEMENT_YAWS = (0.0, 90.0, 180.0, 270.0)
 
 
-def is_planar(spec: RobotSpec) -> bool:
-    """Whether the robot has a planar (driven) base."""
-    return spec.kind.base == "planar"
-
-
 class PlanarRobot:
-    """A planar mobile robot of a scene: footprint, grasp geometry and carried-object poses."""
+    """A planar mobile robot of a scene: footprint, grasp geometry and carried-object poses; the ``planar``
+    kind of :class:`~mrgc.geometry.robot.Robot`.  Its configurations are base poses ``(x, y, yaw)``; it
+    carries an object at its carry pose in its base frame; it picks and places from the base pose the grasp
+    geometry gives, drives every motion as a path and waits parked at its start pose between them."""
+
+    #: it picks and places from the one base pose the grasp gives (:attr:`Robot.approaches
+    #: <mrgc.geometry.robot.Robot.approaches>`)
+    approaches = False
+    #: parked at its start pose between its drives (:attr:`Robot.parks <mrgc.geometry.robot.Robot.parks>`)
+    parks = True
 
     def __init__(self, spec: RobotSpec) -> None:
         if spec.kind.footprint is None:
@@ -74,6 +80,11 @@ class PlanarRobot:
         #: the footprint's frame relative to the base frame
         self.lift = translation(0.0, 0.0, float(self.half[2]) + PLANAR_LIFT)
         self.start = to_se2(spec.base)
+
+    @property
+    def home(self) -> np.ndarray:
+        """Its start pose ``(x, y, yaw)``: where every action drives from and back to."""
+        return self.start
 
     @cached_property
     def radius(self) -> float:
@@ -110,6 +121,27 @@ class PlanarRobot:
     def grasp_base(self, pose: np.ndarray, shape: Shape, grasp: str) -> np.ndarray:
         """The base pose ``(x, y, yaw)`` from which the robot picks (or places) an object at ``pose``."""
         return grasp_base(self.spec.kind, pose, shape, grasp)
+
+    # ------------------------------------------------------------------ the Robot protocol
+    def hold(self, shape: Shape, grasp: str, grasps: Mapping[str, GraspSpec]) -> tuple[float | None, np.ndarray]:
+        """No fingers, and the carried object's pose in the base frame (:meth:`carry_transform`)."""
+        return None, self.carry_transform(shape, grasp)
+
+    def volumes(self, configs: np.ndarray, held: Held | None = None, opening: float | None = None) -> list[Volume]:
+        """The footprint (and the carried object) at each base pose of ``configs`` (:meth:`probe`)."""
+        return [self.probe(q, held) for q in np.atleast_2d(configs)]
+
+    def rest(self) -> Rest:
+        """The footprint at its start pose (nothing of a cart is bolted in place)."""
+        return Rest(self.probe(self.start)[:1])
+
+    def in_reach(self, point: np.ndarray, margin: float = 0.0) -> bool:
+        """Always: a cart drives to what it handles (whether it gets there is its path's question)."""
+        return True
+
+    def comfort(self, tool: np.ndarray, share: float) -> float:
+        """0: no reach bound ranks a cart's placements."""
+        return 0.0
 
 
 def _reach(shape: CollisionShape, t: np.ndarray) -> float:

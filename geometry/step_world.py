@@ -6,10 +6,14 @@ volumes).  This module holds what they share:
 
 - **the scene** with the movable objects where the grounding has put them (:meth:`StepWorld.move`,
   :meth:`StepWorld.moved`: the reverse search moves objects as it grounds steps), as a collision world;
-- **the robots**: each arm's links at home (group ``home:<arm>``) and its mount (``base:<arm>``), planar robots
-  parked at their start pose (group ``robots``), and where each arm of the step being grounded is in each
-  phase (:meth:`StepWorld.step`, the execution model of :mod:`mrgc.geometry.stances`, and
-  :meth:`StepWorld.standing`), which every query keeps clear of (:meth:`StepWorld._others`);
+- **the robots**, each made once through the kinds' table (:meth:`StepWorld.robot`: a
+  :class:`~mrgc.geometry.robot.Robot`, asked, never tested for its kind) and what it leaves in the world
+  (:meth:`Robot.rest <mrgc.geometry.robot.Robot.rest>`): a robot that parks (a planar robot) waits at home,
+  group ``robots``, an obstacle to every query; any other (an arm) is at home (group ``home:<robot>``) in the
+  phases the execution model puts it there, its mount (``base:<robot>``) always; where each arm of the step
+  being grounded is in each phase (:meth:`StepWorld.step`, the execution model of
+  :mod:`mrgc.geometry.stances`, and :meth:`StepWorld.standing`) is what every query keeps clear of
+  (:meth:`StepWorld._others`);
 - **the run's deadline** (:attr:`StepWorld.deadline`, a ``time.perf_counter()`` value;
   ``benchmarks/cpu_plan.py`` swaps that clock for CPU time): every long loop reads it (placements, IK
   attempts, handover pairs, lifts, transfers, transits, RRT solves, lattice searches), and past it the query
@@ -28,21 +32,18 @@ from __future__ import annotations
 import hashlib
 import time
 from contextlib import contextmanager
-from typing import Iterable, Iterator, Mapping, Sequence
+from typing import Iterable, Iterator, Mapping
 
 import numpy as np
 
 from mrgc.geometry.answers import Answer
 from mrgc.geometry.arm import Arm
 from mrgc.geometry.collision import CollisionShape, Posed, collision_shape, scene_world
-from mrgc.geometry.conventions import to_se2
-from mrgc.geometry.planar import PlanarRobot, is_planar
+from mrgc.geometry.kinds import robot_for
+from mrgc.geometry.planar import PlanarRobot
+from mrgc.geometry.robot import Pieces, Robot, Volume
 from mrgc.geometry.scene import SceneSpec
 from mrgc.geometry.stances import Stance, stance
-
-Volume = list[tuple[CollisionShape, np.ndarray]]  # shapes at world transforms
-#: a volume as the queries read it (what other robots sweep meanwhile, ``busy``): any sequence of pieces
-Pieces = Sequence[tuple[CollisionShape, np.ndarray]]
 
 #: path answers (transfers, base paths) remembered per grounder
 REMEMBERED = 4096
@@ -56,25 +57,28 @@ class StepWorld:
         self.seed = seed
         self.world = scene_world(scene)
         self.poses = {b.name: b.pose.copy() for b in scene.movable}
-        self._arms: dict[str, Arm] = {}
-        self._planar: dict[str, PlanarRobot] = {}
+        self._robots: dict[str, Robot] = {}
         self._paths: dict[tuple[object, ...], Answer] = {}
         #: volumes (V_fut, what the step's other robots sweep, ``after``) as the collision kernel reads them
         self._volumes = _VolumeCache()
-        # planar robots wait at their start pose (as the validator assumes): obstacles for the others
-        self.parked: dict[str, str] = {}
+        #: robots that park (:attr:`Robot.parks <mrgc.geometry.robot.Robot.parks>`: planar robots) wait at home
+        #: (their start pose, as the validator assumes), obstacles for the others: robot -> its world bodies
+        #: there, group ``robots``
+        self.parked: dict[str, tuple[str, ...]] = {}
         for spec in scene.robots:
-            if is_planar(spec):
-                pr = self.planar(spec.name)
-                shape, pose = pr.probe(to_se2(spec.base))[0]
-                self.parked[spec.name] = f"@{spec.name}"
-                self.world.add(f"@{spec.name}", shape, pose, "robots")
+            robot = self.robot(spec.name)
+            if robot.parks:
+                home = robot.rest().home
+                names = tuple(f"@{spec.name}" + (f":{i}" if i else "") for i in range(len(home)))
+                for name, (shape, pose) in zip(names, home):
+                    self.world.add(name, shape, pose, "robots")
+                self.parked[spec.name] = names
         self.queries = 0
         #: the run's deadline (``time.perf_counter()``; None: none), and whether it has cut a query short
         self.deadline: float | None = None
         self.cut = False
-        #: arms wait at home while others move (the validator's rule): each arm's links at home, group
-        #: ``home:<arm>``, an obstacle to the other arms' motions
+        #: the other robots (arms) wait at home while others move (the validator's rule): each one's volume at
+        #: home, group ``home:<robot>``, an obstacle to the other arms' motions in the phases it is there
         self.homes: tuple[str, ...] = ()
         #: each arm's mount links (its base), group ``base:<arm>``: an obstacle to the other arms, home or not
         self._bases: tuple[str, ...] = ()
@@ -91,20 +95,20 @@ class StepWorld:
             self.cut = True
         return self.cut
 
-    def _arm_homes(self) -> tuple[str, ...]:
-        """Put every arm's links at home into the world (once) and name their groups."""
+    def _homes(self) -> tuple[str, ...]:
+        """Put every robot that does not park at home into the world (once; its :meth:`Robot.rest
+        <mrgc.geometry.robot.Robot.rest>`: an arm's links) and name their groups."""
         if not self.homes:
-            for spec in self.scene.robots:
-                if not is_planar(spec):
-                    arm = self.arm(spec.name)
-                    links = zip(arm.probes[0], arm.link_transforms(arm.home[None])[0])  # fingers fully open
-                    for i, (shape, t) in enumerate(links):
-                        self.world.add(f"@{spec.name}:{i}", shape, t, f"home:{spec.name}")
-                    for j, (_, shape, t) in enumerate(arm.base_hulls):  # bolted in place: there, home or not
-                        self.world.add(f"@{spec.name}:base" + (f":{j}" if j else ""), shape, t, f"base:{spec.name}")
-                    if arm.base_hulls:
-                        self._bases += (f"base:{spec.name}",)
-            self.homes = tuple(f"home:{s.name}" for s in self.scene.robots if not is_planar(s))
+            staying = [s.name for s in self.scene.robots if not self.robot(s.name).parks]
+            for name in staying:
+                rest = self.robot(name).rest()
+                for i, (shape, t) in enumerate(rest.home):
+                    self.world.add(f"@{name}:{i}", shape, t, f"home:{name}")
+                for j, (_, shape, t) in enumerate(rest.mount):  # bolted in place: there, home or not
+                    self.world.add(f"@{name}:base" + (f":{j}" if j else ""), shape, t, f"base:{name}")
+                if rest.mount:
+                    self._bases += (f"base:{name}",)
+            self.homes = tuple(f"home:{name}" for name in staying)
         return self.homes
 
     def step(self, roles: Mapping[str, str], full: bool = False) -> None:
@@ -135,7 +139,7 @@ class StepWorld:
         role = self._roles.get(robot)
         if role is None:
             return Stance.HOME
-        return stance(role, phase, self._full or self.is_planar(robot))
+        return stance(role, phase, self._full or self.robot(robot).parks)
 
     @contextmanager
     def standing(self, robot: str, where: Mapping[Stance, Volume]) -> Iterator[None]:
@@ -175,7 +179,7 @@ class StepWorld:
         at home, or where :meth:`standing` put them (an arm that moves then is in the query's ``busy``; one
         whose place is not known yet is left out), and every other arm's base link."""
         out = []
-        for home in self._arm_homes():
+        for home in self._homes():
             other = home[5:]
             if other == robot:
                 continue
@@ -186,21 +190,27 @@ class StepWorld:
                 out.append(self._stands[other][where][0])
         return tuple(out) + tuple(b for b in self._bases if b != f"base:{robot}")
 
+    def robot(self, robot: str) -> Robot:
+        """The robot ``robot`` (:class:`~mrgc.geometry.robot.Robot`, of its kind's class), made once."""
+        if robot not in self._robots:
+            self._robots[robot] = robot_for(self.scene.robot(robot))
+        return self._robots[robot]
+
     def arm(self, robot: str) -> Arm:
-        """The arm ``robot`` (its model, home and probes), made once."""
-        if robot not in self._arms:
-            self._arms[robot] = Arm(self.scene.robot(robot))
-        return self._arms[robot]
+        """The arm ``robot``, for the arms' own queries (approaches, arm paths: :meth:`robot` as an
+        :class:`~mrgc.geometry.arm.Arm`)."""
+        out = self.robot(robot)
+        if not isinstance(out, Arm):
+            raise TypeError(f"robot {robot!r} is not an arm")
+        return out
 
     def planar(self, robot: str) -> PlanarRobot:
-        """The planar robot ``robot``, made once."""
-        if robot not in self._planar:
-            self._planar[robot] = PlanarRobot(self.scene.robot(robot))
-        return self._planar[robot]
-
-    def is_planar(self, robot: str) -> bool:
-        """Whether ``robot`` is a planar (mobile) robot rather than an arm."""
-        return is_planar(self.scene.robot(robot))
+        """The planar robot ``robot``, for the planar robots' own queries (base paths, drives: :meth:`robot` as
+        a :class:`~mrgc.geometry.planar.PlanarRobot`)."""
+        out = self.robot(robot)
+        if not isinstance(out, PlanarRobot):
+            raise TypeError(f"robot {robot!r} is not a planar robot")
+        return out
 
     def move(self, obj: str, pose: np.ndarray) -> None:
         """Put ``obj`` at ``pose`` (world) for all later queries."""

@@ -28,11 +28,11 @@ from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action
 from mrgc.geometry.answers import BUSY, SELF, Answer, GroundStatus
 from mrgc.geometry.collision import Posed, paired_collide, pieces_collide
-from mrgc.geometry.conventions import refine, to_se2
+from mrgc.geometry.conventions import refine
 from mrgc.geometry.grounding import Grounder
 from mrgc.geometry.relays import spot_region
+from mrgc.geometry.robot import Volume
 from mrgc.geometry.stances import PHASES, Stance
-from mrgc.geometry.step_world import Volume
 from mrgc.language.model import Box
 from mrgc.planfile.format import PlannedAction
 from mrgc.planner.outcome import DeadlineReached, Failure
@@ -375,46 +375,38 @@ class ReverseGrounder:
         return GroundedStep(actions, step_volume, tuple(a.obj for a in step))
 
     def _motions(self, action: PlannedAction) -> Motions:
-        """Each robot's volume at every sample of every phase of a planned action, arm approaches on the
-        validator's finer interpolation (so later placements keep clear between samples too)."""
+        """Each robot's volume at every sample of every phase of a planned action, approaches on the
+        validator's finer interpolation (so later placements keep clear between samples too).  A robot that
+        picks and places from the one state grasp geometry gives (not :attr:`Robot.approaches
+        <mrgc.geometry.robot.Robot.approaches>`: a planar robot) makes no motion in those phases."""
         g, obj = self.g, action.object
         out: Motions = {}
-        if g.is_planar(action.pick_robot):
-            carried = {"to-pick": None, "to-place": (obj, action.pick_grasp), "home": None}
-            out[action.pick_robot] = {
-                ph: [g.base_volume(action.pick_robot, [q], carried[ph]) for q in np.array(path)]
-                for ph, path in action.paths.items()
-            }
-            return out
-        out.setdefault(action.pick_robot, {})["pick"] = g.arm_volumes(
-            action.pick_robot, refine(np.array(action.configs["pick"])), grasp=(obj, action.pick_grasp)
-        )
+        approach = g.robot(action.pick_robot).approaches
+        if approach:
+            out.setdefault(action.pick_robot, {})["pick"] = g.volumes(
+                action.pick_robot, refine(np.array(action.configs["pick"])), fingers=(obj, action.pick_grasp)
+            )
         if "handover" in action.configs:
             giver, taker = np.array(action.configs["handover"])
-            out[action.pick_robot]["handover"] = [
-                g.arm_volume(action.pick_robot, giver[None], (obj, action.pick_grasp))
-            ]
-            out.setdefault(action.place_robot, {})["handover"] = [
-                g.arm_volume(action.place_robot, taker[None], (obj, action.place_grasp))
-            ]
-        # the paths (every configuration: they are already at the validator's resolution); holding the
-        # object on the transfers, empty-handed otherwise (fingers fully open, a giver's as it let go)
-        for phase, robot, grasp, holds in (
-            ("to-handover", action.pick_robot, action.pick_grasp, True),
-            ("to-place", action.place_robot, action.place_grasp, True),
-            ("to-pick", action.pick_robot, None, False),
-            ("taker-to-handover", action.place_robot, None, False),
-            ("home", action.place_robot, None, False),
-            ("giver-home", action.pick_robot, action.pick_grasp, False),
-        ):
-            if phase in action.paths:
-                grip = (obj, grasp) if grasp is not None else None
-                out.setdefault(robot, {})[PATH_PHASE.get(phase, phase)] = g.arm_volumes(
-                    robot, np.array(action.paths[phase]), holding=grip if holds else None, grasp=grip
-                )
-        out.setdefault(action.place_robot, {})["place"] = g.arm_volumes(
-            action.place_robot, refine(np.array(action.configs["place"])), (obj, action.place_grasp)
-        )
+            out.setdefault(action.pick_robot, {})["handover"] = g.volumes(
+                action.pick_robot, giver[None], (obj, action.pick_grasp)
+            )
+            out.setdefault(action.place_robot, {})["handover"] = g.volumes(
+                action.place_robot, taker[None], (obj, action.place_grasp)
+            )
+        # the paths, in the order grounded (every configuration: they are already at the validator's
+        # resolution); holding the object on the transfers, empty-handed otherwise (fingers fully open, a
+        # giver's as it let go)
+        for phase, path in action.paths.items():
+            robot, grasp, holds = _path_of(action, phase)
+            grip = (obj, grasp) if grasp is not None else None
+            out.setdefault(robot, {})[PATH_PHASE.get(phase, phase)] = g.volumes(
+                robot, np.array(path), holding=grip if holds else None, fingers=grip
+            )
+        if approach:
+            out.setdefault(action.place_robot, {})["place"] = g.volumes(
+                action.place_robot, refine(np.array(action.configs["place"])), (obj, action.place_grasp)
+            )
         return out
 
     def _standing(self, action: PlannedAction, robot: str) -> dict[Stance, Volume]:
@@ -439,9 +431,7 @@ class ReverseGrounder:
     def _volume_at(self, robot: str, q: list[float], grip: tuple[str, str], held: bool) -> Volume:
         """``robot`` at configuration (or base pose) ``q``, holding ``grip`` (object, grasp) or, with its
         fingers at the grasp's opening, not."""
-        if self.g.is_planar(robot):
-            return self.g.base_volume(robot, [np.array(q)], grip if held else None)
-        return self.g.arm_volume(robot, np.array(q)[None], holding=grip if held else None, grasp=grip)
+        return self.g.volumes(robot, np.array(q)[None], holding=grip if held else None, fingers=grip)[0]
 
     def _stood(self, action: PlannedAction) -> Motions:
         """Each robot of a planned action standing still away from home: one volume per phase it stands in."""
@@ -472,7 +462,7 @@ class ReverseGrounder:
         placed: dict[str, np.ndarray] | None = None,
         busy: dict[str, Volume] | None = None,
     ) -> PlannedAction | Failure:
-        if self.g.is_planar(a.pick_robot):
+        if not self.g.robot(a.pick_robot).approaches:  # it picks from where grasp geometry puts it: it drives
             return self._drive(a, avoid, v_fut, key, placed or {}, busy or {})
         g, busy = self.g, busy or {}
         after = self._after(busy, a.pick_robot, Stance.PICKED)
@@ -740,7 +730,7 @@ class ReverseGrounder:
             return Failure(0, "", "planar robots do not hand over")  # no such facts are computed
         pr = g.planar(robot)
         shape = g.scene.body(a.obj).shape
-        home = to_se2(g.scene.robot(robot).base)
+        home = pr.home
         q_pick = pr.grasp_base(g.poses[a.obj], shape, a.pick_grasp)
         # the drive to the pick keeps clear of the object too: the robot stops in front of it
         to_pick = g.base_path(robot, home, q_pick, avoid=[*avoid, a.obj], busy=busy.get("to-pick", []))
@@ -906,6 +896,20 @@ def _spot_key(pose: np.ndarray) -> tuple[float, ...]:
 def _failed(what: str, answer: Answer) -> Failure:
     """A failure of a geometric query: its status as the check, the objects that were in the way as bodies."""
     return Failure(0, "", f"{what}: {answer.status.value}", tuple(sorted(answer.blockers)), answer.detail)
+
+
+def _path_of(action: PlannedAction, phase: str) -> tuple[str, str | None, bool]:
+    """Whose a path of ``action`` is, the grasp its fingers are at (None: fully open) and whether it holds the
+    object: the transfers hold it, the transits are empty-handed (a giver's fingers as it let go)."""
+    table = {
+        "to-handover": (action.pick_robot, action.pick_grasp, True),
+        "to-place": (action.place_robot, action.place_grasp, True),
+        "to-pick": (action.pick_robot, None, False),
+        "taker-to-handover": (action.place_robot, None, False),
+        "home": (action.place_robot, None, False),
+        "giver-home": (action.pick_robot, action.pick_grasp, False),
+    }
+    return table[phase]
 
 
 def _swept_by_others(motions: Motions, robots: tuple[str, ...]) -> dict[str, Volume]:

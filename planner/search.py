@@ -296,7 +296,7 @@ def _cycles_with_evidence(source: SkeletonSource, grounder: Grounder, per_edge: 
         edges = []
         for obj, blocker, _, actions in cycle:
             picks = sorted({(a.pick_robot, a.pick_grasp) for a in actions})[:per_edge]
-            if grounder.is_planar(picks[0][0]):
+            if not grounder.robot(picks[0][0]).approaches:  # no approach to show the obstruction on
                 how = ", ".join(f"{g} by {r}" for r, g in picks)
             else:
                 how = "; ".join(pick_obstruction(grounder, r, obj, g, blocker) for r, g in picks)

@@ -141,12 +141,12 @@ def test_base_path_for_a_planar_robot() -> None:
     problem = parse_file(ROOT / "domains" / "box-moving" / "bo-doorway.mrg").problem()
     g = Grounder(scene_from_problem(problem), seed=0)
     robot = problem.robots[0].name
-    assert g.is_planar(robot)
+    assert g.robot(robot).parks and not g.robot(robot).approaches  # a cart
     start = to_se2(g.scene.robot(robot).base)
     goal = start + np.array([0.3, 0.0, 0.0])
     res = g.base_path(robot, start, goal)
     assert res.ok and np.allclose(res.path[-1], goal, atol=1e-6)
-    assert g.hits(g.base_volume(robot, res.path), among="fixed") == set()
+    assert g.hits([p for v in g.volumes(robot, np.array(res.path)) for p in v], among="fixed") == set()
 
 
 def test_same_queries_same_answers() -> None:
@@ -404,7 +404,7 @@ def test_arm_volumes_are_the_volumes_of_each_configuration(pa3: Grounder) -> Non
     arm = pa3.arm("r1")
     configs = arm.home[None] + np.linspace(0, 0.3, 4)[:, None]
     for holding in (None, ("o1", "top")):
-        batched = pa3.arm_volumes("r1", configs, holding=holding, grasp=("o1", "top"))
+        batched = pa3.volumes("r1", configs, holding=holding, fingers=("o1", "top"))
         for q, volume in zip(configs, batched):
             one = pa3.arm_volume("r1", q[None], holding=holding, grasp=("o1", "top"))
             assert [s for s, _ in volume] == [s for s, _ in one]
@@ -425,7 +425,7 @@ def test_a_base_path_blocked_only_by_another_robot_of_the_step_says_so() -> None
     g = Grounder(scene_from_problem(parse_file(DOORWAY).problem()), seed=0)
     aside = {"door": translation(-2.0, 0.0, 0.15), "front": translation(-2.0, -0.5, 0.15)}
     start, goal = to_se2(g.scene.robot("r1").base), np.array([1.5, 0.0, 0.0])
-    r2_in_doorway = g.base_volume("r2", [np.array([0.0, 0.0, 0.0])])
+    (r2_in_doorway,) = g.volumes("r2", np.array([[0.0, 0.0, 0.0]]))
     with g.moved(aside):
         assert g.base_path("r1", start, goal).ok
         blocked = g.base_path("r1", start, goal, busy=r2_in_doorway)

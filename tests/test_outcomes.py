@@ -226,8 +226,8 @@ class ScriptedGrounder:
         self.steps: list[list[str]] = []
         self.cut = False  # no query of the script stops at a deadline
 
-    def is_planar(self, robot: str) -> bool:
-        return False
+    def robot(self, robot: str) -> Any:
+        return SimpleNamespace(approaches=True, parks=False)  # the script's robots are arms
 
     def step(self, roles: Any, full: bool = False) -> None:
         self.steps.append(sorted(roles))  # the script has no arms at home: only the step's robots are recorded
@@ -301,8 +301,8 @@ class ScriptedGrounder:
     def arm_volume(self, robot: str, configs: np.ndarray, holding: Any = None, grasp: Any = None) -> list[Any]:
         return [(f"arm:{robot}:{holding[0] if holding else ''}", None)]
 
-    def arm_volumes(self, robot: str, configs: np.ndarray, holding: Any = None, grasp: Any = None) -> list[Any]:
-        return [self.arm_volume(robot, configs, holding, grasp)]  # one token volume for the whole motion
+    def volumes(self, robot: str, configs: np.ndarray, holding: Any = None, fingers: Any = None) -> list[Any]:
+        return [self.arm_volume(robot, configs, holding, fingers)]  # one token volume for the whole motion
 
     def shape(self, obj: str) -> str:
         return f"shape:{obj}"

@@ -159,27 +159,23 @@ class ArmPaths(Volumes):
             phase,
             self._presence(),
         ) + fingerprint([start, goal, *poses], busy)
-        if key not in self._paths:
-            answer = self._transfer(robot, obj, grasp, start, goal, avoid, lift, busy, lower, phase)
-            self._remember(key, answer)
-            return answer
-        return self._paths[key]
+        return self._remembered(
+            key, lambda: self._transfer(robot, (obj, grasp), (start, goal), avoid, lift, busy, lower, phase)
+        )
 
     def _transfer(
         self,
         robot: str,
-        obj: str,
-        grasp: str,
-        start: np.ndarray,
-        goal: np.ndarray,
-        avoid: Iterable[str] = (),
-        lift: bool = False,
-        busy: Pieces = (),
-        lower: bool = False,
-        phase: str = "to-place",
+        held: tuple[str, str],
+        ends: tuple[np.ndarray, np.ndarray],
+        avoid: tuple[str, ...],
+        lift: bool,
+        busy: Pieces,
+        lower: bool,
+        phase: str,
     ) -> Answer:
-        """How ``robot`` carries ``obj`` (held with ``grasp``) from configuration ``start`` to ``goal``: when
-        ``lift`` (``start`` grasps the object where it rests), first straight up by :meth:`lift_height`
+        """How ``robot`` carries ``held`` (object, grasp) between ``ends``, configuration ``start`` to ``goal``:
+        when ``lift`` (``start`` grasps the object where it rests), first straight up by :meth:`lift_height`
         (tool poses every centimetre, each by IK from the one before; as far as the way up is free); then the
         straight joint-space line (the validator's reading of a plan that gives no transfer) or, when that line
         collides, an RRTConnect path (a budget of checks, seeded from the query); with ``lower``, that
@@ -189,7 +185,7 @@ class ArmPaths(Volumes):
         robots do meanwhile).
         ``path`` is every configuration, ``start`` first, no joint moving more than
         :data:`PATH_RESOLUTION` between two; ``blockers`` the avoided objects in the way."""
-        held = (obj, grasp)
+        (obj, grasp), (start, goal) = held, ends
         others = tuple(a for a in avoid if a != obj)
         against = ("fixed", *self._others(robot, phase), *others)
         moving = self._busy(busy)

@@ -59,16 +59,17 @@ class BasePaths(Volumes):
         query (same obstacles at the same poses) gets the same answer, and the search never asks twice."""
         movers = sorted({a for a in avoid if not holding or a != holding[0]})
         key = (robot, holding, tuple(movers), *fingerprint([start, goal, *(self.poses[a] for a in movers)], busy))
-        if key not in self._paths:
+
+        def ask() -> Answer:
             answer = self._base_path(robot, start, goal, holding, movers, busy)
             if answer.status is GroundStatus.NO_PATH and busy and not self.cut:
                 # no path: is it the step's other robots (a path exists without them) or the scene?
                 alone = self.base_path(robot, start, goal, holding, avoid, ())
                 if alone.ok:
                     answer = Answer(GroundStatus.NO_PATH, detail=BUSY)
-            self._remember(key, answer)
             return answer
-        return self._paths[key]
+
+        return self._remembered(key, ask)
 
     def _base_path(
         self,

@@ -32,7 +32,7 @@ from __future__ import annotations
 import hashlib
 import time
 from contextlib import contextmanager
-from typing import Iterable, Iterator, Mapping
+from typing import Callable, Iterable, Iterator, Mapping
 
 import numpy as np
 
@@ -237,6 +237,15 @@ class StepWorld:
     def _busy(self, volume: Pieces) -> Posed | None:
         """What other robots of a step sweep meanwhile (``busy``) as the kernel reads it (None: nothing)."""
         return self._volumes.posed(volume) if volume else None
+
+    def _remembered(self, key: tuple[object, ...], ask: Callable[[], Answer]) -> Answer:
+        """The path answer remembered for ``key`` (a query's names and :func:`fingerprint`), else ``ask()``'s,
+        remembered (:meth:`_remember`): the same question gets the same answer without a second search."""
+        if key not in self._paths:
+            answer = ask()
+            self._remember(key, answer)
+            return answer
+        return self._paths[key]
 
     def _remember(self, key: tuple[object, ...], answer: Answer) -> None:
         """Keep a path answer, forgetting the oldest beyond :data:`REMEMBERED` (insertion order: the same

@@ -35,6 +35,7 @@ from mrgc.geometry.robot import Volume
 from mrgc.geometry.stances import PHASES, Stance
 from mrgc.language.model import Box
 from mrgc.planfile.format import PlannedAction
+from mrgc.planner.doomed import DoomedActions
 from mrgc.planner.outcome import DeadlineReached, Failure
 
 PLACEMENT_TRIES = 6  # placements sampled per place before the step gives up
@@ -124,6 +125,17 @@ class ReverseGrounder:
         self._dead_spots: set[tuple[str, str, str, tuple[float, ...]]] = set()
         #: the skeleton being grounded, its actions as re-timed so far (see :class:`_Retiming`)
         self._plan = _Retiming([], None)
+        #: actions found doomed before the later steps are grounded (planner/doomed.py)
+        self.doomed = DoomedActions(
+            grounder,
+            goal,
+            lambda a: [a.region] + ([] if a.obj in goal else self._parking(a)),
+            PLACEMENT_TRIES + OUT_OF_REACH_TRIES,
+            self._dead_spots,
+            _spot_key,
+            self._on_time,
+            label,
+        )
 
     def ground(
         self, skeleton: Skeleton, suffix: list[GroundedStep], key: str = "", order: Order | None = None
@@ -152,6 +164,9 @@ class ReverseGrounder:
         volume: Volume = [p for s in suffix for p in s.volume]
         grounded: list[GroundedStep] = []
         self._plan = _Retiming([list(step) for step in skeleton.steps], order)
+        doomed = self.doomed.first(skeleton, fut_objs, suffix, volume)
+        if doomed is not None:
+            return self._plan.told(Grounding(Outcome.FAIL, reason=doomed.line(), failures=[doomed]))
         for t in range(skeleton.makespan - 1, -1, -1):
             step = tuple(self._plan.steps[t])
             self.grounded = set(fut_objs)
@@ -352,6 +367,7 @@ class ReverseGrounder:
                 timed = self._action(a, avoid_a, v_fut + step_volume, f"{key}:{a.obj}", placed, {})
                 action = action if isinstance(timed, Failure) else timed
             if isinstance(action, Failure):
+                self.doomed.failed(a, action)
                 if action.detail == BUSY:  # name the step's robots in the way, and what they carry
                     action = replace(action, bodies=_others_of(actions, a))
                 return replace(action, step=index, action=label(a))

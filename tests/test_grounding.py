@@ -502,3 +502,37 @@ def test_retiming_moves_an_action_to_the_latest_earlier_step_its_order_constrain
     free.rollback((0, 0))
     assert free.steps[3] == [x] and free.mark() == (0, 0) != mark
     assert not _Retiming([[a], [x]], None).retime(x, 2)  # no order constraints known: no re-timing
+
+
+def test_an_action_doomed_by_what_never_moves_fails_before_the_later_steps(pa3: Grounder) -> None:
+    """planner/doomed.py: r1 cannot reach bin-b.  The first grounding of a skeleton putting o1 there in step 1
+    grounds step 2 first and then fails at step 1; once that part has failed, a skeleton holding it is probed
+    before its later steps are grounded, and fails at the same step with the same check without grounding them."""
+    reverse = ReverseGrounder(pa3, {"o1": "bin-b"})
+    skel = Skeleton(
+        (
+            (Action("o1", "bin-b", "r1", "r1", "top", "top"),),
+            (Action("o2", "bin-a", "r1", "r1", "top", "top"),),
+        )
+    )
+    picked: list[str] = []
+    pick = pa3.pick
+
+    def counted(robot: str, obj: str, *args: object, **kwargs: object) -> object:
+        picked.append(obj)
+        return pick(robot, obj, *args, **kwargs)  # type: ignore[arg-type]
+
+    pa3.pick = counted  # type: ignore[method-assign]
+    first = reverse.ground(skel, [], key="1")
+    assert "o2" in picked  # step 2 was grounded first
+    picked.clear()
+    assert first.outcome is Outcome.FAIL and first.failures, first.reason
+    assert (first.failures[0].step, first.failures[0].check) == (1, "place by r1: no inverse kinematics")
+    second = reverse.ground(skel, [], key="2")
+    assert second.outcome is Outcome.FAIL and second.failures
+    assert (second.failures[0].step, second.failures[0].check) == (1, "place by r1: no inverse kinematics")
+    assert second.failures[0].detail == "probed before the later steps"
+    assert "o2" not in picked  # step 2 was not grounded
+    # an action the probe finds placeable is grounded as before: o2 into bin-a alone succeeds
+    alone = reverse.ground(Skeleton(((Action("o2", "bin-a", "r1", "r1", "top", "top"),),)), [], key="3")
+    assert alone.outcome is Outcome.SUCCESS, alone.reason

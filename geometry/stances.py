@@ -1,6 +1,6 @@
 """The execution model a plan means, as the grounding reads it: the phases of a step and where each arm is.
 
-A step runs in the :data:`PHASES` (docs/validator.md, "What a plan means"; planner/replay.py replays them).
+A step runs in the :data:`PHASES` (docs/validator.md, "What a plan means"; validator/replay.py replays them).
 Each arm of the step has a role in its action (``pick-place``, ``giver`` or ``taker``), and its role fixes
 its :class:`Stance` in every phase (:data:`STANCES`): at home, moving, or standing still where its last motion
 left it.  Every arm starts the step at home; an arm in no action of the step stays there.  Its empty-handed
@@ -34,7 +34,7 @@ class Stance(str, enum.Enum):
     PLACED = "at its release"
 
 
-#: **The execution model a plan means** (docs/validator.md; planner/replay.py replays it), the one place
+#: **The execution model a plan means** (docs/validator.md; validator/replay.py replays it), the one place
 #: the grounding reads it from: an arm's stance in each phase of :data:`PHASES`, by its role in its action,
 #: under the ``configurations`` motion model.  Every arm starts the step at home; between its own motions it
 #: stands where its last motion left it, its fingers as that motion left them; an arm in no action of the

@@ -1,12 +1,13 @@
 """The scene of a geometric problem as plain, picklable data: what is where, in world coordinates.
 
-A :class:`SceneSpec` is built once from a checked geometric :class:`~mrgc.language.model.Problem`; worker
+A :class:`SceneSpec` is built once per checked geometric :class:`~mrgc.language.model.Problem`; worker
 processes rebuild their own collision worlds and robot models from it (one pybullet client per process).
 """
 
 from __future__ import annotations
 
 import os
+import weakref
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -78,10 +79,33 @@ class SceneSpec:
         return next(r for r in self.robots if r.name == name)
 
 
+#: the scene of each problem object alive (keyed by identity; an entry goes when its problem does)
+_SCENES: dict[int, SceneSpec] = {}
+
+
 def scene_from_problem(problem: Problem) -> SceneSpec:
     """The scene of a geometric problem (InputError E402 for a symbolic one).  A fixed-base robot kind
     without ``:tcp`` gets the one derived from its URDF (:mod:`mrgc.geometry.tcp`), so every user of the
-    scene (phase 1, grounding, the validator, the pictures) grasps at the same point."""
+    scene (phase 1, grounding, the validator, the pictures) grasps at the same point.
+
+    Built once per problem object: the layout checks, phase 1, the planning method, the referee and the
+    summary of one ``mrgc plan`` share it (the problem and the scene are immutable: the dataclasses are
+    frozen and every pose array is read-only)."""
+    hit = _SCENES.get(id(problem))
+    if hit is not None:
+        return hit
+    scene = _build(problem)
+    _SCENES[id(problem)] = scene
+    weakref.finalize(problem, _SCENES.pop, id(problem), None)
+    return scene
+
+
+def _frozen(a: np.ndarray) -> np.ndarray:
+    a.setflags(write=False)
+    return a
+
+
+def _build(problem: Problem) -> SceneSpec:
     if problem.symbolic:
         raise InputError(
             [Diagnostic("E402", f"problem '{problem.name}' is symbolic: it has no geometry", problem.span)]
@@ -95,14 +119,15 @@ def scene_from_problem(problem: Problem) -> SceneSpec:
     for r in problem.robots:
         assert r.kind is not None and r.base is not None  # guaranteed by the checks of a geometric problem
         kind = kinds[r.kind]
-        robots.append(RobotSpec(r.name, kind, from_pose(r.base), os.path.dirname(os.path.abspath(kind.source))))
+        base = _frozen(from_pose(r.base))
+        robots.append(RobotSpec(r.name, kind, base, os.path.dirname(os.path.abspath(kind.source))))
     return SceneSpec(
         problem=problem.name,
         robots=tuple(robots),
-        fixed=tuple(Body(o.name, o.shape, from_pose(o.pose)) for o in problem.fixed if o.shape and o.pose),
-        movable=tuple(Body(o.name, o.shape, from_pose(o.pose)) for o in problem.movable if o.shape and o.pose),
-        regions=tuple(Body(o.name, o.shape, from_pose(o.pose)) for o in problem.regions if o.shape and o.pose),
-        handover_points={h.name: np.array(h.position) for h in problem.handover_points if h.position},
+        fixed=tuple(Body(o.name, o.shape, _frozen(from_pose(o.pose))) for o in problem.fixed if o.shape and o.pose),
+        movable=tuple(Body(o.name, o.shape, _frozen(from_pose(o.pose))) for o in problem.movable if o.shape and o.pose),
+        regions=tuple(Body(o.name, o.shape, _frozen(from_pose(o.pose))) for o in problem.regions if o.shape and o.pose),
+        handover_points={h.name: _frozen(np.array(h.position)) for h in problem.handover_points if h.position},
         grasps={m.name: problem.grasps_of(m.name) for m in problem.movable},
         handover_of={m.name: m.handover_points for m in problem.movable},
         goal=problem.goal_regions,

@@ -124,3 +124,34 @@ def test_the_verbose_timing_line_shows_what_the_method_recorded() -> None:
     ap2 = {"seconds": 2.8, "facts_seconds": 0.8, "task_seconds": 0.02, "task_plans": 1, "groundings": 2}
     assert _timing_line(ap2) == "  2.80 s: facts 0.80 s, task plans 0.02 s; 1 task plans, 2 grounded"
     assert _timing_line({"seconds": 0.1, "facts_seconds": 0.0}) == "  0.10 s: facts 0.00 s"
+
+
+def test_the_scene_is_built_once_per_problem(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Issue 25 ("built once"): the layout checks, phase 1, the method, the referee and the summary of one run
+    share the problem's scene, which is immutable (poses read-only)."""
+    import numpy as np
+
+    import mrgc
+    from mrgc.geometry import scene as scene_module
+
+    built: list[str] = []
+    build = scene_module._build
+
+    def counted(problem: Any) -> Any:
+        built.append(problem.name)
+        return build(problem)
+
+    monkeypatch.setattr(scene_module, "_build", counted)
+    problem = mrgc.load_problem(ROOT / "domains" / "packaging" / "pa3-handover.mrg")
+    plan = mrgc.plan(problem, seed=0, time_limit=120)
+    assert plan.status is mrgc.PlanStatus.SOLVED, plan.summary()
+    assert built == ["pa3-handover"]
+    scene = scene_module.scene_from_problem(problem)
+    assert scene is scene_module.scene_from_problem(problem) and built == ["pa3-handover"]
+    with pytest.raises(ValueError):
+        scene.movable[0].pose[0, 3] = 1.0
+    assert not any(b.pose.flags.writeable for b in (*scene.movable, *scene.fixed, *scene.regions))
+    # another problem object (parsed again) gets its own scene, equal in content
+    again = scene_module.scene_from_problem(mrgc.load_problem(ROOT / "domains" / "packaging" / "pa3-handover.mrg"))
+    assert again is not scene and built == ["pa3-handover", "pa3-handover"]
+    assert all(np.array_equal(a.pose, b.pose) for a, b in zip(again.movable, scene.movable))

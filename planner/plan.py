@@ -13,7 +13,7 @@ import json
 from dataclasses import dataclass, field, replace
 from typing import Any
 
-from mrgc.planfile.format import SCHEMA, MotionModel, PlannedAction
+from mrgc.planfile.format import SCHEMA, MotionModel, PlanFile, PlannedAction, Step
 from mrgc.planner.outcome import PlanStatus, Why
 
 
@@ -105,6 +105,29 @@ class Plan:
             **({"why": self.why.to_json()} if self.why is not None else {}),
             "stats": self.stats,
         }
+
+    def as_file(self) -> PlanFile:
+        """The plan as the typed values its file holds -- what reading :meth:`to_json` back gives
+        (:func:`mrgc.planfile.reader.read_plan`), without the JSON text or the schema check: how the referee
+        hands a candidate plan to the validator inside a search (the file, written once at the end, is
+        checked against the schema where it is written and read)."""
+        return PlanFile(
+            schema=SCHEMA,
+            mrgc_version=self.mrgc_version,
+            problem=self.problem,
+            problem_file=self.problem_file,
+            problem_sha256=self.problem_sha256,
+            backend=self.backend,
+            encoding=self.encoding,
+            seed=self.seed,
+            status=str(self.status),
+            symbolic=self.symbolic,
+            makespan=self.makespan if self.steps else None,
+            motion_cost=self.motion_cost if self.steps else None,
+            steps=tuple(Step(i, tuple(step), tuple(self._waiting(step))) for i, step in enumerate(self.steps, 1)),
+            motion_model=None if self.symbolic else (self.motion_model or planner_motion_model()),
+            problem_digest=self.problem_digest,
+        )
 
     def _waiting(self, step: list[PlannedAction]) -> list[str]:
         busy = {r for a in step for r in a.robots()}

@@ -4,8 +4,10 @@ complete plan a method finds before the method may call it solved.
 A rejection is counted (``why.rejected_plans``) and returned as a :class:`~mrgc.planner.outcome.Failure`
 named by the validator's first violation; the method treats it as a grounding failure like any other.  The
 referee judges a plan against the problem object it was made for (no file need exist: a problem parsed from
-a string is planned too); ``mrgc validate`` checks the file's digest besides.  The first violation is the
-verdict, so the replay stops there.
+a string is planned too); ``mrgc validate`` checks the file's digest besides.  The candidate goes to the
+validator as the typed values of a plan file (:meth:`~mrgc.planner.plan.Plan.as_file`), not as JSON text
+checked against the schema again for every candidate.  The first violation is the verdict, so the replay
+stops there.
 """
 
 from __future__ import annotations
@@ -37,7 +39,7 @@ class Referee:
         t0 = time.perf_counter()
         robots = [r.name for r in self.problem.robots]
         candidate = self.plan.candidate(steps, robots, symbolic=self.problem.symbolic)
-        report = validate(self.problem, candidate.to_json(), None, first_only=True)
+        report = validate(self.problem, candidate.as_file(), None, first_only=True)
         self.seconds += time.perf_counter() - t0
         self.checked += 1
         if report.ok:

@@ -118,7 +118,7 @@ def run(base: FactBase, must: list[str], backend: str, encoding: str, limit: flo
     out: dict[str, float | None] = {}
     have = 0
     for label, k in (("first", 1), ("k10", 10), ("k50", 50)):
-        batch = src.next(k - have, time_limit=limit)
+        batch = src.next(k - have, deadline=time.perf_counter() + limit)
         have += len(batch.skeletons)
         if batch.outcome == "time limit":
             out[label] = None

@@ -113,10 +113,11 @@ class SkeletonGenerator:
         self.stats["build_seconds"] += time.perf_counter() - t0
         self.stats["models"] += 1
 
-    def next(self, k: int, time_limit: float | None = None) -> Batch:
+    def next(self, k: int, deadline: float | None = None) -> Batch:
         """Up to ``k`` further skeletons, in (makespan, moved) order (after a :meth:`defer`, within the
-        skeletons without the deferred actions, then within the others)."""
-        deadline = None if time_limit is None else time.perf_counter() + time_limit
+        skeletons without the deferred actions, then within the others).  ``deadline``: a
+        ``time.perf_counter()`` instant (None: none), the one deadline type the planner passes down; each
+        solve is given the seconds left, the unit of the solvers' own time limits."""
         out: list[Skeleton] = []
         if self.trivial and not self.done:
             self.done = True

@@ -181,10 +181,10 @@ class _Skeletons:
         self.outcome: BatchOutcome | None = None
 
     def __call__(self, k: int) -> list[Skeleton]:
-        left = max(0.01, self.deadline - time.perf_counter())
         gen = self.source.generator
         gen.defer(self.deferrals.among(gen.graph.actions))
-        batch = self.source.next(k, time_limit=left)
+        # past the search's deadline a source still gets one 10 ms try (a symbolic problem's first skeleton)
+        batch = self.source.next(k, deadline=max(self.deadline, time.perf_counter() + 0.01))
         for skel in batch.skeletons:
             self.graphs.setdefault(skel, gen.graph)
         self.count += len(batch.skeletons)

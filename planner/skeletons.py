@@ -135,9 +135,10 @@ class SkeletonSource:
         if self.reasons:
             self.generator.done = True
 
-    def next(self, k: int, time_limit: float | None = None) -> Batch:
-        """Up to ``k`` further skeletons, in (makespan, moved) order."""
-        return self.generator.next(k, time_limit)
+    def next(self, k: int, deadline: float | None = None) -> Batch:
+        """Up to ``k`` further skeletons, in (makespan, moved) order, by ``deadline`` (a ``time.perf_counter()``
+        instant; None: none)."""
+        return self.generator.next(k, deadline)
 
 
 def compile_problem(
@@ -156,11 +157,11 @@ def compile_problem(
     base = FactBase.from_problem(problem, fact_list)
     source = SkeletonSource(base, must_move(problem, fact_list), (), backend, encoding, max_makespan, seed)
     t0 = time.perf_counter()
-    batch = source.next(min(1, skeletons), time_limit)  # the first alone, to time it; then the rest
+    deadline = None if time_limit is None else t0 + time_limit
+    batch = source.next(min(1, skeletons), deadline)  # the first alone, to time it; then the rest
     first = time.perf_counter() - t0 + source.graph_seconds if batch.skeletons else None
     if skeletons > 1 and batch.outcome is BatchOutcome.ENOUGH:
-        left = None if time_limit is None else time_limit - (time.perf_counter() - t0)
-        more = source.next(skeletons - 1, left) if left is None or left > 0 else Batch([], BatchOutcome.TIME_LIMIT)
+        more = source.next(skeletons - 1, deadline)
         batch = Batch(batch.skeletons + more.skeletons, more.outcome, more.message, more.stats or batch.stats)
     stats: dict[str, Any] = {
         "objects": len(source.graph.objects),

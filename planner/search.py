@@ -132,6 +132,7 @@ def _search(context: Context, sources: _Sources, deadline: float) -> Result:
     stats["iterations"] = result.iterations
     stats["geometric_queries"] = grounder.queries
     stats["deferred"] = sorted(describe(p) for p in sources.deferrals.deferred)
+    stats["doomed_skeletons"] = reverse.doomed.doomed  # failed by a probe before their later steps (doomed.py)
     stats.update(timing.of(result.steps))
     if out.status is PlanStatus.TIME_LIMIT and result.ended == "iteration limit":
         out.summary = f"the search's iteration limit ({o['max_iterations']}) was reached before a plan was found"

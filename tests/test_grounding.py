@@ -533,6 +533,7 @@ def test_an_action_doomed_by_what_never_moves_fails_before_the_later_steps(pa3: 
     assert (second.failures[0].step, second.failures[0].check) == (1, "place by r1: no inverse kinematics")
     assert second.failures[0].detail == "probed before the later steps"
     assert "o2" not in picked  # step 2 was not grounded
+    assert reverse.doomed.doomed == 1  # the search's statistics count it (``doomed_skeletons``)
     # an action the probe finds placeable is grounded as before: o2 into bin-a alone succeeds
     alone = reverse.ground(Skeleton(((Action("o2", "bin-a", "r1", "r1", "top", "top"),),)), [], key="3")
     assert alone.outcome is Outcome.SUCCESS, alone.reason

@@ -9,6 +9,7 @@ are status values on result objects.
 
 from __future__ import annotations
 
+import stat
 from dataclasses import dataclass, field
 from typing import Iterable, NamedTuple, Sequence
 
@@ -135,3 +136,18 @@ class InternalError(MrgcError):
     """A bug in mrgc; reported without a traceback and exit code 70."""
 
     exit_code = ExitCode.INTERNAL
+
+
+def file_kind(mode: int) -> str:
+    """What a file of ``st_mode`` ``mode`` that is not a regular file is ("a folder", "a FIFO", ...), for the
+    messages that refuse it: an input (:mod:`mrgc.language.files`) or an output (:mod:`mrgc.outputs`)."""
+    for test, name in (
+        (stat.S_ISDIR, "a folder"),
+        (stat.S_ISFIFO, "a FIFO"),
+        (stat.S_ISCHR, "a character device"),
+        (stat.S_ISBLK, "a block device"),
+        (stat.S_ISSOCK, "a socket"),
+    ):
+        if test(mode):
+            return name
+    return "a special file"  # pragma: no cover

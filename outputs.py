@@ -32,7 +32,7 @@ import tempfile
 from typing import BinaryIO, Iterable, Iterator
 
 from mrgc import signals
-from mrgc.errors import Diagnostic, InputError, InternalError
+from mrgc.errors import Diagnostic, InputError, InternalError, file_kind
 
 #: the error codes of this module (docs/errors.md)
 E_IS_INPUT = "E005"
@@ -73,7 +73,7 @@ def check_output(path: str, inputs: Iterable[str] = (), *, option: str = "-o") -
         if not stat.S_ISREG(st.st_mode):
             raise _refuse(
                 E_UNWRITABLE,
-                f"{option} {path}: is not a regular file ({_kind(st.st_mode)}); "
+                f"{option} {path}: is not a regular file ({file_kind(st.st_mode)}); "
                 f"leave out {option} to write to standard output",
             )
         me = (st.st_dev, st.st_ino)
@@ -91,18 +91,6 @@ def check_output(path: str, inputs: Iterable[str] = (), *, option: str = "-o") -
     if not os.access(folder, os.W_OK | os.X_OK):
         raise _refuse(E_UNWRITABLE, f"{option} {path}: folder {os.path.dirname(path) or '.'} is not writable")
     return real
-
-
-def _kind(mode: int) -> str:
-    for test, name in (
-        (stat.S_ISFIFO, "a FIFO"),
-        (stat.S_ISCHR, "a character device"),
-        (stat.S_ISBLK, "a block device"),
-        (stat.S_ISSOCK, "a socket"),
-    ):
-        if test(mode):
-            return name
-    return "a special file"  # pragma: no cover
 
 
 def write_text(path: str, text: str, inputs: Iterable[str] = (), *, option: str = "-o") -> None:

@@ -10,6 +10,8 @@ from __future__ import annotations
 import os
 import stat
 
+from mrgc.errors import file_kind
+
 
 class FileTooLarge(OSError):
     """A file above the size limit of the reader (``size``: its size in bytes)."""
@@ -23,19 +25,6 @@ class NotRegularFile(OSError):
     """A path that names a FIFO, a device, a socket or a folder instead of a regular file."""
 
 
-def _kind_of_file(mode: int) -> str:
-    for test, name in (
-        (stat.S_ISDIR, "a folder"),
-        (stat.S_ISFIFO, "a FIFO"),
-        (stat.S_ISCHR, "a character device"),
-        (stat.S_ISBLK, "a block device"),
-        (stat.S_ISSOCK, "a socket"),
-    ):
-        if test(mode):
-            return name
-    return "not a regular file"  # pragma: no cover
-
-
 def read_regular(path: str, limit: int) -> bytes:
     """The bytes of the regular file ``path`` (at most ``limit``, else :class:`FileTooLarge`).
 
@@ -47,7 +36,7 @@ def read_regular(path: str, limit: int) -> bytes:
     try:
         st = os.fstat(fd)
         if not stat.S_ISREG(st.st_mode):
-            what = _kind_of_file(st.st_mode)
+            what = file_kind(st.st_mode)
             raise NotRegularFile(0, "Is a directory" if what == "a folder" else f"not a regular file: {what}", path)
         if st.st_size > limit:
             raise FileTooLarge(path, st.st_size)

@@ -39,6 +39,9 @@ def pair(a, ta, b, tb) -> bool:
 
 
 CUBE_POINTS = np.array(list(itertools.product([-0.5, 0.5], repeat=3)))
+#: the unit cube's twelve triangles, two a side, as an OBJ file lists them (1-based indices into CUBE_POINTS)
+CUBE_FACES = [(1, 2, 4), (1, 4, 3), (5, 7, 8), (5, 8, 6), (1, 5, 6), (1, 6, 2)]
+CUBE_FACES += [(3, 4, 8), (3, 8, 7), (1, 3, 7), (1, 7, 5), (2, 6, 8), (2, 8, 4)]
 
 
 # --------------------------------------------------------------------------------------- pairs
@@ -147,20 +150,7 @@ def test_nearly_flat_clouds_do_not_crash_qhull() -> None:
 
 def test_mesh_file(tmp_path: Path) -> None:
     corners = list(itertools.product([-0.5, 0.5], repeat=3))
-    faces = [
-        (1, 2, 4),
-        (1, 4, 3),
-        (5, 7, 8),
-        (5, 8, 6),
-        (1, 5, 6),
-        (1, 6, 2),
-        (3, 4, 8),
-        (3, 8, 7),
-        (1, 3, 7),
-        (1, 7, 5),
-        (2, 6, 8),
-        (2, 8, 4),
-    ]
+    faces = CUBE_FACES
     obj = tmp_path / "cube.obj"
     lines = [f"v {x} {y} {z}" for x, y, z in corners] + [f"f {a} {b} {c}" for a, b, c in faces]
     obj.write_text("\n".join(lines) + "\n")
@@ -372,20 +362,7 @@ class MeshFiles:
 
     def box(self, size: np.ndarray) -> tuple[Box, Mesh, np.ndarray]:
         corners = CUBE_POINTS * size
-        faces = [
-            (1, 2, 4),
-            (1, 4, 3),
-            (5, 7, 8),
-            (5, 8, 6),
-            (1, 5, 6),
-            (1, 6, 2),
-            (3, 4, 8),
-            (3, 8, 7),
-            (1, 3, 7),
-            (1, 7, 5),
-            (2, 6, 8),
-            (2, 8, 4),
-        ]
+        faces = CUBE_FACES
         return Box(*size), self.write(corners, faces), corners
 
     def hull(self, seed: int, axes: np.ndarray) -> tuple[ConvexHull, Mesh, np.ndarray]:

@@ -81,17 +81,23 @@ def test_handover_and_place(pa3: Grounder) -> None:
     assert pa3.place("r1", "o1", "top", target.pose).status is GroundStatus.NO_IK
 
 
-def test_transfer_lifts_then_carries_to_the_pre_place(pa3: Grounder) -> None:
-    """The held object's transfer starts at the grasp, rises 8 cm straight up, ends at the pre-place, moves no
-    joint more than 1 cm-rad between configurations, and (past its first centimetre, where the object
-    leaves the table it rests on) keeps the arm and the object clear of the table."""
+def _carry_to_the_exchange(pa3: Grounder) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """r1 picks o1 (avoiding o2 and o3) and carries it, lifted, to its configuration of the exchange at h1:
+    the pick's configurations, the handover's and the transfer's path."""
     pick = pa3.pick("r1", "o1", "top", avoid=["o2", "o3"])
     hand = pa3.handover("o1", "h1", "r1", "top", "r2", "side-x+")
     assert pick.ok and pick.configs is not None and hand.ok and hand.configs is not None
     carry = pa3.transfer("r1", "o1", "top", pick.configs[-1], hand.configs[0], avoid=["o2", "o3"], lift=True)
     assert carry.ok
-    path = np.array(carry.path)
-    assert np.allclose(path[0], pick.configs[-1]) and np.allclose(path[-1], hand.configs[0])
+    return pick.configs, hand.configs, np.array(carry.path)
+
+
+def test_transfer_lifts_then_carries_to_the_pre_place(pa3: Grounder) -> None:
+    """The held object's transfer starts at the grasp, rises 8 cm straight up, ends at the pre-place, moves no
+    joint more than 1 cm-rad between configurations, and (past its first centimetre, where the object
+    leaves the table it rests on) keeps the arm and the object clear of the table."""
+    picked, exchanged, path = _carry_to_the_exchange(pa3)
+    assert np.allclose(path[0], picked[-1]) and np.allclose(path[-1], exchanged[0])
     assert np.abs(np.diff(path, axis=0)).max() <= 0.01 + 1e-9
     arm = pa3.arm("r1")
     z = arm.tool_world(path)[:, 2, 3]
@@ -166,12 +172,7 @@ def test_a_transfer_lifts_the_object_clear_of_taller_neighbours(pa3: Grounder) -
     pa3.move("o3", pa3.poses["o3"] @ translation(0, 0, 0.50))
     assert pa3.lift_height("o1") == pytest.approx(0.30)  # at most MAX_LIFT
     pa3.move("o3", pa3.scene.body("o3").pose)
-    pick = pa3.pick("r1", "o1", "top", avoid=["o2", "o3"])
-    hand = pa3.handover("o1", "h1", "r1", "top", "r2", "side-x+")
-    assert pick.ok and pick.configs is not None and hand.ok and hand.configs is not None
-    carry = pa3.transfer("r1", "o1", "top", pick.configs[-1], hand.configs[0], avoid=["o2", "o3"], lift=True)
-    assert carry.ok
-    path = np.array(carry.path)
+    path = _carry_to_the_exchange(pa3)[2]
     arm = pa3.arm("r1")
     z = arm.tool_world(path)[:, 2, 3]
     rise = next(i for i, h in enumerate(z) if h >= z[0] + 0.23 - 1e-4)

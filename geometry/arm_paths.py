@@ -233,24 +233,35 @@ class ArmPaths(Volumes):
         over = self._over(robot, held, back[-1], tail[0])
         if over is not None and hits(over) is None:
             return Answer(GroundStatus.OK, path=[*back, *over[1:], *tail[1:]])
-        line = joint_line(np.stack([back[-1], tail[0]]), PATH_RESOLUTION)
-        blocked = hits(line)
-        if blocked is None:
-            return Answer(GroundStatus.OK, path=[*back, *line[1:], *tail[1:]])
+        middle, blocked = self._line_or_path(robot, (back[-1], tail[0]), hits, (others, busy, phase), holding=held)
+        if not middle:
+            return Answer(GroundStatus.NO_PATH, blockers=blocked or set(), detail=BUSY if crossed[0] else "")
+        return Answer(GroundStatus.OK, path=[*back, *middle[1:], *tail[1:]])
+
+    def _line_or_path(
+        self,
+        robot: str,
+        ends: tuple[np.ndarray, np.ndarray],
+        blocked: Callable[[np.ndarray], set[str] | None],
+        motion: tuple[tuple[str, ...], Pieces, str],
+        holding: tuple[str, str] | None = None,
+        fingers: tuple[str, str] | None = None,
+    ) -> tuple[list[np.ndarray], set[str] | None]:
+        """How a transfer or a transit of ``robot`` moves between ``ends`` (configurations): the straight
+        joint-space line at :data:`PATH_RESOLUTION` when ``blocked`` finds it free (None), else an RRTConnect
+        path (:meth:`arm_path`, a budget of :data:`TRANSFER_CHECKS`) avoiding ``motion``'s objects, free of its
+        busy pieces, among the other arms where they stand in its phase; ``holding`` and ``fingers`` as for
+        :meth:`arm_path`.  The configurations (empty when neither is free) and what ``blocked`` found on the
+        line."""
+        line = joint_line(np.stack(ends), PATH_RESOLUTION)
+        hit = blocked(line)
+        if hit is None:
+            return list(line), None
+        avoid, busy, phase = motion
         planned = self.arm_path(
-            robot,
-            back[-1],
-            tail[0],
-            holding=held,
-            avoid=others,
-            resolution=PATH_RESOLUTION,
-            busy=busy,
-            phase=phase,
-            max_checks=TRANSFER_CHECKS,
+            robot, *ends, holding, avoid, TRANSFER_CHECKS, PATH_RESOLUTION, busy, phase=phase, fingers=fingers
         )
-        if not planned.ok:
-            return Answer(GroundStatus.NO_PATH, blockers=blocked, detail=BUSY if crossed[0] else "")
-        return Answer(GroundStatus.OK, path=[*back, *planned.path[1:], *tail[1:]])
+        return (planned.path if planned.ok else []), hit
 
     def _descent(
         self, robot: str, goal: np.ndarray, height: float, hits: Callable[[np.ndarray], set[str] | None]
@@ -313,29 +324,20 @@ class ArmPaths(Volumes):
                 return False
             return not self.world.probe_collides(posed, against=against)
 
+        def blocked(configs: np.ndarray) -> set[str] | None:
+            return None if free(configs) else set()
+
         if retreat is not None:
             start = np.asarray(start, dtype=float)
-            via = self._straight(robot, start, APPROACH, lambda c: None if free(c) else set(), retreat)
+            via = self._straight(robot, start, APPROACH, blocked, retreat)
         back = joint_line(np.asarray(via if via is not None else [start], dtype=float), PATH_RESOLUTION)
         if not free(back):
             return Answer(GroundStatus.COLLISION)
-        line = joint_line(np.stack([back[-1], np.asarray(goal, dtype=float)]), PATH_RESOLUTION)
-        if free(line):
-            return Answer(GroundStatus.OK, path=[*back, *line[1:]])
-        planned = self.arm_path(
-            robot,
-            back[-1],
-            np.asarray(goal, dtype=float),
-            avoid=tuple(avoid),
-            resolution=PATH_RESOLUTION,
-            busy=busy,
-            max_checks=TRANSFER_CHECKS,
-            phase=phase,
-            fingers=fingers,
-        )
-        if not planned.ok:
+        ends = (back[-1], np.asarray(goal, dtype=float))
+        middle, _ = self._line_or_path(robot, ends, blocked, (tuple(avoid), busy, phase), fingers=fingers)
+        if not middle:
             return Answer(GroundStatus.NO_PATH)
-        return Answer(GroundStatus.OK, path=[*back, *planned.path[1:]])
+        return Answer(GroundStatus.OK, path=[*back, *middle[1:]])
 
     def lift_height(self, obj: str, start: bool = False, goal: tuple[str, str, np.ndarray] | None = None) -> float:
         """How far to raise ``obj`` straight up from where it rests before carrying it off: until its bottom

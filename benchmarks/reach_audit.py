@@ -75,11 +75,12 @@ def main(argv: list[str] | None = None) -> int:
     from mrgc import parse_file
     from mrgc.geometry.arm import Arm
     from mrgc.geometry.grasps import APPROACH, fits, grasp_transform, pregrasp_transform
+    from mrgc.geometry.kinds import approaches
     from mrgc.geometry.scene import scene_from_problem
     from mrgc.geometry.transforms import translation
 
     scene = scene_from_problem(parse_file(args.problem).problem())
-    arms = [Arm(spec) for spec in scene.robots if spec.kind.base != "planar"]
+    arms = [Arm(spec) for spec in scene.robots if approaches(spec.kind)]
     unreachable = []
     for obj in args.objects:
         body = scene.body(obj)

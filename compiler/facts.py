@@ -49,9 +49,7 @@ class FactBase:
             goal=problem.goal_regions,
             facts=problem.init if facts is None else facts,
             handover_capacity=None if problem.symbolic else len(problem.handover_points),
-            drivers=[
-                r.name for r in problem.robots if r.kind is not None and problem.domain.kind(r.kind).base == "planar"
-            ],
+            drivers=[r.name for r in problem.robots if r.kind is not None and problem.domain.kind(r.kind).driven],
         )
 
     @classmethod

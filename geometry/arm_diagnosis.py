@@ -55,7 +55,9 @@ def arm_diagnostics(problem: Problem) -> list[Diagnostic]:
     """W274, W275 and W276 (module docstring) for the fixed-base robots of ``problem``, in declaration
     order; none for a symbolic problem or when a robot's model cannot be loaded (E400/E401 are reported
     where the model is needed)."""
-    if problem.symbolic or not any(k.base != "planar" for k in problem.domain.robot_kinds):
+    from mrgc.geometry.kinds import approaches
+
+    if problem.symbolic or not any(approaches(k) for k in problem.domain.robot_kinds):
         return []
     return list(_cached(problem))
 
@@ -64,11 +66,12 @@ def arm_diagnostics(problem: Problem) -> list[Diagnostic]:
 def _cached(problem: Problem) -> tuple[Diagnostic, ...]:
     from mrgc.geometry.arm import Arm
     from mrgc.geometry.collision import scene_world
+    from mrgc.geometry.kinds import approaches
     from mrgc.geometry.scene import scene_from_problem
 
     try:  # a model or a mesh that cannot be loaded is reported where it is needed, not as a diagnosis here
         scene = scene_from_problem(problem)
-        arms = [Arm(spec) for spec in scene.robots if spec.kind.base != "planar"]
+        arms = [Arm(spec) for spec in scene.robots if approaches(spec.kind)]
         world = scene_world(scene)
     except InputError:
         return ()

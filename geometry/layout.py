@@ -77,12 +77,13 @@ def tcp_diagnostics(problem: Problem) -> list[Diagnostic]:
     """W273 for each arm kind used by the problem that has no ``:tcp`` and none can be derived from its URDF
     (:mod:`mrgc.geometry.tcp`); a URDF that cannot be found or read, or lacks the end-effector link, is left
     to ``mrgc facts`` (E400/E401)."""
+    from mrgc.geometry.kinds import approaches
     from mrgc.geometry.tcp import derive_tcp
 
     used = {r.kind for r in problem.robots}
     out = []
     for kind in problem.domain.robot_kinds:
-        if kind.name not in used or kind.base != "fixed" or kind.tcp is not None or arm_joints(kind) is None:
+        if kind.name not in used or not approaches(kind) or kind.tcp is not None or arm_joints(kind) is None:
             continue
         if derive_tcp(kind) is None:
             out.append(
@@ -126,10 +127,12 @@ def arm_joints(kind: RobotKind) -> tuple[str, ...] | None:
 
 def home_diagnostics(problem: Problem) -> list[Diagnostic]:
     """E263 for each robot kind used by the problem whose ``:home`` length differs from its arm's joints."""
+    from mrgc.geometry.kinds import approaches
+
     used = {r.kind for r in problem.robots}
     out = []
     for kind in problem.domain.robot_kinds:
-        if kind.name not in used or kind.base != "fixed" or not kind.home:
+        if kind.name not in used or not approaches(kind) or not kind.home:
             continue
         joints = arm_joints(kind)
         if joints is None or len(joints) == len(kind.home):
@@ -152,6 +155,7 @@ def overlap_diagnostics(problem: Problem) -> list[Diagnostic]:
     """E264 (object-object), E265 (object-fixed) and E266 (planar footprint) overlaps at the start.  Mesh
     shapes are left out: a mesh may be concave (a bin that holds objects), and its file is read by
     ``mrgc facts``."""
+    from mrgc.geometry.kinds import approaches
     from mrgc.geometry.planar import PlanarRobot
     from mrgc.geometry.scene import RobotSpec
 
@@ -169,7 +173,7 @@ def overlap_diagnostics(problem: Problem) -> list[Diagnostic]:
         kind = kinds.get(r.kind or "")
         if (
             kind is None
-            or kind.base != "planar"
+            or approaches(kind)
             or kind.footprint is None
             or isinstance(kind.footprint, Mesh)
             or r.base is None
@@ -277,10 +281,11 @@ def robot_diagnostics(problem: Problem) -> list[Diagnostic]:
     if problem.symbolic:
         return []
     from mrgc.geometry.arm import Arm
+    from mrgc.geometry.kinds import approaches
     from mrgc.geometry.scene import scene_from_problem
 
     scene = scene_from_problem(problem)
-    arms = [Arm(spec) for spec in scene.robots if spec.kind.base == "fixed"]
+    arms = [Arm(spec) for spec in scene.robots if approaches(spec.kind)]
     out = _arms_at_home(problem, scene, arms)
     if arms and len(arms) == len(scene.robots):
         out += _regions_out_of_reach(problem, scene, arms)

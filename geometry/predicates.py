@@ -36,6 +36,7 @@ from mrgc.geometry.conventions import APPROACH_SAMPLES, ARM_PLACE_LIFT, lattice_
 from mrgc.geometry.facts import FactsResult, HandoverConfig, RobotFacts
 from mrgc.geometry.grasps import finger_opening, fits, grasp_transform, pregrasp_transform
 from mrgc.geometry.ik import solve_ik_many
+from mrgc.geometry.kinds import approaches
 from mrgc.geometry.kinematics import model_for_kind
 from mrgc.geometry.relays import Asks, Spots, relay_facts, spot_region, stranded
 from mrgc.geometry.relays import asks as relay_asks
@@ -65,7 +66,7 @@ class RobotEvaluator:
         # the other arms wait at home while this one picks or places (the validator's execution model): their
         # links at home are obstacles like the fixed objects, named ``@<arm>:<link>``
         for spec in scene.robots:
-            if spec.name != robot and spec.kind.base != "planar":
+            if spec.name != robot and approaches(spec.kind):
                 other = Arm(spec)
                 shapes, _ = other.probes
                 for i, (shape, t) in enumerate(zip(shapes, other.link_transforms(other.home[None])[0])):
@@ -333,7 +334,7 @@ class RobotEvaluator:
 
 def _robot_worker(args: tuple[SceneSpec, str, int]) -> RobotFacts:
     scene, robot, seed = args
-    if scene.robot(robot).kind.base == "planar":  # path mode (box-moving)
+    if not approaches(scene.robot(robot).kind):  # path mode (box-moving)
         from mrgc.geometry.path_predicates import PlanarEvaluator  # coal's lattice: only for planar robots
 
         return PlanarEvaluator(scene, robot, seed).run()
@@ -351,7 +352,7 @@ def _relays(
 ) -> tuple[set[Fact], int, int] | None:
     """``enable-relay`` facts for the goal objects that need them (:mod:`mrgc.geometry.relays`), with the
     IK solves and collision checks they took; None when ``deadline`` passed first."""
-    arms = {r.name for r in scene.robots if r.kind.base != "planar"}
+    arms = {r.name for r in scene.robots if approaches(r.kind)}
     out: set[Fact] = set()
     ik = checks = 0
     stuck = stranded(scene, facts)
@@ -391,7 +392,7 @@ def compute_facts(
     n = worker_count(workers, len(robots))
     jobs = [(scene, r, seed) for r in robots]
     for spec in scene.robots:  # load every arm model here: errors surface once, and forked workers share them
-        if spec.kind.base != "planar":
+        if approaches(spec.kind):
             model_for_kind(spec.kind, spec.base_dir)
     per_robot = _map(_robot_worker, jobs, n, deadline)
     t_robots = time.perf_counter() - t0

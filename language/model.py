@@ -207,6 +207,15 @@ class RobotKind:
     #: where ``:home`` is written (the layout checks point there)
     home_span: Span = _span()
 
+    @property
+    def driven(self) -> bool:
+        """Whether its robots are driven over the floor (``:base planar``: a cart with a footprint, carrying
+        what it holds on its base, every motion a drive) rather than an arm bolted in place (``fixed``: a URDF,
+        picks and places by IK).  The one reading of :data:`BASE_TYPES` for the layers that may not reach the
+        geometry's robots (the compiler's drivers, the validator's replay world); the geometry asks its robot
+        classes (``geometry/kinds.py``: :func:`~mrgc.geometry.kinds.approaches`)."""
+        return self.base == "planar"
+
 
 @dataclass(frozen=True)
 class Domain:

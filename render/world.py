@@ -88,7 +88,9 @@ class RobotView:
         self.spec = scene.robot(name)
         self.name = name
         self.colour = colour
-        self.planar = self.spec.kind.base == "planar"
+        from mrgc.geometry.kinds import approaches
+
+        self.planar = not approaches(self.spec.kind)  # drawn as its footprint, else as its links
         self._scene = scene
         if self.planar:
             from mrgc.geometry.conventions import to_se2

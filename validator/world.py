@@ -133,7 +133,7 @@ class ReplayScene:
             for b in scene.movable:
                 self.add_object(b.name, b.shape, b.pose)
             for r in scene.robots:
-                if r.kind.base == "planar":
+                if r.kind.driven:
                     self._add_planar(r.name, r.kind.footprint, r.base)
                 else:
                     model = (models or {}).get(r.name)

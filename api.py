@@ -76,7 +76,7 @@ def _tcp_notes(mf: "MrgFile") -> list[str]:
     for domain in [*mf.domains, *(p.domain for p in mf.problems)]:
         for kind in domain.robot_kinds:
             kinds.setdefault((kind.source, kind.span, kind.name), kind)
-    if not any(k.tcp is None and k.base == "fixed" for k in kinds.values()):
+    if not any(k.tcp is None and not k.driven for k in kinds.values()):
         return []
     from mrgc.geometry.tcp import derive_tcp
 

@@ -74,7 +74,7 @@ def grasp_warnings(problem: Problem) -> list[Diagnostic]:
     if problem.symbolic:
         return []
     kinds = {r.kind for r in problem.robots}
-    arms = [k for k in problem.domain.robot_kinds if k.name in kinds and k.base == "fixed"]
+    arms = [k for k in problem.domain.robot_kinds if k.name in kinds and not k.driven]
     specs = problem.grasp_specs
     out = []
     for m in problem.movable:

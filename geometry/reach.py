@@ -76,7 +76,7 @@ def reach_map(scene: SceneSpec) -> ReachMap:
     gx, gy = np.meshgrid(xs, ys)
     points = np.column_stack([gx.ravel(), gy.ravel()])
     for spec in scene.robots:
-        if spec.kind.base != "fixed":
+        if spec.kind.driven:
             continue
         arm = Arm(spec)
         out.reached[spec.name] = _reached(arm, points, top_z, side_z).reshape(gx.shape)

@@ -69,7 +69,7 @@ def derive_tcp(kind: RobotKind) -> DerivedTcp | None:
     """The TCP of ``kind`` derived from its URDF (module docstring), or None when it cannot be derived or
     the kind is not an arm (planar, or no ``:urdf``/``:end-effector``).  A URDF that cannot be found or
     read gives None too: the commands that load it report that (E400/E401)."""
-    if kind.base != "fixed" or kind.urdf is None or kind.end_effector is None:
+    if kind.driven or kind.urdf is None or kind.end_effector is None:
         return None
     from mrgc.geometry.kinematics import resolve_urdf
 

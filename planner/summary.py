@@ -237,7 +237,7 @@ def arm_bounds(scene: SceneSpec) -> list[tuple[str, np.ndarray, float]]:
 
     out = []
     for r in scene.robots:
-        if r.kind.base != "fixed":
+        if r.kind.driven:
             continue
         model = model_for_kind(r.kind, r.base_dir)
         tcp = float(np.linalg.norm(from_pose(r.kind.tcp)[:3, 3])) if r.kind.tcp is not None else 0.0

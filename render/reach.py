@@ -78,7 +78,7 @@ def write(problem: Problem, path: str, width: int, height: int) -> dict[str, Any
             ax.plot([point[0]], [point[1]], marker="x", color="black", ms=7, mew=1.8, zorder=5)
             ax.annotate(name, (point[0], point[1]), xytext=(4, 4), textcoords="offset points", fontsize=7, zorder=6)
         for r in scene.robots:
-            _robot(ax, r.name, r.base, colours[r.name], r.kind.footprint if r.kind.base != "fixed" else None)
+            _robot(ax, r.name, r.base, colours[r.name], r.kind.footprint if r.kind.driven else None)
         handles += [
             Patch(facecolor=ROLE_COLOURS[Role.GOAL], edgecolor="black", label="goal object"),
             Patch(facecolor=ROLE_COLOURS[Role.UNTOUCHED], edgecolor="black", label="other object"),

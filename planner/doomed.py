@@ -82,7 +82,7 @@ class DoomedActions:
         self.dead, self.spot_key, self.on_time, self.label = dead, spot_key, on_time, label
         self.suspects: set[Part] = set()
         self.probes: dict[tuple[Action, frozenset[str], tuple[int, ...]], Failure | None] = {}
-        self._alive: dict[tuple[int, ...], list[Any]] = {}
+        self._alive: dict[tuple[int, ...], tuple[Any, ...]] = {}
         self._volume: Volume = []
         #: probes made and skeletons failed by one (the search's statistics)
         self.probed = 0
@@ -109,7 +109,7 @@ class DoomedActions:
             return None
         self._volume = volume
         tag = tuple(id(s) for s in suffix)
-        self._alive.setdefault(tag, suffix)  # the suffix's steps stay alive while their ids key the probes
+        self._alive.setdefault(tag, tuple(suffix))  # the suffix's steps stay alive while their ids key the probes
         for t in range(skeleton.makespan - 1, -1, -1):
             step = skeleton.steps[t]
             same = {a.obj for a in step}

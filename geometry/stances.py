@@ -12,6 +12,7 @@ the phase.  The grounder keeps each query of a phase clear of the other arms whe
 from __future__ import annotations
 
 import enum
+from typing import Iterable
 
 #: the phases of a step, in the order they run (docs/validator.md, "What a plan means")
 PHASES = ("to-pick", "pick", "to-handover", "handover", "giver-home", "to-place", "place", "home")
@@ -80,6 +81,18 @@ TRANSITS: dict[str, tuple[str, ...]] = {
     "giver": ("to-pick", "giver-home"),
     "taker": ("to-handover", "home"),
 }
+
+
+def roles(actions: Iterable[tuple[str, str]]) -> dict[str, str]:
+    """Each robot's role in a step whose actions are (picking robot, placing robot) pairs: ``pick-place`` for
+    one robot, ``giver`` and ``taker`` for a handover's two."""
+    out: dict[str, str] = {}
+    for pick_robot, place_robot in actions:
+        if pick_robot == place_robot:
+            out[pick_robot] = "pick-place"
+        else:
+            out[pick_robot], out[place_robot] = "giver", "taker"
+    return out
 
 
 def stance(role: str, phase: str, full: bool = False) -> Stance:

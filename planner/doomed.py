@@ -104,9 +104,9 @@ class DoomedActions:
     def first(self, skeleton: Skeleton, later: Iterable[str], suffix: list[Any], volume: Volume) -> Failure | None:
         """The failure of the latest step of ``skeleton`` holding a doomed action (its step and action set),
         when the objects ``later`` (the suffix's) are moved after the skeleton; None when no probe fails."""
-        still = set(later)
         if not self.suspects:
             return None
+        still = set(later)
         self._volume = volume
         tag = tuple(id(s) for s in suffix)
         self._alive.setdefault(tag, tuple(suffix))  # the suffix's steps stay alive while their ids key the probes
@@ -131,12 +131,10 @@ class DoomedActions:
 
     def _ask(self, a: Action, avoid: list[str]) -> Failure | None:
         from mrgc.geometry.answers import GroundStatus
+        from mrgc.geometry.stances import roles
 
         g = self.g
-        roles = {a.pick_robot: "pick-place"} if a.pick_robot == a.place_robot else {a.pick_robot: "giver"}
-        if a.pick_robot != a.place_robot:
-            roles[a.place_robot] = "taker"
-        g.step(roles)
+        g.step(roles([(a.pick_robot, a.place_robot)]))
         try:
             pick = g.pick(a.pick_robot, a.obj, a.pick_grasp, avoid=avoid)
             if pick.status is GroundStatus.NO_IK:

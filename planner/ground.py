@@ -32,7 +32,7 @@ from mrgc.geometry.conventions import refine
 from mrgc.geometry.grounding import Grounder
 from mrgc.geometry.relays import spot_region
 from mrgc.geometry.robot import Volume
-from mrgc.geometry.stances import PHASES, Stance
+from mrgc.geometry.stances import PHASES, Stance, roles
 from mrgc.language.model import Box
 from mrgc.planfile.format import PlannedAction
 from mrgc.planner.doomed import DoomedActions
@@ -336,13 +336,7 @@ class ReverseGrounder:
         self, step: tuple[Action, ...], avoid: set[str], same: set[str], v_fut: Volume, key: str, index: int = 0
     ) -> GroundedStep | Failure:
         # where each robot of the step is in each phase follows from its role (the execution model)
-        roles: dict[str, str] = {}
-        for a in step:
-            if a.pick_robot == a.place_robot:
-                roles[a.pick_robot] = "pick-place"
-            else:
-                roles[a.pick_robot], roles[a.place_robot] = "giver", "taker"
-        self.g.step(roles, self.full)
+        self.g.step(roles((a.pick_robot, a.place_robot) for a in step), self.full)
         try:
             return self._actions(step, avoid, same, v_fut, key, index)
         finally:

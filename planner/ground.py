@@ -304,7 +304,12 @@ class ReverseGrounder:
             others = sorted(avoid - {a.obj})
             found, tried = 0, 0
             where = spot_region(g.scene, a.via, a.pick_robot, a.place_robot)
-            for pose in g.placements(a.obj, where, avoid=others, volume=v_fut + taken, key=key):
+            both = _both(
+                g.comfortable(a.pick_robot, a.obj, a.pick_grasp), g.comfortable(a.place_robot, a.obj, a.place_grasp)
+            )
+            for pose in g.placements(
+                a.obj, where, avoid=others, volume=v_fut + taken, key=key, packed=True, prefer=both
+            ):
                 self._on_time()
                 tried += 1
                 if tried > PLACEMENT_TRIES + OUT_OF_REACH_TRIES:
@@ -895,6 +900,16 @@ def label(a: Action) -> str:
     if a.pick_robot == a.place_robot:
         return f"{a.pick_robot} moves {a.obj} to {a.region} ({a.pick_grasp})"
     return f"{a.pick_robot}->{a.place_robot} hand {a.obj} over to {a.region} ({a.pick_grasp}->{a.place_grasp})"
+
+
+def _both(
+    rank_a: Callable[[np.ndarray], float], rank_b: Callable[[np.ndarray], float]
+) -> Callable[[np.ndarray], float]:
+    """A rank of relay spots by two robots' :meth:`comfortable <mrgc.geometry.placements.Placements.comfortable>`
+    ranks: 0 where both reach comfortably, else the worse of the two (nearer first).  A region both robots
+    reach only in a corner (a crowded start region between two arms) is searched there first, not over its
+    whole area."""
+    return lambda pose: max(rank_a(pose), rank_b(pose))
 
 
 def _spot_key(pose: np.ndarray) -> tuple[float, ...]:

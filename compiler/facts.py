@@ -8,9 +8,12 @@ from __future__ import annotations
 
 from collections import defaultdict
 from dataclasses import dataclass, field
-from typing import Iterable
+from typing import Any, Iterable
 
 from mrgc.language.model import Fact, Problem
+
+#: the obstruction predicates: (M1, *what M1 obstructs)
+_OCCLUDES = ("occludes-pick", "occludes-goal-place", "occludes-handover")
 
 
 @dataclass(frozen=True)
@@ -33,6 +36,8 @@ class FactBase:
     relay: frozenset[tuple[str, str, str, str, str, str]] = frozenset()  # (M, Re, g1, g2, R1, R2)
     occludes_pick: dict[tuple[str, str, str], tuple[str, ...]] = field(default_factory=dict)  # (M2, g, R) -> M1s
     occludes_place: dict[tuple[str, str, str, str], tuple[str, ...]] = field(default_factory=dict)  # (M2, Re, g, R)
+    #: ``occludes-handover`` (beyond the paper): (M2, g1, g2, R1, R2) -> the M1s in the way of the exchange
+    occludes_handover: dict[tuple[str, str, str, str, str], tuple[str, ...]] = field(default_factory=dict)
     #: handovers that can happen at once (the number of handover points); None: no limit (symbolic)
     handover_capacity: int | None = None
     #: robots that drive to their placements (planar bases): their place obstacles lie on the path and must
@@ -69,8 +74,8 @@ class FactBase:
         place: set[tuple[str, str, str, str]] = set()
         hand: set[tuple[str, str, str, str, str]] = set()
         relay: set[tuple[str, str, str, str, str, str]] = set()
-        occ_pick: dict[tuple[str, str, str], list[str]] = defaultdict(list)
-        occ_place: dict[tuple[str, str, str, str], list[str]] = defaultdict(list)
+        # an occludes-* fact (M1, *key): the objects M1 that obstruct key, in the order of the facts
+        occ: dict[str, dict[Any, list[str]]] = {p: defaultdict(list) for p in _OCCLUDES}
         for f in facts:
             a = f.args
             if f.predicate == "in-region":
@@ -83,12 +88,8 @@ class FactBase:
                 hand.add((a[0], a[1], a[2], a[3], a[4]))
             elif f.predicate == "enable-relay":
                 relay.add((a[0], a[1], a[2], a[3], a[4], a[5]))
-            elif f.predicate == "occludes-pick":
-                if a[0] != a[1] and a[0] not in occ_pick[(a[1], a[2], a[3])]:
-                    occ_pick[(a[1], a[2], a[3])].append(a[0])
-            elif f.predicate == "occludes-goal-place":
-                if a[0] != a[1] and a[0] not in occ_place[(a[1], a[2], a[3], a[4])]:
-                    occ_place[(a[1], a[2], a[3], a[4])].append(a[0])
+            elif f.predicate in occ and a[0] != a[1] and a[0] not in occ[f.predicate][a[1:]]:
+                occ[f.predicate][a[1:]].append(a[0])
         objects = tuple(objects)
         order = {o: i for i, o in enumerate(objects)}
         rank = lambda o: (order.get(o, len(order)), o)  # noqa: E731 - undeclared objects last, by name
@@ -102,8 +103,9 @@ class FactBase:
             reachable_place=frozenset(place),
             handover=frozenset(hand),
             relay=frozenset(relay),
-            occludes_pick={k: tuple(sorted(v, key=rank)) for k, v in occ_pick.items()},
-            occludes_place={k: tuple(sorted(v, key=rank)) for k, v in occ_place.items()},
+            occludes_pick={k: tuple(sorted(v, key=rank)) for k, v in occ["occludes-pick"].items()},
+            occludes_place={k: tuple(sorted(v, key=rank)) for k, v in occ["occludes-goal-place"].items()},
+            occludes_handover={k: tuple(sorted(v, key=rank)) for k, v in occ["occludes-handover"].items()},
             handover_capacity=handover_capacity,
             drivers=frozenset(drivers),
         )

@@ -2,7 +2,9 @@
 
 Object nodes are the objects that must or may move; action nodes are partially grounded pick-and-place
 actions (object, target region, pick robot, place robot, pick grasp, place grasp); block-pick and
-block-place edges say which objects obstruct an action.  Beyond the paper, a *relay* action sets a goal
+block-place edges say which objects obstruct an action (beyond the paper, the objects in the way of a
+handover's exchange, ``occludes-handover``, are block-pick edges of the handover action: they must be gone
+before the object is picked).  Beyond the paper, a *relay* action sets a goal
 object down in another region (``via``) and picks it up there with another robot or grasp
 (``enable-relay``); like a handover it occupies both robots for its step, and has the same obstacles (the
 pick's and the goal placement's).  A goal object's target region is its goal region,
@@ -147,7 +149,7 @@ def build_task_graph(facts: FactBase, must_move: Iterable[str], moved: Iterable[
             continue
         nodes[obj] = None
         for act in actions_for(facts, obj):
-            pick_obs = facts.occludes_pick.get((obj, act.pick_grasp, act.pick_robot), ())
+            pick_obs = pick_obstacles(facts, act)
             place_obs: tuple[str, ...] = ()
             if obj in facts.goal:
                 place_obs = facts.occludes_place.get((obj, act.region, act.place_grasp, act.place_robot), ())
@@ -168,6 +170,16 @@ def build_task_graph(facts: FactBase, must_move: Iterable[str], moved: Iterable[
         single_handover_point=facts.handover_capacity == 1,
         strict_place=facts.drivers,
     )
+
+
+def pick_obstacles(facts: FactBase, act: Action) -> tuple[str, ...]:
+    """The objects that must be gone before ``act`` picks its object: its pick's ``occludes-pick`` obstacles,
+    and for a handover those in the way of the exchange (``occludes-handover``, beyond the paper)."""
+    out = facts.occludes_pick.get((act.obj, act.pick_grasp, act.pick_robot), ())
+    if act.handover:
+        key = (act.obj, act.pick_grasp, act.place_grasp, act.pick_robot, act.place_robot)
+        out += tuple(o for o in facts.occludes_handover.get(key, ()) if o not in out)
+    return out
 
 
 def actions_for(facts: FactBase, obj: str) -> list[Action]:

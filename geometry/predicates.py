@@ -16,6 +16,10 @@ For every robot R (in parallel, one process per robot when there are cores to sp
   g1 and R2 holding it with g2 are both collision-free with respect to the fixed objects and to each other
   (up to HANDOVER_CONFIGS distinct IK solutions per arm are tried in pairs: one branch of an arm may reach
   into a waiting arm or into its partner where another does not);
+- ``occludes-handover M1 M g1 g2 R1 R2`` (beyond the paper): M1 is hit by R1's or R2's links, or by M held
+  at the point, at the exchange of that handover, for the pair of configurations (over every handover point)
+  that hits the fewest movable objects; none when a pair hits none (a handover point above the start region
+  is in the way of the tall objects standing under it: they must move before the handover);
 - ``enable-relay M Re g1 g2 R1 R2`` (beyond the paper; only for goal objects no single action takes to
   their goal): R1 sets M down with g1 at a placement in Re where R2 picks it up with g2
   (:mod:`mrgc.geometry.relays`);
@@ -25,6 +29,7 @@ and ``in-region M Re`` from the initial poses.  Everything is deterministic for 
 
 from __future__ import annotations
 
+import itertools
 import time
 from typing import Callable, TypeVar
 
@@ -329,7 +334,11 @@ class RobotEvaluator:
             return
         hits = self.world.batch_hits(shapes, transforms, against="fixed", ignore=(key[0],))
         if all(h.startswith("@") for h in hits):  # only arms at home: fine if the partner is the one hit
-            kept.append(HandoverConfig(q, frozenset(h[1:].split(":")[0] for h in hits)))
+            obj = key[0]
+            held = (self.scene.body(obj).shape, translation(*self.scene.handover_points[key[1]]))
+            movables = self.world.batch_hits(shapes, transforms, against="movable", ignore=(obj,))
+            movables |= self.world.probe_hits([held], against="movable", ignore=(obj,))
+            kept.append(HandoverConfig(q, frozenset(h[1:].split(":")[0] for h in hits), frozenset(movables)))
 
 
 def _robot_worker(args: tuple[SceneSpec, str, int]) -> RobotFacts:
@@ -421,6 +430,7 @@ def compute_facts(
         "occludes-goal-place": 4,
         "enable-goal-handover": 5,
         "enable-relay": 6,
+        "occludes-handover": 7,
     }
     stats = {
         "seconds": time.perf_counter() - t0,
@@ -434,37 +444,58 @@ def compute_facts(
 
 
 def _handovers(scene: SceneSpec, per_robot: dict[str, RobotFacts], deadline: float | None = None) -> set[Fact] | None:
-    """``enable-goal-handover`` from the robots' handover configurations, checking robot–robot collisions;
-    None when ``deadline`` passed first (it is read per goal object)."""
-    out: set[Fact] = set()
+    """``enable-goal-handover`` from the robots' handover configurations, checking robot–robot collisions, and
+    ``occludes-handover`` for the movable objects in the way of the exchange (module docstring); None when
+    ``deadline`` passed first (it is read per goal object)."""
+    #: (M, g1, g2, R1, R2) -> the movable objects the exchange hits at the pair of configurations (over every
+    #: handover point) that hits the fewest
+    blocked: dict[tuple[str, str, str, str, str], frozenset[str]] = {}
     arms = _ArmPoses(scene)
     for obj in scene.goal:
         if deadline is not None and time.perf_counter() > deadline:
             return None
-        for r1 in per_robot:
-            for r2 in per_robot:
-                if r1 == r2:
-                    continue
-                for (o1, point, g1), c1s in per_robot[r1].handover.items():
-                    if o1 != obj:
-                        continue
-                    for (o2, point2, g2), c2s in per_robot[r2].handover.items():
-                        fact = Fact("enable-goal-handover", (obj, g1, g2, r1, r2))
-                        if o2 != obj or point2 != point or fact in out:
-                            continue
-                        shape = scene.body(obj).shape
-                        w1 = finger_opening(scene.grasp(g1), shape)
-                        w2 = finger_opening(scene.grasp(g2), shape)
-                        if any(
-                            # an arm may reach into the other one's home only: that one is at the exchange
-                            c1.homes <= {r2}
-                            and c2.homes <= {r1}
-                            and not posed_collide(arms.at(r1, c1.q, w1), arms.at(r2, c2.q, w2))
-                            for c1 in c1s
-                            for c2 in c2s
-                        ):
-                            out.add(fact)
+        for (r1, (_, point, g1), c1s), (r2, (_, point2, g2), c2s) in itertools.permutations(
+            ((r, k, cs) for r, rf in per_robot.items() for k, cs in rf.handover.items() if k[0] == obj), 2
+        ):
+            key = (obj, g1, g2, r1, r2)
+            if r1 == r2 or point2 != point or blocked.get(key, True) == frozenset():
+                continue  # the same arm, another point, or a pair already found free of every object
+            hits = _exchange_hits(scene, arms, obj, (r1, g1, c1s), (r2, g2, c2s))
+            if hits is not None and (key not in blocked or len(hits) < len(blocked[key])):
+                blocked[key] = hits
+    out: set[Fact] = set()
+    for key, hits in blocked.items():
+        out.add(Fact("enable-goal-handover", key))
+        out.update(Fact("occludes-handover", (o, *key)) for o in sorted(hits))
     return out
+
+
+def _exchange_hits(
+    scene: SceneSpec,
+    arms: "_ArmPoses",
+    obj: str,
+    giver: tuple[str, str, list[HandoverConfig]],
+    taker: tuple[str, str, list[HandoverConfig]],
+) -> frozenset[str] | None:
+    """The movable objects hit at the pair of the two arms' exchange configurations (robot, grasp,
+    configurations) that hits the fewest, among the pairs whose arms do not collide (an arm may reach into
+    the other one's home only: that one is at the exchange); None when every pair collides."""
+    (r1, g1, c1s), (r2, g2, c2s) = giver, taker
+    shape = scene.body(obj).shape
+    w1, w2 = finger_opening(scene.grasp(g1), shape), finger_opening(scene.grasp(g2), shape)
+    best: frozenset[str] | None = None
+    for c1 in c1s:
+        for c2 in c2s:
+            hits = c1.movables | c2.movables
+            if best is not None and (len(hits), sorted(hits)) >= (len(best), sorted(best)):
+                continue
+            if (
+                c1.homes <= {r2}
+                and c2.homes <= {r1}
+                and not posed_collide(arms.at(r1, c1.q, w1), arms.at(r2, c2.q, w2))
+            ):
+                best = hits
+    return best
 
 
 class _ArmPoses:

@@ -15,9 +15,10 @@ from typing import Union
 from mrgc.errors import Span
 from mrgc.language.ast import NOWHERE
 
-# The predicates: name -> sorts of the arguments, in order.  The paper's six, and ``enable-relay`` (beyond
+# The predicates: name -> sorts of the arguments, in order.  The paper's six, ``enable-relay`` (beyond
 # the paper: a goal object set down on its way and picked up again, in a region or on the top of a fixed
-# object, a "surface"; docs/language.md).
+# object, a "surface"; docs/language.md) and ``occludes-handover`` (beyond the paper: an object in the way
+# of the two arms at the exchange of a handover).
 PREDICATES: dict[str, tuple[str, ...]] = {
     "in-region": ("movable", "region"),
     "reachable-pick": ("movable", "grasp", "robot"),
@@ -26,6 +27,7 @@ PREDICATES: dict[str, tuple[str, ...]] = {
     "occludes-goal-place": ("movable", "movable", "region", "grasp", "robot"),
     "enable-goal-handover": ("movable", "grasp", "grasp", "robot", "robot"),
     "enable-relay": ("movable", "surface", "grasp", "grasp", "robot", "robot"),
+    "occludes-handover": ("movable", "movable", "grasp", "grasp", "robot", "robot"),
 }
 
 #: words users write for a predicate -> the predicates they mean (E220's "did you mean"; a word that is a
@@ -47,6 +49,8 @@ PREDICATE_WORDS: dict[str, tuple[str, ...]] = {
     "placeable": ("reachable-place",),
     "blocks": ("occludes-pick", "occludes-goal-place"),
     "obstructs": ("occludes-pick", "occludes-goal-place"),
+    "blocks-handover": ("occludes-handover",),
+    "occludes-exchange": ("occludes-handover",),
     "blocks-pick": ("occludes-pick",),
     "blocks-place": ("occludes-goal-place",),
     "occludes-place": ("occludes-goal-place",),

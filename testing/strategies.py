@@ -163,6 +163,12 @@ def _cases(
                 6,
             )
         ]
+        facts += [
+            ("occludes-handover", *m1, *h[1:])
+            for h in facts
+            if h[0] == "enable-goal-handover"
+            for m1 in some([(m1,) for m1 in objects if m1 != h[1]], False, 1)
+        ]
 
     must = [o for o in goal_objs if goal[o] != region[o]]
     made: bool | None = None

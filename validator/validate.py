@@ -36,12 +36,13 @@ Symbolic plans (a symbolic problem) are checked against the problem's facts, as 
 (DESIGN.md section 5): a pick needs ``reachable-pick``, a place ``reachable-place``, a handover
 ``enable-goal-handover`` and is only for goal objects into their goal region; objects outside the goal
 only move within their own region ``[unsupported]``, ``[region]``; every ``occludes-pick`` obstacle of an
-action moves at a strictly earlier step, every ``occludes-goal-place`` obstacle no later ``[pick-obstacle]``,
-``[place-obstacle]``.  A relay move of M into Re by R1 with g1 needs ``reachable-pick M g1 R1`` and
-``enable-relay M Re g1 g2 R1 R2``, R2 and g2 the robot and grasp that pick M in its onward move; it has pick
-obstacles only.  The onward move needs what a move into the goal needs except ``reachable-pick`` (the relay
-fact covers picking M where it was set down) and has place obstacles only.  Geometric checks (the motion
-model, motions, collisions, support; an onward move picks M where its relay move placed it) are listed in
+action (and every ``occludes-handover`` obstacle of a handover) moves at a strictly earlier step, every
+``occludes-goal-place`` obstacle no later ``[pick-obstacle]``, ``[place-obstacle]``.  A relay move of M into
+Re by R1 with g1 needs ``reachable-pick M g1 R1`` and ``enable-relay M Re g1 g2 R1 R2``, R2 and g2 the robot
+and grasp that pick M in its onward move; it has pick obstacles only.  The onward move needs what a move into
+the goal needs except ``reachable-pick`` (the relay fact covers picking M where it was set down) and has place
+obstacles only.  Geometric checks (the motion model, motions, collisions, support; an onward move picks M
+where its relay move placed it) are listed in
 :mod:`mrgc.validator.replay`.
 """
 
@@ -466,22 +467,24 @@ def _supported(problem: Problem, facts: Facts, t: int, a: PlannedAction, onward:
 def _obstacles_moved(
     facts: Facts, moved_at: dict[str, int], t: int, a: PlannedAction, out: list[Violation], pick: bool, place: bool
 ) -> None:
-    """Every ``occludes-pick`` obstacle of action ``a`` moves at a strictly earlier step, every
+    """Every ``occludes-pick`` obstacle of action ``a`` (and of a handover its ``occludes-handover`` ones)
+    moves at a strictly earlier step, every
     ``occludes-goal-place`` obstacle no later ``[pick-obstacle]``, ``[place-obstacle]``; ``pick``/``place``:
     whether the action has obstacles of that kind (an onward move picks where its relay move set the object
     down, a relay move places on the way, outside the facts' view)."""
     o, re_, r1, r2, g1, g2 = a.object, a.region, a.pick_robot, a.place_robot, a.pick_grasp, a.place_grasp
     for pred, args in facts:
-        if pick and pred == "occludes-pick" and args[1:] == (o, g1, r1):
+        if pick and (
+            (pred == "occludes-pick" and args[1:] == (o, g1, r1))
+            or (pred == "occludes-handover" and r1 != r2 and not a.relay and args[1:] == (o, g1, g2, r1, r2))
+        ):
             when = moved_at.get(args[0])
             if when is None or when >= t:
                 state = "never moves" if when is None else f"moves at step {when}"
+                what = f"{r1} picking {o} with {g1}" if pred == "occludes-pick" else f"{r1} handing {o} to {r2}"
                 out.append(
                     Violation(
-                        t,
-                        o,
-                        "pick-obstacle",
-                        f"{args[0]} blocks {r1} picking {o} with {g1} and {state}; it must move at an earlier step",
+                        t, o, "pick-obstacle", f"{args[0]} blocks {what} and {state}; it must move at an earlier step"
                     )
                 )
         elif place and pred == "occludes-goal-place" and args[1:] == (o, re_, g2, r2):

@@ -26,8 +26,8 @@ Restarts: each run of the depth-first search may ground at most a budget of join
 in another order (seeded): the order the goal objects are stacked in and the hit objects are pushed in.
 Nothing but the time limit depends on the clock, so a seed gives the same plan whenever the time limit does
 not stop the search first.  Symbolic problems have no geometry: an action's ``occludes-pick`` obstacles are
-what its step hits (they must move strictly earlier), its ``occludes-goal-place`` obstacles what its place
-hits (no later).
+what its step hits (they must move strictly earlier; a handover's ``occludes-handover`` obstacles too), its
+``occludes-goal-place`` obstacles what its place hits (no later).
 """
 
 from __future__ import annotations
@@ -39,7 +39,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Callable
 
 from mrgc.compiler.facts import FactBase
-from mrgc.compiler.task_graph import Action, actions_for, build_task_graph
+from mrgc.compiler.task_graph import Action, actions_for, build_task_graph, pick_obstacles
 from mrgc.planner.method import Context, Planner, Result
 from mrgc.planner.outcome import Failure, PlanStatus, Why
 from mrgc.planner.search import planned_action
@@ -128,7 +128,7 @@ class SymbolicSteps:
         facts, same = self.facts, {a.obj for a in actions}
         hits: set[str] = set()
         for a in actions:
-            pick = facts.occludes_pick.get((a.obj, a.pick_grasp, a.pick_robot), ())
+            pick = pick_obstacles(facts, a)
             place = (
                 facts.occludes_place.get((a.obj, a.region, a.place_grasp, a.place_robot), ())
                 if a.obj in facts.goal

@@ -18,7 +18,7 @@ from typing import Callable, Iterable, Iterator
 import numpy as np
 
 from mrgc.geometry.answers import Answer, GroundStatus
-from mrgc.geometry.collision import Posed, posed_collide
+from mrgc.geometry.collision import TOLERANCE, Posed, posed_collide
 from mrgc.geometry.conventions import ARM_PLACE_LIFT, lattice_offsets, seed_for
 from mrgc.geometry.grasps import grasp_transform
 from mrgc.geometry.robot import Volume
@@ -82,7 +82,7 @@ class Placements(StepWorld):
             return
         rng = np.random.default_rng(seed_for("placement", obj, reg.name, key, seed=self.seed))
         h_o, h_r = half_extents(body.shape), half_extents(reg.shape)
-        vol = self._volumes.posed(volume) if volume else None
+        vol = _around(self._volumes.posed(volume), reg) if volume else None
         avoid = tuple(a for a in avoid if a != obj)
         shape = self.shape(obj)
         # first the 3 × 3 lattice phase 1 uses (so a placement the facts relied on is tried first), then
@@ -150,6 +150,14 @@ class Placements(StepWorld):
         mover = self.robot(robot)
         g_t = grasp_transform(spec, self.scene.body(obj).shape)
         return lambda pose: mover.comfort(pose @ g_t, share)
+
+
+def _around(vol: Posed, region: SceneBody) -> Posed:
+    """The pieces of ``vol`` that meet ``region``'s box (grown by twice the collision tolerance and 1 mm):
+    every candidate placement lies inside the region, so only those can touch it (the same answers, far
+    fewer pieces to look through when the volume is a whole suffix's sweep and the region a bin)."""
+    reach = np.abs(region.pose[:3, :3]) @ half_extents(region.shape) + 2 * TOLERANCE + 1e-3
+    return vol.within(region.pose[:3, 3] - reach, region.pose[:3, 3] + reach)
 
 
 def _packing_grid(room: np.ndarray, cells: int = 15) -> list[tuple[float, float, float]]:

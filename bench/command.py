@@ -51,9 +51,10 @@ def add_bench_parser(sub: Any) -> None:
     q.add_argument("--study", default=None, help="only this study (default: every study in the database)")
     q.add_argument(
         "--format",
-        choices=["markdown", "wide", "csv", "runs"],
+        choices=["markdown", "wide", "pairs", "csv", "runs"],  # mrgc.bench.report.FORMATS (not imported here)
         default="markdown",
         help="markdown (default): a row per instance set and method; wide: the paper's layout; "
+        "pairs: the first method against each other one, per instance (time ratio, medians); "
         "csv: the same numbers; runs: every run as CSV",
     )
     q.add_argument(

@@ -6,7 +6,9 @@ runs), and over the **solved** runs the mean ± standard error of the
 mean (sample standard deviation / sqrt(n); no ± for a single run) of planning time, makespan, objects moved
 (the paper's "motion cost") and path length (:mod:`mrgc.bench.outcome`).  A second table counts the
 outcomes, so that no failure is hidden behind a success rate; methods a study skipped are listed with
-their reason.  ``runs`` CSV gives every recorded run, every column.
+their reason.  ``pairs`` sets the study's first method against each other one instance by instance (the
+time ratio per instance, medians, who wins; :func:`pairs`).  ``runs`` CSV gives every recorded run, every
+column.
 
 Time is one of two clocks (``--time``, :data:`CLOCKS`): ``wall`` (default), the planning time the plan
 reports (``planning_seconds``: wall-clock seconds of phase 1, search and the planner's own validation), or
@@ -19,6 +21,8 @@ from __future__ import annotations
 import csv
 import io
 import math
+import re
+import statistics
 from collections import Counter
 from dataclasses import dataclass, field
 from typing import Any, Callable, Iterable
@@ -27,7 +31,7 @@ from mrgc.bench.db import COLUMNS, ResultsDB
 from mrgc.bench.outcome import RunStatus
 
 #: report formats of ``mrgc bench report --format``
-FORMATS = ("markdown", "wide", "csv", "runs")
+FORMATS = ("markdown", "wide", "pairs", "csv", "runs")
 #: the clocks a report's time can be read on (module docstring): clock -> (runs column, table heading)
 CLOCKS = {"wall": ("planning_seconds", "planning time (s)"), "cpu": ("cpu_seconds", "CPU time (s)")}
 _DASH = "–"
@@ -214,6 +218,96 @@ def wide(db: ResultsDB, study: str | None = None, clock: str = "wall") -> str:
     return "\n".join(parts)
 
 
+def pairs(db: ResultsDB, study: str | None = None, clock: str = "wall") -> str:
+    """The study's first method (the reference, A) against each other method (B), instance by instance: per
+    instance set a row per instance and seed with A's and B's outcome, time, makespan and objects moved and
+    the time ratio B / A (above 1: A faster), then the set's summary: solved by each, median time of each
+    over its solved runs, median ratio and A's wins over the runs both solved, and the makespan and
+    objects-moved means over those runs.  "Ours below Ap1 on every set" reads off the medians."""
+    column = CLOCKS[clock][0]
+    parts = []
+    for name in [study] if study is not None else db.studies():
+        runs = list(db.runs(name))
+        methods = list(dict.fromkeys(r["method"] for r in sorted(runs, key=lambda r: r["method_index"])))
+        for other in methods[1:]:
+            parts.append(_pairs(name, methods[0], other, runs, column, clock))
+    return "\n".join(parts)
+
+
+def _pairs(study: str, a: str, b: str, runs: list[dict[str, Any]], column: str, clock: str) -> str:
+    """:func:`pairs` of methods ``a`` and ``b`` of one study."""
+    by: dict[tuple[str, str, int], dict[str, dict[str, Any]]] = {}
+    sets: dict[str, None] = {}
+    for r in sorted(runs, key=lambda r: (r["set_index"], _natural(r["instance"]), r["seed"])):
+        by.setdefault((r["instance_set"], r["instance"], r["seed"]), {})[r["method"]] = r
+        sets.setdefault(r["instance_set"], None)
+    unit = "s" if clock == "wall" else "CPU s"
+
+    def cell(r: dict[str, Any] | None) -> list[str]:
+        if r is None:
+            return [_DASH] * 3
+        if not r["success"]:
+            return [r["status"], _DASH, _DASH]
+        return [f"{r[column]:.2f}", str(r["makespan"]), str(r["objects_moved"])]
+
+    lines = [f"## Study {study}: {a} (A) against {b} (B), {unit}", ""]
+    summary = []
+    for s in sets:
+        keys = [k for k in by if k[0] == s]
+        body, both = [], []
+        for k in keys:
+            ra, rb = by[k].get(a), by[k].get(b)
+            ratio = _DASH
+            if ra is not None and rb is not None and ra["success"] and rb["success"]:
+                both.append((ra, rb))
+                ratio = f"{rb[column] / ra[column]:.2f}" if ra[column] else _DASH
+            body.append([s, k[1], str(k[2]), *cell(ra), *cell(rb), ratio])
+        header = ["set", "instance", "seed", f"{a} time", f"{a} makespan", f"{a} moved"]
+        header += [f"{b} time", f"{b} makespan", f"{b} moved", "B / A"]
+        lines += _table(header, body, 3) + [""]
+        summary.append(_pair_summary(s, a, b, [by[k] for k in keys], both, column))
+    header = ["set", f"solved {a}", f"solved {b}", f"median {a}", f"median {b}", "median B / A", f"{a} faster"]
+    header += [f"makespan {a}", f"makespan {b}", f"moved {a}", f"moved {b}"]
+    return "\n".join(lines + _table(header, summary, 1)) + "\n"
+
+
+def _natural(name: str) -> tuple[Any, ...]:
+    """A sort key that puts ``PA5-s2`` before ``PA5-s10``."""
+    return tuple(int(p) if p.isdigit() else p for p in re.split(r"(\d+)", name))
+
+
+def _pair_summary(
+    s: str,
+    a: str,
+    b: str,
+    cells: list[dict[str, dict[str, Any]]],
+    both: list[tuple[dict[str, Any], dict[str, Any]]],
+    column: str,
+) -> list[str]:
+    """One set's summary row of :func:`_pairs`."""
+
+    def solved(m: str) -> list[dict[str, Any]]:
+        return [c[m] for c in cells if m in c and c[m]["success"]]
+
+    def med(xs: list[float]) -> str:
+        return f"{statistics.median(xs):.2f}" if xs else _DASH
+
+    ratios = [rb[column] / ra[column] for ra, rb in both if ra[column]]
+    return [
+        s,
+        f"{len(solved(a))}/{sum(a in c for c in cells)}",
+        f"{len(solved(b))}/{sum(b in c for c in cells)}",
+        med([r[column] for r in solved(a)]),
+        med([r[column] for r in solved(b)]),
+        med(ratios),
+        f"{sum(x > 1 for x in ratios)}/{len(ratios)}",
+        Stat.of(ra["makespan"] for ra, _ in both).text(2),
+        Stat.of(rb["makespan"] for _, rb in both).text(2),
+        Stat.of(ra["objects_moved"] for ra, _ in both).text(2),
+        Stat.of(rb["objects_moved"] for _, rb in both).text(2),
+    ]
+
+
 def _seeds(seeds: list[int]) -> str:
     if len(seeds) > 2 and seeds == list(range(seeds[0], seeds[-1] + 1)):
         return f"{seeds[0]}..{seeds[-1]}"
@@ -282,4 +376,6 @@ def runs_csv(db: ResultsDB, study: str | None = None, clock: str = "wall") -> st
 
 def render(db: ResultsDB, fmt: str = "markdown", study: str | None = None, clock: str = "wall") -> str:
     """The report in format ``fmt`` (:data:`FORMATS`), time on ``clock`` (:data:`CLOCKS`)."""
-    return {"markdown": markdown, "wide": wide, "csv": csv_text, "runs": runs_csv}[fmt](db, study, clock)
+    return {"markdown": markdown, "wide": wide, "pairs": pairs, "csv": csv_text, "runs": runs_csv}[fmt](
+        db, study, clock
+    )

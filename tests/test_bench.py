@@ -493,7 +493,10 @@ def golden_db(tmp_path: Path) -> Path:
     return db
 
 
-@pytest.mark.parametrize("fmt, name", [("markdown", "report.md"), ("wide", "report-wide.md"), ("csv", "report.csv")])
+@pytest.mark.parametrize(
+    "fmt, name",
+    [("markdown", "report.md"), ("wide", "report-wide.md"), ("pairs", "report-pairs.md"), ("csv", "report.csv")],
+)
 def test_reports_of_a_fixed_database_are_golden(tmp_path: Path, fmt: str, name: str) -> None:
     db = golden_db(tmp_path)
     out = subprocess.run(
@@ -522,6 +525,32 @@ def test_report_numbers_are_means_and_standard_errors_of_the_solved_runs(tmp_pat
                 mean = sum(solved) / len(solved)
                 se = math.sqrt(sum((x - mean) ** 2 for x in solved) / (len(solved) - 1) / len(solved))
                 assert row.time.mean == pytest.approx(mean) and row.time.se == pytest.approx(se)
+
+
+def test_pairs_give_each_instance_its_time_ratio_and_each_set_its_medians(tmp_path: Path) -> None:
+    import statistics
+
+    from mrgc.bench.report import pairs
+
+    with ResultsDB(str(golden_db(tmp_path)), readonly=True) as db:
+        runs = list(db.runs())
+        text = pairs(db)
+    methods = list(dict.fromkeys(r["method"] for r in sorted(runs, key=lambda r: r["method_index"])))
+    a, b = methods[0], methods[1]
+    cell = {(r["instance_set"], r["instance"], r["seed"], r["method"]): r for r in runs}
+    for (s, inst, seed, m), ra in cell.items():
+        rb = cell.get((s, inst, seed, b))
+        if m != a or rb is None or not (ra["success"] and rb["success"]):
+            continue
+        ratio = rb["planning_seconds"] / ra["planning_seconds"]
+        assert any(
+            line.startswith(f"| {s} | {inst} | {seed} |") and line.endswith(f"| {ratio:.2f} |")
+            for line in text.splitlines()
+        )
+    for s in dict.fromkeys(r["instance_set"] for r in runs):
+        solved = [r["planning_seconds"] for r in runs if (r["instance_set"], r["method"]) == (s, a) and r["success"]]
+        row = [line for line in text.splitlines() if line.startswith(f"| {s} | ") and "/" in line.split("|")[2]]
+        assert row and f"| {statistics.median(solved):.2f} |" in row[-1]
 
 
 def test_figures_of_a_fixed_database(tmp_path: Path) -> None:

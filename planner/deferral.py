@@ -13,6 +13,14 @@ search fails on it skeleton after skeleton while the skeletons without it, one s
 - anything else (collisions, crowded regions, handovers, relays, robots of a step colliding): the action
   itself, grasps included: those depend on the grasp and on what else the skeleton moves.
 
+A pick that failed on what never moves (every attempt out of reach, into a fixed body, a robot's base or the
+arm itself: :attr:`Failure.static <mrgc.planner.outcome.Failure.static>`) also counts against the pick with
+its grasp (``r1 picks o1 with side-x-``), and that part is deferred at once: the object is picked where it
+stands at the start (a skeleton moves each object once; relays are counted as themselves), the pick's
+attempts are seeded by robot, object and grasp, so every skeleton holding that pick fails on it again.  On
+PA10-s15 (``mrgc generate packaging --preset pa10 --seed 15``) eight skeletons in a row failed on
+``pick by r1: collision: hits table`` with one grasp of a handover, deferred three at a time per pair of grasps.
+
 On nine generated runs that hit the time limit before deferral, this split solved 7, counting every
 failure by the action 6, and every place and pick failure by its part 5 (docs/planner.md, "Deferred
 actions").
@@ -43,15 +51,22 @@ def parts(a: Action) -> list[Part]:
     whole: Part = ("action", a)
     if a.via is not None:
         return [whole]
-    return [("place", a.obj, a.region, a.place_robot), ("pick", a.obj, a.pick_robot), whole]
+    return [("place", a.obj, a.region, a.place_robot), ("pick", a.obj, a.pick_robot), _grasped(a), whole]
+
+
+def _grasped(a: Action) -> Part:
+    """The pick of ``a`` with its grasp: the part a static pick failure is counted against."""
+    return ("grasp", a.obj, a.pick_robot, a.pick_grasp)
 
 
 def describe(part: Part) -> str:
-    """A part in words: ``r1 places o6 in bin-b``, ``r1 picks o6``, or the action."""
+    """A part in words: ``r1 places o6 in bin-b``, ``r1 picks o6``, ``r1 picks o6 with top``, or the action."""
     if part[0] == "place":
         return f"{part[3]} places {part[1]} in {part[2]}"
     if part[0] == "pick":
         return f"{part[2]} picks {part[1]}"
+    if part[0] == "grasp":
+        return f"{part[2]} picks {part[1]} with {part[3]}"
     return str(part[1])
 
 
@@ -73,13 +88,23 @@ class Deferrals:
         for a in skeleton.steps[failure.step - 1]:
             names = (label(a), *(label(h) for h in (a.halves if a.via is not None else ())))
             if failure.action in names:
-                part = _part(a, failure.check)
-                self.counts[part] = self.counts.get(part, 0) + 1
-                if self.counts[part] == self.after:
-                    self.deferred.add(part)
-                    return part
-                return None
+                counted = [(_part(a, failure.check), 1)]
+                if failure.static and a.via is None and failure.check.startswith("pick by"):
+                    counted.insert(0, (_grasped(a), self.after))  # fails wherever it is tried: at once
+                found: Part | None = None
+                for part, weight in counted:
+                    self.counts[part] = self.counts.get(part, 0) + weight
+                    if part not in self.deferred and self.counts[part] >= self.after:
+                        self.deferred.add(part)
+                        found = found or part
+                return found
         return None
+
+    def reason(self, part: Part) -> str:
+        """Why ``part`` was deferred, in words (the search's ``--verbose`` line)."""
+        if part[0] == "grasp":
+            return "at its first failure, on what never moves"
+        return f"after {self.after} failures"
 
     def covers(self, a: Action) -> bool:
         """Whether ``a`` has a deferred part."""

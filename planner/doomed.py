@@ -26,6 +26,12 @@ lattice are drawn with the probe's own seed, so the implication holds for the la
 rest in distribution.  The skeleton then fails at that step without grounding the later ones (its failure
 line is the probe's).  Probes are cached per (action, objects in place); they read no clock and draw their
 samples from fixed seeds, so the same search makes the same probes.
+
+A pick that failed on what never moves (:attr:`Failure.static <mrgc.planner.outcome.Failure.static>`: every
+attempt out of reach, into a fixed body, a robot's base or the arm itself) needs no probe: the object is
+picked where it stands at the start (a skeleton moves each object once; relays are left out) and the pick's
+attempts are seeded by robot, object and grasp, so the same pick fails the same way in every skeleton.  A
+skeleton holding one fails at once at that step, with the first failure's line.
 """
 
 from __future__ import annotations
@@ -81,6 +87,8 @@ class DoomedActions:
         self.g, self.goal, self.regions, self.tries = grounder, goal, regions, tries
         self.dead, self.spot_key, self.on_time, self.label = dead, spot_key, on_time, label
         self.suspects: set[Part] = set()
+        #: (robot, object, grasp) of picks that failed on what never moves, with their failure
+        self.static_picks: dict[tuple[str, str, str], Failure] = {}
         self.probes: dict[tuple[Action, frozenset[str], tuple[int, ...]], Failure | None] = {}
         self._alive: dict[tuple[int, ...], tuple[Any, ...]] = {}
         self._volume: Volume = []
@@ -90,6 +98,8 @@ class DoomedActions:
 
     def failed(self, a: Action, failure: Failure) -> None:
         """Note the failure of action ``a`` in some grounding."""
+        if failure.static and a.via is None and failure.check.startswith("pick by"):
+            self.static_picks.setdefault((a.pick_robot, a.obj, a.pick_grasp), failure)
         part = failed_part(a, failure.check)
         if part is not None and self.g.robot(a.pick_robot).approaches:
             self.suspects.add(part)
@@ -104,8 +114,9 @@ class DoomedActions:
     def first(self, skeleton: Skeleton, later: Iterable[str], suffix: list[Any], volume: Volume) -> Failure | None:
         """The failure of the latest step of ``skeleton`` holding a doomed action (its step and action set),
         when the objects ``later`` (the suffix's) are moved after the skeleton; None when no probe fails."""
-        if not self.suspects:
-            return None
+        known = self._static(skeleton)
+        if known is not None or not self.suspects:
+            return known
         still = set(later)
         self._volume = volume
         tag = tuple(id(s) for s in suffix)
@@ -120,6 +131,19 @@ class DoomedActions:
                         self.doomed += 1
                         return Failure(t + 1, self.label(a), f.check, f.bodies, f.detail)
             still |= same
+        return None
+
+    def _static(self, skeleton: Skeleton) -> Failure | None:
+        """The failure of the latest step of ``skeleton`` holding a pick known to fail on what never moves."""
+        if not self.static_picks:
+            return None
+        for t in range(skeleton.makespan - 1, -1, -1):
+            for a in skeleton.steps[t]:
+                f = self.static_picks.get((a.pick_robot, a.obj, a.pick_grasp)) if a.via is None else None
+                if f is not None:
+                    self.doomed += 1
+                    detail = f.detail or "fails on what never moves"
+                    return Failure(t + 1, self.label(a), f.check, f.bodies, f"{detail} (known)", static=True)
         return None
 
     def _probe(self, a: Action, still: frozenset[str], tag: tuple[int, ...]) -> Failure | None:

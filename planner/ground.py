@@ -920,7 +920,9 @@ def _spot_key(pose: np.ndarray) -> tuple[float, ...]:
 
 def _failed(what: str, answer: Answer) -> Failure:
     """A failure of a geometric query: its status as the check, the objects that were in the way as bodies."""
-    return Failure(0, "", f"{what}: {answer.status.value}", tuple(sorted(answer.blockers)), answer.detail)
+    return Failure(
+        0, "", f"{what}: {answer.status.value}", tuple(sorted(answer.blockers)), answer.detail, answer.static
+    )
 
 
 def _path_of(action: PlannedAction, phase: str) -> tuple[str, str | None, bool]:

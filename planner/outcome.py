@@ -77,6 +77,10 @@ class Failure:
     check: str
     bodies: tuple[str, ...] = ()
     detail: str = ""
+    #: every attempt failed on what never moves (no inverse kinematics, fixed bodies, robots' bases, the arm
+    #: itself; :attr:`Answer.static <mrgc.geometry.answers.Answer.static>`): the same query fails again in
+    #: any state of the movable objects and the other robots
+    static: bool = False
 
     def key(self) -> tuple[int, str, str, tuple[str, ...]]:
         """What identifies the failure when failures are counted (everything but the detail)."""

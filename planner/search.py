@@ -120,8 +120,8 @@ def _search(context: Context, sources: _Sources, deadline: float) -> Result:
         deferred = sources.deferrals.failed(skel, result.failures[0]) if failed else None
         say(_log_line(time.perf_counter() - context.started, count[0], skel, suffix, result))
         if deferred is not None:
-            after = sources.deferrals.after
-            say(f"  deferred after {after} failures: {describe(deferred)} (skeletons without it first)")
+            why_deferred = sources.deferrals.reason(deferred)
+            say(f"  deferred {why_deferred}: {describe(deferred)} (skeletons without it first)")
         return result
 
     search = MCTS(ground, sources, set(context.goals), c=o["c"], alpha=o["alpha"], k=o["skeletons"])

@@ -102,3 +102,24 @@ def test_a_finished_source_is_not_reopened_by_a_deferral() -> None:
     solves = gen.stats["solves"]
     gen.defer([A2, B])
     assert more(10) == [] and gen.stats["solves"] == solves and not gen.deferred
+
+
+def test_a_pick_failing_on_what_never_moves_defers_that_pick_with_its_grasp_at_once() -> None:
+    """A pick whose every attempt failed on what never moves (``Failure.static``: the table, the arm itself,
+    out of reach) fails again in every skeleton holding it: the pick with that grasp is deferred at its first
+    failure; the action's own count goes on as before, and a relay (picked elsewhere) is not."""
+    d = Deferrals()
+    skel = Skeleton(((B,), (A3,)))
+    hit = Failure(2, label(A3), "pick by r1: collision", (), "hits table", static=True)
+    part = d.failed(skel, hit)
+    assert part == ("grasp", "o1", "r1", "top") and describe(part) == "r1 picks o1 with top"
+    assert d.reason(part) == "at its first failure, on what never moves"
+    assert d.covers(A1) and d.covers(A3) and not d.covers(A2)  # every pick of o1 by r1 with top
+    assert d.counts[("action", A3)] == 1 and ("action", A3) not in d.deferred
+    assert d.failed(skel, hit) is None  # deferred once
+    moving = Deferrals()
+    assert moving.failed(skel, replace(hit, static=False)) is None and not moving.deferred  # counted by action
+    relay = Action("o1", "goal", "r1", "r2", "top", "side", via="start")
+    rskel = Skeleton(((relay,),))
+    down = relay.halves[0]
+    assert Deferrals().failed(rskel, replace(hit, step=1, action=label(down))) is None

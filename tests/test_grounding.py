@@ -505,6 +505,19 @@ def test_retiming_moves_an_action_to_the_latest_earlier_step_its_order_constrain
     assert not _Retiming([[a], [x]], None).retime(x, 2)  # no order constraints known: no re-timing
 
 
+def _count_picks(grounder: Grounder) -> list[str]:
+    """The objects of every pick query ``grounder`` answers from now on, in order (a wrapper around its own)."""
+    picked: list[str] = []
+    pick = grounder.pick
+
+    def counted(robot: str, obj: str, *args: object, **kwargs: object) -> object:
+        picked.append(obj)
+        return pick(robot, obj, *args, **kwargs)  # type: ignore[arg-type]
+
+    grounder.pick = counted  # type: ignore[method-assign]
+    return picked
+
+
 def test_an_action_doomed_by_what_never_moves_fails_before_the_later_steps(pa3: Grounder) -> None:
     """planner/doomed.py: r1 cannot reach bin-b.  The first grounding of a skeleton putting o1 there in step 1
     grounds step 2 first and then fails at step 1; once that part has failed, a skeleton holding it is probed
@@ -516,14 +529,7 @@ def test_an_action_doomed_by_what_never_moves_fails_before_the_later_steps(pa3: 
             (Action("o2", "bin-a", "r1", "r1", "top", "top"),),
         )
     )
-    picked: list[str] = []
-    pick = pa3.pick
-
-    def counted(robot: str, obj: str, *args: object, **kwargs: object) -> object:
-        picked.append(obj)
-        return pick(robot, obj, *args, **kwargs)  # type: ignore[arg-type]
-
-    pa3.pick = counted  # type: ignore[method-assign]
+    picked = _count_picks(pa3)
     first = reverse.ground(skel, [], key="1")
     assert "o2" in picked  # step 2 was grounded first
     picked.clear()
@@ -538,3 +544,34 @@ def test_an_action_doomed_by_what_never_moves_fails_before_the_later_steps(pa3: 
     # an action the probe finds placeable is grounded as before: o2 into bin-a alone succeeds
     alone = reverse.ground(Skeleton(((Action("o2", "bin-a", "r1", "r1", "top", "top"),),)), [], key="3")
     assert alone.outcome is Outcome.SUCCESS, alone.reason
+
+
+def test_a_pick_failing_on_what_never_moves_fails_every_skeleton_holding_it_at_once(pa3: Grounder) -> None:
+    """planner/doomed.py: r1 reaches o2 with no side-y+ grasp (every attempt fails on its inverse kinematics:
+    a static answer).  Once one grounding has failed on that pick, another skeleton holding the same pick (with
+    another place grasp, in another step) fails at that step before any geometric query, with the same check;
+    a pick of o2 by r1 with another grasp is grounded as before."""
+    pa3.step({"r1": Stance.PICKED})
+    answer = pa3.pick("r1", "o2", "side-y+")
+    pa3.step({})
+    assert answer.status is GroundStatus.NO_IK and answer.static  # the premise, measured
+    reverse = ReverseGrounder(pa3, {"o1": "bin-a", "o2": "bin-a"})
+    first = reverse.ground(Skeleton(((Action("o2", "bin-a", "r1", "r1", "side-y+", "top"),),)), [], key="1")
+    assert first.outcome is Outcome.FAIL and first.failures[0].static, first.reason
+    assert first.failures[0].check == "pick by r1: no inverse kinematics"
+    queries = pa3.queries
+    picked = _count_picks(pa3)
+    later = Skeleton(
+        (
+            (Action("o2", "bin-a", "r1", "r1", "side-y+", "side-y+"),),
+            (Action("o1", "bin-a", "r1", "r1", "top", "top"),),
+        )
+    )
+    second = reverse.ground(later, [], key="2")
+    assert second.outcome is Outcome.FAIL and second.failures
+    f = second.failures[0]
+    assert (f.step, f.check, f.static) == (1, "pick by r1: no inverse kinematics", True)
+    assert f.detail.endswith("(known)") and picked == [] and pa3.queries == queries  # nothing was asked
+    other = reverse.ground(Skeleton(((Action("o2", "bin-a", "r1", "r1", "top", "top"),),)), [], key="3")
+    assert picked and picked[0] == "o2"  # asked again: another grasp is another query
+    assert other.outcome is Outcome.SUCCESS, other.reason

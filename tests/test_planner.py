@@ -157,9 +157,15 @@ def test_mcts_memoises_failures_and_reports_no_plan() -> None:
 
 
 def test_puct_prefers_fewer_objects_at_first() -> None:
-    search = MCTS(
-        lambda s, x: Grounding(Outcome.FAIL), lambda n, m: lambda k: [SKEL_CLEAR, SKEL_DIRECT][:k], {"o1"}, k=2
-    )
+    left = [SKEL_CLEAR, SKEL_DIRECT]
+
+    def more(k: int) -> list[Skeleton]:
+        out, left[:] = left[:k], left[k:]
+        return out
+
+    search = MCTS(lambda s, x: Grounding(Outcome.FAIL), lambda n, m: more, {"o1"}, k=2)
+    assert [e.skeleton for e in search.root.edges] == [SKEL_CLEAR]  # the first of k, the others lazily
+    search.root.refill(1)
     search.root.visits = 1
     q = {len(e.skeleton.moved): search.q(search.root, e) for e in search.root.edges}
     assert q[1] == pytest.approx(1.0) and q[2] == pytest.approx(0.5)
@@ -176,3 +182,25 @@ def test_a_time_limit_is_exit_3(capsys: pytest.CaptureFixture[str]) -> None:
     src = str(ROOT / "domains" / "packaging" / "pa10.mrg")
     assert cli.main(["plan", src, "--time-limit", "0.05"]) == 3
     assert json.loads(capsys.readouterr().out)["status"] == "time limit"
+
+
+def test_a_nodes_skeletons_are_made_lazily_the_first_alone() -> None:
+    """planner/mcts.py: a new node asks its source for one skeleton (the one its first selection picks), the
+    other k - 1 when it is selected again; where the first grounds to a plan no other is made."""
+    asked: list[int] = []
+    queue = [SKEL_DIRECT, SKEL_CLEAR, Skeleton(((Action("o1", "goal", "r1", "r1", "side", "side"),),))]
+
+    def more(k: int) -> list[Skeleton]:
+        asked.append(k)
+        out, queue[:] = queue[:k], queue[k:]
+        return out
+
+    failing = MCTS(lambda s, x: Grounding(Outcome.FAIL), lambda n, m: more, {"o1"}, k=3)
+    assert asked == [1]
+    result = failing.run(deadline=float("inf"))
+    assert result.steps is None and failing.stats["groundings"] == 3  # every skeleton grounded once
+    assert asked[:2] == [1, 3] and failing.stats["skeletons"] == 3  # (the first failed: a full batch)
+    asked.clear()
+    queue[:] = [SKEL_DIRECT, SKEL_CLEAR]
+    solved = MCTS(lambda s, x: Grounding(Outcome.SUCCESS, [step_of(A1)]), lambda n, m: more, {"o1"}, k=3)
+    assert solved.run(deadline=float("inf")).steps is not None and asked == [1]

@@ -45,6 +45,13 @@ HANDOVER_PAIRS = 6
 CONTACT_START = 1.5
 
 
+def _out_of_reach(ik: str, attempt: int, status: GroundStatus) -> bool:
+    """Whether an approach whose IK attempt ``attempt`` failed (``ik``: the solver's status) gives up: the pose
+    is provably out of reach (no other seed helps), or no start converged in :data:`IK_GIVE_UP` attempts and
+    none before collided (phase 1 gives up there too)."""
+    return ik == "unreachable" or (attempt + 1 >= IK_GIVE_UP and status is GroundStatus.NO_IK)
+
+
 class Approaches(Volumes):
     """An arm's pick, place and handover configurations (see the module docstring)."""
 
@@ -86,10 +93,8 @@ class Approaches(Volumes):
             )
             q = solve_ik_many(arm.model, arm.ee_target(pose @ g_t)[None], seed, q_init=start)[0]
             if not q.solved or q.q is None:  # (q is None exactly when the solve failed)
-                if q.status.value == "unreachable":
-                    return Answer(GroundStatus.NO_IK, static=True)  # provably out of reach: no other seed helps
-                if attempt + 1 >= IK_GIVE_UP and status is GroundStatus.NO_IK:
-                    return Answer(GroundStatus.NO_IK, static=True)  # no start converged (phase 1 gives up too)
+                if _out_of_reach(q.status.value, attempt, status):
+                    return Answer(GroundStatus.NO_IK, static=True)
                 continue
             configs = self._approach_configs(arm, pose @ g_t, q.q, seed) if approach else np.asarray(q.q)[None]
             if configs is None:
@@ -112,6 +117,8 @@ class Approaches(Volumes):
             if hit:
                 blockers |= hit
                 status = GroundStatus.COLLISION
+                if self._hand_hits(robot, configs, (obj, grasp), avoid):
+                    break  # the hand, where the grasp puts it in every attempt: no other branch helps
                 continue
             if (moving is not None and posed_collide(posed, moving)) or (
                 after and self._standing_clash(robot, obj, grasp, configs[-1], after)
@@ -125,6 +132,15 @@ class Approaches(Volumes):
         if clash is not None and not blockers:
             detail = self._clash_detail(robot, phase, clash, ignore=() if held else (obj,))
         return Answer(status, blockers=blockers, detail=detail, static=static)
+
+    def _hand_hits(self, robot: str, configs: np.ndarray, grip: tuple[str, str], avoid: tuple[str, ...]) -> bool:
+        """Whether ``robot``'s hand (:attr:`Arm.hand <mrgc.geometry.arm.Arm.hand>`), at the pre-grasp or the grasp
+        of an approach ``configs`` with the fingers at ``grip``'s opening, hits one of ``avoid``: those two tool
+        poses are the grasp's, the same in every IK attempt (to the solver's 0.1 mm), so no other attempt
+        clears it."""
+        opening = self._grip(robot, *grip)[0]
+        hand = self.arm(robot).hand_volume(configs[[0, -1]], opening)
+        return bool(hand) and self.world.probe_collides(Posed.of(hand), against=avoid)
 
     def _standing_clash(self, robot: str, obj: str, grasp: str, q: np.ndarray, after: Pieces) -> bool:
         """Whether ``robot`` standing at ``q`` holding ``obj`` hits ``after``: what the step's other robots do

@@ -16,7 +16,7 @@ import numpy as np
 from mrgc.geometry.collision import CollisionShape, ConvexHull, PairCheck, collision_shape
 from mrgc.geometry.fk import ee_pose, fk_world
 from mrgc.geometry.grasps import finger_opening, grasp_transform
-from mrgc.geometry.kinematics import RobotModel, model_for_kind
+from mrgc.geometry.kinematics import RobotModel, gripper_frames, model_for_kind
 from mrgc.geometry.robot import Held, Rest, Volume
 from mrgc.geometry.scene import RobotSpec
 from mrgc.geometry.transforms import from_pose, inverse
@@ -80,6 +80,19 @@ class Arm:
         mount = set(self.model.mount)
         index = [k for k in self.hulls if k not in mount]
         return [self.hulls[k] for k in index], index
+
+    @cached_property
+    def hand(self) -> list[int]:
+        """Positions in :attr:`probes` of the end-effector link and the links below it (the hand and its
+        fingers): where they are follows from the tool pose and the finger opening alone, whatever the joints."""
+        below = set(gripper_frames(self.model))
+        return [i for i, k in enumerate(self.probes[1]) if k in below]
+
+    def hand_volume(self, q: np.ndarray, opening: float | None = None) -> Volume:
+        """The :attr:`hand`'s hulls at each of configurations ``q`` (C, dof), the fingers ``opening`` apart."""
+        shapes = self.probes[0]
+        transforms = self.link_transforms(np.atleast_2d(q), opening)
+        return [(shapes[i], t[i]) for t in transforms for i in self.hand]
 
     @cached_property
     def base_hulls(self) -> tuple[tuple[str, CollisionShape, np.ndarray], ...]:

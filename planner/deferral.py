@@ -20,6 +20,9 @@ stands at the start (a skeleton moves each object once; relays are counted as th
 attempts are seeded by robot, object and grasp, so every skeleton holding that pick fails on it again.  On
 PA10-s15 (``mrgc generate packaging --preset pa10 --seed 15``) eight skeletons in a row failed on
 ``pick by r1: collision: hits table`` with one grasp of a handover, deferred three at a time per pair of grasps.
+A place whose every placement tried failed that way (``r4 places o2 in bin-b with side-y-``: the fingers of a
+side grasp into the table wherever the bin's floor puts the object) is deferred at once too: the placements a
+later grounding tries are others (the failed ones are remembered and skipped), but the grasp is what fails.
 
 On nine generated runs that hit the time limit before deferral, this split solved 7, counting every
 failure by the action 6, and every place and pick failure by its part 5 (docs/planner.md, "Deferred
@@ -51,12 +54,28 @@ def parts(a: Action) -> list[Part]:
     whole: Part = ("action", a)
     if a.via is not None:
         return [whole]
-    return [("place", a.obj, a.region, a.place_robot), ("pick", a.obj, a.pick_robot), _grasped(a), whole]
+    return [("place", a.obj, a.region, a.place_robot), ("pick", a.obj, a.pick_robot), _grasped(a), _put(a), whole]
 
 
 def _grasped(a: Action) -> Part:
     """The pick of ``a`` with its grasp: the part a static pick failure is counted against."""
     return ("grasp", a.obj, a.pick_robot, a.pick_grasp)
+
+
+def _put(a: Action) -> Part:
+    """The place of ``a`` in its region with its grasp: the part a static place failure is counted against."""
+    return ("put", a.obj, a.region, a.place_robot, a.place_grasp)
+
+
+def _held(a: Action, failure: Failure) -> Part | None:
+    """The part a static ``failure`` of ``a`` defers at once (a pick or a place with its grasp), else None."""
+    if not failure.static or a.via is not None:
+        return None
+    if failure.check.startswith("pick by"):
+        return _grasped(a)
+    if failure.check.startswith("place by"):
+        return _put(a)
+    return None
 
 
 def describe(part: Part) -> str:
@@ -67,6 +86,8 @@ def describe(part: Part) -> str:
         return f"{part[2]} picks {part[1]}"
     if part[0] == "grasp":
         return f"{part[2]} picks {part[1]} with {part[3]}"
+    if part[0] == "put":
+        return f"{part[3]} places {part[1]} in {part[2]} with {part[4]}"
     return str(part[1])
 
 
@@ -89,8 +110,9 @@ class Deferrals:
             names = (label(a), *(label(h) for h in (a.halves if a.via is not None else ())))
             if failure.action in names:
                 counted = [(_part(a, failure.check), 1)]
-                if failure.static and a.via is None and failure.check.startswith("pick by"):
-                    counted.insert(0, (_grasped(a), self.after))  # fails wherever it is tried: at once
+                held = _held(a, failure)
+                if held is not None:
+                    counted.insert(0, (held, self.after))  # fails wherever it is tried: at once
                 found: Part | None = None
                 for part, weight in counted:
                     self.counts[part] = self.counts.get(part, 0) + weight
@@ -102,7 +124,7 @@ class Deferrals:
 
     def reason(self, part: Part) -> str:
         """Why ``part`` was deferred, in words (the search's ``--verbose`` line)."""
-        if part[0] == "grasp":
+        if part[0] in ("grasp", "put"):
             return "at its first failure, on what never moves"
         return f"after {self.after} failures"
 

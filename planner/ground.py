@@ -556,11 +556,13 @@ class ReverseGrounder:
             )
         )
         looked = 0
+        static = True  # every placement tried failed on what never moves (Failure.static)
         while looked < PLACEMENT_TRIES + OUT_OF_REACH_TRIES and tried < PLACEMENT_TRIES:
             self._on_time()
             pose = next(spots, None)
             if pose is None:
-                return last or Failure(0, "", f"placement: no free pose of {a.obj} in {region}")
+                none = Failure(0, "", f"placement: no free pose of {a.obj} in {region}")
+                return _static(last, static) if last else none
             spot = (a.place_robot, a.obj, a.place_grasp, _spot_key(pose))
             if spot in self._dead_spots:
                 continue  # failed before on what never moves: fails again, and costs no try
@@ -579,7 +581,9 @@ class ReverseGrounder:
                 tried += place.status is not GroundStatus.NO_IK
                 if place.static:
                     self._dead_spots.add(spot)
+                static = static and place.static
                 continue
+            static = False
             tried += 1
             assert place.configs is not None
             carry = g.transfer(
@@ -609,7 +613,7 @@ class ReverseGrounder:
                 continue
             return planned
         assert last is not None
-        return last
+        return _static(last, static)
 
     def _crowds(
         self,
@@ -916,6 +920,11 @@ def _spot_key(pose: np.ndarray) -> tuple[float, ...]:
     """A placement as a set key: its rotation and position rounded to 1e-6 (the same candidate drawn again by
     another grounding is the same key)."""
     return tuple(float(v) + 0.0 for v in np.round(pose[:3], 6).ravel())
+
+
+def _static(failure: Failure, static: bool) -> Failure:
+    """``failure`` marked static exactly when ``static``: every try behind it failed on what never moves."""
+    return failure if failure.static == static else replace(failure, static=static)
 
 
 def _failed(what: str, answer: Answer) -> Failure:

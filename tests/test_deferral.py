@@ -123,3 +123,13 @@ def test_a_pick_failing_on_what_never_moves_defers_that_pick_with_its_grasp_at_o
     rskel = Skeleton(((relay,),))
     down = relay.halves[0]
     assert Deferrals().failed(rskel, replace(hit, step=1, action=label(down))) is None
+
+
+def test_a_place_failing_on_what_never_moves_at_every_placement_defers_that_place_with_its_grasp_at_once() -> None:
+    d = Deferrals()
+    skel = Skeleton(((B,), (A3,)))
+    hit = Failure(2, label(A3), "place by r2: collision", (), "hits table", static=True)
+    part = d.failed(skel, hit)
+    assert part == ("put", "o1", "goal", "r2", "side") and describe(part) == "r2 places o1 in goal with side"
+    assert d.covers(A2) and d.covers(A3) and not d.covers(A1)  # r2 placing o1 in goal with side
+    assert Deferrals().failed(skel, replace(hit, static=False)) is None

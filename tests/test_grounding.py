@@ -17,6 +17,7 @@ from mrgc.geometry.arm_paths import joint_line
 from mrgc.geometry.collision import CollisionShape, CollisionWorld
 from mrgc.geometry.conventions import PATH_RESOLUTION, to_se2
 from mrgc.geometry.grounding import Grounder
+from mrgc.geometry.kinematics import Link
 from mrgc.geometry.scene import inside, scene_from_problem
 from mrgc.geometry.stances import PHASES, Stance, stance
 from mrgc.geometry.transforms import translation
@@ -535,6 +536,7 @@ def test_an_action_doomed_by_what_never_moves_fails_before_the_later_steps(pa3: 
     picked.clear()
     assert first.outcome is Outcome.FAIL and first.failures, first.reason
     assert (first.failures[0].step, first.failures[0].check) == (1, "place by r1: no inverse kinematics")
+    assert first.failures[0].static  # every placement tried is out of reach: what never moves
     second = reverse.ground(skel, [], key="2")
     assert second.outcome is Outcome.FAIL and second.failures
     assert (second.failures[0].step, second.failures[0].check) == (1, "place by r1: no inverse kinematics")
@@ -575,3 +577,38 @@ def test_a_pick_failing_on_what_never_moves_fails_every_skeleton_holding_it_at_o
     other = reverse.ground(Skeleton(((Action("o2", "bin-a", "r1", "r1", "top", "top"),),)), [], key="3")
     assert picked and picked[0] == "o2"  # asked again: another grasp is another query
     assert other.outcome is Outcome.SUCCESS, other.reason
+
+
+def test_a_pick_whose_hand_hits_a_neighbour_stops_after_one_attempt(
+    pa3: Grounder, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """geometry/approaches.py: o1 stands 2 cm from o2 and o3; its top-x grasp closes the fingers across them.
+    The hand (the end-effector link and the fingers: :attr:`Arm.hand`) stands where the grasp puts it in every
+    IK attempt, so the first attempt's hit ends the query with the same answer (collision, those blockers)
+    instead of trying every IK branch; without the neighbours to avoid the pick is found."""
+    import mrgc.geometry.approaches as approaches
+
+    arm = pa3.arm("r1")
+    links = arm.model.links
+    below = {k for k in range(len(links)) if _below(links, k, arm.model.ee_link)}
+    assert arm.hand and {arm.probes[1][i] for i in arm.hand} == below & set(arm.probes[1])
+    solves: list[int] = []
+    real = approaches.solve_ik_many
+
+    def counted(*args: object, **kwargs: object) -> object:
+        solves.append(1)
+        return real(*args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(approaches, "solve_ik_many", counted)
+    pa3.step({"r1": Stance.PICKED})
+    blocked = pa3.pick("r1", "o1", "top-x", avoid=["o2", "o3"])
+    assert blocked.status is GroundStatus.COLLISION and blocked.blockers == {"o2", "o3"}
+    assert len(solves) == 2  # one attempt: the grasp and its pre-grasp
+    assert pa3.pick("r1", "o1", "top-x").ok
+
+
+def _below(links: tuple[Link, ...], k: int, ancestor: int) -> bool:
+    """Whether link ``k`` is link ``ancestor`` or lies below it in the tree."""
+    while k != ancestor and links[k].parent is not None and links[k].parent >= 0:
+        k = links[k].parent
+    return k == ancestor

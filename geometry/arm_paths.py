@@ -45,6 +45,12 @@ NEIGHBOURHOOD = 0.10
 #: search costs all of them, at 0.5-1.5 ms a check (an arm holding an object, 1 cm steps), and a step tries
 #: several placements; 20,000 (motion.MAX_CHECKS) let one grounding run for minutes on a loaded machine
 TRANSFER_CHECKS = 4_000
+#: the budget when the path must also keep clear of what the step's other robots sweep meanwhile (``busy``):
+#: that search is the optimistic first try (the grounding then tries the motion against the other robots as
+#: they pass, sample by sample) and among four or five arms of one step it rarely ends: on PA18 with 5 arms
+#: (seed 7) 43 such searches spent 1,750 checks each, none found a path, 40 of the grounding's 55 s of CPU;
+#: those that succeed on PA10 and PA18 with 3-4 arms used 162-866 checks
+BUSY_TRANSFER_CHECKS = 2_000
 #: joint-space distance (rad) between the states an arm's path search checks when a finer path is asked
 #: for (:meth:`ArmPaths.arm_path`): the path found is checked again, densely, before it is used
 COARSE_RESOLUTION = 0.04
@@ -258,8 +264,9 @@ class ArmPaths(Volumes):
         if hit is None:
             return list(line), None
         avoid, busy, phase = motion
+        budget = BUSY_TRANSFER_CHECKS if len(busy) else TRANSFER_CHECKS
         planned = self.arm_path(
-            robot, *ends, holding, avoid, TRANSFER_CHECKS, PATH_RESOLUTION, busy, phase=phase, fingers=fingers
+            robot, *ends, holding, avoid, budget, PATH_RESOLUTION, busy, phase=phase, fingers=fingers
         )
         return (planned.path if planned.ok else []), hit
 

@@ -179,24 +179,3 @@ def test_coal_and_pybullet_agree_on_robot_box_collisions(
     ours = world.batch_collides(SHAPES, fk_world(PANDA, q, np.eye(4))[[link.index for link in LINKS]], against="fixed")
     if abs(reference) > 0.005:  # both engines use convex hulls of the same meshes; skip grazing contacts
         assert ours == (reference < 0), f"coal says {ours}, pybullet distance {reference:.4f} m"
-
-
-def test_a_handover_pair_hitting_an_arm_at_home_is_not_kept_not_even_the_partners() -> None:
-    """predicates._exchange_hits: in the execution model the taker waits at home while the giver carries the
-    object to its exchange (and the giver is home while the taker carries it on), so a pair in which either
-    exchange configuration hits an arm at home, the partner's included, gives no ``enable-goal-handover``."""
-    from mrgc.geometry.arm import Arm
-    from mrgc.geometry.facts import HandoverConfig
-    from mrgc.geometry.predicates import _ArmPoses, _exchange_hits
-
-    scene = scene_from_problem(parse_file(ROOT / "domains" / "packaging" / "pa3-handover.mrg").problem())
-    q1, q2 = Arm(scene.robot("r1")).home, Arm(scene.robot("r2")).home  # apart: the two arms do not collide
-    clean1, clean2 = HandoverConfig(q1, frozenset(), frozenset({"o2"})), HandoverConfig(q2, frozenset())
-    arms = _ArmPoses(scene)
-    assert _exchange_hits(scene, arms, "o1", ("r1", "top", [clean1]), ("r2", "top", [clean2])) == {"o2"}
-    into_taker = HandoverConfig(q1, frozenset({"r2"}))
-    into_giver = HandoverConfig(q2, frozenset({"r1"}))
-    assert _exchange_hits(scene, arms, "o1", ("r1", "top", [into_taker]), ("r2", "top", [clean2])) is None
-    assert _exchange_hits(scene, arms, "o1", ("r1", "top", [clean1]), ("r2", "top", [into_giver])) is None
-    # among several configurations the clean pair is the one found
-    assert _exchange_hits(scene, arms, "o1", ("r1", "top", [into_taker, clean1]), ("r2", "top", [clean2])) == {"o2"}

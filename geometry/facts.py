@@ -29,8 +29,8 @@ class RobotFacts:
 
     facts: list[Fact] = field(default_factory=list)
     #: (M, point, g) -> the distinct configurations found holding M with g at the point, each with the other
-    #: arms whose links at home it hits (a pair is kept only when neither hits any arm at home, the partner's
-    #: included: predicates._exchange_hits); the first one found from home first
+    #: arms whose links at home it hits (the partner may be one of them: it is at the exchange then, not at
+    #: home); the first one found from home first
     handover: dict[tuple[str, str, str], list[HandoverConfig]] = field(default_factory=dict)
     ik_solves: int = 0
     collision_checks: int = 0

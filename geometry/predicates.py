@@ -478,12 +478,8 @@ def _exchange_hits(
     taker: tuple[str, str, list[HandoverConfig]],
 ) -> frozenset[str] | None:
     """The movable objects hit at the pair of the two arms' exchange configurations (robot, grasp,
-    configurations) that hits the fewest, among the pairs whose arms do not collide and hit no arm at home;
-    None when every pair collides.  Not even the partner's home: in the execution model (geometry/stances.py)
-    the taker waits at home while the giver carries the object to its exchange, and the giver is back home
-    while the taker carries it on from its exchange, so a giver's exchange into the taker's home ends a carry
-    no path can reach, and a taker's into the giver's home starts one no path can leave (generated i14 of
-    benchmarks/generated.py: every such handover failed `carry to the handover: no path`)."""
+    configurations) that hits the fewest, among the pairs whose arms do not collide (an arm may reach into
+    the other one's home only: that one is at the exchange); None when every pair collides."""
     (r1, g1, c1s), (r2, g2, c2s) = giver, taker
     shape = scene.body(obj).shape
     w1, w2 = finger_opening(scene.grasp(g1), shape), finger_opening(scene.grasp(g2), shape)
@@ -493,7 +489,11 @@ def _exchange_hits(
             hits = c1.movables | c2.movables
             if best is not None and (len(hits), sorted(hits)) >= (len(best), sorted(best)):
                 continue
-            if not c1.homes and not c2.homes and not posed_collide(arms.at(r1, c1.q, w1), arms.at(r2, c2.q, w2)):
+            if (
+                c1.homes <= {r2}
+                and c2.homes <= {r1}
+                and not posed_collide(arms.at(r1, c1.q, w1), arms.at(r2, c2.q, w2))
+            ):
                 best = hits
     return best
 

@@ -29,8 +29,9 @@ samples from fixed seeds, so the same search makes the same probes.
 
 A pick that failed on what never moves (:attr:`Failure.static <mrgc.planner.outcome.Failure.static>`: every
 attempt out of reach, into a fixed body, a robot's base or the arm itself) needs no probe: the object is
-picked where it stands at the start (a skeleton moves each object once; relays are left out) and the pick's
-attempts are seeded by robot, object and grasp, so the same pick fails the same way in every skeleton.  A
+picked where it stands at the start (a skeleton moves each object once; relays are left out, and so is a
+failure while the object stands elsewhere: a relay's onward half picks it up at the relay's spot) and the
+pick's attempts are seeded by robot, object and grasp, so the same pick fails the same way in every skeleton.  A
 skeleton holding one fails at once at that step, with the first failure's line.
 """
 
@@ -98,7 +99,7 @@ class DoomedActions:
 
     def failed(self, a: Action, failure: Failure) -> None:
         """Note the failure of action ``a`` in some grounding."""
-        if failure.static and a.via is None and failure.check.startswith("pick by"):
+        if failure.static and a.via is None and failure.check.startswith("pick by") and self._at_start(a.obj):
             self.static_picks.setdefault((a.pick_robot, a.obj, a.pick_grasp), failure)
         part = failed_part(a, failure.check)
         if part is not None and self.g.robot(a.pick_robot).approaches:
@@ -132,6 +133,11 @@ class DoomedActions:
                         return Failure(t + 1, self.label(a), f.check, f.bodies, f.detail)
             still |= same
         return None
+
+    def _at_start(self, obj: str) -> bool:
+        """Whether ``obj`` stands at its initial pose in the grounder now (not at a relay's spot, where the
+        onward half of a relay picks it up)."""
+        return bool(np.array_equal(self.g.poses[obj], self.g.scene.body(obj).pose))
 
     def _static(self, skeleton: Skeleton) -> Failure | None:
         """The failure of the latest step of ``skeleton`` holding a pick known to fail on what never moves."""

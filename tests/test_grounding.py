@@ -612,3 +612,19 @@ def _below(links: tuple[Link, ...], k: int, ancestor: int) -> bool:
     while k != ancestor and links[k].parent is not None and links[k].parent >= 0:
         k = links[k].parent
     return k == ancestor
+
+
+def test_a_static_pick_failure_away_from_the_start_is_not_remembered(pa3: Grounder) -> None:
+    """planner/doomed.py: a relay's onward half picks its object up at the relay's spot; a pick failing there on
+    what never moves says nothing of the pick from the object's initial pose, so it is not remembered."""
+    from mrgc.planner.outcome import Failure
+
+    reverse = ReverseGrounder(pa3, {"o1": "bin-a"})
+    a = Action("o2", "bin-a", "r1", "r1", "side-y+", "top")
+    failure = Failure(1, "r1 moves o2", "pick by r1: no inverse kinematics", static=True)
+    elsewhere = pa3.poses["o2"] @ translation(0.0, 0.05, 0.0)
+    with pa3.moved({"o2": elsewhere}):
+        reverse.doomed.failed(a, failure)
+    assert reverse.doomed.static_picks == {}
+    reverse.doomed.failed(a, failure)  # at its initial pose: remembered
+    assert list(reverse.doomed.static_picks) == [("r1", "o2", "side-y+")]

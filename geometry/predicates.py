@@ -42,7 +42,6 @@ from mrgc.geometry.facts import FactsResult, HandoverConfig, RobotFacts
 from mrgc.geometry.grasps import finger_opening, fits, grasp_transform, pregrasp_transform
 from mrgc.geometry.ik import solve_ik_many
 from mrgc.geometry.kinds import approaches
-from mrgc.geometry.kinematics import model_for_kind
 from mrgc.geometry.relays import Asks, Spots, relay_facts, spot_region, stranded
 from mrgc.geometry.relays import asks as relay_asks
 from mrgc.geometry.scene import Body, SceneSpec, half_extents, inside
@@ -400,9 +399,9 @@ def compute_facts(
     robots = [r.name for r in scene.robots]
     n = worker_count(workers, len(robots))
     jobs = [(scene, r, seed) for r in robots]
-    for spec in scene.robots:  # load every arm model here: errors surface once, and forked workers share them
-        if approaches(spec.kind):
-            model_for_kind(spec.kind, spec.base_dir)
+    for spec in scene.robots:  # every arm's model and link hulls built here: errors surface once, forked workers
+        if approaches(spec.kind):  # share them (and the pybullet check of its URDF), grounding reuses them
+            _ = Arm(spec).hulls
     per_robot = _map(_robot_worker, jobs, n, deadline)
     t_robots = time.perf_counter() - t0
     facts: set[Fact] = set()

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import pickle
 import subprocess
 import sys
@@ -360,3 +361,18 @@ def test_pybullet_ik_reference(panda) -> None:
         res = pybullet_ik(panda, t, seed=0)
         if res.solved:
             assert pose_error(F.ee_pose(panda, res.q), t)[0] <= 1e-4 and panda.within_limits(res.q)
+
+
+def _checks_in_a_worker(_: int) -> bool:
+    """In a forked worker: load the Panda's model again and say whether that started a pybullet client."""
+    from mrgc.geometry import bullet
+
+    load_robot_model(PANDA, "/tmp", "panda_hand")
+    return bullet._CLIENT.get("pid") == os.getpid()
+
+
+def test_a_urdf_accepted_once_is_not_loaded_again_by_forked_workers() -> None:
+    from mrgc.workers import map_in_workers
+
+    load_robot_model(PANDA, "/tmp", "panda_hand")  # checked by pybullet here
+    assert map_in_workers(_checks_in_a_worker, [0, 1], 2) == [False, False]

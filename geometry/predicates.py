@@ -164,6 +164,7 @@ class RobotEvaluator:
         the first clean answer wins, else the first answer.
         """
         found: dict[int, tuple[np.ndarray, set[str]]] = {}
+        settled: set[int] = set()  # the hand hits what made the answer fail or unclean: no other branch helps
         todo = list(range(len(queries)))
         for attempt in range(IK_SEEDS):
             if not todo:
@@ -198,6 +199,8 @@ class RobotEvaluator:
                 opening = self.opening(obj, grasp)
                 path = self._approach(q_pre, q)
                 if not self._free(refine(path), (obj,), opening):
+                    if self._hand_hits(path, (obj,), opening, "fixed"):
+                        settled.add(i)
                     continue
                 if held:  # the object in hand, along the approach, must stay clear of fixed objects too
                     shape = self.scene.body(obj).shape
@@ -209,9 +212,23 @@ class RobotEvaluator:
                     hits |= self._object_hits(obj, self.scene.body(obj).shape, g, path, pose)
                 if i not in found or (found[i][1] and not hits):
                     found[i] = (path, hits)
+                if hits and want_free and self._hand_hits(path, (obj,), opening, "movable"):
+                    settled.add(i)
             # try other IK solutions for queries with no answer yet, or (if asked) one that hits movables
-            todo = [i for i in todo if i not in unsolvable and (i not in found or (want_free and found[i][1]))]
+            todo = [
+                i
+                for i in todo
+                if i not in unsolvable and i not in settled and (i not in found or (want_free and found[i][1]))
+            ]
         return found
+
+    def _hand_hits(self, path: np.ndarray, ignore: tuple[str, ...], opening: float | None, against: str) -> bool:
+        """Whether the hand (:attr:`Arm.hand <mrgc.geometry.arm.Arm.hand>`) at the first or last configuration of
+        an approach ``path`` (the pre-grasp and the grasp: tool poses every IK branch shares, to the solver's
+        0.1 mm) hits an ``against`` object but ``ignore``: then every other branch's approach does too, and a
+        retry cannot give a free (or cleaner) answer."""
+        hand = self.arm.hand_volume(path[[0, -1]], opening)
+        return bool(hand) and self.world.probe_collides(hand, against=against, ignore=ignore)
 
     def placements(self, obj: str, region: str | Body) -> list[np.ndarray]:
         """Candidate poses of ``obj`` resting inside ``region`` (a name or a region body): a lattice, centre

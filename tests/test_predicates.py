@@ -179,3 +179,23 @@ def test_coal_and_pybullet_agree_on_robot_box_collisions(
     ours = world.batch_collides(SHAPES, fk_world(PANDA, q, np.eye(4))[[link.index for link in LINKS]], against="fixed")
     if abs(reference) > 0.005:  # both engines use convex hulls of the same meshes; skip grazing contacts
         assert ours == (reference < 0), f"coal says {ours}, pybullet distance {reference:.4f} m"
+
+
+def test_a_pick_whose_hand_hits_a_neighbour_is_not_retried(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """geometry/predicates.py: o2 stands 7 cm on o1's +x side, where the hand is at the pre-grasp of o1's
+    side-x+ grasp.  The hand stands there in every IK branch, so the first answer (reachable, occluded by o2)
+    is final: no retry for a free approach, and the same answer as with every retry made."""
+    from mrgc.geometry.predicates import RobotEvaluator
+
+    shutil.copy(PACKAGING / "domain.mrg", tmp_path / "domain.mrg")
+    (tmp_path / "tiny.mrg").write_text(SCENE, encoding="utf-8")
+    scene = scene_from_problem(parse_file(tmp_path / "tiny.mrg").problem())
+    query = [("o1", "side-x+", scene.body("o1").pose, False, "pick")]
+    settled = RobotEvaluator(scene, "r1")
+    answer = settled._solve(query, want_free=True)
+    monkeypatch.setattr(RobotEvaluator, "_hand_hits", lambda *_: False)
+    retried = RobotEvaluator(scene, "r1")
+    again = retried._solve(query, want_free=True)
+    assert answer[0][1] == again[0][1] == {"o2"}
+    assert np.array_equal(answer[0][0], again[0][0])
+    assert settled.out.ik_solves == 2 < retried.out.ik_solves  # one attempt: the grasp and its pre-grasp

@@ -161,7 +161,9 @@ class RobotEvaluator:
         Queries whose IK solution collides with a fixed object (or has no pre-grasp) are retried with other
         IK seeds (other solution branches), and so are those whose approach hits movable objects when
         ``want_free`` (the paper's "collision-free, if possible");
-        the first clean answer wins, else the first answer.
+        the first clean answer wins, else the first answer.  A query whose hand hits what failed it (a fixed
+        body; a movable one when ``want_free``) at its pre-grasp or grasp is not retried (:meth:`_hand_hits`):
+        every branch puts the hand there, so a retry gives the same facts.
         """
         found: dict[int, tuple[np.ndarray, set[str]]] = {}
         settled: set[int] = set()  # the hand hits what made the answer fail or unclean: no other branch helps

@@ -45,6 +45,9 @@ OUT_OF_REACH_TRIES = 30
 #: other regions an obstacle with no reachable place in its own may be parked in, nearest first
 PARKING_REGIONS = 2
 RELAY_TRIES = 3  # spots tried per relay (the k-th spot both of its robots reach at the k-th try)
+#: random placements (beyond the lattice and the packing grid) a goal region is searched with before a suffix is
+#: called a dead end for want of room in it (:meth:`ReverseGrounder.dead_end`)
+DEAD_END_SAMPLES = 400
 #: paths replayed in another path's phase (the validator's execution model): name -> phase
 PATH_PHASE = {"taker-to-handover": "to-handover"}
 #: a skeleton's order constraints: an action's obstacles, (object, strict) (``TaskGraph.obstacles``)
@@ -87,6 +90,9 @@ class Grounding:
     resolved: list[Failure] = field(default_factory=list)
     #: actions re-timed into an earlier skeleton step: (action label, from step, to step)
     retimed: list[tuple[str, int, int]] = field(default_factory=list)
+    #: why no skeleton at all can be grounded before the suffix this one failed under ('' when the failure
+    #: says nothing of the kind): a goal object it leaves no free pose in its goal region
+    dead_end: str = ""
 
 
 def _matrix(t: np.ndarray) -> list[list[float]]:
@@ -123,6 +129,8 @@ class ReverseGrounder:
         #: (robot, object, grasp, placement) whose place failed on what never moves (no IK, fixed bodies):
         #: later groundings pass over them without spending one of their tries
         self._dead_spots: set[tuple[str, str, str, tuple[float, ...]]] = set()
+        #: (suffix step ids, object, region) -> (the suffix, whether it leaves the object no free pose there)
+        self._full: dict[tuple[tuple[int, ...], str, str], tuple[tuple[GroundedStep, ...], bool]] = {}
         #: the skeleton being grounded, its actions as re-timed so far (see :class:`_Retiming`)
         self._plan = _Retiming([], None)
         #: actions found doomed before the later steps are grounded (planner/doomed.py)
@@ -153,9 +161,33 @@ class ReverseGrounder:
         result = self._ground(skeleton, suffix, key, order)
         if result.retimed and result.outcome is not Outcome.SUCCESS:
             result = self._ground(skeleton, suffix, key, None)
+        if result.outcome is Outcome.FAIL and result.failures:
+            result.dead_end = self.dead_end(result.failures[0], skeleton, suffix)
         if self.g.cut:  # a query stopped at the deadline: what it answered decides nothing
             raise DeadlineReached()
         return result
+
+    def dead_end(self, failure: Failure, skeleton: Skeleton, suffix: list[GroundedStep]) -> str:
+        """Why no skeleton can be grounded before ``suffix`` ('' when ``failure``, of a grounding of ``skeleton``
+        under it, does not show it): the failure found no free pose of a goal object in its goal region, and
+        the region has none even with nothing avoided but what the suffix sweeps and leaves there (every
+        object at its initial pose ignored: a relaxation of every skeleton's context there), among the
+        lattice, the packing grid and :data:`DEAD_END_SAMPLES` random placements.  Every plan through the
+        suffix puts that object there before the suffix's steps, so none exists.  Cached per (suffix,
+        object, region)."""
+        for a in (a for step in skeleton.steps for a in step):
+            if self.goal.get(a.obj) != a.region or failure.check != f"placement: no free pose of {a.obj} in {a.region}":
+                continue
+            key = (tuple(id(s) for s in suffix), a.obj, a.region)
+            if key not in self._full:  # the suffix is kept with the answer: its steps' ids stay theirs
+                volume = [p for s in suffix for p in s.volume]
+                free = self.g.placements(
+                    a.obj, a.region, volume=volume or None, samples=DEAD_END_SAMPLES, key="dead-end", packed=True
+                )
+                self._full[key] = (tuple(suffix), next(free, None) is None)
+            if self._full[key][1]:
+                return f"no free pose of {a.obj} in {a.region} is left by the {len(suffix)} step(s) grounded after it"
+        return ""
 
     def _ground(self, skeleton: Skeleton, suffix: list[GroundedStep], key: str, order: Order | None) -> Grounding:
         fut_objs = {o for s in suffix for o in s.moved}

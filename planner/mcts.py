@@ -8,7 +8,9 @@ M* (the suffix's objects excluded) and reward ``|S'|/(|S'|+|S̄*|) + α/(objects
 and objects, S̄* the new skeleton with the fewest steps (0 and a terminal node when there is none);
 backpropagation adds the reward to the selected edges and counts visits.  Grounding failures are memoised
 (suffix, skeleton actions) so known-infeasible branches are skipped.  Beyond the paper: a node whose
-skeletons are all used up asks its skeleton source for more instead of becoming terminal.
+skeletons are all used up asks its skeleton source for more instead of becoming terminal, unless a grounding
+under it showed its suffix a dead end (:attr:`Grounding.dead_end <mrgc.planner.ground.Grounding.dead_end>`:
+a goal object left no room in its goal region), which ends the node and the edge into it.
 
 A node's K skeletons are made lazily (beyond the paper, the same search): a new node gets its first skeleton
 only, the one its first selection picks anyway (every edge of an unvisited node has the value 0 and the
@@ -161,6 +163,8 @@ class MCTS:
             path.append((node, edge))
             if edge.child is None:
                 done, reward = self._expand(node, edge)
+                if node.exhausted and not node.open_edges and len(path) > 1:
+                    path[-2][1].dead = True  # a dead end: nothing left below the edge into this node
                 if done is not None:
                     edge.dead = True  # a full plan: nothing more to ground below this edge
                     if self.best is None or _cost(done) < _cost(self.best):
@@ -191,6 +195,10 @@ class MCTS:
         if result.outcome is Outcome.FAIL:
             self.memo.add(memo_key)
             edge.dead = True
+            if result.dead_end:  # no skeleton can come before this node's suffix: the node is used up
+                node.exhausted = True
+                for e in node.edges:
+                    e.dead = True
             return None, 0.0
         if result.outcome is Outcome.SUCCESS:
             plan = result.steps

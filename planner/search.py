@@ -122,6 +122,8 @@ def _search(context: Context, sources: _Sources, deadline: float) -> Result:
         if deferred is not None:
             why_deferred = sources.deferrals.reason(deferred)
             say(f"  deferred {why_deferred}: {describe(deferred)} (skeletons without it first)")
+        if result.dead_end:
+            say(f"  dead end: {result.dead_end}: no skeleton before those steps is grounded")
         return result
 
     search = MCTS(ground, sources, set(context.goals), c=o["c"], alpha=o["alpha"], k=o["skeletons"])

@@ -628,3 +628,22 @@ def test_a_static_pick_failure_away_from_the_start_is_not_remembered(pa3: Ground
     assert reverse.doomed.static_picks == {}
     reverse.doomed.failed(a, failure)  # at its initial pose: remembered
     assert list(reverse.doomed.static_picks) == [("r1", "o2", "side-y+")]
+
+
+def test_a_suffix_leaving_a_goal_object_no_room_in_its_goal_region_is_a_dead_end(pa3: Grounder) -> None:
+    """planner/ground.py: a skeleton under a suffix failed on "no free pose of o1 in bin-b", o1's goal region;
+    when the suffix's volume alone (nothing else avoided) leaves o1 no free pose in bin-b, no skeleton can come
+    before that suffix (``dead_end``); a suffix leaving room, a failure of another kind or a region that is not
+    the object's goal say nothing of the kind."""
+    from mrgc.planner.ground import GroundedStep
+    from mrgc.planner.outcome import Failure
+
+    reverse = ReverseGrounder(pa3, {"o1": "bin-b"})
+    skeleton = Skeleton(((Action("o1", "bin-b", "r1", "r2", "top", "top"),),))
+    full = Failure(1, "r1->r2 moves o1", "placement: no free pose of o1 in bin-b")
+    walled = [GroundedStep([], _wall(pa3, "bin-b"), ("o2",))]
+    why = reverse.dead_end(full, skeleton, walled)
+    assert "no free pose of o1 in bin-b" in why and "1 step(s)" in why
+    assert reverse.dead_end(full, skeleton, [GroundedStep([], _wall(pa3, "bin-b")[:1], ("o2",))]) == ""
+    assert reverse.dead_end(Failure(1, "r1->r2 moves o1", "place by r2: no inverse kinematics"), skeleton, walled) == ""
+    assert ReverseGrounder(pa3, {"o1": "bin-a"}).dead_end(full, skeleton, walled) == ""

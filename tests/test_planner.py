@@ -204,3 +204,37 @@ def test_a_nodes_skeletons_are_made_lazily_the_first_alone() -> None:
     queue[:] = [SKEL_DIRECT, SKEL_CLEAR]
     solved = MCTS(lambda s, x: Grounding(Outcome.SUCCESS, [step_of(A1)]), lambda n, m: more, {"o1"}, k=3)
     assert solved.run(deadline=float("inf")).steps is not None and asked == [1]
+
+
+def test_a_dead_end_ends_its_node_and_the_search_moves_on() -> None:
+    """planner/mcts.py: a grounding under a node's suffix that says no skeleton can come before that suffix
+    (:attr:`Grounding.dead_end`) ends the node -- its other skeletons are never grounded, its source never asked
+    again -- and the edge into it; the search goes on from the root's other skeletons."""
+    other = Skeleton(((Action("o1", "goal", "r1", "r1", "side", "side"),),))
+    calls: list[tuple[Skeleton, int]] = []
+    asked: list[set[str]] = []
+
+    def ground(skel: Skeleton, suffix: list[GroundedStep]) -> Grounding:
+        calls.append((skel, len(suffix)))
+        if skel == SKEL_DIRECT and not suffix:  # o1 placed, o2 in the way: a node with a suffix of 1 step
+            return Grounding(Outcome.PARTIAL, [step_of(A1)], {"o2"})
+        if suffix:  # under that suffix: a dead end
+            return Grounding(Outcome.FAIL, dead_end="no free pose of o2 in start is left by the 1 step(s)")
+        return Grounding(Outcome.SUCCESS, [step_of(A1)]) if skel == other else Grounding(Outcome.FAIL)
+
+    def sources(need: set[str], moved: set[str]):  # type: ignore[no-untyped-def]
+        asked.append(need)
+        queue = [SKEL_DIRECT, other] if "o1" in need else [Skeleton(((A2,),)), SKEL_CLEAR, SKEL_CLEAR]
+
+        def more(k: int) -> list[Skeleton]:
+            out, queue[:] = queue[:k], queue[k:]
+            return out
+
+        return more
+
+    search = MCTS(ground, sources, {"o1"}, k=3)
+    result = search.run(deadline=float("inf"))
+    assert result.steps is not None and [s.moved for s in result.steps] == [("o1",)]
+    assert calls == [(SKEL_DIRECT, 0), (Skeleton(((A2,),)), 1), (other, 0)]  # the node's others never grounded
+    dead = search.root.edges[0]
+    assert dead.dead and dead.child is not None and dead.child.exhausted and not dead.child.open_edges

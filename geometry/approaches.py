@@ -7,14 +7,15 @@ IK from one branch (:meth:`Approaches._approach_configs`).  An approach is kept 
 :data:`APPROACH_CHECK` of joint motion, it collides with nothing: not with itself, fixed bodies, the other arms
 where they stand in the phase, the objects to avoid, what the step's other robots sweep meanwhile (``busy``),
 and, at its last configuration, what they do in the later phases it stands there (``after``).  Attempts start
-from home, then from seeded random starts; a pose no start solves is out of reach after :data:`IK_GIVE_UP`.
+from home, then from seeded random starts; a pose no start solves is out of reach after :data:`IK_GIVE_UP`, or
+after the first when the analytic solver has no branch for it either (:meth:`Approaches._no_branch`).
 A *handover* is both arms at their exchange configurations holding the object at a handover point, not
 colliding with each other (:data:`HANDOVER_PAIRS` rounds of drawing).
 """
 
 from __future__ import annotations
 
-from typing import Iterable, Mapping
+from typing import Callable, Iterable, Mapping
 
 import numpy as np
 
@@ -25,6 +26,7 @@ from mrgc.geometry.collision import Posed, posed_collide
 from mrgc.geometry.conventions import APPROACH_SAMPLES, PATH_RESOLUTION, seed_for
 from mrgc.geometry.grasps import APPROACH, fits, grasp_transform, pregrasp_transform
 from mrgc.geometry.ik import solve_ik_many
+from mrgc.geometry.ik_analytic import panda_chain
 from mrgc.geometry.robot import Pieces, Volume
 from mrgc.geometry.step_world import named_body
 from mrgc.geometry.transforms import translation
@@ -45,11 +47,14 @@ HANDOVER_PAIRS = 6
 CONTACT_START = 1.5
 
 
-def _out_of_reach(ik: str, attempt: int, status: GroundStatus) -> bool:
+def _out_of_reach(ik: str, attempt: int, status: GroundStatus, no_branch: Callable[[], bool]) -> bool:
     """Whether an approach whose IK attempt ``attempt`` failed (``ik``: the solver's status) gives up: the pose
-    is provably out of reach (no other seed helps), or no start converged in :data:`IK_GIVE_UP` attempts and
-    none before collided (phase 1 gives up there too)."""
-    return ik == "unreachable" or (attempt + 1 >= IK_GIVE_UP and status is GroundStatus.NO_IK)
+    is provably out of reach (no other seed helps), or no attempt so far converged (none collided) and either
+    :data:`IK_GIVE_UP` attempts have (phase 1 gives up there too) or ``no_branch()`` says the analytic solver
+    has no branch for it either (:meth:`Approaches._no_branch`)."""
+    if ik == "unreachable":
+        return True
+    return status is GroundStatus.NO_IK and (attempt + 1 >= IK_GIVE_UP or no_branch())
 
 
 class Approaches(Volumes):
@@ -93,7 +98,7 @@ class Approaches(Volumes):
             )
             q = solve_ik_many(arm.model, arm.ee_target(pose @ g_t)[None], seed, q_init=start)[0]
             if not q.solved or q.q is None:  # (q is None exactly when the solve failed)
-                if _out_of_reach(q.status.value, attempt, status):
+                if _out_of_reach(q.status.value, attempt, status, lambda: self._no_branch(arm, pose @ g_t)):
                     return Answer(GroundStatus.NO_IK, static=True)
                 continue
             configs = self._approach_configs(arm, pose @ g_t, q.q, seed) if approach else np.asarray(q.q)[None]
@@ -132,6 +137,16 @@ class Approaches(Volumes):
         if clash is not None and not blockers:
             detail = self._clash_detail(robot, phase, clash, ignore=() if held else (obj,))
         return Answer(status, blockers=blockers, detail=detail, static=static)
+
+    @staticmethod
+    def _no_branch(arm: Arm, tool: np.ndarray) -> bool:
+        """Whether the analytic solver (:mod:`mrgc.geometry.ik_analytic`; arms with a Panda's kinematics only,
+        else False) finds no configuration putting the tool at ``tool``: over the q7 grid, every branch out of
+        the joint limits or off the target.  A numeric solve that failed from its start is then not retried
+        from others (the analytic search covers what their random starts would: measured, docs/geometry.md)."""
+        if panda_chain(arm.model) is None:
+            return False
+        return not solve_ik_many(arm.model, arm.ee_target(tool)[None], 0, q_init=arm.home, analytic=True)[0].solved
 
     def _hand_hits(self, robot: str, configs: np.ndarray, grip: tuple[str, str], avoid: tuple[str, ...]) -> bool:
         """Whether ``robot``'s hand (:attr:`Arm.hand <mrgc.geometry.arm.Arm.hand>`), at the pre-grasp or the grasp

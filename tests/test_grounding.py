@@ -647,3 +647,33 @@ def test_a_suffix_leaving_a_goal_object_no_room_in_its_goal_region_is_a_dead_end
     assert reverse.dead_end(full, skeleton, [GroundedStep([], _wall(pa3, "bin-b")[:1], ("o2",))]) == ""
     assert reverse.dead_end(Failure(1, "r1->r2 moves o1", "place by r2: no inverse kinematics"), skeleton, walled) == ""
     assert ReverseGrounder(pa3, {"o1": "bin-a"}).dead_end(full, skeleton, walled) == ""
+
+
+def test_a_place_the_analytic_solver_has_no_branch_for_gives_up_after_one_attempt(
+    pa3: Grounder, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """geometry/approaches.py: a place of o1 with the top grasp 0.87 m from r1's shoulder (inside its reach
+    bound, but no Panda configuration holds the tool there pointing down).  The first numeric attempt fails,
+    the analytic solver (every branch over the q7 grid) has none either, so the place is out of reach at once
+    -- the same answer (no inverse kinematics, static) as after the :data:`IK_GIVE_UP` numeric attempts."""
+    import mrgc.geometry.approaches as approaches
+
+    far = translation(-0.75, -1.05, 0.06)
+    solves: list[bool] = []
+    real = approaches.solve_ik_many
+
+    def counted(*args: object, **kwargs: object) -> object:
+        solves.append(bool(kwargs.get("analytic")))
+        return real(*args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(approaches, "solve_ik_many", counted)
+    pa3.step({"r1": Stance.PLACED})
+    quick = pa3.place("r1", "o1", "top", far)
+    assert solves == [False, True]  # one numeric attempt, then the analytic check
+    solves.clear()
+    monkeypatch.setattr(approaches.Approaches, "_no_branch", staticmethod(lambda arm, tool: False))
+    slow = pa3.place("r1", "o1", "top", far)
+    pa3.step({})
+    assert solves == [False] * approaches.IK_GIVE_UP
+    assert (quick.status, quick.static) == (slow.status, slow.static) == (GroundStatus.NO_IK, True)
+    assert not pa3._no_branch(pa3.arm("r1"), pa3.arm("r1").tool_world(pa3.arm("r1").home))  # home: a branch

@@ -102,6 +102,11 @@ class ArmPaths(Volumes):
                 return False
             return not self.world.probe_collides(posed, against=against, ignore=ignore)
 
+        def all_free(configs: np.ndarray) -> bool:
+            ok = free(configs)  # counted as the single checks it stands for (on a collision, those that follow)
+            self.queries += len(configs) - 1 if ok else -1
+            return ok
+
         def solve(step: float, budget: int) -> list[np.ndarray]:
             res = plan_joint_path(
                 arm.model.lower,
@@ -113,6 +118,7 @@ class ArmPaths(Volumes):
                 seed=seed_for(robot, "arm-path", seed=self.seed),
                 resolution=step,
                 deadline=self.deadline,
+                all_valid=all_free,
             )
             self.late()  # a solve the deadline stopped has set nothing: it is read here
             return list(res.path)

@@ -29,6 +29,8 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 Validity = Callable[[np.ndarray], bool]
+#: a validity test of many states at once ((k, n) array): True when every one of them is valid
+BatchValidity = Callable[[np.ndarray], bool]
 #: joint values (bounds, configurations): a sequence of floats or a 1-D array
 Vector = Sequence[float] | np.ndarray
 
@@ -94,12 +96,15 @@ def plan_joint_path(
     resolution: float = 0.05,
     simplify: bool = False,
     deadline: float | None = None,
+    all_valid: BatchValidity | None = None,
 ) -> MotionResult:
     """A collision-free path in the box ``lower <= q <= upper`` from ``start`` to ``goal`` (RRTConnect).
 
     ``is_valid(q)`` gets a fresh float array of the joint values; ``resolution`` is the largest step
     between checked (and returned) states along a motion, in joint units.  ``deadline`` (a
-    ``time.perf_counter()`` value): the solve stops there with status ``TIME_LIMIT``.
+    ``time.perf_counter()`` value): the solve stops there with status ``TIME_LIMIT``.  ``all_valid`` (the
+    same test of many states in one call, when cheaper per state): the states between a motion's ends are
+    then checked in one batch (:class:`_EdgeBatches`), with the same answers, paths and check counts.
     """
     lo, hi = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
     q0, q1 = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
@@ -134,6 +139,9 @@ def plan_joint_path(
     setup.setStateValidityChecker(check)
     extent = space.getMaximumExtent()
     setup.getSpaceInformation().setStateValidityCheckingResolution(min(1.0, resolution / extent) if extent > 0 else 1.0)
+    if all_valid is not None and not simplify:  # (the simplifier asks motions for their last valid state)
+        si = setup.getSpaceInformation()
+        si.setMotionValidator(_edge_batches(ob, si, space, n, is_valid, all_valid, budget))
     s, g = space.allocState(), space.allocState()
     for i in index:
         s[i], g[i] = float(q0[i]), float(q1[i])
@@ -143,6 +151,59 @@ def plan_joint_path(
         return np.fromiter((state[i] for i in index), float, n)
 
     return _solve(ob, og, setup, budget, simplify, read)
+
+
+def _edge_batches(
+    ob: Any, si: Any, space: Any, n: int, is_valid: Validity, all_valid: BatchValidity, budget: _Budget
+) -> Any:
+    """An OMPL motion validator that answers as OMPL's ``DiscreteMotionValidator`` does, with the states
+    between a motion's ends checked in one batch (see :class:`_EdgeBatches`)."""
+
+    class _EdgeBatches(ob.MotionValidator):  # type: ignore[misc]
+        """``checkMotion(s1, s2)`` as OMPL's discrete validator: ``s2`` first, then the states at ``k / nd``
+        of the way (``nd`` = the space's valid segment count), middles first, breadth first, stopping at the
+        first invalid one; ``s1`` is valid (the tree's).  Here the middle states are checked in one
+        ``all_valid`` call; only when one of them is invalid are they checked again one by one in OMPL's
+        order, so that the budget counts exactly the checks OMPL would have made (and the same solve ends
+        at the same iteration).  The states are interpolated with OMPL's formula (``a + (b - a) * t``)."""
+
+        def checkMotion(self, s1: Any, s2: Any) -> bool:  # noqa: N802 (OMPL's name)
+            q1 = np.fromiter((s1[i] for i in range(n)), float, n)
+            q2 = np.fromiter((s2[i] for i in range(n)), float, n)
+            budget.used += 1
+            if not is_valid(q2.copy()):
+                return False
+            nd = int(space.validSegmentCount(s1, s2))
+            if nd < 2:
+                return True
+            ts = np.array([k / nd for k in _bisection_order(nd)])
+            states = q1[None] + (q2 - q1)[None] * ts[:, None]
+            if all_valid(states):
+                budget.used += len(states)
+                return True
+            for q in states:
+                budget.used += 1
+                if not is_valid(q.copy()):
+                    return False
+            return False  # (the batch found a collision the single checks did not: kept invalid)
+
+    return _EdgeBatches(si)
+
+
+def _bisection_order(nd: int) -> list[int]:
+    """The order OMPL's discrete motion validator checks the states ``1 .. nd - 1`` of a motion in: the
+    middle of each interval first, intervals breadth first (a queue)."""
+    out: list[int] = []
+    queue = [(1, nd - 1)]
+    while queue:
+        lo, hi = queue.pop(0)
+        mid = (lo + hi) // 2
+        out.append(mid)
+        if lo < mid:
+            queue.append((lo, mid - 1))
+        if hi > mid:
+            queue.append((mid + 1, hi))
+    return out
 
 
 class _Budget:

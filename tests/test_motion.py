@@ -162,3 +162,29 @@ def test_seven_joints() -> None:
     check_path(r, start, goal, valid, 0.05)
     simple = plan_joint_path(lo, hi, start, goal, valid, seed=2, resolution=0.05, simplify=True)
     check_path(simple, start, goal, valid, 0.05)
+
+
+@pytest.mark.parametrize("budget", [150, 400, 5000, MAX_CHECKS])
+@pytest.mark.parametrize("seed", [0, 5, 11])
+def test_motions_checked_in_batches_give_the_same_results(budget: int, seed: int) -> None:
+    """geometry/motion.py: with ``all_valid`` the states inside a motion are checked in one batch; the status,
+    the path (bit for bit) and the count of checks are those of OMPL's own motion validator, with budgets that
+    stop the search and budgets that do not, and the batch is asked of a whole motion at a time."""
+
+    def maze(q: np.ndarray) -> bool:
+        x, y = q
+        return not any(
+            abs(x - w) < 0.02 and (y < 0.9 if k % 2 == 0 else y > 0.1) for k, w in enumerate((0.25, 0.5, 0.75))
+        )
+
+    batches: list[int] = []
+
+    def all_valid(states: np.ndarray) -> bool:
+        batches.append(len(states))
+        return all(maze(q) for q in states)
+
+    args = (LOWER, UPPER, [0.1, 0.1], [0.9, 0.9], maze)
+    one = plan_joint_path(*args, max_checks=budget, seed=seed, resolution=0.01)
+    batched = plan_joint_path(*args, max_checks=budget, seed=seed, resolution=0.01, all_valid=all_valid)
+    assert same_result(one, batched), (one.status, batched.status, one.checks, batched.checks)
+    assert batches and max(batches) > 1

@@ -52,9 +52,11 @@ def test_a_deadline_cuts_phase_1_and_keeps_no_fact() -> None:
 
 @pytest.mark.parametrize("planner", ["mcts", "ap1"])
 def test_a_planner_whose_limit_passes_in_phase_1_says_so(planner: str) -> None:
+    # 50 ms: far below PA10's phase 1 even in a process that has its robot models and hulls already (0.3 s
+    # was not, once phase 1's workers stopped loading pybullet: the search then ran out of time instead)
     t0 = time.monotonic()
-    plan = api.plan(PA10, planner=planner, time_limit=0.3)
+    plan = api.plan(PA10, planner=planner, time_limit=0.05)
     assert plan.status == PlanStatus.TIME_LIMIT and not plan.steps
     assert plan.why is not None and "phase 1" in plan.why.summary
-    assert plan.stats["facts"] == 0 and plan.stats["seconds"] >= 0.3
+    assert plan.stats["facts"] == 0 and plan.stats["seconds"] >= 0.05
     assert time.monotonic() - t0 < 30

@@ -60,6 +60,7 @@ class Node:
     edges: list[Edge] = field(default_factory=list)
     visits: int = 0
     exhausted: bool = False  # the source has no more skeletons
+    dead_end: bool = False  # a grounding showed that no skeleton can come before this node's suffix
 
     def refill(self, k: int) -> None:
         """Ask for up to ``k`` more skeletons for this node's edges (none once exhausted)."""
@@ -163,8 +164,8 @@ class MCTS:
             path.append((node, edge))
             if edge.child is None:
                 done, reward = self._expand(node, edge)
-                if node.exhausted and not node.open_edges and len(path) > 1:
-                    path[-2][1].dead = True  # a dead end: nothing left below the edge into this node
+                if node.dead_end and len(path) > 1:
+                    path[-2][1].dead = True  # nothing left below the edge into this node
                 if done is not None:
                     edge.dead = True  # a full plan: nothing more to ground below this edge
                     if self.best is None or _cost(done) < _cost(self.best):
@@ -196,7 +197,7 @@ class MCTS:
             self.memo.add(memo_key)
             edge.dead = True
             if result.dead_end:  # no skeleton can come before this node's suffix: the node is used up
-                node.exhausted = True
+                node.exhausted = node.dead_end = True
                 for e in node.edges:
                     e.dead = True
             return None, 0.0

@@ -129,6 +129,28 @@ class Arm:
         ((C, L, 4, 4)): a caller that has them already (collision probes) saves the forward kinematics."""
         return self._self_check.collides(self._with_base(transforms))
 
+    def held_collides_at(self, transforms: np.ndarray, shape: CollisionShape, poses: np.ndarray) -> bool:
+        """Whether an object of ``shape`` this arm holds, at world ``poses`` (C, 4, 4), comes within
+        :data:`SELF_CLEARANCE` of one of the arm's own solid links (the mount's included) at the probed links'
+        ``transforms`` (C, L, 4, 4), the :attr:`hand`'s excepted: the hand and its fingers hold it where the
+        grasp puts them, the same all along a motion (the validator's ``collision-self-held``: a carry that
+        swings the object into the arm's base or shoulder)."""
+        kept = self._held_checks.get(id(shape))
+        if kept is None:
+            hand = {self.probes[1][i] for i in self.hand}
+            links = [k for k in self.model.mount if k in self.hulls] + self.probes[1]
+            pairs = [(len(links), j) for j, k in enumerate(links) if k not in hand]
+            check = PairCheck([self.hulls[k] for k in links] + [shape], pairs, SELF_CLEARANCE)
+            kept = self._held_checks[id(shape)] = (shape, check)  # the shape kept alive: its id stays its own
+        check = kept[1]
+        t = self._with_base(transforms)
+        return check.collides(np.concatenate([t, np.asarray(poses, dtype=float).reshape(len(t), 1, 4, 4)], axis=1))
+
+    @cached_property
+    def _held_checks(self) -> dict[int, tuple[CollisionShape, PairCheck]]:
+        """The :meth:`held_collides_at` checks made so far, by held shape."""
+        return {}
+
     def _with_base(self, transforms: np.ndarray) -> np.ndarray:
         """The probed links' transforms (C, L, 4, 4) with the mount's solid links' (fixed) in front."""
         t = np.asarray(transforms, dtype=float).reshape(-1, len(self.probes[1]), 4, 4)

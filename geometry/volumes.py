@@ -70,7 +70,14 @@ class Volumes(StepWorld):
         if self.late():
             return None
         volume, transforms = self._arm_volume(robot, configs, holding, grasp)
-        return None if self.arm(robot).self_collides_at(transforms) else volume
+        arm = self.arm(robot)
+        if arm.self_collides_at(transforms):
+            return None
+        if holding is not None:  # the held object against the arm holding it
+            held = volume[len(volume) - len(transforms) :]
+            if arm.held_collides_at(transforms, held[0][0], np.stack([pose for _, pose in held])):
+                return None
+        return volume
 
     def _arm_volume(
         self, robot: str, configs: np.ndarray, holding: tuple[str, str] | None, grasp: tuple[str, str] | None

@@ -677,3 +677,15 @@ def test_a_place_the_analytic_solver_has_no_branch_for_gives_up_after_one_attemp
     assert solves == [False] * approaches.IK_GIVE_UP
     assert (quick.status, quick.static) == (slow.status, slow.static) == (GroundStatus.NO_IK, True)
     assert not pa3._no_branch(pa3.arm("r1"), pa3.arm("r1").tool_world(pa3.arm("r1").home))  # home: a branch
+
+
+def test_a_held_object_swung_into_its_own_arm_is_not_free(pa3: Grounder) -> None:
+    """geometry/arm.py ``held_collides_at``: r1 holding o1 with the top grasp at a configuration whose links are
+    free of each other and of everything, but which folds the object into the arm's own links (the validator's
+    ``collision-self-held``; the 6-arm 40-object instance's first plan was rejected for 1 mm of it between two
+    samples of a carry): not a free configuration; at home, holding o1, it is."""
+    q = np.array([1.499, -0.016, 2.04, -3.13, 0.985, 2.913, -1.029])
+    assert pa3.free_volume("r1", q[None], grasp=("o1", "top")) is not None  # the arm alone, fingers as holding
+    assert pa3.free_volume("r1", q[None], holding=("o1", "top")) is None
+    arm = pa3.arm("r1")
+    assert pa3.free_volume("r1", arm.home[None], holding=("o1", "top")) is not None

@@ -110,6 +110,16 @@ def step_of(action: Action) -> GroundedStep:
     return GroundedStep([PlannedAction(action.obj, action.region, "r1", "r1", "top", "top")], [], (action.obj,))
 
 
+def feeder(skeletons: list[Skeleton]):  # type: ignore[no-untyped-def]
+    """A skeleton source handing out ``skeletons`` in order, ``k`` at a time."""
+
+    def more(k: int) -> list[Skeleton]:
+        out, skeletons[:] = skeletons[:k], skeletons[k:]
+        return out
+
+    return more
+
+
 def test_mcts_follows_a_partial_grounding_to_a_plan() -> None:
     calls: list[tuple[Skeleton, int]] = []
 
@@ -143,13 +153,7 @@ def test_mcts_memoises_failures_and_reports_no_plan() -> None:
         return Grounding(Outcome.FAIL)
 
     def sources(need: set[str], moved: set[str]):  # type: ignore[no-untyped-def]
-        left = [SKEL_DIRECT, SKEL_CLEAR]
-
-        def more(k: int) -> list[Skeleton]:
-            out, left[:] = left[:k], left[k:]
-            return out
-
-        return more
+        return feeder([SKEL_DIRECT, SKEL_CLEAR])
 
     search = MCTS(ground, sources, {"o1"}, k=1)
     result = search.run(deadline=float("inf"))
@@ -212,7 +216,6 @@ def test_a_dead_end_ends_its_node_and_the_search_moves_on() -> None:
     again -- and the edge into it; the search goes on from the root's other skeletons."""
     other = Skeleton(((Action("o1", "goal", "r1", "r1", "side", "side"),),))
     calls: list[tuple[Skeleton, int]] = []
-    asked: list[set[str]] = []
 
     def ground(skel: Skeleton, suffix: list[GroundedStep]) -> Grounding:
         calls.append((skel, len(suffix)))
@@ -223,14 +226,7 @@ def test_a_dead_end_ends_its_node_and_the_search_moves_on() -> None:
         return Grounding(Outcome.SUCCESS, [step_of(A1)]) if skel == other else Grounding(Outcome.FAIL)
 
     def sources(need: set[str], moved: set[str]):  # type: ignore[no-untyped-def]
-        asked.append(need)
-        queue = [SKEL_DIRECT, other] if "o1" in need else [Skeleton(((A2,),)), SKEL_CLEAR, SKEL_CLEAR]
-
-        def more(k: int) -> list[Skeleton]:
-            out, queue[:] = queue[:k], queue[k:]
-            return out
-
-        return more
+        return feeder([SKEL_DIRECT, other] if "o1" in need else [Skeleton(((A2,),)), SKEL_CLEAR, SKEL_CLEAR])
 
     search = MCTS(ground, sources, {"o1"}, k=3)
     result = search.run(deadline=float("inf"))

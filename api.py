@@ -111,21 +111,23 @@ def _resolve(source: ProblemSource, name: str | None, allow_outside: Sequence[st
     return parse_file(path, allow_outside=tuple(allow_outside)).problem(name), path
 
 
-def _layout(problem: "Problem", robots: bool) -> list[Diagnostic]:
+def _layout(problem: "Problem", robots: bool, arms: bool = True) -> list[Diagnostic]:
     """The layout diagnostics of a geometric problem (none for a symbolic one): those ``check`` reports, or
-    (``robots``) those that need the robots' models (docs/errors.md, E263-E266, W270-W272)."""
+    (``robots``) those that need the robots' models (docs/errors.md, E263-E266, W270-W272); ``arms`` False
+    leaves out the warnings W274-W276 (:mod:`mrgc.geometry.arm_diagnosis`)."""
     if problem.symbolic:
         return []
     from mrgc.geometry import layout
 
-    return layout.robot_diagnostics(problem) if robots else layout.layout_diagnostics(problem)
+    return layout.robot_diagnostics(problem, arms) if robots else layout.layout_diagnostics(problem, arms)
 
 
-def _checked_layout(problem: "Problem", robots: bool = True) -> list[Diagnostic]:
+def _checked_layout(problem: "Problem", robots: bool = True, arms: bool = True) -> list[Diagnostic]:
     """InputError when the layout of a geometric problem has errors (of ``check``'s checks, and with
-    ``robots`` of those needing the robots' models too); else the warnings of the robot-model checks."""
-    errors = [d for d in _layout(problem, False) if d.severity != "warning"]
-    found = _layout(problem, True) if robots and not errors else []
+    ``robots`` of those needing the robots' models too); else the warnings of the robot-model checks
+    (without W274-W276 when not ``arms``: warnings, never errors)."""
+    errors = [d for d in _layout(problem, False, arms) if d.severity != "warning"]
+    found = _layout(problem, True, arms) if robots and not errors else []
     errors += [d for d in found if d.severity != "warning"]
     if errors:
         raise InputError(errors)
@@ -305,7 +307,7 @@ def plan(
 
     started = time.perf_counter()  # the time limit covers the layout checks, which load the robots' models
     problem, path = _resolve(source, name, allow_outside)
-    warnings = _checked_layout(problem)
+    _checked_layout(problem, arms=False)  # W274-W276 (warnings) only explain a plan not found: asked for then
     digest = problem_digest(problem)
     problem_file = path if path is not None else (problem.source or "<string>")
     sha256 = file_sha256(path) if path is not None else digest
@@ -325,9 +327,9 @@ def plan(
     )
     result.problem_digest = digest
     if result.why is not None and result.status is not PlanStatus.SOLVED:  # an arm that reaches nothing, and why
-        from mrgc.geometry.arm_diagnosis import reasons
+        from mrgc.geometry.arm_diagnosis import arm_diagnostics, reasons
 
-        result.why.facts[:0] = reasons(warnings)
+        result.why.facts[:0] = reasons(arm_diagnostics(problem))
     return result
 
 

@@ -8,7 +8,9 @@ IK from one branch (:meth:`Approaches._approach_configs`).  An approach is kept 
 where they stand in the phase, the objects to avoid, what the step's other robots sweep meanwhile (``busy``),
 and, at its last configuration, what they do in the later phases it stands there (``after``).  Attempts start
 from home, then from seeded random starts; a pose no start solves is out of reach after :data:`IK_GIVE_UP`, or
-after the first when the analytic solver has no branch for it either (:meth:`Approaches._no_branch`).
+after the first when the analytic solver has no branch for it either (:meth:`Arm.no_branch
+<mrgc.geometry.arm.Arm.no_branch>`); an approach whose pre-grasp (the same tool pose in every attempt) has no
+numeric answer and no analytic branch either is out of reach at once.
 A *handover* is both arms at their exchange configurations holding the object at a handover point, not
 colliding with each other (:data:`HANDOVER_PAIRS` rounds of drawing).
 """
@@ -25,8 +27,7 @@ from mrgc.geometry.arm_paths import joint_line
 from mrgc.geometry.collision import Posed, posed_collide
 from mrgc.geometry.conventions import APPROACH_SAMPLES, PATH_RESOLUTION, seed_for
 from mrgc.geometry.grasps import APPROACH, fits, grasp_transform, pregrasp_transform
-from mrgc.geometry.ik import solve_ik_many
-from mrgc.geometry.ik_analytic import panda_chain
+from mrgc.geometry.ik import IKResult, solve_ik_many
 from mrgc.geometry.robot import Pieces, Volume
 from mrgc.geometry.step_world import named_body
 from mrgc.geometry.transforms import translation
@@ -40,6 +41,8 @@ APPROACH_CHECK = PATH_RESOLUTION / 2
 #: IK attempts (each with its restarts) after which a pose none of them solved is called out of reach, as
 #: phase 1 does (predicates.IK_SEEDS); attempts that solve it but collide go on to other branches
 IK_GIVE_UP = 3
+#: what :meth:`Approaches._attempt` answers when no IK attempt of an approach can succeed
+OUT_OF_REACH = "out of reach"
 #: pairs of exchange configurations tried for a handover before the two arms are said to collide
 HANDOVER_PAIRS = 6
 #: an approach's last segment starts at most this many equal shares of the back-off from the grasp (the
@@ -51,7 +54,7 @@ def _out_of_reach(ik: str, attempt: int, status: GroundStatus, no_branch: Callab
     """Whether an approach whose IK attempt ``attempt`` failed (``ik``: the solver's status) gives up: the pose
     is provably out of reach (no other seed helps), or no attempt so far converged (none collided) and either
     :data:`IK_GIVE_UP` attempts have (phase 1 gives up there too) or ``no_branch()`` says the analytic solver
-    has no branch for it either (:meth:`Approaches._no_branch`)."""
+    has no branch for it either (:meth:`Arm.no_branch <mrgc.geometry.arm.Arm.no_branch>`)."""
     if ik == "unreachable":
         return True
     return status is GroundStatus.NO_IK and (attempt + 1 >= IK_GIVE_UP or no_branch())
@@ -87,6 +90,7 @@ class Approaches(Volumes):
         clash: tuple[str, Volume] | None = None  # the last attempt's collision not with ``avoid``: told at the end
         phase = key.split(":")[0]  # "pick", "place" or "handover"
         static = True  # every attempt so far failed on what never moves (IK, fixed bodies, bases)
+        asked: dict[str, bool] = {}  # the analytic solver's answers for this approach's poses (asked once)
         for attempt in range(attempts):
             seed = seed_for(robot, obj, grasp, key, str(attempt), seed=self.seed)
             # the first attempt starts from home (the solution nearest it); the others from a start drawn from
@@ -96,13 +100,10 @@ class Approaches(Volumes):
                 if attempt == 0 and from_home
                 else np.random.default_rng(seed).uniform(arm.model.lower, arm.model.upper)
             )
-            q = solve_ik_many(arm.model, arm.ee_target(pose @ g_t)[None], seed, q_init=start)[0]
-            if not q.solved or q.q is None:  # (q is None exactly when the solve failed)
-                if _out_of_reach(q.status.value, attempt, status, lambda: self._no_branch(arm, pose @ g_t)):
-                    return Answer(GroundStatus.NO_IK, static=True)
-                continue
-            configs = self._approach_configs(arm, pose @ g_t, q.q, seed) if approach else np.asarray(q.q)[None]
-            if configs is None:
+            configs = self._attempt(arm, pose @ g_t, start, seed, attempt, status, approach, asked)
+            if configs is OUT_OF_REACH:
+                return Answer(GroundStatus.NO_IK, static=True)
+            if not isinstance(configs, np.ndarray):
                 continue
             # checked at every APPROACH_CHECK of joint motion (finer than the validator samples), with the
             # object in hand when placing
@@ -138,16 +139,6 @@ class Approaches(Volumes):
             detail = self._clash_detail(robot, phase, clash, ignore=() if held else (obj,))
         return Answer(status, blockers=blockers, detail=detail, static=static)
 
-    @staticmethod
-    def _no_branch(arm: Arm, tool: np.ndarray) -> bool:
-        """Whether the analytic solver (:mod:`mrgc.geometry.ik_analytic`; arms with a Panda's kinematics only,
-        else False) finds no configuration putting the tool at ``tool``: over the q7 grid, every branch out of
-        the joint limits or off the target.  A numeric solve that failed from its start is then not retried
-        from others (the analytic search covers what their random starts would: measured, docs/geometry.md)."""
-        if panda_chain(arm.model) is None:
-            return False
-        return not solve_ik_many(arm.model, arm.ee_target(tool)[None], 0, q_init=arm.home, analytic=True)[0].solved
-
     def _hand_hits(self, robot: str, configs: np.ndarray, grip: tuple[str, str], avoid: tuple[str, ...]) -> bool:
         """Whether ``robot``'s hand (:attr:`Arm.hand <mrgc.geometry.arm.Arm.hand>`), at the pre-grasp or the grasp
         of an approach ``configs`` with the fingers at ``grip``'s opening, hits one of ``avoid``: those two tool
@@ -182,15 +173,55 @@ class Approaches(Volumes):
         early = self.arm_volume(robot, joint_line(configs[:-1], APPROACH_CHECK), grasp=(obj, grasp))
         return self.world.probe_collides(early, against=(obj,))
 
+    def _attempt(
+        self,
+        arm: Arm,
+        tool: np.ndarray,
+        start: np.ndarray,
+        seed: int,
+        attempt: int,
+        status: GroundStatus,
+        approach: bool,
+        asked: dict[str, bool],
+    ) -> np.ndarray | str | None:
+        """One IK attempt of an approach to tool pose ``tool`` from ``start``: its configurations (the grasp
+        alone without ``approach``), None when it failed, :data:`OUT_OF_REACH` when no attempt can succeed.
+        That is when the grasp has no answer and :func:`_out_of_reach` says so, or when no attempt so far has
+        got past the pre-grasp (``status`` still no IK), this one's pre-grasp has no numeric answer from its
+        branch and the analytic solver has no branch for it either: it is the same tool pose in every attempt
+        (``asked`` keeps the analytic answers of this approach)."""
+        q = solve_ik_many(arm.model, arm.ee_target(tool)[None], seed, q_init=start)[0]
+        if not q.solved or q.q is None:  # (q is None exactly when the solve failed)
+            gone = _out_of_reach(q.status.value, attempt, status, lambda: self._asked(asked, "grasp", arm, tool))
+            return OUT_OF_REACH if gone else None
+        if not approach:
+            return np.asarray(q.q)[None]
+        configs = self._approach_configs(arm, tool, q.q, seed)
+        if configs is None and status is GroundStatus.NO_IK and not self._pre(arm, tool, q.q, seed).solved:
+            return OUT_OF_REACH if self._asked(asked, "pre", arm, tool @ pregrasp_transform(np.eye(4))) else None
+        return configs
+
     @staticmethod
-    def _approach_configs(arm: Arm, tool: np.ndarray, q: np.ndarray, seed: int) -> np.ndarray | None:
+    def _asked(asked: dict[str, bool], what: str, arm: Arm, tool: np.ndarray) -> bool:
+        """:meth:`Arm.no_branch <mrgc.geometry.arm.Arm.no_branch>` for ``tool``, asked once per ``what``."""
+        if what not in asked:
+            asked[what] = arm.no_branch(tool)
+        return asked[what]
+
+    @staticmethod
+    def _pre(arm: Arm, tool: np.ndarray, q: np.ndarray, seed: int) -> IKResult:
+        """The pre-grasp of grasp configuration ``q`` (tool at ``tool``): numeric IK from ``q`` (cached by
+        :func:`~mrgc.geometry.ik.solve_ik_many`, so asking twice solves once)."""
+        target = arm.ee_target(tool @ pregrasp_transform(np.eye(4)))[None]
+        return solve_ik_many(arm.model, target, seed, q_init=q[None], restarts=2)[0]
+
+    @classmethod
+    def _approach_configs(cls, arm: Arm, tool: np.ndarray, q: np.ndarray, seed: int) -> np.ndarray | None:
         """The approach to grasp configuration ``q`` (tool at ``tool``): the pre-grasp by IK from ``q``, then
         :data:`APPROACH_SAMPLES` configurations to ``q``; None when the pre-grasp has no solution, or when
         pre-grasp and grasp come from different IK branches and swing the tool off the approach line (the
         contact segment must start near the grasp: the validator's rule, with a margin)."""
-        pre = solve_ik_many(
-            arm.model, arm.ee_target(tool @ pregrasp_transform(np.eye(4)))[None], seed, q_init=q[None], restarts=2
-        )[0]
+        pre = cls._pre(arm, tool, q, seed)
         if not pre.solved or pre.q is None:
             return None
         s = np.linspace(0.0, 1.0, APPROACH_SAMPLES)[:, None]

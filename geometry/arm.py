@@ -176,6 +176,20 @@ class Arm:
         fingers = None if opening is None else self.model.finger_value(opening)
         return fk_world(self.model, q, self.base, fingers)[..., index, :, :]
 
+    def no_branch(self, tool_world: np.ndarray) -> bool:
+        """Whether the analytic solver (:mod:`mrgc.geometry.ik_analytic`; arms with a Panda's kinematics only,
+        else False) finds no configuration putting the tool at ``tool_world``: over the q7 grid, every branch
+        out of the joint limits or off the target.  A numeric solve that failed from its start need then not
+        be retried from others (the analytic search covers what their random starts would, but for solutions
+        within GeoFIK's 0.07 rad margin inside the limits: measured, docs/geometry.md)."""
+        from mrgc.geometry.ik import solve_ik_many
+        from mrgc.geometry.ik_analytic import panda_chain
+
+        if panda_chain(self.model) is None:
+            return False
+        target = self.ee_target(tool_world)[None]
+        return not solve_ik_many(self.model, target, 0, q_init=self.home, analytic=True)[0].solved
+
     def in_reach(self, point: np.ndarray, margin: float = 0.0) -> bool:
         """Whether a world point can be within reach of the tool (cheap pre-filter)."""
         local = self.base_inv[:3, :3] @ point + self.base_inv[:3, 3]

@@ -53,9 +53,10 @@ if TYPE_CHECKING:
 TOLERANCE = 1e-3
 
 
-def layout_diagnostics(problem: Problem) -> list[Diagnostic]:
+def layout_diagnostics(problem: Problem, arms: bool = True) -> list[Diagnostic]:
     """The layout diagnostics of ``problem`` that need no robot model (none for a symbolic one), in
-    declaration order within each check; :func:`robot_diagnostics` has the others."""
+    declaration order within each check; :func:`robot_diagnostics` has the others.  ``arms`` False leaves
+    out W274-W276 (they load the arms' models; ``plan`` asks for them only when it finds no plan)."""
     if problem.symbolic:
         return []
     from mrgc.geometry.grasps import grasp_warnings
@@ -65,7 +66,7 @@ def layout_diagnostics(problem: Problem) -> list[Diagnostic]:
     out += grasp_warnings(problem)
     out += region_diagnostics(problem)
     out += tcp_diagnostics(problem)
-    if not any(d.severity != "warning" for d in out):  # an arm that can reach nothing, and why
+    if arms and not any(d.severity != "warning" for d in out):  # an arm that can reach nothing, and why
         from mrgc.geometry.arm_diagnosis import arm_diagnostics
 
         out += arm_diagnostics(problem)
@@ -275,9 +276,9 @@ def region_diagnostics(problem: Problem) -> list[Diagnostic]:
 
 
 # ---------------------------------------------------------------------------------------------- robots
-def robot_diagnostics(problem: Problem) -> list[Diagnostic]:
+def robot_diagnostics(problem: Problem, arms: bool = True) -> list[Diagnostic]:
     """E266 for arms at home that overlap something, W272 for regions no robot reaches (none for a
-    symbolic problem)."""
+    symbolic problem), and (``arms``) W274-W276."""
     if problem.symbolic:
         return []
     from mrgc.geometry.arm import Arm
@@ -285,10 +286,12 @@ def robot_diagnostics(problem: Problem) -> list[Diagnostic]:
     from mrgc.geometry.scene import scene_from_problem
 
     scene = scene_from_problem(problem)
-    arms = [Arm(spec) for spec in scene.robots if approaches(spec.kind)]
-    out = _arms_at_home(problem, scene, arms)
-    if arms and len(arms) == len(scene.robots):
-        out += _regions_out_of_reach(problem, scene, arms)
+    models = [Arm(spec) for spec in scene.robots if approaches(spec.kind)]
+    out = _arms_at_home(problem, scene, models)
+    if models and len(models) == len(scene.robots):
+        out += _regions_out_of_reach(problem, scene, models)
+    if not arms:
+        return out
     from mrgc.geometry.arm_diagnosis import arm_diagnostics
 
     return out + arm_diagnostics(problem)

@@ -163,7 +163,9 @@ class RobotEvaluator:
         ``want_free`` (the paper's "collision-free, if possible");
         the first clean answer wins, else the first answer.  A query whose hand hits what failed it (a fixed
         body; a movable one when ``want_free``) at its pre-grasp or grasp is not retried (:meth:`_hand_hits`):
-        every branch puts the hand there, so a retry gives the same facts.
+        every branch puts the hand there, so a retry gives the same facts; nor is one whose pre-grasp has no
+        answer when the analytic solver has no branch for that tool pose either (:meth:`Arm.no_branch
+        <mrgc.geometry.arm.Arm.no_branch>`).
         """
         found: dict[int, tuple[np.ndarray, set[str]]] = {}
         settled: set[int] = set()  # the hand hits what made the answer fail or unclean: no other branch helps
@@ -195,27 +197,11 @@ class RobotEvaluator:
                 restarts=2,
             )
             for (i, g, q), q_pre in zip(ok, pres):
-                if q_pre is None:
-                    continue
-                obj, grasp, pose, held, _ = queries[i]
-                opening = self.opening(obj, grasp)
-                path = self._approach(q_pre, q)
-                if not self._free(refine(path), (obj,), opening):
-                    if self._hand_hits(path, (obj,), opening, "fixed"):
-                        settled.add(i)
-                    continue
-                if held:  # the object in hand, along the approach, must stay clear of fixed objects too
-                    shape = self.scene.body(obj).shape
-                    in_hand = self.arm.tool_world(refine(path)) @ np.linalg.inv(g)
-                    if self.world.probe_collides([(shape, t) for t in in_hand], against="fixed"):
-                        continue
-                hits = self._swept_hits(path, (obj,), opening)
-                if held:
-                    hits |= self._object_hits(obj, self.scene.body(obj).shape, g, path, pose)
-                if i not in found or (found[i][1] and not hits):
-                    found[i] = (path, hits)
-                if hits and want_free and self._hand_hits(path, (obj,), opening, "movable"):
+                answer, final = self._branch(queries[i], g, q, q_pre, want_free)
+                if final:
                     settled.add(i)
+                if answer is not None and (i not in found or (found[i][1] and not answer[1])):
+                    found[i] = answer
             # try other IK solutions for queries with no answer yet, or (if asked) one that hits movables
             todo = [
                 i
@@ -223,6 +209,34 @@ class RobotEvaluator:
                 if i not in unsolvable and i not in settled and (i not in found or (want_free and found[i][1]))
             ]
         return found
+
+    def _branch(
+        self,
+        query: tuple[str, str, np.ndarray, bool, str],
+        g: np.ndarray,
+        q: np.ndarray,
+        q_pre: np.ndarray | None,
+        want_free: bool,
+    ) -> tuple[tuple[np.ndarray, set[str]] | None, bool]:
+        """One IK branch's answer to a query of :meth:`_solve` (grasp transform ``g``, grasp configuration
+        ``q``, pre-grasp ``q_pre`` or None): the approach path and the movable objects it hits, or None when it
+        fails; and whether no other branch can do better (the query is settled)."""
+        obj, grasp, pose, held, _ = query
+        if q_pre is None:  # the pre-grasp, the same tool pose on every branch: settled when no branch reaches it
+            return None, self.arm.no_branch(pose @ pregrasp_transform(g))
+        opening = self.opening(obj, grasp)
+        path = self._approach(q_pre, q)
+        if not self._free(refine(path), (obj,), opening):
+            return None, self._hand_hits(path, (obj,), opening, "fixed")
+        if held:  # the object in hand, along the approach, must stay clear of fixed objects too
+            shape = self.scene.body(obj).shape
+            in_hand = self.arm.tool_world(refine(path)) @ np.linalg.inv(g)
+            if self.world.probe_collides([(shape, t) for t in in_hand], against="fixed"):
+                return None, False
+        hits = self._swept_hits(path, (obj,), opening)
+        if held:
+            hits |= self._object_hits(obj, self.scene.body(obj).shape, g, path, pose)
+        return (path, hits), bool(hits) and want_free and self._hand_hits(path, (obj,), opening, "movable")
 
     def _hand_hits(self, path: np.ndarray, ignore: tuple[str, ...], opening: float | None, against: str) -> bool:
         """Whether the hand (:attr:`Arm.hand <mrgc.geometry.arm.Arm.hand>`) at the first or last configuration of

@@ -657,26 +657,63 @@ def test_a_place_the_analytic_solver_has_no_branch_for_gives_up_after_one_attemp
     the analytic solver (every branch over the q7 grid) has none either, so the place is out of reach at once
     -- the same answer (no inverse kinematics, static) as after the :data:`IK_GIVE_UP` numeric attempts."""
     import mrgc.geometry.approaches as approaches
+    from mrgc.geometry.arm import Arm
 
     far = translation(-0.75, -1.05, 0.06)
     solves: list[bool] = []
-    real = approaches.solve_ik_many
+    real, oracle = approaches.solve_ik_many, Arm.no_branch
 
     def counted(*args: object, **kwargs: object) -> object:
-        solves.append(bool(kwargs.get("analytic")))
+        solves.append(False)
         return real(*args, **kwargs)  # type: ignore[arg-type]
 
+    def asked(arm: Arm, tool: np.ndarray) -> bool:
+        solves.append(True)
+        return oracle(arm, tool)
+
     monkeypatch.setattr(approaches, "solve_ik_many", counted)
+    monkeypatch.setattr(Arm, "no_branch", asked)
     pa3.step({"r1": Stance.PLACED})
     quick = pa3.place("r1", "o1", "top", far)
     assert solves == [False, True]  # one numeric attempt, then the analytic check
     solves.clear()
-    monkeypatch.setattr(approaches.Approaches, "_no_branch", staticmethod(lambda arm, tool: False))
+    monkeypatch.setattr(Arm, "no_branch", lambda arm, tool: False)
     slow = pa3.place("r1", "o1", "top", far)
     pa3.step({})
     assert solves == [False] * approaches.IK_GIVE_UP
     assert (quick.status, quick.static) == (slow.status, slow.static) == (GroundStatus.NO_IK, True)
-    assert not pa3._no_branch(pa3.arm("r1"), pa3.arm("r1").tool_world(pa3.arm("r1").home))  # home: a branch
+    assert not oracle(pa3.arm("r1"), pa3.arm("r1").tool_world(pa3.arm("r1").home))  # home: a branch
+
+
+def test_a_place_whose_pre_grasp_no_branch_reaches_gives_up_at_its_first_attempt(
+    pa3: Grounder, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """geometry/approaches.py: o1 placed with the side-x+ grasp 0.5 m from r1's base, toward the table's edge:
+    the grasp has an IK answer, its pre-grasp (backed off outward, the same tool pose for every branch) none,
+    and the analytic solver has no branch for the pre-grasp either: no inverse kinematics (static) after the
+    first attempt, where without the check all eight attempts solve the grasp and fail at the pre-grasp."""
+    import mrgc.geometry.approaches as approaches
+    from mrgc.geometry.arm import Arm
+
+    pose = translation(0.433, -0.45, 0.06)
+    solves: list[str] = []
+    real = approaches.solve_ik_many
+
+    def counted(*args: object, **kwargs: object) -> object:
+        solves.append("numeric")
+        return real(*args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(approaches, "solve_ik_many", counted)
+    pa3.step({"r1": Stance.PLACED})
+    quick = pa3.place("r1", "o1", "side-x+", pose)
+    assert len(solves) == 3  # the grasp, its pre-grasp, the pre-grasp again (the cache answers), then the oracle
+    asked = 2
+    solves.clear()
+    monkeypatch.setattr(Arm, "no_branch", lambda arm, tool: False)
+    slow = pa3.place("r1", "o1", "side-x+", pose)
+    pa3.step({})
+    assert len(solves) > 4 * asked  # every attempt: a grasp and its pre-grasp
+    assert (quick.status, quick.static) == (slow.status, slow.static) == (GroundStatus.NO_IK, True)
 
 
 def test_a_held_object_swung_into_its_own_arm_is_not_free(pa3: Grounder) -> None:

@@ -171,17 +171,7 @@ def solve_ik_many(
     per_target = q_init is not None and np.ndim(q_init) == 2  # one first start per target
     inits = np.asarray(q_init, dtype=float) if per_target else None
     keys = [_key(model, t, seed, inits[i] if inits is not None else q_init, params) for i, t in enumerate(targets)]
-    todo = []
-    gap = np.linalg.norm(targets[:, :3, 3] - model.shoulder, axis=-1) - model.reach  # > 0: out of reach
-    for i, key in enumerate(keys):
-        hit = _CACHE.get(key)
-        if hit is not None:
-            results[i] = hit
-        elif gap[i] > 1e-9:
-            results[i] = miss = IKResult(IKStatus.UNREACHABLE, None, float(gap[i]), float("inf"), 0)
-            _remember(key, miss)
-        else:
-            todo.append(i)
+    todo, twins = _answered(model, targets, keys, results)
     if todo and chain is not None:
         if inits is not None:
             refs = model.clamp(inits[todo])
@@ -203,7 +193,34 @@ def solve_ik_many(
             for i, res in zip(part, _lm(model, targets[part], batch, seed, tol_pos, tol_rot, max_iters)):
                 results[i] = res
                 _remember(keys[i], res)
+    for i, j in twins.items():
+        results[i] = results[j]
     return results  # type: ignore[return-value]
+
+
+def _answered(
+    model: RobotModel, targets: np.ndarray, keys: list[tuple[object, ...]], results: list[IKResult | None]
+) -> tuple[list[int], dict[int, int]]:
+    """Fill ``results`` with what needs no solve (the cache's answers; targets beyond the reach bound are
+    UNREACHABLE); the targets left to solve, and those asked again in the batch (the same key), each with the
+    one solved for it (its rows would run exactly as that one's)."""
+    todo: list[int] = []
+    twins: dict[int, int] = {}
+    first: dict[tuple[object, ...], int] = {}
+    gap = np.linalg.norm(targets[:, :3, 3] - model.shoulder, axis=-1) - model.reach  # > 0: out of reach
+    for i, key in enumerate(keys):
+        hit = _CACHE.get(key)
+        if hit is not None:
+            results[i] = hit
+        elif gap[i] > 1e-9:
+            results[i] = miss = IKResult(IKStatus.UNREACHABLE, None, float(gap[i]), float("inf"), 0)
+            _remember(key, miss)
+        elif key in first:
+            twins[i] = first[key]
+        else:
+            first[key] = i
+            todo.append(i)
+    return todo, twins
 
 
 def _analytic(

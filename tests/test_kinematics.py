@@ -320,6 +320,30 @@ def test_single_solves_agree_with_the_batch(panda, round_trip) -> None:
             assert np.allclose(one.q, res.q, atol=1e-9)
 
 
+@settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(picks=st.lists(st.integers(0, 5), min_size=2, max_size=12), per_target=st.booleans())
+def test_a_target_asked_twice_in_a_batch_gets_the_answer_of_one_asked_once(panda, round_trip, picks, per_target):
+    """ik.py: a batch holding the same target (with the same start) more than once solves it once and gives
+    every copy that answer: the same answers, each the same as a batch without the copies (the numeric rows
+    of a target run the same whatever else is in the batch), unsolved ones too."""
+    targets, _ = round_trip
+    hard = tf.from_xyz_rpy([0.0, 0.0, -0.5], [0.0, 0.0, 0.0])  # within the reach bound, no solution
+    pool = np.concatenate([targets[:5], hard[None]])
+    batch = pool[picks]
+    starts = np.tile(panda.clamp((panda.lower + panda.upper) / 2), (len(batch), 1)) if per_target else None
+    I.clear_ik_cache()
+    together = I.solve_ik_many(panda, batch, seed=3, q_init=starts)
+    for i, res in enumerate(together):
+        I.clear_ik_cache()
+        alone = I.solve_ik_many(panda, batch[i : i + 1], seed=3, q_init=None if starts is None else starts[i : i + 1])[
+            0
+        ]
+        assert res.status == alone.status
+        assert (res.q is None) == (alone.q is None) and (res.q is None or np.allclose(res.q, alone.q, atol=1e-9))
+        first = picks.index(picks[i])
+        assert together[first] is res  # solved once
+
+
 def test_ik_is_deterministic(panda) -> None:
     target = F.ee_pose(panda, np.array([0.5, 0.3, -0.4, -1.8, 0.2, 2.2, -0.3]))
     I.clear_ik_cache()

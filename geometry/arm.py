@@ -13,7 +13,7 @@ from typing import Mapping
 
 import numpy as np
 
-from mrgc.geometry.collision import CollisionShape, ConvexHull, PairCheck, collision_shape
+from mrgc.geometry.collision import TOLERANCE, CollisionShape, ConvexHull, PairCheck, Posed, collision_shape
 from mrgc.geometry.fk import ee_pose, fk_world
 from mrgc.geometry.grasps import finger_opening, grasp_transform
 from mrgc.geometry.kinematics import RobotModel, gripper_frames, model_for_kind
@@ -228,6 +228,26 @@ class Arm:
             for tool in self.tool_world(configs):
                 out.append((shape, tool @ in_tool))
         return out, transforms
+
+    def posed(
+        self, configs: np.ndarray, held: Held | None = None, opening: float | None = None
+    ) -> tuple[Posed, np.ndarray, np.ndarray | None]:
+        """:meth:`volume` as the collision kernel reads it (:class:`~mrgc.geometry.collision.Posed`: the same
+        pieces in the same order, made from the arrays without a list of pieces between), the links' world
+        transforms (C, L, 4, 4), and the held object's world poses (C, 4, 4; None when it holds nothing)."""
+        configs = np.atleast_2d(configs)
+        shapes: list[CollisionShape] = list(self.probes[0])
+        transforms = self.link_transforms(configs, opening)
+        kind = np.tile(np.arange(len(shapes)), len(configs))
+        flat = transforms.reshape(-1, 4, 4)
+        poses = None
+        if held is not None:
+            shape, in_tool = held
+            poses = np.stack([tool @ in_tool for tool in self.tool_world(configs)])  # as :meth:`volume` has them
+            shapes.append(shape)
+            kind = np.concatenate([kind, np.full(len(configs), len(shapes) - 1)])
+            flat = np.concatenate([flat, poses])
+        return Posed(shapes, kind, flat, TOLERANCE), transforms, poses
 
     def volumes(self, configs: np.ndarray, held: Held | None = None, opening: float | None = None) -> list[Volume]:
         """:meth:`volume` at each of ``configs`` separately (one volume per configuration: a motion's samples,

@@ -94,10 +94,9 @@ class ArmPaths(Volumes):
 
         def free(configs: np.ndarray) -> bool:
             self.queries += 1
-            volume = self.free_volume(robot, configs, holding, fingers)
-            if volume is None:
+            posed = self.free_posed(robot, configs, holding, fingers)
+            if posed is None:
                 return False
-            posed = Posed.of(volume)
             if moving is not None and posed_collide(posed, moving):
                 return False
             return not self.world.probe_collides(posed, against=against, ignore=ignore)
@@ -208,8 +207,7 @@ class ArmPaths(Volumes):
             """None when free, else the avoided objects hit (empty: a fixed one, a moving robot or the arm
             itself)."""
             self.queries += 1
-            volume = self.free_volume(robot, configs, holding=holding, grasp=held)
-            posed = None if volume is None else Posed.of(volume)
+            posed = self.free_posed(robot, configs, holding=holding, grasp=held)
             crossed[0] = posed is not None and moving is not None and posed_collide(posed, moving)
             if crossed[0] or posed is None:
                 return set()

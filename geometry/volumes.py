@@ -18,6 +18,7 @@ from typing import Iterable
 
 import numpy as np
 
+from mrgc.geometry.collision import CollisionShape, Posed
 from mrgc.geometry.robot import Held, Volume
 from mrgc.geometry.step_world import StepWorld
 
@@ -70,14 +71,36 @@ class Volumes(StepWorld):
         if self.late():
             return None
         volume, transforms = self._arm_volume(robot, configs, holding, grasp)
+        held = volume[len(volume) - len(transforms) :] if holding is not None else []
+        poses = np.stack([pose for _, pose in held]) if held else None
+        return None if self._itself(robot, transforms, held[0][0] if held else None, poses) else volume
+
+    def free_posed(
+        self,
+        robot: str,
+        configs: np.ndarray,
+        holding: tuple[str, str] | None = None,
+        grasp: tuple[str, str] | None = None,
+    ) -> Posed | None:
+        """:meth:`free_volume` as the collision kernel reads it (:meth:`Arm.posed
+        <mrgc.geometry.arm.Arm.posed>`: no list of pieces made): the motion checks' form."""
+        if self.late():
+            return None
+        fingers = holding or grasp
+        opening = None if fingers is None else self._grip(robot, *fingers)[0]
+        held = self._held(robot, holding)
+        posed, transforms, poses = self.arm(robot).posed(configs, held, opening)
+        return None if self._itself(robot, transforms, held[0] if held else None, poses) else posed
+
+    def _itself(
+        self, robot: str, transforms: np.ndarray, shape: CollisionShape | None, poses: np.ndarray | None
+    ) -> bool:
+        """Whether the arm at its probed links' ``transforms`` collides with itself, or the object of ``shape``
+        it holds at ``poses`` (None: it holds nothing) with the arm holding it."""
         arm = self.arm(robot)
         if arm.self_collides_at(transforms):
-            return None
-        if holding is not None:  # the held object against the arm holding it
-            held = volume[len(volume) - len(transforms) :]
-            if arm.held_collides_at(transforms, held[0][0], np.stack([pose for _, pose in held])):
-                return None
-        return volume
+            return True
+        return shape is not None and poses is not None and arm.held_collides_at(transforms, shape, poses)
 
     def _arm_volume(
         self, robot: str, configs: np.ndarray, holding: tuple[str, str] | None, grasp: tuple[str, str] | None

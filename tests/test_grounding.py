@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import functools
 from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 from support import ROOT
 
 import mrgc
@@ -14,7 +17,7 @@ from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action
 from mrgc.geometry.answers import GroundStatus
 from mrgc.geometry.arm_paths import joint_line
-from mrgc.geometry.collision import CollisionShape, CollisionWorld
+from mrgc.geometry.collision import CollisionShape, CollisionWorld, Posed
 from mrgc.geometry.conventions import PATH_RESOLUTION, to_se2
 from mrgc.geometry.grounding import Grounder
 from mrgc.geometry.kinematics import Link
@@ -714,6 +717,42 @@ def test_a_place_whose_pre_grasp_no_branch_reaches_gives_up_at_its_first_attempt
     pa3.step({})
     assert len(solves) > 4 * asked  # every attempt: a grasp and its pre-grasp
     assert (quick.status, quick.static) == (slow.status, slow.static) == (GroundStatus.NO_IK, True)
+
+
+@functools.lru_cache(maxsize=1)
+def _pa3() -> Grounder:
+    """One grounder of pa3-handover for a property test's examples (a fixture is made once per test, not
+    per example)."""
+    return Grounder(
+        scene_from_problem(parse_file(ROOT / "domains" / "packaging" / "pa3-handover.mrg").problem()), seed=0
+    )
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    u=st.lists(st.lists(st.floats(0.0, 1.0), min_size=7, max_size=7), min_size=1, max_size=6),
+    holding=st.sampled_from([None, ("o1", "top"), ("o2", "side-x+")]),
+    grasp=st.sampled_from([None, ("o3", "top")]),
+)
+def test_a_volume_made_from_the_arrays_is_the_volume_made_from_its_pieces(u, holding, grasp) -> None:
+    """geometry/volumes.py ``free_posed`` (the motion checks' form, :meth:`Arm.posed`): at any configurations,
+    holding an object or not, the same pieces (shapes, transforms, boxes, in order) as :meth:`free_volume`'s
+    list converted by :meth:`Posed.of`, and None exactly where that is None."""
+    g = _pa3()
+    arm = g.arm("r1")
+    qs = arm.model.lower + np.array(u) * (arm.model.upper - arm.model.lower)
+    listed = g.free_volume("r1", qs, holding=holding, grasp=grasp)
+    direct = g.free_posed("r1", qs, holding=holding, grasp=grasp)
+    assert (listed is None) == (direct is None)
+    whole = g.arm_volume("r1", qs, holding=holding, grasp=grasp)
+    made, _, _ = arm.posed(
+        qs, g._held("r1", holding), None if not (holding or grasp) else g._grip("r1", *(holding or grasp))[0]
+    )
+    of = Posed.of(whole)
+    assert len(made) == len(of) == len(whole)
+    assert [made.shape(i) for i in range(len(made))] == [of.shape(i) for i in range(len(of))]
+    assert np.array_equal(made.transforms, of.transforms)
+    assert np.allclose(made.lo, of.lo, atol=1e-12) and np.allclose(made.hi, of.hi, atol=1e-12)
 
 
 def test_a_held_object_swung_into_its_own_arm_is_not_free(pa3: Grounder) -> None:

@@ -217,17 +217,8 @@ class Arm:
         """The probed link hulls at each of ``configs`` (C, dof), the fingers ``opening`` apart (None: fully
         open), then the held object (shape, pose in the tool frame) at each; and the links' world transforms
         ((C, L, 4, 4), for :meth:`self_collides_at`)."""
-        configs = np.atleast_2d(configs)
-        shapes, _ = self.probes
-        out: Volume = []
-        transforms = self.link_transforms(configs, opening)
-        for t in transforms:
-            out.extend(zip(shapes, t))
-        if held is not None:
-            shape, in_tool = held
-            for tool in self.tool_world(configs):
-                out.append((shape, tool @ in_tool))
-        return out, transforms
+        shapes, kind, flat, transforms, _ = self._pieces(configs, held, opening)
+        return [(shapes[k], t) for k, t in zip(kind.tolist(), flat)], transforms
 
     def posed(
         self, configs: np.ndarray, held: Held | None = None, opening: float | None = None
@@ -235,6 +226,15 @@ class Arm:
         """:meth:`volume` as the collision kernel reads it (:class:`~mrgc.geometry.collision.Posed`: the same
         pieces in the same order, made from the arrays without a list of pieces between), the links' world
         transforms (C, L, 4, 4), and the held object's world poses (C, 4, 4; None when it holds nothing)."""
+        shapes, kind, flat, transforms, poses = self._pieces(configs, held, opening)
+        return Posed(shapes, kind, flat, TOLERANCE), transforms, poses
+
+    def _pieces(
+        self, configs: np.ndarray, held: Held | None, opening: float | None
+    ) -> tuple[list[CollisionShape], np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
+        """The pieces of :meth:`volume` as arrays: the distinct shapes, each piece's shape index and world
+        transform (links of each configuration in turn, then the held object at each), the links' transforms
+        (C, L, 4, 4) and the held object's poses (C, 4, 4; None when it holds nothing)."""
         configs = np.atleast_2d(configs)
         shapes: list[CollisionShape] = list(self.probes[0])
         transforms = self.link_transforms(configs, opening)
@@ -243,11 +243,11 @@ class Arm:
         poses = None
         if held is not None:
             shape, in_tool = held
-            poses = np.stack([tool @ in_tool for tool in self.tool_world(configs)])  # as :meth:`volume` has them
+            poses = np.stack([tool @ in_tool for tool in self.tool_world(configs)])
             shapes.append(shape)
             kind = np.concatenate([kind, np.full(len(configs), len(shapes) - 1)])
             flat = np.concatenate([flat, poses])
-        return Posed(shapes, kind, flat, TOLERANCE), transforms, poses
+        return shapes, kind, flat, transforms, poses
 
     def volumes(self, configs: np.ndarray, held: Held | None = None, opening: float | None = None) -> list[Volume]:
         """:meth:`volume` at each of ``configs`` separately (one volume per configuration: a motion's samples,

@@ -86,10 +86,8 @@ class Volumes(StepWorld):
         <mrgc.geometry.arm.Arm.posed>`: no list of pieces made): the motion checks' form."""
         if self.late():
             return None
-        fingers = holding or grasp
-        opening = None if fingers is None else self._grip(robot, *fingers)[0]
         held = self._held(robot, holding)
-        posed, transforms, poses = self.arm(robot).posed(configs, held, opening)
+        posed, transforms, poses = self.arm(robot).posed(configs, held, self._opening(robot, holding, grasp))
         return None if self._itself(robot, transforms, held[0] if held else None, poses) else posed
 
     def _itself(
@@ -106,9 +104,13 @@ class Volumes(StepWorld):
         self, robot: str, configs: np.ndarray, holding: tuple[str, str] | None, grasp: tuple[str, str] | None
     ) -> tuple[Volume, np.ndarray]:
         """:meth:`arm_volume` and the probed links' transforms it was made of."""
+        return self.arm(robot).volume(configs, self._held(robot, holding), self._opening(robot, holding, grasp))
+
+    def _opening(self, robot: str, holding: tuple[str, str] | None, grasp: tuple[str, str] | None) -> float | None:
+        """The finger opening of the (object, grasp) held, or of ``grasp`` (approaching it), else None (fully
+        open)."""
         fingers = holding or grasp
-        opening = None if fingers is None else self._grip(robot, *fingers)[0]
-        return self.arm(robot).volume(configs, self._held(robot, holding), opening)
+        return None if fingers is None else self._grip(robot, *fingers)[0]
 
     def _grip(self, robot: str, obj: str, grasp: str) -> tuple[float | None, np.ndarray]:
         """How ``robot`` holds ``obj`` with ``grasp``: the finger opening and the object's pose in its holding

@@ -92,14 +92,14 @@ class ArmPaths(Volumes):
         ignore = (holding[0],) if holding else ()
         moving = self._busy(busy)
 
-        def free(configs: np.ndarray) -> bool:
-            self.queries += 1
-            posed = self.free_posed(robot, configs, holding, fingers)
-            if posed is None:
-                return False
+        def clear(posed: Posed) -> bool:
             if moving is not None and posed_collide(posed, moving):
                 return False
             return not self.world.probe_collides(posed, against=against, ignore=ignore)
+
+        def free(configs: np.ndarray) -> bool:
+            self.queries += 1
+            return self.free_posed(robot, configs, holding, fingers, clear=clear) is not None
 
         def all_free(configs: np.ndarray) -> bool:
             ok = free(configs)  # counted as the single checks it stands for (on a collision, those that follow)

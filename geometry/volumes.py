@@ -14,7 +14,7 @@ robots sweep) and what :meth:`Volumes.hits` tests against the world's objects.
 from __future__ import annotations
 
 from functools import cached_property
-from typing import Iterable
+from typing import Callable, Iterable
 
 import numpy as np
 
@@ -81,13 +81,19 @@ class Volumes(StepWorld):
         configs: np.ndarray,
         holding: tuple[str, str] | None = None,
         grasp: tuple[str, str] | None = None,
+        clear: Callable[[Posed], bool] | None = None,
     ) -> Posed | None:
         """:meth:`free_volume` as the collision kernel reads it (:meth:`Arm.posed
-        <mrgc.geometry.arm.Arm.posed>`: no list of pieces made): the motion checks' form."""
+        <mrgc.geometry.arm.Arm.posed>`: no list of pieces made): the motion checks' form.  ``clear``: what
+        else the volume must be clear of (the world, what other robots sweep), tested before the arm's
+        self-collision check, which then runs only on volumes it clears (None when it does not: the same
+        answer as testing it afterwards, the cheaper test first)."""
         if self.late():
             return None
         held = self._held(robot, holding)
         posed, transforms, poses = self.arm(robot).posed(configs, held, self._opening(robot, holding, grasp))
+        if clear is not None and not clear(posed):
+            return None
         return None if self._itself(robot, transforms, held[0] if held else None, poses) else posed
 
     def _itself(

@@ -574,6 +574,30 @@ def test_the_kernel_agrees_with_pairwise_coal(n_a: int, n_b: int) -> None:
             assert world.probe_collides(pa) == expected == world.probe_collides(a)  # type: ignore[arg-type]
 
 
+@settings(max_examples=20, deadline=None)
+@given(st.integers(0, 2**31 - 1), st.sampled_from([1.5, 2.0]), st.sampled_from([13, 16, 120]))
+def test_a_large_set_probed_often_answers_as_before_through_its_tree(seed: int, reach: float, n_probe: int) -> None:
+    """A large set probed more than TREE_AFTER times answers through coal's broadphase tree (its boxes grown
+    by the tolerance): the same answers as the numpy path (a fresh copy of the set, never probed before; that
+    path agrees with pairwise coal: the test above), for probes of one configuration (a few pieces, up to
+    GROUP) and of a batch, each a cluster somewhere in the set (about half of them collide)."""
+    from mrgc.geometry import collision
+    from mrgc.geometry.collision import Posed, posed_collide
+
+    rng = np.random.default_rng(seed)
+    large = _random_pieces(rng, collision.DIRECT_PAIRS // 12 + 50, reach)
+    reused = Posed.of(large)  # type: ignore[arg-type]
+    seen = set()
+    for k in range(collision.TREE_AFTER + 16):
+        centre = translation(*rng.uniform(-reach, reach, 3))
+        probe = Posed.of([(s, centre @ t) for s, t in _random_pieces(rng, n_probe, 0.1)])  # type: ignore[misc]
+        answer = posed_collide(probe, reused)
+        assert answer == posed_collide(probe, Posed.of(large)), k  # type: ignore[arg-type]
+        seen.add(answer)
+    assert reused._tree is not None  # the later probes went through the tree
+    assert len(seen) == 2 or n_probe == 120  # both answers occur (a batch of 120 pieces mostly collides)
+
+
 def test_paired_collide_tests_only_pieces_of_the_same_slot() -> None:
     """Two motions compared sample by sample: pieces of different samples never count."""
     from mrgc.geometry.collision import Posed, paired_collide

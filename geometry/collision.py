@@ -231,7 +231,7 @@ class Posed:
     queries; nothing is copied into coal (the exact test moves no coal object: :func:`_exact`).
     """
 
-    __slots__ = ("shapes", "kind", "transforms", "lo", "hi", "_coarse", "_tree", "_probed")
+    __slots__ = ("shapes", "kind", "transforms", "lo", "hi", "_coarse", "_tree", "_probed", "_parts")
 
     def __init__(self, shapes: Sequence[CollisionShape], kind: np.ndarray, transforms: np.ndarray, pad: float) -> None:
         self.shapes = list(shapes)
@@ -239,7 +239,8 @@ class Posed:
         self.transforms = np.asarray(transforms, dtype=float).reshape(-1, 4, 4)
         self._coarse: tuple[np.ndarray, np.ndarray] | None = None
         self._tree: tuple[float, Any, list[Any]] | None = None  # (pad, coal's tree, its objects): Posed.tree
-        self._probed = 0  # large-set queries so far (posed_collide): a tree pays from the TREE_AFTER-th on
+        self._probed = 0  # large-set queries so far (posed_collide): a tree pays after enough of them
+        self._parts: dict[bytes, Posed] = {}  # within()'s answers, by box
         if not len(self.kind):
             self.lo = self.hi = np.zeros((0, 3))
             return
@@ -297,13 +298,23 @@ class Posed:
     def within(self, lo: np.ndarray, hi: np.ndarray) -> "Posed":
         """The pieces whose boxes meet the world box ``[lo, hi]``, in their order (the same shapes, no copy of
         them): every probe whose box lies in ``[lo, hi]`` gets the same answers from it as from all pieces,
-        fewer of them to look through (placements inside a small region against a large swept volume)."""
+        fewer of them to look through (placements inside a small region against a large swept volume).
+        The same box asked again gets the same object (its query count and tree go on)."""
+        box = np.concatenate([lo, hi]).tobytes()
+        out = self._parts.get(box)
+        if out is not None:
+            return out
         keep = np.flatnonzero(np.all(self.lo <= hi, axis=1) & np.all(lo <= self.hi, axis=1))
         if len(keep) == len(self.kind):
-            return self
-        out = Posed.__new__(Posed)
-        out.shapes, out.kind, out.transforms = self.shapes, self.kind[keep], self.transforms[keep]
-        out.lo, out.hi, out._coarse, out._tree, out._probed = self.lo[keep], self.hi[keep], None, None, 0
+            out = self
+        else:
+            out = Posed.__new__(Posed)
+            out.shapes, out.kind, out.transforms = self.shapes, self.kind[keep], self.transforms[keep]
+            out.lo, out.hi, out._coarse, out._tree, out._probed = self.lo[keep], self.hi[keep], None, None, 0
+            out._parts = {}
+        if len(self._parts) >= 16:
+            del self._parts[next(iter(self._parts))]
+        self._parts[box] = out
         return out
 
     def tree(self, pad: float) -> Any:
@@ -482,37 +493,38 @@ def _exact(
 
 def posed_collide(a: Posed, b: Posed, tolerance: float = TOLERANCE) -> bool:
     """Whether some piece of ``a`` collides with some piece of ``b`` (within ``tolerance``); large sets are
-    opened a chunk of groups at a time, stopping at the first collision."""
+    opened a chunk of groups at a time, stopping at the first collision; a large ``b`` asked again and again
+    answers through its tree (:data:`TREE_MIN`)."""
+    if len(b) >= TREE_MIN and len(a) <= min(TREE_PIECES, len(b)):
+        b._probed += 1
+        if b._probed > max(TREE_AFTER, len(b) // TREE_AMORTISED):
+            return _tree_probe(a, b, tolerance)
     if len(a) * len(b) <= DIRECT_PAIRS:
         i, j = overlaps(a, b)
         return bool(_exact(a, b, i, j, tolerance, stop=True))
     if len(a) <= GROUP:  # a probe against a large set (one configuration against a swept volume)
-        if len(b) >= TREE_MIN:
-            b._probed += 1
-            if b._probed > TREE_AFTER:
-                return _tree_probe(a, b, tolerance)
         i, j = _near(a, b)
         return bool(_exact(a, b, i, j, tolerance, stop=True))
     if len(b) <= GROUP:
         j, i = _near(b, a)
         return bool(_exact(a, b, i, j, tolerance, stop=True))
-    if len(b) >= TREE_MIN and len(a) <= TREE_PIECES:
-        b._probed += 1
-        if b._probed > TREE_AFTER:
-            return _tree_probe(a, b, tolerance)
     return any(_exact(a, b, i, j, tolerance, stop=True) for i, j in _chunks(a, b))
 
 
-#: a set of at least TREE_MIN pieces (another arm's sweep, a step's busy volume) asked about more than
-#: TREE_AFTER times by probes of at most TREE_PIECES pieces gets coal's broadphase tree (:meth:`Posed.tree`,
-#: built once, about 10 µs a piece) and answers each later probe by one tree query per probe piece (a few
-#: µs each) instead of the numpy broadphase and the pairs it leaves: the RRT of a carry among another arm's
-#: sweep asks the same set hundreds of times (measured on a PA5 instance: 1,144 one-configuration probes of
-#: 11 pieces against 2,706, 0.6 ms each -> 0.1 ms; 367 batches of 589 pieces, 3.9 -> 1.4 ms).  The answers
-#: are the same: the tree's boxes are grown by the tolerance and coal's narrowphase runs with it as its
-#: security margin (tests/test_collision.py compares both paths).  A count, not a clock, decides the path.
+#: a set of at least TREE_MIN pieces (another arm's sweep, a step's busy volume, a suffix's sweep around a
+#: region) asked about by probes of at most TREE_PIECES pieces (and no more than its own) more than
+#: max(TREE_AFTER, size / TREE_AMORTISED) times gets coal's broadphase tree (:meth:`Posed.tree`, built once,
+#: about 10 µs a piece, so a numpy query of about 0.3 ms pays for some 30 pieces of it) and answers each later
+#: probe by one tree query per probe piece (a few µs each) instead of the numpy broadphase and the pairs it
+#: leaves: the RRT of a carry among another arm's sweep asks the same set hundreds of times (measured on a
+#: PA5 instance: 1,164 one-configuration probes of 11 pieces against 2,706, 377 -> 60 µs each; 373 batches of
+#: 591 pieces, 2,256 -> 344 µs); placements ask a suffix's sweep around a region (one piece against 3,500:
+#: 431 -> 20 µs).  The answers are the same: the tree's boxes are grown by the tolerance and coal's
+#: narrowphase runs with it as its security margin (tests/test_collision.py compares both paths).  A count,
+#: not a clock, decides the path.
 TREE_MIN = 256
 TREE_AFTER = 4
+TREE_AMORTISED = 32
 TREE_PIECES = 4096
 
 
@@ -673,6 +685,7 @@ class CollisionWorld:
             posed.transforms[entry.slot] = t
             posed.lo[entry.slot], posed.hi[entry.slot] = one.lo[0], one.hi[0]
             posed._coarse = posed._tree = None
+            posed._parts = {}
 
     def transform(self, name: str) -> np.ndarray:
         """Object ``name``'s pose (a copy)."""
@@ -717,9 +730,18 @@ class CollisionWorld:
 
     def probe_collides(self, shapes: Probe | Posed, against: Against = None, ignore: Against = ()) -> bool:
         """Does any shape of the probe ((shape, 4×4 transform) pairs, not in the world) hit a selected object?"""
-        if not isinstance(shapes, Posed) and len(shapes) <= SMALL_PROBE:
+        if len(shapes) <= SMALL_PROBE:
             tree = self._tree(against, ignore, ())
-            return tree is not None and self._tree_collides(tree, [_posed(s, t) for s, t in shapes])
+            if tree is None:
+                return False
+            pieces: Probe = (
+                [(shapes.shapes[k], t) for k, t in zip(shapes.kind.tolist(), shapes.transforms)]
+                if isinstance(shapes, Posed)
+                else shapes
+            )
+            # one piece at a time: each is its shape's probe object moved there, and one shape may stand at
+            # several pieces (an object along a path: moved there all at once, only its last pose was tested)
+            return any(self._tree_collides(tree, [_posed(s, t)]) for s, t in pieces)
         return self._query(self._probe(shapes), self._select(against, ignore, ()), stop=True) is True
 
     def probe_hits(self, shapes: Probe | Posed, against: Against = None, ignore: Against = ()) -> set[str]:
@@ -774,6 +796,7 @@ class CollisionWorld:
         chosen = Posed.__new__(Posed)  # the selection's rows of the world (views of nothing: copies of a few rows)
         chosen.shapes, chosen.kind, chosen.transforms = world.shapes, world.kind[sel], world.transforms[sel]
         chosen.lo, chosen.hi, chosen._coarse, chosen._tree, chosen._probed = world.lo[sel], world.hi[sel], None, None, 0
+        chosen._parts = {}
         if stop:
             return posed_collide(pieces, chosen, self.tolerance)
         i, j = overlaps(pieces, chosen)

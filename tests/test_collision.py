@@ -577,10 +577,11 @@ def test_the_kernel_agrees_with_pairwise_coal(n_a: int, n_b: int) -> None:
 @settings(max_examples=20, deadline=None)
 @given(st.integers(0, 2**31 - 1), st.sampled_from([1.5, 2.0]), st.sampled_from([13, 16, 120]))
 def test_a_large_set_probed_often_answers_as_before_through_its_tree(seed: int, reach: float, n_probe: int) -> None:
-    """A large set probed more than TREE_AFTER times answers through coal's broadphase tree (its boxes grown
-    by the tolerance): the same answers as the numpy path (a fresh copy of the set, never probed before; that
-    path agrees with pairwise coal: the test above), for probes of one configuration (a few pieces, up to
-    GROUP) and of a batch, each a cluster somewhere in the set (about half of them collide)."""
+    """A large set probed often enough (more than TREE_AFTER times, and than its size / TREE_AMORTISED) answers
+    through coal's broadphase tree (its boxes grown by the tolerance): the same answers as the numpy path (a
+    fresh copy of the set, never probed before; that path agrees with pairwise coal: the test above), for
+    probes of one configuration (a few pieces, up to GROUP) and of a batch, each a cluster somewhere in the
+    set (about half of them collide).  The part of it within a box is the same object when asked again."""
     from mrgc.geometry import collision
     from mrgc.geometry.collision import Posed, posed_collide
 
@@ -588,14 +589,35 @@ def test_a_large_set_probed_often_answers_as_before_through_its_tree(seed: int, 
     large = _random_pieces(rng, collision.DIRECT_PAIRS // 12 + 50, reach)
     reused = Posed.of(large)  # type: ignore[arg-type]
     seen = set()
-    for k in range(collision.TREE_AFTER + 16):
+    for k in range(max(collision.TREE_AFTER, len(large) // collision.TREE_AMORTISED) + 12):
         centre = translation(*rng.uniform(-reach, reach, 3))
         probe = Posed.of([(s, centre @ t) for s, t in _random_pieces(rng, n_probe, 0.1)])  # type: ignore[misc]
         answer = posed_collide(probe, reused)
         assert answer == posed_collide(probe, Posed.of(large)), k  # type: ignore[arg-type]
         seen.add(answer)
     assert reused._tree is not None  # the later probes went through the tree
+    lo, hi = np.full(3, -0.3), np.full(3, 0.3)
+    part = reused.within(lo, hi)
+    assert part is reused.within(lo, hi) and 0 < len(part) < len(reused)
     assert len(seen) == 2 or n_probe == 120  # both answers occur (a batch of 120 pieces mostly collides)
+
+
+def test_a_small_probe_tests_every_pose_of_a_shape_it_holds_twice() -> None:
+    """A small probe (up to SMALL_PROBE pieces, through the selection's coal tree) with one shape at several
+    poses (an object along a path): the pose that collides is found wherever it is in the probe, as a list
+    and as a Posed (a shape's probe object moved to all of them at once answered for the last pose only)."""
+    from mrgc.geometry.collision import Posed
+
+    world = CollisionWorld()
+    world.add("wall", Box(0.1, 1.0, 1.0), translation(0, 0, 0))
+    box = collision_shape(Box(0.05, 0.05, 0.05))
+    for k in range(3):  # the colliding pose first, in the middle, last
+        poses = [translation(0.5 + 0.1 * i, 0, 0) for i in range(3)]
+        poses[k] = translation(0.02, 0, 0)
+        probe = [(box, t) for t in poses]
+        assert world.probe_collides(probe), k  # type: ignore[arg-type]
+        assert world.probe_collides(Posed.of(probe)), k  # type: ignore[arg-type]
+    assert not world.probe_collides([(box, translation(0.5 + 0.1 * i, 0, 0)) for i in range(3)])  # type: ignore[misc]
 
 
 def test_paired_collide_tests_only_pieces_of_the_same_slot() -> None:

@@ -93,6 +93,9 @@ class Grounding:
     #: why no skeleton at all can be grounded before the suffix this one failed under ('' when the failure
     #: says nothing of the kind): a goal object it leaves no free pose in its goal region
     dead_end: str = ""
+    #: the grounding (its key) whose failure this one repeats without grounding anything ('' when it was
+    #: grounded): the same steps from the failing one on, under the same suffix, moving the same objects
+    repeats: str = ""
 
 
 def _matrix(t: np.ndarray) -> list[list[float]]:
@@ -131,6 +134,11 @@ class ReverseGrounder:
         self._dead_spots: set[tuple[str, str, str, tuple[float, ...]]] = set()
         #: (suffix step ids, object, region) -> (the suffix, whether it leaves the object no free pose there)
         self._full: dict[tuple[tuple[int, ...], str, str], tuple[tuple[GroundedStep, ...], bool]] = {}
+        #: failed groundings by what their failure depended on (:meth:`_context`) -> (the suffix, kept so that
+        #: its steps' ids stay its own; the failed grounding; its key)
+        self._failed: dict[tuple[object, ...], tuple[tuple[GroundedStep, ...], Grounding, str]] = {}
+        #: groundings that repeated a failure instead of grounding anything (:meth:`ground`)
+        self.repeated = 0
         #: the skeleton being grounded, its actions as re-timed so far (see :class:`_Retiming`)
         self._plan = _Retiming([], None)
         #: actions found doomed before the later steps are grounded (planner/doomed.py)
@@ -158,6 +166,9 @@ class ReverseGrounder:
         :class:`DeadlineReached` when the search's deadline cut a query of it short (its answer may then be
         wrong)."""
         self._on_time()
+        known = self._repeated(skeleton, suffix)
+        if known is not None:
+            return known
         result = self._ground(skeleton, suffix, key, order)
         if result.retimed and result.outcome is not Outcome.SUCCESS:
             result = self._ground(skeleton, suffix, key, None)
@@ -165,7 +176,43 @@ class ReverseGrounder:
             result.dead_end = self.dead_end(result.failures[0], skeleton, suffix)
         if self.g.cut:  # a query stopped at the deadline: what it answered decides nothing
             raise DeadlineReached()
+        if result.outcome is Outcome.FAIL and result.failures and not result.retimed:
+            step = result.failures[0].step
+            if 1 <= step <= skeleton.makespan:
+                self._failed[self._context(skeleton, suffix, step)] = (tuple(suffix), result, key)
         return result
+
+    @staticmethod
+    def _context(skeleton: Skeleton, suffix: list[GroundedStep], step: int) -> tuple[object, ...]:
+        """What the reverse search's grounding of ``skeleton``'s step ``step`` (1-based) and of the steps after
+        it depends on besides the random draws: the suffix (its steps' ids), the objects the skeleton moves
+        (the others never move: M_out) and its steps from ``step`` on."""
+        steps = tuple(frozenset(s) for s in skeleton.steps[step - 1 :])
+        return (tuple(id(s) for s in suffix), frozenset(skeleton.moved), steps)
+
+    def _repeated(self, skeleton: Skeleton, suffix: list[GroundedStep]) -> Grounding | None:
+        """The failure of an earlier grounding whose context (:meth:`_context`) at its failing step is this
+        skeleton's at the same step, as this grounding's (nothing grounded); None when there is none.  The
+        reverse search grounds the steps from the last one back to that one as it did then; only its random
+        draws would differ, which the failure has already had (:data:`PLACEMENT_TRIES` and more), so the
+        skeleton is passed over: memoised failures, not a second search of the same steps (a 6-arm skeleton
+        grounding takes seconds, and a skeleton source offers many skeletons that differ only before the step
+        that failed)."""
+        if not self._failed:
+            return None
+        for step in range(skeleton.makespan, 0, -1):
+            known = self._failed.get(self._context(skeleton, suffix, step))
+            if known is not None:
+                _, failed, key = known
+                self.repeated += 1
+                return Grounding(
+                    Outcome.FAIL,
+                    reason=failed.reason,
+                    failures=list(failed.failures),
+                    dead_end=failed.dead_end,
+                    repeats=key,
+                )
+        return None
 
     def dead_end(self, failure: Failure, skeleton: Skeleton, suffix: list[GroundedStep]) -> str:
         """Why no skeleton can be grounded before ``suffix`` ('' when ``failure``, of a grounding of ``skeleton``

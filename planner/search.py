@@ -135,6 +135,7 @@ def _search(context: Context, sources: _Sources, deadline: float) -> Result:
     stats["geometric_queries"] = grounder.queries
     stats["deferred"] = sorted(describe(p) for p in sources.deferrals.deferred)
     stats["doomed_skeletons"] = reverse.doomed.doomed  # failed by a probe before their later steps (doomed.py)
+    stats["repeated_failures"] = reverse.repeated  # failed as an earlier grounding did (ReverseGrounder._repeated)
     stats.update(timing.of(result.steps))
     if out.status is PlanStatus.TIME_LIMIT and result.ended == "iteration limit":
         out.summary = f"the search's iteration limit ({o['max_iterations']}) was reached before a plan was found"
@@ -340,7 +341,10 @@ def _log_line(elapsed: float, n: int, skel: Skeleton, suffix: list[GroundedStep]
         grounded = len(result.steps) - len(suffix)
         return f"{head}: grounded {grounded} step(s); must move {sorted(result.must_move)}{why}{retimed}{resolved}"
     f = result.failures[0] if result.failures else None
-    return f"{head}: fails at {f.line() if f else result.reason}"
+    again = (
+        f" (as grounding {result.repeats}: the same steps from there on, not grounded again)" if result.repeats else ""
+    )
+    return f"{head}: fails at {f.line() if f else result.reason}{again}"
 
 
 def planned_action(a: Action, relay: bool = False) -> PlannedAction:

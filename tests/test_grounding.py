@@ -540,15 +540,37 @@ def test_an_action_doomed_by_what_never_moves_fails_before_the_later_steps(pa3: 
     assert first.outcome is Outcome.FAIL and first.failures, first.reason
     assert (first.failures[0].step, first.failures[0].check) == (1, "place by r1: no inverse kinematics")
     assert first.failures[0].static  # every placement tried is out of reach: what never moves
-    second = reverse.ground(skel, [], key="2")
+    # another skeleton with that step (its step 2 places o2 with another grasp: not a repeated failure)
+    other = Skeleton((skel.steps[0], (Action("o2", "bin-a", "r1", "r1", "top", "top-x"),)))
+    second = reverse.ground(other, [], key="2")
     assert second.outcome is Outcome.FAIL and second.failures
     assert (second.failures[0].step, second.failures[0].check) == (1, "place by r1: no inverse kinematics")
-    assert second.failures[0].detail == "probed before the later steps"
+    assert second.failures[0].detail == "probed before the later steps" and not second.repeats
     assert "o2" not in picked  # step 2 was not grounded
     assert reverse.doomed.doomed == 1  # the search's statistics count it (``doomed_skeletons``)
     # an action the probe finds placeable is grounded as before: o2 into bin-a alone succeeds
     alone = reverse.ground(Skeleton(((Action("o2", "bin-a", "r1", "r1", "top", "top"),),)), [], key="3")
     assert alone.outcome is Outcome.SUCCESS, alone.reason
+
+
+def test_a_failure_is_not_grounded_again_under_the_same_steps(pa3: Grounder) -> None:
+    """planner/ground.py ``ReverseGrounder._repeated``: a skeleton whose steps from the one that failed on are
+    those of a failed grounding (the same suffix, the same objects moved) fails as that one did without a
+    geometric query: here r1 cannot reach bin-b (step 2), and a second skeleton differs only in step 1 (o3
+    into bin-a with another grasp).  One whose failing step differs is grounded as before."""
+    reverse = ReverseGrounder(pa3, {"o1": "bin-b", "o3": "bin-a"})
+    o1 = (Action("o1", "bin-b", "r1", "r1", "top", "top"),)
+    first = reverse.ground(Skeleton(((Action("o3", "bin-a", "r1", "r1", "top", "top"),), o1)), [], key="1")
+    assert first.outcome is Outcome.FAIL and first.failures and first.failures[0].step == 2, first.reason
+    queries = pa3.queries
+    picked = _count_picks(pa3)
+    again = reverse.ground(Skeleton(((Action("o3", "bin-a", "r1", "r1", "top-x", "top-x"),), o1)), [], key="2")
+    assert again.outcome is Outcome.FAIL and again.repeats == "1" and reverse.repeated == 1
+    assert [f.line() for f in again.failures] == [f.line() for f in first.failures]
+    assert picked == [] and pa3.queries == queries  # nothing was asked
+    handed = (Action("o1", "bin-b", "r1", "r2", "top", "top"),)  # another step 2: grounded
+    third = reverse.ground(Skeleton(((Action("o3", "bin-a", "r1", "r1", "top", "top"),), handed)), [], key="3")
+    assert not third.repeats and pa3.queries > queries
 
 
 def test_a_pick_failing_on_what_never_moves_fails_every_skeleton_holding_it_at_once(pa3: Grounder) -> None:

@@ -787,3 +787,30 @@ def test_a_held_object_swung_into_its_own_arm_is_not_free(pa3: Grounder) -> None
     assert pa3.free_volume("r1", q[None], holding=("o1", "top")) is None
     arm = pa3.arm("r1")
     assert pa3.free_volume("r1", arm.home[None], holding=("o1", "top")) is not None
+
+
+@pytest.mark.parametrize(
+    "q",
+    [
+        [0.2, 0.3, 0.1, -1.8, 0.0, 2.1, 0.8],
+        [-0.6, 0.5, 0.3, -2.0, 0.2, 2.5, -0.4],
+        [1.0, -0.2, -0.5, -1.5, -0.3, 1.6, 1.9],
+    ],
+)
+def test_a_contact_segment_off_the_approach_line_is_refused(pa3: Grounder, q: list[float]) -> None:
+    """geometry/approaches.py ``on_the_line``: a contact segment from the grasp backed off 2 cm along the
+    tool's z axis (IK from the grasp configuration) keeps the tool on the approach line; one whose start has
+    the first joint turned 0.05 rad (the tool some 2-4 cm off sideways) does not, and the approach is refused
+    before the validator would reject its plan (10 mm, 0.05 rad)."""
+    from mrgc.geometry.approaches import on_the_line
+    from mrgc.geometry.ik import solve_ik_many
+
+    arm = pa3.arm("r1")
+    grasp = np.array(q)
+    tool = arm.tool_world(grasp[None])[0]
+    back = solve_ik_many(arm.model, arm.ee_target(tool @ translation(0, 0, -0.02))[None], 0, q_init=grasp[None])[0]
+    assert back.solved and back.q is not None
+    assert on_the_line(arm, tool, np.asarray(back.q), grasp)
+    turned = np.asarray(back.q).copy()
+    turned[0] += 0.05
+    assert not on_the_line(arm, tool, turned, grasp)

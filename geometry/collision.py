@@ -228,7 +228,8 @@ class Posed:
     ``shapes`` are the distinct shapes, ``kind`` (N,) which of them each piece is, ``transforms`` (N, 4, 4)
     where; ``lo`` / ``hi`` (N, 3) the world axis-aligned bounding boxes, grown by ``pad`` (a query's
     tolerance: the boxes of two shapes within it of each other meet).  Built once, read by any number of
-    queries; nothing is copied into coal (the exact test moves no coal object: :func:`_exact`).
+    queries; nothing is copied into coal (the exact test moves no coal object: :func:`_exact`) unless the set
+    is asked often enough to get a broadphase tree of its own (:meth:`tree`, :data:`TREE_MIN`).
     """
 
     __slots__ = ("shapes", "kind", "transforms", "lo", "hi", "_coarse", "_tree", "_probed", "_parts")
@@ -305,16 +306,25 @@ class Posed:
         if out is not None:
             return out
         keep = np.flatnonzero(np.all(self.lo <= hi, axis=1) & np.all(lo <= self.hi, axis=1))
-        if len(keep) == len(self.kind):
-            out = self
-        else:
-            out = Posed.__new__(Posed)
-            out.shapes, out.kind, out.transforms = self.shapes, self.kind[keep], self.transforms[keep]
-            out.lo, out.hi, out._coarse, out._tree, out._probed = self.lo[keep], self.hi[keep], None, None, 0
-            out._parts = {}
+        out = self if len(keep) == len(self.kind) else self.rows(keep)
         if len(self._parts) >= 16:
             del self._parts[next(iter(self._parts))]
         self._parts[box] = out
+        return out
+
+    def rows(self, index: np.ndarray) -> "Posed":
+        """The pieces ``index`` (an index array), in that order: the same shapes, the rows copied, nothing
+        cached yet."""
+        out = Posed.__new__(Posed)
+        out.shapes, out.kind, out.transforms = self.shapes, self.kind[index], self.transforms[index]
+        out.lo, out.hi, out._coarse, out._tree, out._probed, out._parts = (
+            self.lo[index],
+            self.hi[index],
+            None,
+            None,
+            0,
+            {},
+        )
         return out
 
     def tree(self, pad: float) -> Any:
@@ -793,10 +803,7 @@ class CollisionWorld:
         if not len(sel) or not len(pieces):
             return False if stop else set()
         world = self._world()
-        chosen = Posed.__new__(Posed)  # the selection's rows of the world (views of nothing: copies of a few rows)
-        chosen.shapes, chosen.kind, chosen.transforms = world.shapes, world.kind[sel], world.transforms[sel]
-        chosen.lo, chosen.hi, chosen._coarse, chosen._tree, chosen._probed = world.lo[sel], world.hi[sel], None, None, 0
-        chosen._parts = {}
+        chosen = world.rows(sel)
         if stop:
             return posed_collide(pieces, chosen, self.tolerance)
         i, j = overlaps(pieces, chosen)

@@ -197,12 +197,13 @@ class Arm:
             np.linalg.norm(local - self.model.shoulder) <= self.model.reach + np.linalg.norm(self.tcp[:3, 3]) + margin
         )
 
-    def comfort(self, tool: np.ndarray, share: float) -> float:
-        """0 when the end effector for world tool pose ``tool`` lies within ``share`` of the reach bound from
-        the shoulder, else its distance from the shoulder (m): the far corners of a bin at the edge of the
-        reach fail IK after every restart."""
-        far = float(np.linalg.norm(self.ee_target(tool)[:3, 3] - self.model.shoulder))
-        return 0.0 if far <= share * self.model.reach else far
+    def comfort(self, tools: np.ndarray, share: float) -> np.ndarray:
+        """For each world tool pose of ``tools`` (..., 4, 4): 0 when the end effector lies within ``share`` of
+        the reach bound from the shoulder, else its distance from the shoulder (m): the far corners of a bin at
+        the edge of the reach fail IK after every restart."""
+        far = np.linalg.norm(self.ee_target(tools)[..., :3, 3] - self.model.shoulder, axis=-1)
+        out: np.ndarray = np.where(far <= share * self.model.reach, 0.0, far)
+        return out
 
     # ------------------------------------------------------------------ volumes (the Robot protocol)
     def hold(self, shape: Shape, grasp: str, grasps: Mapping[str, GraspSpec]) -> tuple[float | None, np.ndarray]:

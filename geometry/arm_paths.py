@@ -28,7 +28,6 @@ from mrgc.geometry.ik import solve_ik_many
 from mrgc.geometry.motion import MAX_CHECKS, plan_joint_path
 from mrgc.geometry.robot import Pieces
 from mrgc.geometry.scene import half_extents
-from mrgc.geometry.step_world import fingerprint
 from mrgc.geometry.transforms import translation
 from mrgc.geometry.volumes import Volumes
 
@@ -169,7 +168,7 @@ class ArmPaths(Volumes):
             lower,
             phase,
             self._presence(),
-        ) + fingerprint([start, goal, *poses], busy)
+        ) + self.fingerprint([start, goal, *poses], busy)
         return self._remembered(
             key, lambda: self._transfer(robot, (obj, grasp), (start, goal), avoid, lift, busy, lower, phase)
         )

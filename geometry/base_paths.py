@@ -22,7 +22,6 @@ from mrgc.geometry.conventions import PATH_RESOLUTION
 from mrgc.geometry.lattice import Body, LatticePlanner, box_corners
 from mrgc.geometry.motion import MotionStatus
 from mrgc.geometry.planar import DiscGrid, scene_bounds
-from mrgc.geometry.step_world import fingerprint
 from mrgc.geometry.volumes import Volumes
 from mrgc.language.model import Shape
 
@@ -58,7 +57,7 @@ class BasePaths(Volumes):
         hopeless queries are refused at once by an inscribed-disc grid test.  Answers are cached: the same
         query (same obstacles at the same poses) gets the same answer, and the search never asks twice."""
         movers = sorted({a for a in avoid if not holding or a != holding[0]})
-        key = (robot, holding, tuple(movers), *fingerprint([start, goal, *(self.poses[a] for a in movers)], busy))
+        key = (robot, holding, tuple(movers), *self.fingerprint([start, goal, *(self.poses[a] for a in movers)], busy))
 
         def ask() -> Answer:
             answer = self._base_path(robot, start, goal, holding, movers, busy)

@@ -262,19 +262,14 @@ class Posed:
     @classmethod
     def of(cls, pieces: Iterable[tuple[ShapeLike, np.ndarray]], pad: float = TOLERANCE) -> "Posed":
         """The pieces of a probe or a volume ((shape, 4×4 world transform) pairs)."""
-        shapes: list[CollisionShape] = []
-        index: dict[int, int] = {}
-        kind: list[int] = []
-        transforms: list[np.ndarray] = []
-        for shape, t in pieces:
-            s = shape if type(shape) is CollisionShape else collision_shape(shape)
-            k = index.get(id(s))
-            if k is None:
-                k = index[id(s)] = len(shapes)
-                shapes.append(s)
-            kind.append(k)
-            transforms.append(t)
-        return cls(shapes, np.array(kind, dtype=np.intp), np.array(transforms, dtype=float).reshape(-1, 4, 4), pad)
+        pieces = pieces if isinstance(pieces, (list, tuple)) else list(pieces)
+        given = [collision_shape(p[0]) if type(p[0]) is not CollisionShape else p[0] for p in pieces]
+        ids = list(map(id, given))
+        first = dict(zip(ids, given))  # each distinct shape, in order of first appearance
+        index = {i: k for k, i in enumerate(first)}
+        shapes = list(first.values())
+        kind = np.fromiter(map(index.__getitem__, ids), dtype=np.intp, count=len(ids))
+        return cls(shapes, kind, np.array([p[1] for p in pieces], dtype=float).reshape(-1, 4, 4), pad)
 
     @classmethod
     def batch(cls, shapes: Sequence[ShapeLike], transforms: np.ndarray, pad: float = TOLERANCE) -> "Posed":

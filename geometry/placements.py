@@ -13,6 +13,7 @@ still to come.
 
 from __future__ import annotations
 
+import functools
 from typing import Callable, Iterable, Iterator
 
 import numpy as np
@@ -69,11 +70,11 @@ class Placements(StepWorld):
         samples: int = 200,
         key: str = "",
         packed: bool = False,
-        prefer: Callable[[np.ndarray], float] | None = None,
+        prefer: Callable[[np.ndarray], np.ndarray] | None = None,
     ) -> Iterator[np.ndarray]:
         """The poses :meth:`placement` would return with ``skip`` 0, 1, 2 ..., in that order, each checked
-        once (asking :meth:`placement` for the k-th checks the first k again).  ``prefer`` (a rank of a pose,
-        e.g. :meth:`comfortable`'s) orders the grid and lattice candidates by rank, keeping their order
+        once (asking :meth:`placement` for the k-th checks the first k again).  ``prefer`` (ranks of poses
+        (N, 4, 4) -> (N,), e.g. :meth:`comfortable`'s) orders the grid and lattice candidates by rank, keeping their order
         among equal ranks.  ``region`` is a region's name or a region body (a relay's spot on a fixed object's
         top: :func:`mrgc.geometry.relays.spot_region`)."""
         body = self.scene.body(obj)
@@ -91,12 +92,9 @@ class Placements(StepWorld):
         fixed: list[tuple[float, float, float]] = [(0.0, a * room[0], b * room[1]) for a, b in lattice_offsets(3)]
         if packed:
             fixed = _packing_grid(h_r[:2] - min(h_o[0], h_o[1])) + fixed
-        if prefer is not None:  # accepted ones first in their order, then the others by the preference's rank
-            rank = {
-                c: prefer(reg.pose @ translation(c[1], c[2], -h_r[2] + h_o[2] + ARM_PLACE_LIFT) @ rot_z(c[0]))
-                for c in fixed
-            }
-            fixed = sorted(fixed, key=lambda c: rank[c])  # stable
+        if prefer is not None:  # by the preference's rank, keeping their order among equal ranks
+            rank = prefer(_candidate_poses(reg.pose, fixed, -h_r[2] + h_o[2] + ARM_PLACE_LIFT))
+            fixed = [fixed[i] for i in np.argsort(rank, kind="stable")]
         for k in range(len(fixed) + samples):
             if self.late():
                 return
@@ -138,18 +136,21 @@ class Placements(StepWorld):
                 return obj
         return None
 
-    def comfortable(self, robot: str, obj: str, grasp: str, share: float = COMFORT) -> Callable[[np.ndarray], float]:
-        """A rank of placements of ``obj`` for ``robot`` holding it with ``grasp``: its :meth:`Robot.comfort
-        <mrgc.geometry.robot.Robot.comfort>` of the tool pose (an arm: 0 where the end effector lies within
-        ``share`` of its reach bound from the shoulder, else its distance from the shoulder, nearer first; a
-        bin at the edge of an arm's reach is reachable in its near part only, and IK at its far corners fails
-        after every restart).  0 everywhere for a grasp without geometry."""
+    def comfortable(
+        self, robot: str, obj: str, grasp: str, share: float = COMFORT
+    ) -> Callable[[np.ndarray], np.ndarray]:
+        """A rank of placements of ``obj`` (object poses (N, 4, 4) -> ranks (N,)) for ``robot`` holding it with
+        ``grasp``: its :meth:`Robot.comfort <mrgc.geometry.robot.Robot.comfort>` of the tool poses (an arm: 0
+        where the end effector lies within ``share`` of its reach bound from the shoulder, else its distance
+        from the shoulder, nearer first; a bin at the edge of an arm's reach is reachable in its near part
+        only, and IK at its far corners fails after every restart).  0 everywhere for a grasp without
+        geometry."""
         spec = self.scene.grasp_specs.get(grasp)
         if spec is None:
-            return lambda pose: 0.0
+            return lambda poses: np.zeros(len(poses))
         mover = self.robot(robot)
         g_t = grasp_transform(spec, self.scene.body(obj).shape)
-        return lambda pose: mover.comfort(pose @ g_t, share)
+        return lambda poses: mover.comfort(poses @ g_t, share)
 
 
 def _around(vol: Posed, region: SceneBody) -> Posed:
@@ -160,10 +161,31 @@ def _around(vol: Posed, region: SceneBody) -> Posed:
     return vol.within(region.pose[:3, 3] - reach, region.pose[:3, 3] + reach)
 
 
+def _candidate_poses(region: np.ndarray, cands: list[tuple[float, float, float]], z: float) -> np.ndarray:
+    """The world poses (N, 4, 4) of candidates (yaw, x, y) at height ``z`` in the ``region`` pose's frame,
+    made in one go (each is ``region @ translation(x, y, z) @ rot_z(yaw)``)."""
+    c = np.array(cands, dtype=float).reshape(-1, 3)
+    local = np.zeros((len(c), 4, 4))
+    cos, sin = np.cos(c[:, 0]), np.sin(c[:, 0])
+    local[:, 0, 0], local[:, 0, 1], local[:, 1, 0], local[:, 1, 1] = cos, -sin, sin, cos
+    local[:, 2, 2] = local[:, 3, 3] = 1.0
+    local[:, 0, 3], local[:, 1, 3], local[:, 2, 3] = c[:, 1], c[:, 2], z
+    out: np.ndarray = region @ local
+    return out
+
+
 def _packing_grid(room: np.ndarray, cells: int = 15) -> list[tuple[float, float, float]]:
     """(yaw, x, y) over ``[-room, room]`` (region frame) on a grid of at most ``cells`` per side (at least 1 cm
-    apart), the four yaws at each point, points nearest a corner first."""
+    apart), the four yaws at each point, points nearest a corner first (a new list; the grid of a room is
+    made once)."""
     room = np.maximum(room, 0.0)
+    return list(_grid(float(room[0]), float(room[1]), cells))
+
+
+@functools.lru_cache(maxsize=64)
+def _grid(rx: float, ry: float, cells: int) -> tuple[tuple[float, float, float], ...]:
+    """:func:`_packing_grid` of the room ``(rx, ry)`` (kept: a bin's grid is asked for at every placement)."""
+    room = np.array([rx, ry])
     axes = [np.linspace(-r, r, max(1, min(cells, int(2 * r / 0.01) + 1))) for r in room]
     scale = np.maximum(room, 1e-9)
 
@@ -173,4 +195,4 @@ def _packing_grid(room: np.ndarray, cells: int = 15) -> list[tuple[float, float,
     # the points of one level (the four corners, ...) at one yaw before the next yaw: a place that fails
     # at one corner (out of reach) is tried at the others before another yaw
     cands = [(level(float(x), float(y)), k, float(x), float(y)) for x in axes[0] for y in axes[1] for k in range(4)]
-    return [(k * np.pi / 2, x, y) for _, k, x, y in sorted(cands)]
+    return tuple((k * np.pi / 2, x, y) for _, k, x, y in sorted(cands))

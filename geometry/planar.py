@@ -139,9 +139,9 @@ class PlanarRobot:
         """Always: a cart drives to what it handles (whether it gets there is its path's question)."""
         return True
 
-    def comfort(self, tool: np.ndarray, share: float) -> float:
-        """0: no reach bound ranks a cart's placements."""
-        return 0.0
+    def comfort(self, tools: np.ndarray, share: float) -> np.ndarray:
+        """0 for each pose of ``tools`` (..., 4, 4): no reach bound ranks a cart's placements."""
+        return np.zeros(np.shape(tools)[:-2])
 
 
 def _reach(shape: CollisionShape, t: np.ndarray) -> float:

@@ -104,7 +104,8 @@ class Robot(Protocol):
         """Whether it may reach world ``point`` (a cheap test that never says no wrongly)."""
         ...
 
-    def comfort(self, tool: np.ndarray, share: float) -> float:
-        """A rank of a world tool pose: 0 within ``share`` of its reach, else how far beyond (m; nearer
-        first)."""
+    def comfort(self, tools: np.ndarray, share: float) -> np.ndarray:
+        """A rank of each world tool pose of ``tools`` (..., 4, 4; one array of ranks of their leading shape,
+        made in one go: a placement search ranks hundreds of candidates): 0 within ``share`` of its reach,
+        else how far beyond (m; nearer first)."""
         ...

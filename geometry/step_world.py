@@ -238,6 +238,16 @@ class StepWorld:
         """What other robots of a step sweep meanwhile (``busy``) as the kernel reads it (None: nothing)."""
         return self._volumes.posed(volume) if volume else None
 
+    def fingerprint(self, arrays: Iterable[np.ndarray], busy: Pieces) -> tuple[tuple[int, ...], bytes]:
+        """What a path query's answer depends on besides its names: the shapes of ``busy`` and a digest of
+        ``arrays`` (configurations, object poses) and of ``busy``'s pieces (the path caches' keys), read from
+        ``busy`` as the kernel reads it (:meth:`_busy`: converted once however often it is asked)."""
+        posed = self._busy(busy)
+        if posed is None:
+            return fingerprint(arrays, ())
+        ids, digest = fingerprint([*arrays, posed.kind, posed.transforms], ())
+        return tuple(id(s) for s in posed.shapes), digest
+
     def _remembered(self, key: tuple[object, ...], ask: Callable[[], Answer]) -> Answer:
         """The path answer remembered for ``key`` (a query's names and :func:`fingerprint`), else ``ask()``'s,
         remembered (:meth:`_remember`): the same question gets the same answer without a second search."""

@@ -986,13 +986,13 @@ def label(a: Action) -> str:
 
 
 def _both(
-    rank_a: Callable[[np.ndarray], float], rank_b: Callable[[np.ndarray], float]
-) -> Callable[[np.ndarray], float]:
+    rank_a: Callable[[np.ndarray], np.ndarray], rank_b: Callable[[np.ndarray], np.ndarray]
+) -> Callable[[np.ndarray], np.ndarray]:
     """A rank of relay spots by two robots' :meth:`comfortable <mrgc.geometry.placements.Placements.comfortable>`
     ranks: 0 where both reach comfortably, else the worse of the two (nearer first).  A region both robots
     reach only in a corner (a crowded start region between two arms) is searched there first, not over its
     whole area."""
-    return lambda pose: max(rank_a(pose), rank_b(pose))
+    return lambda poses: np.maximum(rank_a(poses), rank_b(poses))
 
 
 def _spot_key(pose: np.ndarray) -> tuple[float, ...]:

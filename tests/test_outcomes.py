@@ -293,7 +293,7 @@ class ScriptedGrounder:
         yield np.eye(4)
 
     def comfortable(self, robot: str, obj: str, grasp: str) -> Any:
-        return lambda pose: 0.0
+        return lambda poses: np.zeros(len(poses))
 
     def crowded_out(self, objs: Any, region: str, avoid: Any = (), volume: Any = None, key: str = "") -> str | None:
         return None

@@ -63,8 +63,10 @@ def test_each_kind_implements_the_protocol(base: str) -> None:
 
     # its reach: it reaches where it stands, and ranks tool poses by a distance
     assert robot.in_reach(rest.home[-1][1][:3, 3]) is True
-    rank = robot.comfort(rest.home[-1][1], 0.85)
-    assert isinstance(rank, float) and rank >= 0.0
+    tools = np.stack([t for _, t in rest.home])
+    rank = robot.comfort(tools, 0.85)
+    assert rank.shape == (len(tools),) and (rank >= 0.0).all()
+    assert robot.comfort(tools[0], 0.85) == rank[0]  # one pose: the same rank as in the stack
 
 
 @pytest.mark.parametrize("base", sorted(KINDS))

@@ -129,12 +129,12 @@ def check_urdf(path: str) -> str | None:
     shapes; visual shapes are not loaded (:func:`shared_body`), so a broken visual mesh is not reported
     (nothing in mrgc reads visual shapes: the renderer draws collision geometry).  A version of the file
     accepted before (the same path, size and modification time) is not loaded again, in this process or a
-    fork of it."""
+    fork of it, and pybullet_data's own files are not loaded to be checked (:func:`_pybullets_own`)."""
     try:
         key = _file_key(path)
     except OSError as exc:
         return str(exc)
-    if key in _ACCEPTED:
+    if key in _ACCEPTED or _pybullets_own(key[0]):
         return None
     pb, _ = shared_client()
     try:
@@ -143,6 +143,15 @@ def check_urdf(path: str) -> str | None:
         return str(exc) or "loadURDF failed"
     _ACCEPTED.add(key)
     return None
+
+
+def _pybullets_own(real: str) -> bool:
+    """Whether the real path ``real`` is one of pybullet_data's own files (the Panda of most problems): the
+    files pybullet ships load in it, and checking one would start a pybullet client in every planning run
+    (0.05 s of CPU) only to load what the validator's world loads anyway (tests/test_kinematics.py loads
+    them)."""
+    folder = os.path.realpath(data_path())
+    return os.path.commonpath([folder, real]) == folder
 
 
 def pose_of(pos: Sequence[float], orn: Sequence[float]) -> NDArray[np.float64]:

@@ -74,9 +74,9 @@ class Placements(StepWorld):
     ) -> Iterator[np.ndarray]:
         """The poses :meth:`placement` would return with ``skip`` 0, 1, 2 ..., in that order, each checked
         once (asking :meth:`placement` for the k-th checks the first k again).  ``prefer`` (ranks of poses
-        (N, 4, 4) -> (N,), e.g. :meth:`comfortable`'s) orders the grid and lattice candidates by rank, keeping their order
-        among equal ranks.  ``region`` is a region's name or a region body (a relay's spot on a fixed object's
-        top: :func:`mrgc.geometry.relays.spot_region`)."""
+        (N, 4, 4) -> (N,), e.g. :meth:`comfortable`'s) orders the grid and lattice candidates by rank, keeping
+        their order among equal ranks.  ``region`` is a region's name or a region body (a relay's spot on a
+        fixed object's top: :func:`mrgc.geometry.relays.spot_region`)."""
         body = self.scene.body(obj)
         reg = region if isinstance(region, SceneBody) else self.scene.body(region)
         if not isinstance(reg.shape, Box):

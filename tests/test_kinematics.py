@@ -387,16 +387,36 @@ def test_pybullet_ik_reference(panda) -> None:
             assert pose_error(F.ee_pose(panda, res.q), t)[0] <= 1e-4 and panda.within_limits(res.q)
 
 
-def _checks_in_a_worker(_: int) -> bool:
-    """In a forked worker: load the Panda's model again and say whether that started a pybullet client."""
+def _checks_in_a_worker(folder: str) -> bool:
+    """In a forked worker: load the toy's model again and say whether that started a pybullet client."""
     from mrgc.geometry import bullet
 
-    load_robot_model(PANDA, "/tmp", "panda_hand")
+    load_robot_model("toy.urdf", folder, "tool")
     return bullet._CLIENT.get("pid") == os.getpid()
 
 
-def test_a_urdf_accepted_once_is_not_loaded_again_by_forked_workers() -> None:
+def test_a_urdf_accepted_once_is_not_loaded_again_by_forked_workers(toy) -> None:
+    from mrgc.geometry import bullet
     from mrgc.workers import map_in_workers
 
-    load_robot_model(PANDA, "/tmp", "panda_hand")  # checked by pybullet here
-    assert map_in_workers(_checks_in_a_worker, [0, 1], 2) == [False, False]
+    folder = os.path.dirname(toy.urdf)
+    assert bullet.check_urdf(toy.urdf) is None and bullet._file_key(toy.urdf) in bullet._ACCEPTED  # pybullet's
+    assert map_in_workers(_checks_in_a_worker, [folder, folder], 2) == [False, False]
+
+
+def _panda_in_a_worker(_: int) -> tuple[bool, bool]:
+    """In a forked worker: whether checking pybullet_data's Panda started a pybullet client, and whether it
+    loads in one (pybullet's own files are not loaded to be checked, but they must load)."""
+    from mrgc.geometry import bullet
+    from mrgc.geometry.kinematics import resolve_urdf
+
+    path = resolve_urdf(PANDA, "/tmp")
+    refused = bullet.check_urdf(path)
+    started = bullet._CLIENT.get("pid") == os.getpid()
+    return refused is None and not started, isinstance(bullet.shared_body(path), int)
+
+
+def test_pybullets_own_urdfs_are_not_loaded_to_be_checked() -> None:
+    from mrgc.workers import map_in_workers
+
+    assert map_in_workers(_panda_in_a_worker, [0, 1], 2) == [(True, True), (True, True)]

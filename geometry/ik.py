@@ -86,8 +86,10 @@ def restart_configurations(model: RobotModel, seed: int, restarts: int, q_init: 
     limits; the middle of the limits when None), then uniform draws within the limits from
     ``default_rng(seed)``."""
     first = (model.lower + model.upper) / 2 if q_init is None else model.clamp(np.asarray(q_init, dtype=float))
+    if restarts <= 1:  # the start alone (a generator made for no draw costs more than the rest of a 1 cm lift)
+        return first[None].copy()
     rng = np.random.default_rng(seed)
-    rest = rng.uniform(model.lower, model.upper, size=(max(restarts, 1) - 1, model.dof))
+    rest = rng.uniform(model.lower, model.upper, size=(restarts - 1, model.dof))
     return np.concatenate([first[None], rest])
 
 

@@ -99,11 +99,13 @@ class Grounding:
 
 
 def _matrix(t: np.ndarray) -> list[list[float]]:
-    return [[float(v) for v in row] for row in t]
+    out: list[list[float]] = np.asarray(t, dtype=float).tolist()
+    return out
 
 
 def _configs(c: np.ndarray | None) -> list[list[float]]:
-    return [] if c is None else [[float(v) for v in q] for q in np.atleast_2d(c)]
+    out: list[list[float]] = [] if c is None else np.atleast_2d(np.asarray(c, dtype=float)).tolist()
+    return out
 
 
 class ReverseGrounder:

@@ -232,10 +232,11 @@ class Posed:
     is asked often enough to get a broadphase tree of its own (:meth:`tree`, :data:`TREE_MIN`).
     """
 
-    __slots__ = ("shapes", "kind", "transforms", "lo", "hi", "_coarse", "_tree", "_probed", "_parts")
+    __slots__ = ("shapes", "kind", "transforms", "lo", "hi", "pad", "_coarse", "_tree", "_probed", "_parts")
 
     def __init__(self, shapes: Sequence[CollisionShape], kind: np.ndarray, transforms: np.ndarray, pad: float) -> None:
         self.shapes = list(shapes)
+        self.pad = pad
         self.kind = np.asarray(kind, dtype=np.intp)
         self.transforms = np.asarray(transforms, dtype=float).reshape(-1, 4, 4)
         self._coarse: tuple[np.ndarray, np.ndarray] | None = None
@@ -262,14 +263,33 @@ class Posed:
     @classmethod
     def of(cls, pieces: Iterable[tuple[ShapeLike, np.ndarray]], pad: float = TOLERANCE) -> "Posed":
         """The pieces of a probe or a volume ((shape, 4×4 world transform) pairs)."""
-        pieces = pieces if isinstance(pieces, (list, tuple)) else list(pieces)
-        given = [collision_shape(p[0]) if type(p[0]) is not CollisionShape else p[0] for p in pieces]
-        ids = list(map(id, given))
-        first = dict(zip(ids, given))  # each distinct shape, in order of first appearance
-        index = {i: k for k, i in enumerate(first)}
-        shapes = list(first.values())
-        kind = np.fromiter(map(index.__getitem__, ids), dtype=np.intp, count=len(ids))
-        return cls(shapes, kind, np.array([p[1] for p in pieces], dtype=float).reshape(-1, 4, 4), pad)
+        return cls(*_arrays(pieces), pad)
+
+    def extended(self, pieces: Sequence[tuple[ShapeLike, np.ndarray]]) -> "Posed | None":
+        """This set followed by ``pieces``, equal to the bit to :meth:`of` of this set's pieces and then
+        ``pieces`` (same shapes in the same order, same rows, the new pieces' boxes made the way :meth:`of`
+        makes them), without converting this set's pieces again; None where :meth:`of` would take its
+        one-shape way (every piece one shape) or this set is empty."""
+        more, kind_more, transforms = _arrays(pieces)
+        index = {id(s): k for k, s in enumerate(self.shapes)}
+        shapes = list(self.shapes)
+        remap = np.empty(len(more), dtype=np.intp)
+        for j, shape in enumerate(more):
+            k = index.get(id(shape))
+            if k is None:
+                k = index[id(shape)] = len(shapes)
+                shapes.append(shape)
+            remap[j] = k
+        if len(shapes) == 1 or not len(self.kind):
+            return None
+        tail = Posed(shapes, remap[kind_more], transforms, self.pad)  # boxes by the shapes' table, as of() does
+        out = Posed.__new__(Posed)
+        out.shapes, out.pad = shapes, self.pad
+        out.kind = np.concatenate([self.kind, tail.kind])
+        out.transforms = np.concatenate([self.transforms, tail.transforms])
+        out.lo, out.hi = np.concatenate([self.lo, tail.lo]), np.concatenate([self.hi, tail.hi])
+        out._coarse, out._tree, out._probed, out._parts = None, None, 0, {}
+        return out
 
     @classmethod
     def batch(cls, shapes: Sequence[ShapeLike], transforms: np.ndarray, pad: float = TOLERANCE) -> "Posed":
@@ -311,7 +331,7 @@ class Posed:
         """The pieces ``index`` (an index array), in that order: the same shapes, the rows copied, nothing
         cached yet."""
         out = Posed.__new__(Posed)
-        out.shapes, out.kind, out.transforms = self.shapes, self.kind[index], self.transforms[index]
+        out.shapes, out.kind, out.transforms, out.pad = self.shapes, self.kind[index], self.transforms[index], self.pad
         out.lo, out.hi, out._coarse, out._tree, out._probed, out._parts = (
             self.lo[index],
             self.hi[index],
@@ -987,6 +1007,18 @@ class PairCheck:
                 if stop:
                     break
         return out
+
+
+def _arrays(pieces: Iterable[tuple[ShapeLike, np.ndarray]]) -> tuple[list[CollisionShape], np.ndarray, np.ndarray]:
+    """(shape, 4×4 transform) pieces as :class:`Posed` holds them: the distinct shapes in order of first
+    appearance, each piece's index among them, the transforms (N, 4, 4)."""
+    pieces = pieces if isinstance(pieces, (list, tuple)) else list(pieces)
+    given = [collision_shape(p[0]) if type(p[0]) is not CollisionShape else p[0] for p in pieces]
+    ids = list(map(id, given))
+    first = dict(zip(ids, given))  # each distinct shape, in order of first appearance
+    index = {i: k for k, i in enumerate(first)}
+    kind = np.fromiter(map(index.__getitem__, ids), dtype=np.intp, count=len(ids))
+    return list(first.values()), kind, np.array([p[1] for p in pieces], dtype=float).reshape(-1, 4, 4)
 
 
 def _homogeneous(points: Sequence[np.ndarray]) -> np.ndarray:

@@ -630,3 +630,50 @@ def test_paired_collide_tests_only_pieces_of_the_same_slot() -> None:
     assert not paired_collide(a, np.array([0, 1]), b, np.array([0, 1]))  # each sample apart from its pair
     assert paired_collide(a, np.array([0, 1]), b, np.array([1, 1]))  # sample 1 of a against both of b
     assert paired_collide(a, np.array([0, 0]), b, np.array([0, 0]))
+
+
+def _same_posed(a: object, b: object) -> bool:
+    """Two kernel sets equal to the bit: the same shape objects in the same order, rows and boxes."""
+    return (
+        [id(s) for s in a.shapes] == [id(s) for s in b.shapes]  # type: ignore[attr-defined]
+        and all(
+            np.array_equal(getattr(a, f), getattr(b, f)) and getattr(a, f).dtype == getattr(b, f).dtype
+            for f in ("kind", "transforms", "lo", "hi")
+        )
+        and a.pad == b.pad  # type: ignore[attr-defined]
+    )
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**31 - 1), st.integers(1, 200), st.integers(1, 200), st.sampled_from([1, 2, 3]))
+def test_a_set_extended_by_pieces_is_the_set_of_all_its_pieces(seed: int, n_a: int, n_b: int, kinds: int) -> None:
+    """``Posed.extended`` (a set followed by more pieces, its own not converted again) is, to the bit, the set
+    ``Posed.of`` makes of all the pieces: shapes in order of first appearance, rows, boxes (or None where
+    ``of`` would take its one-shape way).  The volume cache of the grounding converts a list that begins with
+    the pieces of a list it kept that way: the same set as converting it whole, and the kept one's rows are
+    not converted again."""
+    from mrgc.geometry import step_world
+    from mrgc.geometry.collision import Posed
+
+    rng = np.random.default_rng(seed)
+    pool = _random_pieces(rng, max(n_a, n_b), 0.5)
+    a = [pool[k] for k in rng.integers(0, len(pool), n_a) if k % 3 < kinds]
+    b = [(pool[k][0], translation(0.1, 0, 0) @ pool[k][1]) for k in rng.integers(0, len(pool), n_b) if k % 3 < kinds]
+    assume(a and b)
+    whole = Posed.of(a + b)  # type: ignore[operator]
+    made = Posed.of(a).extended(b)  # type: ignore[arg-type]
+    assert (made is None) == (len(whole.shapes) == 1)
+    if made is not None:
+        assert _same_posed(made, whole)
+    cache = step_world._VolumeCache()
+    cache.PREFIX_MIN = 1
+    first = cache.posed(a)  # type: ignore[arg-type]
+    converted: list[int] = []
+    real = step_world.Posed.of
+    try:
+        step_world.Posed.of = lambda pieces, pad=TOLERANCE: converted.append(len(pieces)) or real(pieces, pad)  # type: ignore[method-assign,func-returns-value]
+        longer = cache.posed(a + b)  # type: ignore[operator]
+    finally:
+        step_world.Posed.of = real  # type: ignore[method-assign]
+    assert _same_posed(longer, whole) and _same_posed(first, Posed.of(a))  # type: ignore[arg-type]
+    assert converted == ([] if made is not None else [len(a) + len(b)])

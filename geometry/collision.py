@@ -481,15 +481,57 @@ def _kit() -> _Kit:
     return _KIT[0]
 
 
+#: candidate pairs of one query given to coal as they come; past them, blocks of :data:`EXACT_BLOCK` pairs
+#: are first cut down to those whose oriented boxes meet (:func:`_oriented_meet`)
+EXACT_PLAIN = 32
+EXACT_BLOCK = 512
+
+
 def _exact(
     a: Posed, b: Posed, i: np.ndarray, j: np.ndarray, tolerance: float, stop: bool, skip: np.ndarray | None = None
 ) -> list[int]:
     """coal's narrowphase on the candidate pairs (a's piece i[k], b's piece j[k]): the k of the pairs that
-    collide (within ``tolerance``, coal's security margin: the module docstring's semantics), the first one
-    only with ``stop``.  ``skip`` (a bool array over b's pieces): pairs whose b piece is marked are passed
-    over, and a colliding one marks it (which-objects queries need one contact per object).  Each call is a
-    prebuilt ``ComputeCollision`` of the two geometries (cached on the first shape), b's shape placed in a's
-    frame: no coal object is moved or copied."""
+    collide (within ``tolerance``, coal's security margin: the module docstring's semantics), in order, the
+    first one only with ``stop``.  ``skip`` (a bool array over b's pieces): pairs whose b piece is marked are
+    passed over, and a colliding one marks it (which-objects queries need one contact per object).
+
+    The first :data:`EXACT_PLAIN` pairs go to coal as they are (a yes/no query that collides mostly stops
+    among them); the others, in blocks of :data:`EXACT_BLOCK`, only where the two pieces' oriented boxes
+    (their shapes' local boxes, placed) come within twice the tolerance of each other: two arms working side
+    by side have world-aligned boxes that meet far more often than their links (on the 6-arm, 40-object
+    instance 89 % of the candidate pairs of free answers were so parted, at a quarter of coal's cost per
+    pair).  The pairs passed over cannot collide, so the answers are the same."""
+    out: list[int] = []
+    start, n = 0, len(i)
+    while start < n:
+        end = min(n, start + EXACT_BLOCK if start else EXACT_PLAIN)
+        k = np.arange(start, end)
+        if start:
+            k = k[_oriented_meet(a, b, i[k], j[k], 2 * tolerance)]
+        out.extend(int(k[x]) for x in _narrow(a, b, i[k], j[k], tolerance, stop, skip))
+        if stop and out:
+            break
+        start = end
+    return out
+
+
+def _oriented_meet(a: Posed, b: Posed, i: np.ndarray, j: np.ndarray, grow: float) -> np.ndarray:
+    """Whether the oriented boxes of a's pieces ``i`` and b's pieces ``j`` (each shape's local box at the
+    piece's transform, a's grown by ``grow``) meet, pair by pair (a bool array)."""
+    ta, tb = a.transforms[i], b.transforms[j]
+    box_a, box_b = np.stack([s.box for s in a.shapes])[a.kind[i]], np.stack([s.box for s in b.shapes])[b.kind[j]]
+    centre_a = (ta[:, :3, :3] @ box_a[:, 0, :, None])[..., 0] + ta[:, :3, 3]
+    centre_b = (tb[:, :3, :3] @ box_b[:, 0, :, None])[..., 0] + tb[:, :3, 3]
+    meet: np.ndarray = _boxes_meet(ta[:, :3, :3], centre_a, box_a[:, 1] + grow, tb[:, :3, :3], centre_b, box_b[:, 1])
+    return meet
+
+
+def _narrow(
+    a: Posed, b: Posed, i: np.ndarray, j: np.ndarray, tolerance: float, stop: bool, skip: np.ndarray | None
+) -> list[int]:
+    """:func:`_exact` on pairs it has chosen: each call is a prebuilt ``ComputeCollision`` of the two
+    geometries (cached on the first shape), b's shape placed in a's frame: no coal object is moved or
+    copied."""
     if not len(i):
         return []
     kit = _kit()

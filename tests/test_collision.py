@@ -677,3 +677,25 @@ def test_a_set_extended_by_pieces_is_the_set_of_all_its_pieces(seed: int, n_a: i
         step_world.Posed.of = real  # type: ignore[method-assign]
     assert _same_posed(longer, whole) and _same_posed(first, Posed.of(a))  # type: ignore[arg-type]
     assert converted == ([] if made is not None else [len(a) + len(b)])
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**31 - 1), st.sampled_from([0.1, 0.25, 0.6]), st.booleans())
+def test_the_oriented_box_cut_keeps_every_colliding_pair(seed: int, spread: float, skipping: bool) -> None:
+    """Past its first pairs the narrowphase hands coal only the pairs whose oriented boxes meet: the pairs
+    that collide, in order, are those coal finds among all the candidate pairs (which-objects with a skip
+    mark per piece, and yes/no stopping at the first), on rotated boxes, spheres and thin hulls."""
+    from mrgc.geometry import collision
+    from mrgc.geometry.collision import Posed, overlaps
+
+    rng = np.random.default_rng(seed)
+    thin = collision_shape(ConvexHull(rng.normal(size=(20, 3)) * [0.12, 0.01, 0.01]))
+    a = [(thin, t) for _, t in _random_pieces(rng, 40, spread)] + _random_pieces(rng, 20, spread)
+    b = _random_pieces(rng, 60, spread)
+    pa, pb = Posed.of(a), Posed.of(b)  # type: ignore[arg-type]
+    i, j = overlaps(pa, pb)
+    assume(len(i) > collision.EXACT_PLAIN + 10)
+    marks = (lambda: np.zeros(len(pb), dtype=bool)) if skipping else (lambda: None)
+    every = collision._narrow(pa, pb, i, j, TOLERANCE, False, marks())
+    assert collision._exact(pa, pb, i, j, TOLERANCE, False, marks()) == every
+    assert collision._exact(pa, pb, i, j, TOLERANCE, True) == every[:1]

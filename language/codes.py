@@ -129,7 +129,9 @@ HELP: dict[str, str] = {
     "E302": "The backend cannot run the chosen encoding.",
     "E303": "`--encoding` is one of `paper`, `disaggregated`, `time-of-move`.",
     "E400": "A robot kind's `:urdf` names no readable URDF (looked up beside the .mrg file, then in "
-    "pybullet_data), or pybullet refuses the file.",
+    "pybullet_data), or pybullet refuses the file (a URDF of one's own is loaded into pybullet to be checked "
+    "once per version of the file; pybullet_data's own files are not, as pybullet ships them and the "
+    "validator loads them anyway).",
     "E401": "A robot kind's `:end-effector` is not a link of its URDF; the message lists the links.",
     "E403": "A mesh file (of a `(mesh ...)` shape or of a URDF link) that cannot be used: not a regular file, "
     "too large, a coordinate that is not a finite number or beyond 10 km (after scaling), a face naming a "

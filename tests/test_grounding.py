@@ -814,3 +814,26 @@ def test_a_contact_segment_off_the_approach_line_is_refused(pa3: Grounder, q: li
     turned = np.asarray(back.q).copy()
     turned[0] += 0.05
     assert not on_the_line(arm, tool, turned, grasp)
+
+
+def test_a_handover_failing_at_every_point_tells_the_failure_that_can_be_acted_on() -> None:
+    """An action's handover fails at each of its points: the failure reported is the one another robot of the
+    step caused (the step's passes are compared, or the step is split), else one with bodies in the way
+    (objects to move), else any but a point out of reach, else the last; never merely the last point's, which
+    for a point out of the arms' reach hid why the reachable one failed."""
+    from mrgc.geometry.answers import BUSY
+    from mrgc.planner.ground import _telling
+    from mrgc.planner.outcome import Failure
+
+    def at(point: str, status: GroundStatus, bodies: tuple[str, ...] = (), detail: str = "") -> Failure:
+        return Failure(0, "", f"handover at {point}: {status.value}", bodies, detail, status is GroundStatus.NO_IK)
+
+    far = at("h5", GroundStatus.NO_IK)
+    busy = at("h1", GroundStatus.COLLISION, detail=BUSY)
+    blocked = at("h2", GroundStatus.COLLISION, ("o3",))
+    fixed = at("h3", GroundStatus.COLLISION, detail="hits table")
+    assert _telling([blocked, busy, far]) is busy
+    assert _telling([fixed, blocked, far]) is blocked
+    assert _telling([fixed, far]) is fixed and _telling([far, fixed]) is fixed
+    nearer = at("h1", GroundStatus.NO_IK)
+    assert _telling([nearer, far]) is far and _telling([far]) is far

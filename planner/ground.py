@@ -1017,7 +1017,8 @@ def _telling(failures: list[Failure]) -> Failure:
     sample, or the step is split), else bodies in the way (objects to move first, or the two arms), else
     anything but a point out of the arms' reach, else the last.  The last point's failure alone hid the
     others': on the 6-arm, 40-object instance one handover failed 42 times as "handover at h5: no inverse
-    kinematics" (h5 is out of reach for that grasp pair) whatever had stopped it at h1, the point in reach."""
+    kinematics" (h5 is out of reach for that grasp pair) where another robot of the step was in the way at
+    h1, the point in reach; the step was never split."""
     unreachable = f": {GroundStatus.NO_IK.value}"
     for telling in (
         lambda f: f.detail == BUSY,

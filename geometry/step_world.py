@@ -246,7 +246,7 @@ class StepWorld:
         posed = self._busy(busy)
         if posed is None:
             return fingerprint(arrays, ())
-        ids, digest = fingerprint([*arrays, posed.kind, posed.transforms], ())
+        _, digest = fingerprint([*arrays, posed.kind, posed.transforms], ())
         return tuple(id(s) for s in posed.shapes), digest
 
     def _remembered(self, key: tuple[object, ...], ask: Callable[[], Answer]) -> Answer:

@@ -872,7 +872,7 @@ class ReverseGrounder:
     def _handover(
         self, a: Action, avoid: list[str], busy: Volume, after: dict[str, Volume]
     ) -> tuple[str, Answer] | Failure:
-        failures: list[Failure] = []
+        failures: list[tuple[Failure, GroundStatus]] = []
         for point in self.g.scene.handover_of.get(a.obj, ()):
             if point not in self.g.scene.handover_points:
                 continue
@@ -900,7 +900,7 @@ class ReverseGrounder:
                     check=f"handover at {point}: the two arms collide",
                     bodies=tuple(sorted((a.pick_robot, a.place_robot))),
                 )
-            failures.append(failure)
+            failures.append((failure, ans.status))
         if not failures:
             return Failure(0, "", f"handover: no handover point usable for {a.obj}")
         return _telling(failures)
@@ -1011,24 +1011,24 @@ def _static(failure: Failure, static: bool) -> Failure:
     return failure if failure.static == static else replace(failure, static=static)
 
 
-def _telling(failures: list[Failure]) -> Failure:
-    """Of an action's failures at each of its handover points, the one that says most about what would let it
+def _telling(failures: list[tuple[Failure, GroundStatus]]) -> Failure:
+    """Of an action's failures at each of its handover points (each with its query's status), the one that
+    says most about what would let it
     through: another robot of the step in the way (the step's robots' passes are then compared sample by
     sample, or the step is split), else bodies in the way (objects to move first, or the two arms), else
     anything but a point out of the arms' reach, else the last.  The last point's failure alone hid the
     others': on the 6-arm, 40-object instance one handover failed 42 times as "handover at h5: no inverse
     kinematics" (h5 is out of reach for that grasp pair) where another robot of the step was in the way at
     h1, the point in reach; the step was never split."""
-    unreachable = f": {GroundStatus.NO_IK.value}"
     for telling in (
-        lambda f: f.detail == BUSY,
-        lambda f: bool(f.bodies),
-        lambda f: not f.check.endswith(unreachable),
+        lambda f, _: f.detail == BUSY,
+        lambda f, _: bool(f.bodies),
+        lambda _, status: status is not GroundStatus.NO_IK,
     ):
-        for f in failures:
-            if telling(f):
+        for f, status in failures:
+            if telling(f, status):
                 return f
-    return failures[-1]
+    return failures[-1][0]
 
 
 def _failed(what: str, answer: Answer) -> Failure:

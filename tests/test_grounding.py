@@ -825,15 +825,17 @@ def test_a_handover_failing_at_every_point_tells_the_failure_that_can_be_acted_o
     from mrgc.planner.ground import _telling
     from mrgc.planner.outcome import Failure
 
-    def at(point: str, status: GroundStatus, bodies: tuple[str, ...] = (), detail: str = "") -> Failure:
-        return Failure(0, "", f"handover at {point}: {status.value}", bodies, detail, status is GroundStatus.NO_IK)
+    def at(
+        point: str, status: GroundStatus, bodies: tuple[str, ...] = (), detail: str = ""
+    ) -> tuple[Failure, GroundStatus]:
+        return Failure(0, "", f"handover at {point}: {status.value}", bodies, detail), status
 
     far = at("h5", GroundStatus.NO_IK)
     busy = at("h1", GroundStatus.COLLISION, detail=BUSY)
     blocked = at("h2", GroundStatus.COLLISION, ("o3",))
     fixed = at("h3", GroundStatus.COLLISION, detail="hits table")
-    assert _telling([blocked, busy, far]) is busy
-    assert _telling([fixed, blocked, far]) is blocked
-    assert _telling([fixed, far]) is fixed and _telling([far, fixed]) is fixed
+    assert _telling([blocked, busy, far]) is busy[0]
+    assert _telling([fixed, blocked, far]) is blocked[0]
+    assert _telling([fixed, far]) is fixed[0] and _telling([far, fixed]) is fixed[0]
     nearer = at("h1", GroundStatus.NO_IK)
-    assert _telling([nearer, far]) is far and _telling([far]) is far
+    assert _telling([nearer, far]) is far[0] and _telling([far]) is far[0]

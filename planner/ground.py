@@ -730,36 +730,49 @@ class ReverseGrounder:
         self, a: Action, planned: PlannedAction, grasped: np.ndarray, avoid: list[str], busy: dict[str, Volume]
     ) -> np.ndarray | Failure:
         """A handover action's exchange (both arms at a handover point) and the giver's carry there from
-        ``grasped`` (its pick configuration), into ``planned``; the taker's configuration at the exchange."""
+        ``grasped`` (its pick configuration), into ``planned``; the taker's configuration at the exchange.
+        The object's handover points are tried in order until one has both an exchange and a carry to it: a
+        point near the edge of the giver's reach can have a free exchange that no carry from the pick gets
+        to, where the next point is easy (the 6-arm, 40-object instance of seed 8: one handover failed 40
+        times in a row as "carry to the handover: no path" at h1, its other point never tried)."""
         g = self.g
         # each arm then stands at its exchange while the step's other robots do what ``after`` holds
         after = {
             a.pick_robot: self._after(busy, a.pick_robot, Stance.EXCHANGE),
             a.place_robot: self._after(busy, a.place_robot, Stance.RECEIVED),
         }
-        hand = self._handover(a, avoid, busy.get("handover", []), after)
-        if isinstance(hand, Failure):
-            return hand
-        point, answer = hand
-        assert answer.configs is not None
-        planned.handover_point = point
-        planned.configs["handover"] = _configs(answer.configs)
-        giver = g.transfer(
-            a.pick_robot,
-            a.obj,
-            a.pick_grasp,
-            grasped,
-            answer.configs[0],
-            avoid,
-            lift=True,
-            busy=busy.get("to-handover", []),
-            phase="to-handover",
-        )
-        if not giver.ok:
-            return _failed(f"carry to the handover by {a.pick_robot}", giver)
-        planned.paths["to-handover"] = _configs(np.array(giver.path))
-        taker: np.ndarray = answer.configs[1]
-        return taker
+        failures: list[tuple[Failure, GroundStatus]] = []
+        for point in self.g.scene.handover_of.get(a.obj, ()):
+            if point not in self.g.scene.handover_points:
+                continue
+            self._on_time()
+            hand = self._exchange(a, point, avoid, busy.get("handover", []), after)
+            if isinstance(hand, tuple):
+                failures.append(hand)
+                continue
+            assert hand.configs is not None
+            giver = g.transfer(
+                a.pick_robot,
+                a.obj,
+                a.pick_grasp,
+                grasped,
+                hand.configs[0],
+                avoid,
+                lift=True,
+                busy=busy.get("to-handover", []),
+                phase="to-handover",
+            )
+            if not giver.ok:
+                failures.append((_failed(f"carry to the handover by {a.pick_robot}", giver), giver.status))
+                continue
+            planned.handover_point = point
+            planned.configs["handover"] = _configs(hand.configs)
+            planned.paths["to-handover"] = _configs(np.array(giver.path))
+            taker: np.ndarray = hand.configs[1]
+            return taker
+        if not failures:
+            return Failure(0, "", f"handover: no handover point usable for {a.obj}")
+        return _telling(failures)
 
     def _transits(
         self, a: Action, planned: PlannedAction, avoid: list[str], busy: dict[str, Volume], new: dict[str, np.ndarray]
@@ -869,41 +882,36 @@ class ReverseGrounder:
         assert last is not None
         return last
 
-    def _handover(
-        self, a: Action, avoid: list[str], busy: Volume, after: dict[str, Volume]
-    ) -> tuple[str, Answer] | Failure:
-        failures: list[tuple[Failure, GroundStatus]] = []
-        for point in self.g.scene.handover_of.get(a.obj, ()):
-            if point not in self.g.scene.handover_points:
-                continue
-            ans = self.g.handover(
-                a.obj,
-                point,
-                a.pick_robot,
-                a.pick_grasp,
-                a.place_robot,
-                a.place_grasp,
-                avoid=avoid,
-                busy=busy,
-                after=after,
+    def _exchange(
+        self, a: Action, point: str, avoid: list[str], busy: Volume, after: dict[str, Volume]
+    ) -> Answer | tuple[Failure, GroundStatus]:
+        """Both arms' exchange configurations for ``a`` at handover point ``point`` (giver, taker), or the
+        failure there with its query's status (two arms colliding named as such)."""
+        ans = self.g.handover(
+            a.obj,
+            point,
+            a.pick_robot,
+            a.pick_grasp,
+            a.place_robot,
+            a.place_grasp,
+            avoid=avoid,
+            busy=busy,
+            after=after,
+        )
+        if ans.ok:
+            return ans
+        failure = _failed(f"handover at {point}", ans)
+        if (
+            ans.status is GroundStatus.COLLISION
+            and not ans.blockers
+            and not ans.detail.startswith(("hits", BUSY, SELF))
+        ):
+            failure = replace(
+                failure,
+                check=f"handover at {point}: the two arms collide",
+                bodies=tuple(sorted((a.pick_robot, a.place_robot))),
             )
-            if ans.ok:
-                return point, ans
-            failure = _failed(f"handover at {point}", ans)
-            if (
-                ans.status is GroundStatus.COLLISION
-                and not ans.blockers
-                and not ans.detail.startswith(("hits", BUSY, SELF))
-            ):
-                failure = replace(
-                    failure,
-                    check=f"handover at {point}: the two arms collide",
-                    bodies=tuple(sorted((a.pick_robot, a.place_robot))),
-                )
-            failures.append((failure, ans.status))
-        if not failures:
-            return Failure(0, "", f"handover: no handover point usable for {a.obj}")
-        return _telling(failures)
+        return failure, ans.status
 
 
 class _Retiming:
@@ -1012,7 +1020,8 @@ def _static(failure: Failure, static: bool) -> Failure:
 
 
 def _telling(failures: list[tuple[Failure, GroundStatus]]) -> Failure:
-    """Of an action's failures at each of its handover points (each with its query's status), the one that
+    """Of an action's failures at each of its handover points (the exchange's there, or the giver's carry to
+    it; each with its query's status), the one that
     says most about what would let it
     through: another robot of the step in the way (the step's robots' passes are then compared sample by
     sample, or the step is split), else bodies in the way (objects to move first, or the two arms), else

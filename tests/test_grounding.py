@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import functools
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -15,7 +16,7 @@ import mrgc
 from mrgc import parse_file
 from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action
-from mrgc.geometry.answers import GroundStatus
+from mrgc.geometry.answers import Answer, GroundStatus
 from mrgc.geometry.arm_paths import joint_line
 from mrgc.geometry.collision import CollisionShape, CollisionWorld, Posed
 from mrgc.geometry.conventions import PATH_RESOLUTION, to_se2
@@ -839,3 +840,45 @@ def test_a_handover_failing_at_every_point_tells_the_failure_that_can_be_acted_o
     assert _telling([fixed, far]) is fixed[0] and _telling([far, fixed]) is fixed[0]
     nearer = at("h1", GroundStatus.NO_IK)
     assert _telling([nearer, far]) is far[0] and _telling([far]) is far[0]
+
+
+def test_a_handover_whose_carry_to_one_point_fails_is_tried_at_the_next(tmp_path: Path) -> None:
+    """planner/ground.py ``ReverseGrounder._hand_over``: an object with two handover points whose giver can
+    exchange it at the first but not carry it there (a carry refused here for every goal at that point's
+    exchange, as RRTConnect refuses one near the edge of the arm's reach) is handed over at the second; when
+    the carries to both fail, the action fails with the carry's line.  Before, the first point with a free
+    exchange was the only one tried: on the 6-arm, 40-object instance of seed 8 one handover failed 40 times
+    as "carry to the handover by r3: no path" at h1 and was never tried at h2."""
+    text = (ROOT / "domains" / "packaging" / "pa3-handover.mrg").read_text(encoding="utf-8")
+    text = text.replace("(h1 :position (0 0 0.4))", "(h0 :position (0.05 0 0.42)) (h1 :position (0 0 0.4))")
+    path = tmp_path / "two-points.mrg"
+    path.write_text(text, encoding="utf-8")
+    domain = ROOT / "domains" / "packaging" / "domain.mrg"
+    (tmp_path / "domain.mrg").write_text(domain.read_text(encoding="utf-8"), encoding="utf-8")
+    g = Grounder(scene_from_problem(parse_file(path).problem()), seed=0)
+    assert g.scene.handover_of["o1"] == ("h0", "h1")
+    refused: set[str] = set()
+    exchanges: dict[str, np.ndarray] = {}
+    for point in ("h0", "h1"):
+        hand = g.handover("o1", point, "r1", "top", "r2", "side-x+")
+        assert hand.ok and hand.configs is not None, point
+        exchanges[point] = hand.configs[0]
+    transfer = g.transfer
+
+    def carry(robot: str, obj: str, grasp: str, start: np.ndarray, goal: np.ndarray, *args: Any, **kw: Any) -> Answer:
+        if any(np.allclose(goal, exchanges[p]) for p in refused):
+            return Answer(GroundStatus.NO_PATH)
+        return transfer(robot, obj, grasp, start, goal, *args, **kw)
+
+    g.transfer = carry  # type: ignore[method-assign]
+    skeleton = Skeleton(((Action("o1", "bin-b", "r1", "r2", "top", "side-x+"),),))
+    grounded = ReverseGrounder(g, {"o1": "bin-b"}).ground(skeleton, [], key="both")
+    assert grounded.outcome is Outcome.SUCCESS and grounded.steps[0].actions[0].handover_point == "h0"
+    refused.add("h0")
+    second = ReverseGrounder(g, {"o1": "bin-b"}).ground(skeleton, [], key="h1")
+    assert second.outcome is Outcome.SUCCESS, second.reason
+    assert second.steps[0].actions[0].handover_point == "h1"
+    refused.add("h1")
+    neither = ReverseGrounder(g, {"o1": "bin-b"}).ground(skeleton, [], key="neither")
+    assert neither.outcome is Outcome.FAIL and neither.failures
+    assert neither.failures[0].check == "carry to the handover by r1: no path"

@@ -180,15 +180,23 @@ class Arm:
         """Whether the analytic solver (:mod:`mrgc.geometry.ik_analytic`; arms with a Panda's kinematics only,
         else False) finds no configuration putting the tool at ``tool_world``: over the q7 grid, every branch
         out of the joint limits or off the target.  A numeric solve that failed from its start need then not
-        be retried from others (the analytic search covers what their random starts would, but for solutions
-        within GeoFIK's 0.07 rad margin inside the limits: measured, docs/geometry.md)."""
+        be retried from others, nor one asked at all (the analytic search covers what their random starts
+        would, but for solutions at q7 between its grid values: measured, docs/geometry.md)."""
+        return self.no_branches([tool_world])[0]
+
+    def no_branches(self, tool_worlds: list[np.ndarray], starts: np.ndarray | None = None) -> list[bool]:
+        """:meth:`no_branch` for each of ``tool_worlds``, solved in one batch; ``starts`` (one configuration
+        per tool pose) only say where the search begins, which is all the cost of a reachable pose's answer:
+        from a configuration near it, one or two calls of the solver (whether a branch exists over the q7 grid
+        does not depend on the start)."""
         from mrgc.geometry.ik import solve_ik_many
         from mrgc.geometry.ik_analytic import panda_chain
 
-        if panda_chain(self.model) is None:
-            return False
-        target = self.ee_target(tool_world)[None]
-        return not solve_ik_many(self.model, target, 0, q_init=self.home, analytic=True)[0].solved
+        if panda_chain(self.model) is None or not tool_worlds:
+            return [False] * len(tool_worlds)
+        targets = np.stack([self.ee_target(t) for t in tool_worlds])
+        q_init = self.home if starts is None else starts
+        return [not r.solved for r in solve_ik_many(self.model, targets, 0, q_init=q_init, analytic=True)]
 
     def in_reach(self, point: np.ndarray, margin: float = 0.0) -> bool:
         """Whether a world point can be within reach of the tool (cheap pre-filter)."""

@@ -36,12 +36,12 @@ FINGER_CLEARANCE = 0.01  # the fingers open this much wider than the object (m)
 
 def grasp_transform(spec: GraspSpec, shape: Shape) -> np.ndarray:
     """Tool pose in the object frame for grasp ``spec`` of an object of ``shape``."""
-    z = np.array(spec.approach, dtype=float)
-    y = np.array(spec.fingers, dtype=float)
-    x = np.cross(y, z)
+    (y0, y1, y2), (z0, z1, z2) = (float(v) for v in spec.fingers), (float(v) for v in spec.approach)
+    z = np.array((z0, z1, z2))
     reach = float(np.abs(z) @ half_extents(shape))  # half extent along the approach axis
     t = np.eye(4)
-    t[:3, 0], t[:3, 1], t[:3, 2] = x, y, z
+    t[:3, 0] = (y1 * z2 - y2 * z1, y2 * z0 - y0 * z2, y0 * z1 - y1 * z0)  # x = y × z
+    t[:3, 1], t[:3, 2] = (y0, y1, y2), z
     t[:3, 3] = -z * max(reach - min(spec.depth, reach), 0.0) + np.array(spec.offset, dtype=float)
     return t
 

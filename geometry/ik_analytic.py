@@ -18,8 +18,11 @@ tolerances; the answer is the one nearest ``q_init`` (Euclidean in joint space; 
 a tie).  Deterministic: no randomness, no clock, and a target's answer depends on nothing else of its batch.
 
 GeoFIK's own joint limits (:data:`GEOFIK_LOWER`, :data:`GEOFIK_UPPER`, Franka's datasheet) are inside the
-URDF's of pybullet_data's Panda by 0.07 rad; solutions in that margin are not found here (docs/geometry.md,
-"Analytic IK", measures how often that matters).
+URDF's of pybullet_data's Panda by 0.07 rad: GeoFIK computes each branch in full, then blanks (NaN) every
+joint beyond them.  A branch with one joint blanked gets it back from the target (:func:`recover`) and counts
+if it is within the model's limits; such a branch is the answer only when no branch GeoFIK gave in full
+qualifies (near the start, then over the grid), so every target answered before is answered as before.  q7
+stays locked within GeoFIK's range (docs/geometry.md, "Analytic IK", measures what is still missed).
 """
 
 from __future__ import annotations
@@ -32,7 +35,7 @@ from typing import Callable
 import numpy as np
 from numpy.typing import NDArray
 
-from mrgc.geometry.fk import ee_pose
+from mrgc.geometry.fk import chain_frames, ee_pose
 from mrgc.geometry.kinematics import RobotModel
 from mrgc.geometry.transforms import from_xyz_rpy, inverse, rot_z, translation
 
@@ -159,14 +162,19 @@ def solve_many(
         owner += [i] * len(found)
         rows += found
     answers = _pick(model, targets, refs, owner, rows, tol_pos, tol_rot, misses)
-    todo = np.array([i for i in range(len(targets)) if i not in answers], dtype=int)
+    # to the grid: targets with no answer, or only one GeoFIK had blanked a joint of (the grid may have a
+    # branch within GeoFIK's limits; the near search's branches of those targets compete again beside it)
+    todo = np.array([i for i in range(len(targets)) if i not in answers or answers[i][3]], dtype=int)
     if len(todo):
-        owner, rows = _grid_rows(franka_ik_q7, e, refs, todo, chain, calls)
+        again = set(todo.tolist())
+        kept = [k for k, i in enumerate(owner) if i in again]
+        grid_owner, grid_rows = _grid_rows(franka_ik_q7, e, refs, todo, chain, calls)
+        owner, rows = [owner[k] for k in kept] + grid_owner, [rows[k] for k in kept] + grid_rows
         answers.update(_pick(model, targets, refs, owner, rows, tol_pos, tol_rot, misses))
     out = []
     for i in range(len(targets)):
         if i in answers:
-            q, p, r = answers[i]
+            q, p, r, _ = answers[i]
             q.setflags(write=False)
             out.append(Answer(q, p, r, int(calls[i])))
         else:
@@ -183,6 +191,7 @@ def _near_rows(
     calls.  Only values where the elbow triangle closes are asked."""
     seen: dict[float, float] = {}  # q7 -> squared distance of its nearest branch to ref (inf: none)
     found: list[Array] = []
+    blanked: list[Array] = []  # branches with one joint GeoFIK blanked: recovered by the caller, with the rest
 
     def near(q7: float) -> float:
         q7 = min(max(q7, chain.q7_lo), chain.q7_hi)
@@ -190,7 +199,10 @@ def _near_rows(
             seen[q7] = np.inf
             if _closes_one(e, q7):
                 sols = solve(q7)
-                sols = sols[~np.isnan(sols).any(axis=1) & model.within_limits(sols)]
+                blanks = np.isnan(sols).sum(axis=1)
+                if (blanks == 1).any():
+                    blanked.append(sols[blanks == 1])
+                sols = sols[(blanks == 0) & model.within_limits(sols)]
                 if len(sols):
                     found.append(sols)
                     seen[q7] = float(np.min(np.sum((sols - ref) ** 2, axis=1)))
@@ -199,7 +211,7 @@ def _near_rows(
     x0 = float(ref[6])
     f0 = near(x0)
     if f0 < np.inf and float(np.abs(found[0] - ref).max(axis=1).min()) <= NEAR:
-        return list(found[0]), len(seen)
+        return list(found[0]) + [row for sols in blanked for row in sols], len(seen)
     for h in NEAR_STEPS:
         fm, fp = near(x0 - h), near(x0 + h)
         if fm < np.inf and fp < np.inf and f0 < np.inf and fp - 2 * f0 + fm > 0:
@@ -207,7 +219,7 @@ def _near_rows(
             near(min(max(x1, x0 - 4 * h), x0 + 4 * h))
         x0 = min(seen, key=lambda q7: (seen[q7], q7))
         f0 = seen[x0]
-    return [row for sols in found for row in sols], len(seen)
+    return [row for sols in found + blanked for row in sols], len(seen)
 
 
 def _grid_rows(
@@ -246,17 +258,20 @@ def _pick(
     tol_pos: float,
     tol_rot: float,
     misses: Array,
-) -> dict[int, tuple[Array, float, float]]:
+) -> dict[int, tuple[Array, float, float, bool]]:
     """Of branches ``rows`` (of targets ``owner``), those within the limits that forward kinematics puts on
-    their target to the tolerances; the nearest to its ``refs`` row per target (the first of equally near
-    ones), with its position and rotation errors.  ``misses`` keeps the errors of the nearest rejected
-    branch per target."""
+    their target to the tolerances (a joint GeoFIK blanked filled in first: :func:`recover`); per target the
+    nearest to its ``refs`` row among those GeoFIK gave in full, else among the recovered ones (the first of
+    equally near ones), with its position and rotation errors and whether it was recovered.  ``misses`` keeps
+    the errors of the nearest rejected branch per target."""
     if not rows:
         return {}
-    cand = np.array(rows, dtype=float).reshape(-1, 7)
     who = np.array(owner, dtype=int)
+    cand = np.array(rows, dtype=float).reshape(-1, 7)
+    blanked = np.isnan(cand).any(axis=1)
+    cand = recover(model, cand, targets[who])
     keep = ~np.isnan(cand).any(axis=1) & model.within_limits(cand)
-    cand, who = cand[keep], who[keep]
+    cand, who, blanked = cand[keep], who[keep], blanked[keep]
     if not len(cand):
         return {}
     p, r = _errors(ee_pose(model, cand), targets[who])
@@ -264,13 +279,40 @@ def _pick(
     for j in np.flatnonzero(~good):
         if p[j] + r[j] < misses[who[j]].sum():
             misses[who[j]] = (p[j], r[j])
-    best: dict[int, int] = {}  # target -> index of its nearest qualifying branch
+    best: dict[int, int] = {}  # target -> index of its preferred qualifying branch
     dist = np.einsum("ij,ij->i", cand - refs[who], cand - refs[who])
     for idx in np.flatnonzero(good):
         i = int(who[idx])
-        if i not in best or dist[idx] < dist[best[i]]:
+        if i not in best or (blanked[idx], dist[idx]) < (blanked[best[i]], dist[best[i]]):
             best[i] = int(idx)
-    return {i: (cand[idx].copy(), float(p[idx]), float(r[idx])) for i, idx in best.items()}
+    return {i: (cand[idx].copy(), float(p[idx]), float(r[idx]), bool(blanked[idx])) for i, idx in best.items()}
+
+
+def recover(model: RobotModel, rows: Array, targets: Array) -> Array:
+    """``rows`` (N, 7; GeoFIK's branches, for end-effector ``targets`` (N, 4, 4) in the model's base frame)
+    with each joint GeoFIK blanked alone filled in: GeoFIK computes a branch in full, then replaces every
+    joint beyond Franka's datasheet limits by NaN, and those lie inside the URDF's (:data:`GEOFIK_LOWER`).
+    With the other six joints known, the blanked joint ``j`` follows from the target: with ``F`` the frame of
+    joint ``j`` at angle 0 and ``E0`` the end effector's there, ``Rz(q_j) = F⁻¹ · target · E0⁻¹ · F``; the
+    angle is shifted by 2π into the model's limits where one shift fits, else left blank.  A row with two or
+    more blanks is returned as it is.  What comes back is still only a candidate: the caller checks its
+    limits and its forward kinematics (:func:`_pick`, :func:`_near_rows`)."""
+    blank = np.isnan(rows)
+    one = np.flatnonzero(blank.sum(axis=1) == 1)
+    if not len(one):
+        return rows
+    rows = rows.copy()
+    joint = np.argmax(blank[one], axis=1)
+    frames, ee = chain_frames(model, np.nan_to_num(rows[one]))
+    f = frames[np.arange(len(one)), joint, :3, :3]
+    ft = np.swapaxes(f, -1, -2)
+    m = ft @ targets[one][:, :3, :3] @ np.swapaxes(ee[:, :3, :3], -1, -2) @ f
+    angle = np.arctan2(m[:, 1, 0], m[:, 0, 0])
+    lo, hi = model.lower[joint] - 1e-9, model.upper[joint] + 1e-9
+    for shift in (0.0, 2 * np.pi, -2 * np.pi):
+        fits = np.isnan(rows[one, joint]) & (angle + shift >= lo) & (angle + shift <= hi)
+        rows[one[fits], joint[fits]] = angle[fits] + shift
+    return rows
 
 
 def _errors(poses: Array, targets: Array) -> tuple[Array, Array]:

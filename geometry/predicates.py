@@ -41,6 +41,7 @@ from mrgc.geometry.conventions import APPROACH_SAMPLES, ARM_PLACE_LIFT, lattice_
 from mrgc.geometry.facts import FactsResult, HandoverConfig, RobotFacts
 from mrgc.geometry.grasps import finger_opening, fits, grasp_transform, pregrasp_transform
 from mrgc.geometry.ik import solve_ik_many
+from mrgc.geometry.ik_analytic import panda_chain
 from mrgc.geometry.kinds import approaches
 from mrgc.geometry.relays import Asks, Spots, relay_facts, spot_region, stranded
 from mrgc.geometry.relays import asks as relay_asks
@@ -189,14 +190,25 @@ class RobotEvaluator:
                     )
                 )
             ]
-            pres = self._ik(
-                [queries[i][2] @ pregrasp_transform(g) for i, g, _ in ok],
+            tools = [queries[i][2] @ pregrasp_transform(g) for i, g, _ in ok]
+            # a pre-grasp no branch reaches (the analytic search, from the grasp's configuration) is settled
+            # without a numeric solve: it would fail, restarts and all, and so would every retry
+            none = self.arm.no_branches(tools, np.stack([q for _, _, q in ok]) if ok else None)
+            asked = [k for k in range(len(ok)) if not none[k]]
+            pres: list[np.ndarray | None] = [None] * len(ok)
+            solved = self._ik(
+                [tools[k] for k in asked],
                 "pre",
                 attempt=attempt,
-                q_init=np.stack([q for _, _, q in ok]) if ok else None,
+                q_init=np.stack([ok[k][2] for k in asked]) if asked else None,
                 restarts=2,
             )
-            for (i, g, q), q_pre in zip(ok, pres):
+            for k, q_pre in zip(asked, solved):
+                pres[k] = q_pre
+            for k, ((i, g, q), q_pre) in enumerate(zip(ok, pres)):
+                if none[k]:
+                    settled.add(i)
+                    continue
                 answer, final = self._branch(queries[i], g, q, q_pre, want_free)
                 if final:
                     settled.add(i)
@@ -343,15 +355,19 @@ class RobotEvaluator:
                         keys.append((obj, point, g))
                         tools.append(pose @ grasp_transform(self.scene.grasp(g), body.shape))
         model = self.arm.model
+        todo = list(range(len(keys)))
         for attempt in range(HANDOVER_STARTS):
             start = None
             if attempt:  # another branch of the arm: start the solve from a seeded random configuration
                 rng = np.random.default_rng(seed_for(self.arm.name, "handover-start", str(attempt), seed=self.seed))
                 start = rng.uniform(model.lower, model.upper)
-            todo = [i for i, k in enumerate(keys) if len(self.out.handover.get(k, ())) < HANDOVER_CONFIGS]
-            for i, q in zip(todo, self._ik([tools[i] for i in todo], "handover", q_init=start, attempt=attempt)):
+            todo = [i for i in todo if len(self.out.handover.get(keys[i], ())) < HANDOVER_CONFIGS]
+            qs = self._ik([tools[i] for i in todo], "handover", q_init=start, attempt=attempt)
+            for i, q in zip(todo, qs):
                 if q is not None:
                     self._keep_handover(keys[i], q)
+            if not attempt and panda_chain(model) is not None:  # analytic from home: None is no branch at all
+                todo = [i for i, q in zip(todo, qs) if q is not None]
 
     def _keep_handover(self, key: tuple[str, str, str], q: np.ndarray) -> None:
         """Keep ``q`` as a handover configuration of ``key`` if it is free of itself and of the fixed objects
@@ -543,6 +559,8 @@ class _ArmPoses:
         """The links of ``robot`` at ``q``, its fingers ``opening`` apart."""
         key = (robot, np.asarray(q, dtype=float).tobytes(), opening)
         if key not in self.posed:
-            arm = self.arms.setdefault(robot, Arm(self.scene.robot(robot)))
+            arm = self.arms.get(robot)
+            if arm is None:
+                arm = self.arms[robot] = Arm(self.scene.robot(robot))
             self.posed[key] = Posed.batch(arm.probes[0], arm.link_transforms(np.asarray(q)[None], opening)[0])
         return self.posed[key]

@@ -199,3 +199,26 @@ def test_a_pick_whose_hand_hits_a_neighbour_is_not_retried(tmp_path: Path, monke
     assert answer[0][1] == again[0][1] == {"o2"}
     assert np.array_equal(answer[0][0], again[0][0])
     assert settled.out.ik_solves == 2 < retried.out.ik_solves  # one attempt: the grasp and its pre-grasp
+
+
+def test_phase_1_asks_the_numeric_solver_only_what_a_branch_reaches(monkeypatch: pytest.MonkeyPatch) -> None:
+    """geometry/predicates.py: a pre-grasp or handover target no analytic branch reaches (the search over q7
+    covers every branch within the limits) is not handed to the numeric solver, whose restarts would all run
+    to their limits and fail (pa3-handover: 20 of its 75 numeric targets before).  The facts are the same
+    (`test_golden_facts_of_a_hand_made_scene` checks pa3-handover's list)."""
+    import mrgc.geometry.ik as ik
+
+    asked: list[tuple[object, np.ndarray]] = []
+    numeric = ik._lm
+
+    def recording(model, targets, *args, **kwargs):  # type: ignore[no-untyped-def]
+        asked.extend((model, t) for t in targets)
+        return numeric(model, targets, *args, **kwargs)
+
+    monkeypatch.setattr(ik, "_lm", recording)
+    ik.clear_ik_cache()
+    problem = parse_file(PACKAGING / "pa3-handover.mrg").problem()
+    facts = compute_facts(scene_from_problem(problem), workers=1).facts
+    monkeypatch.setattr(ik, "_lm", numeric)
+    assert asked and facts
+    assert all(ik.solve_ik_many(m, t[None], 0, analytic=True)[0].solved for m, t in asked)

@@ -189,14 +189,16 @@ class Arm:
         per tool pose) only say where the search begins, which is all the cost of a reachable pose's answer:
         from a configuration near it, one or two calls of the solver (whether a branch exists over the q7 grid
         does not depend on the start)."""
-        from mrgc.geometry.ik import solve_ik_many
-        from mrgc.geometry.ik_analytic import panda_chain
+        from mrgc.geometry.ik import TOL_POS, TOL_ROT, solve_ik_many
+        from mrgc.geometry.ik_analytic import panda_chain, reaches
 
-        if panda_chain(self.model) is None or not tool_worlds:
+        chain = panda_chain(self.model)
+        if chain is None or not tool_worlds:
             return [False] * len(tool_worlds)
         targets = np.stack([self.ee_target(t) for t in tool_worlds])
-        q_init = self.home if starts is None else starts
-        return [not r.solved for r in solve_ik_many(self.model, targets, 0, q_init=q_init, analytic=True)]
+        if starts is None:
+            return [not r.solved for r in solve_ik_many(self.model, targets, 0, q_init=self.home, analytic=True)]
+        return [not ok for ok in reaches(self.model, chain, targets, starts, TOL_POS, TOL_ROT)]
 
     def in_reach(self, point: np.ndarray, margin: float = 0.0) -> bool:
         """Whether a world point can be within reach of the tool (cheap pre-filter)."""

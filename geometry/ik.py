@@ -32,6 +32,8 @@ from mrgc.geometry.kinematics import RobotModel
 
 #: weight of the orientation error (radians) against the position error (metres) in the least squares
 ROT_WEIGHT = 0.5
+#: a solve's tolerances unless its caller says otherwise: metres, and radians of the rotation's angle
+TOL_POS, TOL_ROT = 1e-4, 1e-3
 #: Sugihara's bias damping w̄
 DAMPING = 1e-3
 #: a restart whose error has not dropped by STALL_RATIO over STALL_WINDOW iterations is drawn afresh ...
@@ -126,8 +128,8 @@ def solve_ik(
     seed: int,
     q_init: np.ndarray | None = None,
     restarts: int = 8,
-    tol_pos: float = 1e-4,
-    tol_rot: float = 1e-3,
+    tol_pos: float = TOL_POS,
+    tol_rot: float = TOL_ROT,
     max_iters: int = 100,
     analytic: bool | None = None,
 ) -> IKResult:
@@ -149,8 +151,8 @@ def solve_ik_many(
     seed: int,
     q_init: np.ndarray | None = None,
     restarts: int = 8,
-    tol_pos: float = 1e-4,
-    tol_rot: float = 1e-3,
+    tol_pos: float = TOL_POS,
+    tol_rot: float = TOL_ROT,
     max_iters: int = 100,
     analytic: bool | None = None,
 ) -> list[IKResult]:

@@ -182,6 +182,36 @@ def solve_many(
     return out
 
 
+def reaches(
+    model: RobotModel, chain: PandaChain, targets: Array, refs: Array, tol_pos: float, tol_rot: float
+) -> list[bool]:
+    """Whether some branch reaches each of ``targets`` (M, 4, 4; model's base frame): the branches with q7
+    locked at ``refs[i]``'s value first, then the grid for the targets those do not reach: the search of
+    :func:`solve_many` without the part that looks for the branch nearest the start, so a target near its
+    start costs one call of the solver."""
+    from geofikpy import franka_ik_q7
+
+    targets = np.asarray(targets, dtype=float).reshape(-1, 4, 4)
+    refs = np.asarray(refs, dtype=float).reshape(-1, 7)
+    e = chain.base_inv @ targets @ chain.to_e
+    calls = np.zeros(len(targets), dtype=int)
+    misses = np.full((len(targets), 2), np.inf)
+    owner: list[int] = []
+    rows: list[Array] = []
+    for i in range(len(targets)):
+        q7 = min(max(float(refs[i, 6]), chain.q7_lo), chain.q7_hi)
+        if _closes_one(e[i], q7):
+            sols, n = franka_ik_q7(e[i, :3, 3].tolist(), e[i, :3, :3].ravel().tolist(), q7, float(refs[i, 0]))
+            owner += [i] * n
+            rows += [np.asarray(row, dtype=float) for row in sols[:n]]
+    found = set(_pick(model, targets, refs, owner, rows, tol_pos, tol_rot, misses))
+    todo = np.array([i for i in range(len(targets)) if i not in found], dtype=int)
+    if len(todo):
+        owner, rows = _grid_rows(franka_ik_q7, e, refs, todo, chain, calls)
+        found |= set(_pick(model, targets, refs, owner, rows, tol_pos, tol_rot, misses))
+    return [i in found for i in range(len(targets))]
+
+
 def _near_rows(
     solve: Callable[[float], Array], e: Array, ref: Array, chain: PandaChain, model: RobotModel
 ) -> tuple[list[Array], int]:

@@ -169,6 +169,30 @@ def test_configurations_in_the_urdf_margin_beyond_geofiks_limits_are_reached(pan
     assert sum(a.q is None for a in answers) <= 1
 
 
+@pytest.mark.parametrize("seed", [0, 1])
+def test_whether_a_branch_reaches_agrees_with_the_full_search(panda, seed, monkeypatch) -> None:
+    """``reaches`` (the existence test phase 1 asks about pre-grasps) answers as ``solve_many`` does, on
+    300 targets from random starts, a third of them pushed out of reach; from the configuration itself, a
+    target costs one call of GeoFIK."""
+    rng = np.random.default_rng(seed)
+    qs = rng.uniform(panda.lower, panda.upper, (300, 7))
+    targets = F.ee_pose(panda, qs)
+    targets[::3, :3, 3] *= 1.6
+    starts = rng.uniform(panda.lower, panda.upper, (300, 7))
+    chain = A.panda_chain(panda)
+    found = [a.q is not None for a in A.solve_many(panda, chain, targets, starts, 1e-4, 1e-3)]
+    assert A.reaches(panda, chain, targets, starts, 1e-4, 1e-3) == found
+    assert 0 < sum(found) < 300
+    import geofikpy
+
+    calls = []
+    solver = geofikpy.franka_ik_q7
+    monkeypatch.setattr(geofikpy, "franka_ik_q7", lambda *args: calls.append(args) or solver(*args))
+    inside = _in_geofik_limits(panda, rng, 20)
+    assert all(A.reaches(panda, chain, F.ee_pose(panda, inside), inside, 1e-4, 1e-3))
+    assert len(calls) == 20
+
+
 def test_the_answer_is_the_start_itself_when_the_start_reaches_the_target(panda) -> None:
     rng = np.random.default_rng(3)
     for q in _in_geofik_limits(panda, rng, 40):

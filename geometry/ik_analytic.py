@@ -15,7 +15,9 @@ then, for targets that gives no solution, at each of :data:`Q7_GRID` values even
 limits.  Every branch of a stage is kept if it lies within the model's joint limits and the project's own
 forward kinematics (:func:`mrgc.geometry.fk.ee_pose`) puts the end effector on the target to the solver's
 tolerances; the answer is the one nearest ``q_init`` (Euclidean in joint space; the first in branch order on
-a tie).  Deterministic: no randomness, no clock, and a target's answer depends on nothing else of its batch.
+a tie).  :func:`reaches` asks only whether some branch exists (the start's q7, then the grid), without the
+search for the nearest.  Deterministic: no randomness, no clock, and a target's answer depends on nothing else
+of its batch.
 
 GeoFIK's own joint limits (:data:`GEOFIK_LOWER`, :data:`GEOFIK_UPPER`, Franka's datasheet) are inside the
 URDF's of pybullet_data's Panda by 0.07 rad: GeoFIK computes each branch in full, then blanks (NaN) every

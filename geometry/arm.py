@@ -178,27 +178,27 @@ class Arm:
 
     def no_branch(self, tool_world: np.ndarray) -> bool:
         """Whether the analytic solver (:mod:`mrgc.geometry.ik_analytic`; arms with a Panda's kinematics only,
-        else False) finds no configuration putting the tool at ``tool_world``: over the q7 grid, every branch
-        out of the joint limits or off the target.  A numeric solve that failed from its start need then not
-        be retried from others, nor one asked at all (the analytic search covers what their random starts
-        would, but for solutions at q7 between its grid values: measured, docs/geometry.md)."""
+        else False) finds no configuration within the joint limits putting the tool at ``tool_world``: over
+        the q7 grid, every branch out of the limits or off the target (:func:`~mrgc.geometry.ik_analytic.
+        reaches`).  A numeric solve that failed from its start need then not be retried from others, nor one
+        asked at all (the analytic search covers what their random starts would, but for solutions at q7
+        between its grid values or in q7's own margin: measured, docs/geometry.md)."""
         return self.no_branches([tool_world])[0]
 
     def no_branches(self, tool_worlds: list[np.ndarray], starts: np.ndarray | None = None) -> list[bool]:
         """:meth:`no_branch` for each of ``tool_worlds``, solved in one batch; ``starts`` (one configuration
-        per tool pose) only say where the search begins, which is all the cost of a reachable pose's answer:
-        from a configuration near it, one or two calls of the solver (whether a branch exists over the q7 grid
-        does not depend on the start)."""
-        from mrgc.geometry.ik import TOL_POS, TOL_ROT, solve_ik_many
+        per tool pose; home by default) only say where the search begins, which is all the cost of a
+        reachable pose's answer: from a configuration near it, one call of the solver (whether a branch
+        exists over the q7 grid does not depend on the start)."""
+        from mrgc.geometry.ik import TOL_POS, TOL_ROT
         from mrgc.geometry.ik_analytic import panda_chain, reaches
 
         chain = panda_chain(self.model)
         if chain is None or not tool_worlds:
             return [False] * len(tool_worlds)
         targets = np.stack([self.ee_target(t) for t in tool_worlds])
-        if starts is None:
-            return [not r.solved for r in solve_ik_many(self.model, targets, 0, q_init=self.home, analytic=True)]
-        return [not ok for ok in reaches(self.model, chain, targets, starts, TOL_POS, TOL_ROT)]
+        refs = np.tile(self.home, (len(targets), 1)) if starts is None else starts
+        return [not ok for ok in reaches(self.model, chain, targets, refs, TOL_POS, TOL_ROT)]
 
     def in_reach(self, point: np.ndarray, margin: float = 0.0) -> bool:
         """Whether a world point can be within reach of the tool (cheap pre-filter)."""

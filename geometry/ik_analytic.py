@@ -21,10 +21,11 @@ of its batch.
 
 GeoFIK's own joint limits (:data:`GEOFIK_LOWER`, :data:`GEOFIK_UPPER`, Franka's datasheet) are inside the
 URDF's of pybullet_data's Panda by 0.07 rad: GeoFIK computes each branch in full, then blanks (NaN) every
-joint beyond them.  A branch with one joint blanked gets it back from the target (:func:`recover`) and counts
-if it is within the model's limits; such a branch is the answer only when no branch GeoFIK gave in full
-qualifies (near the start, then over the grid), so every target answered before is answered as before.  q7
-stays locked within GeoFIK's range (docs/geometry.md, "Analytic IK", measures what is still missed).
+joint beyond them.  :func:`solve_many`'s answers keep to GeoFIK's limits (a configuration that near a joint's
+limit is a poor one to plan from, and phase 1's facts stay those they were).  :func:`reaches`, the question
+whether any branch exists, fills a joint blanked alone back in from the target (:func:`recover`) and counts
+the branch if it is within the model's limits, so "no branch" means none within the URDF's limits; q7 stays
+locked within GeoFIK's range (docs/geometry.md, "Analytic IK", measures what is still missed).
 """
 
 from __future__ import annotations
@@ -164,19 +165,14 @@ def solve_many(
         owner += [i] * len(found)
         rows += found
     answers = _pick(model, targets, refs, owner, rows, tol_pos, tol_rot, misses)
-    # to the grid: targets with no answer, or only one GeoFIK had blanked a joint of (the grid may have a
-    # branch within GeoFIK's limits; the near search's branches of those targets compete again beside it)
-    todo = np.array([i for i in range(len(targets)) if i not in answers or answers[i][3]], dtype=int)
+    todo = np.array([i for i in range(len(targets)) if i not in answers], dtype=int)
     if len(todo):
-        again = set(todo.tolist())
-        kept = [k for k, i in enumerate(owner) if i in again]
-        grid_owner, grid_rows = _grid_rows(franka_ik_q7, e, refs, todo, chain, calls)
-        owner, rows = [owner[k] for k in kept] + grid_owner, [rows[k] for k in kept] + grid_rows
+        owner, rows = _grid_rows(franka_ik_q7, e, refs, todo, chain, calls)
         answers.update(_pick(model, targets, refs, owner, rows, tol_pos, tol_rot, misses))
     out = []
     for i in range(len(targets)):
         if i in answers:
-            q, p, r, _ = answers[i]
+            q, p, r = answers[i]
             q.setflags(write=False)
             out.append(Answer(q, p, r, int(calls[i])))
         else:
@@ -187,10 +183,11 @@ def solve_many(
 def reaches(
     model: RobotModel, chain: PandaChain, targets: Array, refs: Array, tol_pos: float, tol_rot: float
 ) -> list[bool]:
-    """Whether some branch reaches each of ``targets`` (M, 4, 4; model's base frame): the branches with q7
-    locked at ``refs[i]``'s value first, then the grid for the targets those do not reach: the search of
-    :func:`solve_many` without the part that looks for the branch nearest the start, so a target near its
-    start costs one call of the solver."""
+    """Whether some branch within the model's limits reaches each of ``targets`` (M, 4, 4; model's base
+    frame), a joint GeoFIK blanked filled in (:func:`recover`): the branches with q7 locked at ``refs[i]``'s
+    value first, then the grid for the targets those do not reach: the search of :func:`solve_many` without
+    the part that looks for the branch nearest the start, so a target near its start costs one call of the
+    solver."""
     from geofikpy import franka_ik_q7
 
     targets = np.asarray(targets, dtype=float).reshape(-1, 4, 4)
@@ -206,11 +203,11 @@ def reaches(
             sols, n = franka_ik_q7(e[i, :3, 3].tolist(), e[i, :3, :3].ravel().tolist(), q7, float(refs[i, 0]))
             owner += [i] * n
             rows += [np.asarray(row, dtype=float) for row in sols[:n]]
-    found = set(_pick(model, targets, refs, owner, rows, tol_pos, tol_rot, misses))
+    found = set(_pick(model, targets, refs, owner, rows, tol_pos, tol_rot, misses, fill=True))
     todo = np.array([i for i in range(len(targets)) if i not in found], dtype=int)
     if len(todo):
         owner, rows = _grid_rows(franka_ik_q7, e, refs, todo, chain, calls)
-        found |= set(_pick(model, targets, refs, owner, rows, tol_pos, tol_rot, misses))
+        found |= set(_pick(model, targets, refs, owner, rows, tol_pos, tol_rot, misses, fill=True))
     return [i in found for i in range(len(targets))]
 
 
@@ -223,7 +220,6 @@ def _near_rows(
     calls.  Only values where the elbow triangle closes are asked."""
     seen: dict[float, float] = {}  # q7 -> squared distance of its nearest branch to ref (inf: none)
     found: list[Array] = []
-    blanked: list[Array] = []  # branches with one joint GeoFIK blanked: recovered by the caller, with the rest
 
     def near(q7: float) -> float:
         q7 = min(max(q7, chain.q7_lo), chain.q7_hi)
@@ -231,10 +227,7 @@ def _near_rows(
             seen[q7] = np.inf
             if _closes_one(e, q7):
                 sols = solve(q7)
-                blanks = np.isnan(sols).sum(axis=1)
-                if (blanks == 1).any():
-                    blanked.append(sols[blanks == 1])
-                sols = sols[(blanks == 0) & model.within_limits(sols)]
+                sols = sols[~np.isnan(sols).any(axis=1) & model.within_limits(sols)]
                 if len(sols):
                     found.append(sols)
                     seen[q7] = float(np.min(np.sum((sols - ref) ** 2, axis=1)))
@@ -243,7 +236,7 @@ def _near_rows(
     x0 = float(ref[6])
     f0 = near(x0)
     if f0 < np.inf and float(np.abs(found[0] - ref).max(axis=1).min()) <= NEAR:
-        return list(found[0]) + [row for sols in blanked for row in sols], len(seen)
+        return list(found[0]), len(seen)
     for h in NEAR_STEPS:
         fm, fp = near(x0 - h), near(x0 + h)
         if fm < np.inf and fp < np.inf and f0 < np.inf and fp - 2 * f0 + fm > 0:
@@ -251,7 +244,7 @@ def _near_rows(
             near(min(max(x1, x0 - 4 * h), x0 + 4 * h))
         x0 = min(seen, key=lambda q7: (seen[q7], q7))
         f0 = seen[x0]
-    return [row for sols in found + blanked for row in sols], len(seen)
+    return [row for sols in found for row in sols], len(seen)
 
 
 def _grid_rows(
@@ -290,20 +283,20 @@ def _pick(
     tol_pos: float,
     tol_rot: float,
     misses: Array,
-) -> dict[int, tuple[Array, float, float, bool]]:
+    fill: bool = False,
+) -> dict[int, tuple[Array, float, float]]:
     """Of branches ``rows`` (of targets ``owner``), those within the limits that forward kinematics puts on
-    their target to the tolerances (a joint GeoFIK blanked filled in first: :func:`recover`); per target the
-    nearest to its ``refs`` row among those GeoFIK gave in full, else among the recovered ones (the first of
-    equally near ones), with its position and rotation errors and whether it was recovered.  ``misses`` keeps
-    the errors of the nearest rejected branch per target."""
+    their target to the tolerances; the nearest to its ``refs`` row per target (the first of equally near
+    ones), with its position and rotation errors.  ``misses`` keeps the errors of the nearest rejected
+    branch per target.  ``fill``: a joint GeoFIK blanked is filled in first (:func:`recover`)."""
     if not rows:
         return {}
-    who = np.array(owner, dtype=int)
     cand = np.array(rows, dtype=float).reshape(-1, 7)
-    blanked = np.isnan(cand).any(axis=1)
-    cand = recover(model, cand, targets[who])
+    who = np.array(owner, dtype=int)
+    if fill:
+        cand = recover(model, cand, targets[who])
     keep = ~np.isnan(cand).any(axis=1) & model.within_limits(cand)
-    cand, who, blanked = cand[keep], who[keep], blanked[keep]
+    cand, who = cand[keep], who[keep]
     if not len(cand):
         return {}
     p, r = _errors(ee_pose(model, cand), targets[who])
@@ -311,13 +304,13 @@ def _pick(
     for j in np.flatnonzero(~good):
         if p[j] + r[j] < misses[who[j]].sum():
             misses[who[j]] = (p[j], r[j])
-    best: dict[int, int] = {}  # target -> index of its preferred qualifying branch
+    best: dict[int, int] = {}  # target -> index of its nearest qualifying branch
     dist = np.einsum("ij,ij->i", cand - refs[who], cand - refs[who])
     for idx in np.flatnonzero(good):
         i = int(who[idx])
-        if i not in best or (blanked[idx], dist[idx]) < (blanked[best[i]], dist[best[i]]):
+        if i not in best or dist[idx] < dist[best[i]]:
             best[i] = int(idx)
-    return {i: (cand[idx].copy(), float(p[idx]), float(r[idx]), bool(blanked[idx])) for i, idx in best.items()}
+    return {i: (cand[idx].copy(), float(p[idx]), float(r[idx])) for i, idx in best.items()}
 
 
 def recover(model: RobotModel, rows: Array, targets: Array) -> Array:
@@ -328,7 +321,7 @@ def recover(model: RobotModel, rows: Array, targets: Array) -> Array:
     joint ``j`` at angle 0 and ``E0`` the end effector's there, ``Rz(q_j) = F⁻¹ · target · E0⁻¹ · F``; the
     angle is shifted by 2π into the model's limits where one shift fits, else left blank.  A row with two or
     more blanks is returned as it is.  What comes back is still only a candidate: the caller checks its
-    limits and its forward kinematics (:func:`_pick`, :func:`_near_rows`)."""
+    limits and its forward kinematics (:func:`_pick`)."""
     blank = np.isnan(rows)
     one = np.flatnonzero(blank.sum(axis=1) == 1)
     if not len(one):

@@ -41,7 +41,6 @@ from mrgc.geometry.conventions import APPROACH_SAMPLES, ARM_PLACE_LIFT, lattice_
 from mrgc.geometry.facts import FactsResult, HandoverConfig, RobotFacts
 from mrgc.geometry.grasps import finger_opening, fits, grasp_transform, pregrasp_transform
 from mrgc.geometry.ik import solve_ik_many
-from mrgc.geometry.ik_analytic import panda_chain
 from mrgc.geometry.kinds import approaches
 from mrgc.geometry.relays import Asks, Spots, relay_facts, spot_region, stranded
 from mrgc.geometry.relays import asks as relay_asks
@@ -366,8 +365,10 @@ class RobotEvaluator:
             for i, q in zip(todo, qs):
                 if q is not None:
                     self._keep_handover(keys[i], q)
-            if not attempt and panda_chain(model) is not None:  # analytic from home: None is no branch at all
-                todo = [i for i, q in zip(todo, qs) if q is not None]
+            if not attempt:  # no retry for a target no branch reaches (the analytic search: Panda arms only)
+                missed = [i for i, q in zip(todo, qs) if q is None]
+                none = {i for i, n in zip(missed, self.arm.no_branches([tools[i] for i in missed])) if n}
+                todo = [i for i in todo if i not in none]
 
     def _keep_handover(self, key: tuple[str, str, str], q: np.ndarray) -> None:
         """Keep ``q`` as a handover configuration of ``key`` if it is free of itself and of the fixed objects

@@ -147,6 +147,11 @@ class Arm:
         return check.collides(np.concatenate([t, np.asarray(poses, dtype=float).reshape(len(t), 1, 4, 4)], axis=1))
 
     @cached_property
+    def _no_branch_memo(self) -> dict[bytes, bool]:
+        """:meth:`no_branches`' answers from home, by end-effector target (its bytes)."""
+        return {}
+
+    @cached_property
     def _held_checks(self) -> dict[int, tuple[CollisionShape, PairCheck]]:
         """The :meth:`held_collides_at` checks made so far, by held shape."""
         return {}
@@ -197,8 +202,17 @@ class Arm:
         if chain is None or not tool_worlds:
             return [False] * len(tool_worlds)
         targets = np.stack([self.ee_target(t) for t in tool_worlds])
-        refs = np.tile(self.home, (len(targets), 1)) if starts is None else starts
-        return [not ok for ok in reaches(self.model, chain, targets, refs, TOL_POS, TOL_ROT)]
+        if starts is not None:
+            return [not ok for ok in reaches(self.model, chain, targets, starts, TOL_POS, TOL_ROT)]
+        # from home, remembered per target (grounding asks again for the same poses, skeleton after skeleton)
+        memo = self._no_branch_memo
+        keys = [t.tobytes() for t in targets]
+        todo = [k for k, key in enumerate(keys) if key not in memo]
+        if todo:
+            refs = np.tile(self.home, (len(todo), 1))
+            for k, ok in zip(todo, reaches(self.model, chain, targets[todo], refs, TOL_POS, TOL_ROT)):
+                memo[keys[k]] = not ok
+        return [memo[key] for key in keys]
 
     def in_reach(self, point: np.ndarray, margin: float = 0.0) -> bool:
         """Whether a world point can be within reach of the tool (cheap pre-filter)."""

@@ -21,7 +21,7 @@ of its batch.
 
 GeoFIK's own joint limits (:data:`GEOFIK_LOWER`, :data:`GEOFIK_UPPER`, Franka's datasheet) are inside the
 URDF's of pybullet_data's Panda by 0.07 rad: GeoFIK computes each branch in full, then blanks (NaN) every
-joint beyond them.  :func:`solve_many`'s answers keep to GeoFIK's limits (a configuration that near a joint's
+joint beyond them.  :func:`solve_many`'s answers keep to GeoFIK's limits (a configuration so close to a joint's
 limit is a poor one to plan from, and phase 1's facts stay those they were).  :func:`reaches`, the question
 whether any branch exists, fills a joint blanked alone back in from the target (:func:`recover`) and counts
 the branch if it is within the model's limits, so "no branch" means none within the URDF's limits; q7 stays

@@ -18,6 +18,7 @@ them.
 from __future__ import annotations
 
 import hashlib
+import json
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -180,6 +181,36 @@ class PlanFile:
     steps: tuple[Step, ...]
     motion_model: MotionModel | None = None
     problem_digest: str | None = None
+
+
+def plan_text(doc: Any) -> str:
+    """A plan file's text from its JSON value (``PlanResult.to_json()``): indented one space per level, each
+    list of scalars (a configuration, a row of a pose, a list of names) on one line, so that a plan reads and
+    diffs a configuration per line; the same JSON value as ``json.dumps`` gives (floats as ``repr`` writes
+    them), each such line written by the standard library's C encoder."""
+    out: list[str] = []
+    _write(doc, 0, out)
+    out.append("\n")
+    return "".join(out)
+
+
+def _write(value: Any, depth: int, out: list[str]) -> None:
+    if isinstance(value, dict) and value:
+        inner = "\n" + " " * (depth + 1)
+        for k, (key, item) in enumerate(value.items()):
+            # keys as json.dumps writes them: a string as it is, a number, bool or null as its JSON text
+            out.append(("{" if k == 0 else ",") + inner + json.dumps(key if isinstance(key, str) else json.dumps(key)))
+            out.append(": ")
+            _write(item, depth + 1, out)
+        out.append("\n" + " " * depth + "}")
+    elif isinstance(value, (list, tuple)) and value and any(isinstance(v, (dict, list, tuple)) for v in value):
+        inner = "\n" + " " * (depth + 1)
+        for k, item in enumerate(value):
+            out.append(("[" if k == 0 else ",") + inner)
+            _write(item, depth + 1, out)
+        out.append("\n" + " " * depth + "]")
+    else:  # a scalar, an empty container, or a list of scalars: one line
+        out.append(json.dumps(value))
 
 
 def file_sha256(path: str) -> str:

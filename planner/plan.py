@@ -9,11 +9,10 @@ actions).
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass, field, replace
 from typing import Any
 
-from mrgc.planfile.format import SCHEMA, MotionModel, PlanFile, PlannedAction, Step
+from mrgc.planfile.format import SCHEMA, MotionModel, PlanFile, PlannedAction, Step, plan_text
 from mrgc.planner.outcome import PlanStatus, Why
 
 
@@ -134,8 +133,8 @@ class Plan:
         return sorted(set(self.stats.get("robots", [])) - busy)
 
     def dumps(self) -> str:
-        """The plan file's text."""
-        return json.dumps(self.to_json(), indent=1, sort_keys=False) + "\n"
+        """The plan file's text (:func:`~mrgc.planfile.format.plan_text`: a configuration per line)."""
+        return plan_text(self.to_json())
 
     def summary(self) -> list[str]:
         """The plan in a few lines, as ``mrgc plan`` prints it."""

@@ -149,10 +149,11 @@ class MCTS:
         reward = 0.0
         while True:
             short = self.k - len(node.edges) if node.visits else 0  # a visited node's K skeletons, made lazily
-            if not node.open_edges or short > 0:  # beyond the paper: ask for more skeletons before giving up
+            wider = short <= 0 and self._wider(node)
+            if not node.open_edges or short > 0 or wider:  # beyond the paper: more skeletons before giving up
                 t0 = time.perf_counter()
                 before = len(node.edges)
-                node.refill(short if short > 0 and node.open_edges else self.k)
+                node.refill(short if short > 0 and node.open_edges else 1 if wider else self.k)
                 self.stats["skeleton_seconds"] += time.perf_counter() - t0
                 self.stats["skeletons"] += len(node.edges) - before
             edges = node.open_edges
@@ -177,6 +178,19 @@ class MCTS:
             return False  # the root ran out of skeletons
         self._backprop(path, reward)
         return True
+
+    def _wider(self, node: Node) -> bool:
+        """Progressive widening: whether a skeleton not made yet would be selected over every open edge of
+        ``node`` (all visited), given the prior of its last skeleton (the source gives them cheapest first, so
+        the next one's prior is at most that) and no visits.  Without it a node whose open edges lead only
+        into a subtree that keeps failing is never offered another skeleton of its own: that subtree's node
+        asks its source for more, failure after failure, and the search never comes back up (the 6-arm,
+        40-object instance of seed 6: 170 skeletons under one suffix of 8 steps, the root's 5 used up)."""
+        edges = node.open_edges
+        if node.exhausted or not edges or any(e.visits == 0 for e in edges):
+            return False
+        fresh = self.c * node.edges[-1].prior * math.sqrt(node.visits)
+        return fresh > max(self.q(node, e) for e in edges)
 
     def _expand(self, node: Node, edge: Edge) -> tuple[list[GroundedStep] | None, float]:
         memo_key = (

@@ -234,3 +234,36 @@ def test_a_dead_end_ends_its_node_and_the_search_moves_on() -> None:
     assert calls == [(SKEL_DIRECT, 0), (Skeleton(((A2,),)), 1), (other, 0)]  # the node's others never grounded
     dead = search.root.edges[0]
     assert dead.dead and dead.child is not None and dead.child.exhausted and not dead.child.open_edges
+
+
+def test_a_node_gets_another_skeleton_when_the_subtree_below_its_edges_keeps_failing() -> None:
+    """planner/mcts.py, progressive widening: the root's only skeleton grounds a suffix whose node has an
+    endless supply of skeletons that all fail; without widening the root (its k = 1 skeleton made, the edge
+    open) would never be offered another one and the search would stay below that suffix forever.  With it
+    the root asks its source for one more once a fresh skeleton would be selected over the failing edge, and
+    that one grounds to a plan."""
+    other = Skeleton(((Action("o1", "goal", "r1", "r1", "side", "side"),),))
+    below: list[int] = []
+
+    def ground(skel: Skeleton, suffix: list[GroundedStep]) -> Grounding:
+        if skel == SKEL_DIRECT and not suffix:  # a suffix of one step, o2 in the way
+            return Grounding(Outcome.PARTIAL, [step_of(A1)], {"o2"})
+        if suffix:
+            below.append(1)
+            return Grounding(Outcome.FAIL)  # every skeleton before that suffix fails
+        return Grounding(Outcome.SUCCESS, [step_of(A1)]) if skel == other else Grounding(Outcome.FAIL)
+
+    def endless(k: int) -> list[Skeleton]:
+        return [Skeleton(((A2,),))] * k  # never exhausted
+
+    def sources(need: set[str], moved: set[str]):  # type: ignore[no-untyped-def]
+        return feeder([SKEL_DIRECT, other]) if "o1" in need else endless
+
+    search = MCTS(ground, sources, {"o1"}, k=1)
+    result = search.run(deadline=float("inf"), max_iterations=50)
+    assert result.ended == "solved" and result.steps is not None
+    assert [s.moved for s in result.steps] == [("o1",)] and [e.skeleton for e in search.root.edges] == [
+        SKEL_DIRECT,
+        other,
+    ]
+    assert 1 <= len(below) <= 10  # a few failures below the suffix, then the root widened

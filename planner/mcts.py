@@ -18,6 +18,11 @@ first, fewest steps and objects, wins the tie), and the other K - 1 when the nod
 the first skeleton grounds to a plan (most of PA5-PA10) the other solves are never paid for (0.06-0.08 s of
 CPU of a 1.1-1.6 s PA10 run); where it does not, they are made after its grounding, so the deferrals that
 grounding caused already shape them.
+
+Progressive widening (beyond the paper, :meth:`MCTS._wider`): a node whose open edges are all visited asks
+for one more skeleton when the selection rule would pick it (unvisited, with its last skeleton's prior) over
+each of them -- the search selects as if the node held all its source's skeletons -- so a node whose subtree
+keeps failing is offered skeletons of its own, not only more under the failing suffix.
 """
 
 from __future__ import annotations
@@ -180,12 +185,19 @@ class MCTS:
         return True
 
     def _wider(self, node: Node) -> bool:
-        """Progressive widening: whether a skeleton not made yet would be selected over every open edge of
-        ``node`` (all visited), given the prior of its last skeleton (the source gives them cheapest first, so
-        the next one's prior is at most that) and no visits.  Without it a node whose open edges lead only
-        into a subtree that keeps failing is never offered another skeleton of its own: that subtree's node
-        asks its source for more, failure after failure, and the search never comes back up (the 6-arm,
-        40-object instance of seed 6: 170 skeletons under one suffix of 8 steps, the root's 5 used up)."""
+        """Progressive widening: whether ``node``, its open edges all visited, should ask its source for one
+        more skeleton -- when the selection rule would pick that skeleton, unvisited, over every open edge
+        (its prior taken as the node's last skeleton's: the source gives them in (makespan, moved) order,
+        though a deferral lifted starts that order again).  So the search selects as if the node held every
+        skeleton of its source from the start (with equal priors, exactly: tests/test_planner.py), each made
+        only when it would be selected.  Like PUCT over so many children, a node widens once ``c·prior·
+        sqrt(visits)`` exceeds its open edges' mean rewards: soon under a subtree whose groundings keep failing
+        (the mean falls towards 0), and after about ``(reward/(c·prior))²`` visits under one that keeps
+        grounding suffixes without a plan, then at most of its visits (the paper's fixed K never widens).
+        Without it a node whose open edges lead only into a subtree that keeps failing was never offered
+        another skeleton of its own: that subtree's node asked its source for more, failure after failure,
+        and the search never came back up (the 6-arm, 40-object instance of seed 6: the root's 5 skeletons
+        used up at 83 s, then the rest of the run's 208 under the suffix of 8 steps the fifth had grounded)."""
         edges = node.open_edges
         if node.exhausted or not edges or any(e.visits == 0 for e in edges):
             return False

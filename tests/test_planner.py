@@ -3,10 +3,13 @@
 from __future__ import annotations
 
 import json
+import zlib
 from dataclasses import replace
 from pathlib import Path
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from support import ROOT
 
 from mrgc import __version__, cli, parse_file
@@ -236,6 +239,22 @@ def test_a_dead_end_ends_its_node_and_the_search_moves_on() -> None:
     assert dead.dead and dead.child is not None and dead.child.exhausted and not dead.child.open_edges
 
 
+def _distinct(prefix: str, objs: tuple[str, ...] = ("o2",)):  # type: ignore[no-untyped-def]
+    """An endless skeleton source: at each ask a new skeleton moving ``objs`` in one step (distinct grasps, so
+    none is memoised)."""
+    made = [0]
+
+    def more(k: int) -> list[Skeleton]:
+        out = []
+        for _ in range(k):
+            made[0] += 1
+            region = "goal" if "o1" in objs else "start"
+            out.append(Skeleton((tuple(Action(o, region, "r1", "r1", f"{prefix}{made[0]}", "top") for o in objs),)))
+        return out
+
+    return more
+
+
 def test_a_node_gets_another_skeleton_when_the_subtree_below_its_edges_keeps_failing() -> None:
     """planner/mcts.py, progressive widening: the root's only skeleton grounds a suffix whose node has an
     endless supply of skeletons that all fail; without widening the root (its k = 1 skeleton made, the edge
@@ -243,27 +262,54 @@ def test_a_node_gets_another_skeleton_when_the_subtree_below_its_edges_keeps_fai
     the root asks its source for one more once a fresh skeleton would be selected over the failing edge, and
     that one grounds to a plan."""
     other = Skeleton(((Action("o1", "goal", "r1", "r1", "side", "side"),),))
-    below: list[int] = []
+    below: list[Skeleton] = []
 
     def ground(skel: Skeleton, suffix: list[GroundedStep]) -> Grounding:
         if skel == SKEL_DIRECT and not suffix:  # a suffix of one step, o2 in the way
             return Grounding(Outcome.PARTIAL, [step_of(A1)], {"o2"})
         if suffix:
-            below.append(1)
+            below.append(skel)
             return Grounding(Outcome.FAIL)  # every skeleton before that suffix fails
         return Grounding(Outcome.SUCCESS, [step_of(A1)]) if skel == other else Grounding(Outcome.FAIL)
 
-    def endless(k: int) -> list[Skeleton]:
-        return [Skeleton(((A2,),))] * k  # never exhausted
-
     def sources(need: set[str], moved: set[str]):  # type: ignore[no-untyped-def]
-        return feeder([SKEL_DIRECT, other]) if "o1" in need else endless
+        return feeder([SKEL_DIRECT, other]) if "o1" in need else _distinct("g")
 
     search = MCTS(ground, sources, {"o1"}, k=1)
-    result = search.run(deadline=float("inf"), max_iterations=50)
+    result = search.run(deadline=float("inf"), max_iterations=200)
     assert result.ended == "solved" and result.steps is not None
-    assert [s.moved for s in result.steps] == [("o1",)] and [e.skeleton for e in search.root.edges] == [
-        SKEL_DIRECT,
-        other,
-    ]
-    assert 1 <= len(below) <= 10  # a few failures below the suffix, then the root widened
+    assert [s.moved for s in result.steps] == [("o1",)]
+    assert [e.skeleton for e in search.root.edges] == [SKEL_DIRECT, other]
+    assert 1 <= len(below) == len(set(below)) <= 10  # a few distinct failures below the suffix, then the root widened
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 10**6), st.integers(1, 3))
+def test_widening_selects_as_if_every_node_held_all_its_skeletons(seed: int, k: int) -> None:
+    """planner/mcts.py, progressive widening: with skeletons of equal priors (here three objects each) and a
+    scripted grounder (fail, ground a suffix, or a plan, by a hash of the skeleton and its suffix), a search
+    making k skeletons per node and the rest as the selection asks for them grounds exactly what one whose
+    nodes hold 200 skeletons from the start grounds, in the same order (without widening the two part at the
+    first node whose subtree keeps failing)."""
+
+    def run(per_node: int) -> tuple[list[tuple[str, int]], str]:
+        calls: list[tuple[str, int]] = []
+
+        def ground(skel: Skeleton, suffix: list[GroundedStep]) -> Grounding:
+            name = skel.steps[0][0].pick_grasp
+            calls.append((name, len(suffix)))
+            h = zlib.crc32(f"{seed}:{name}:{len(suffix)}".encode()) % 7
+            if h == 0 and len(suffix) >= 2:
+                return Grounding(Outcome.SUCCESS, [step_of(A1), *suffix])
+            if h <= 3:
+                return Grounding(Outcome.FAIL)
+            return Grounding(Outcome.PARTIAL, [step_of(A2), *suffix] if suffix else [step_of(A1)], {"o2"})
+
+        def sources(need: set[str], moved: set[str]):  # type: ignore[no-untyped-def]
+            return _distinct(f"d{len(moved)}-", ("o1", "o3", "o4") if "o1" in need else ("o2", "o6", "o7"))
+
+        result = MCTS(ground, sources, {"o1"}, k=per_node).run(deadline=float("inf"), max_iterations=60)
+        return calls, result.ended
+
+    lazy, eager = run(k), run(200)
+    assert lazy == eager

@@ -198,6 +198,8 @@ def _write(value: Any, depth: int, out: list[str]) -> None:
     if isinstance(value, dict) and value:
         inner = "\n" + " " * (depth + 1)
         for k, (key, item) in enumerate(value.items()):
+            if not (key is None or isinstance(key, (str, int, float))):  # as json.dumps refuses them
+                raise TypeError(f"keys must be str, int, float, bool or None, not {type(key).__name__}")
             # keys as json.dumps writes them: a string as it is, a number, bool or null as its JSON text
             out.append(("{" if k == 0 else ",") + inner + json.dumps(key if isinstance(key, str) else json.dumps(key)))
             out.append(": ")

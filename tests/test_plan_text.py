@@ -7,6 +7,7 @@ import json
 import math
 from typing import Any
 
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -40,3 +41,11 @@ def test_each_configuration_sits_on_one_line_with_its_floats_as_written(configs:
     assert rows == configs and all(
         math.copysign(1, a) == math.copysign(1, b) for r, c in zip(rows, configs) for a, b in zip(r, c)
     )
+
+
+def test_a_key_json_cannot_write_is_refused_as_json_dumps_refuses_it() -> None:
+    for doc in ({(1, 2): 3}, {"a": [{frozenset(): 1}]}):
+        with pytest.raises(TypeError):
+            json.dumps(doc)
+        with pytest.raises(TypeError):
+            plan_text(doc)

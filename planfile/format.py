@@ -196,23 +196,22 @@ def plan_text(doc: Any) -> str:
 
 def _write(value: Any, depth: int, out: list[str]) -> None:
     if isinstance(value, dict) and value:
-        inner = "\n" + " " * (depth + 1)
-        for k, (key, item) in enumerate(value.items()):
+        for key in value:
             if not (key is None or isinstance(key, (str, int, float))):  # as json.dumps refuses them
                 raise TypeError(f"keys must be str, int, float, bool or None, not {type(key).__name__}")
-            # keys as json.dumps writes them: a string as it is, a number, bool or null as its JSON text
-            out.append(("{" if k == 0 else ",") + inner + json.dumps(key if isinstance(key, str) else json.dumps(key)))
-            out.append(": ")
-            _write(item, depth + 1, out)
-        out.append("\n" + " " * depth + "}")
-    elif isinstance(value, (list, tuple)) and value and any(isinstance(v, (dict, list, tuple)) for v in value):
-        inner = "\n" + " " * (depth + 1)
-        for k, item in enumerate(value):
-            out.append(("[" if k == 0 else ",") + inner)
-            _write(item, depth + 1, out)
-        out.append("\n" + " " * depth + "]")
+        # keys as json.dumps writes them: a string as it is, a number, bool or null as its JSON text
+        entries = [(json.dumps(k if isinstance(k, str) else json.dumps(k)) + ": ", v) for k, v in value.items()]
+        brackets = "{}"
+    elif isinstance(value, (list, tuple)) and any(isinstance(v, (dict, list, tuple)) for v in value):
+        entries, brackets = [("", v) for v in value], "[]"
     else:  # a scalar, an empty container, or a list of scalars: one line
         out.append(json.dumps(value))
+        return
+    inner = "\n" + " " * (depth + 1)
+    for k, (head, item) in enumerate(entries):
+        out.append((brackets[0] if k == 0 else ",") + inner + head)
+        _write(item, depth + 1, out)
+    out.append("\n" + " " * depth + brackets[1])
 
 
 def file_sha256(path: str) -> str:

@@ -117,7 +117,13 @@ class Arm:
         """Whether the arm collides with itself at each configuration of ``q`` (C, dof): two links of
         :attr:`RobotModel.self_collision_pairs` within :data:`SELF_CLEARANCE`, the fingers ``opening`` apart
         (None: fully open).  A (C,) bool array."""
-        return self._self_check.colliding(self._with_base(self.link_transforms(np.atleast_2d(q), opening)))
+        return self.self_colliding_at(self.link_transforms(np.atleast_2d(q), opening))
+
+    def self_colliding_at(self, transforms: np.ndarray) -> np.ndarray:
+        """:meth:`self_colliding` for the probed links' world transforms ((C, L, 4, 4), as
+        :meth:`link_transforms` gives them): a (C,) bool array."""
+        out: np.ndarray = self._self_check.colliding(self._with_base(transforms))
+        return out
 
     def self_collides(self, q: np.ndarray, opening: float | None = None) -> bool:
         """Whether the arm collides with itself at some configuration of ``q`` ((C, dof) or (dof,)); stops at

@@ -362,6 +362,37 @@ class Posed:
         return self._tree[1]
 
 
+@dataclass(frozen=True, eq=False)
+class Probes:
+    """Many probes as one set of pieces (:meth:`CollisionWorld.slot_collides`, :meth:`CollisionWorld.slot_hits`):
+    ``pieces``, and ``slots`` (N,) the probe each piece belongs to, 0 ≤ slot < ``count``."""
+
+    pieces: Posed
+    slots: np.ndarray
+    count: int
+
+    @classmethod
+    def of(cls, probes: Sequence[Probe], pad: float = TOLERANCE) -> "Probes":
+        """The probes given as lists of (shape, 4×4 world transform) pieces, in order."""
+        slots = np.repeat(np.arange(len(probes)), [len(p) for p in probes])
+        return cls(Posed.of([piece for p in probes for piece in p], pad), slots, len(probes))
+
+    @classmethod
+    def batch(cls, shapes: Sequence[ShapeLike], transforms: np.ndarray, pad: float = TOLERANCE) -> "Probes":
+        """One probe per leading row of ``transforms`` (K, ..., L, 4, 4): shapes ``L`` at each of its
+        configurations (:meth:`Posed.batch`)."""
+        t = np.asarray(transforms, dtype=float)
+        per = int(np.prod(t.shape[1:-3], dtype=int)) * len(shapes)
+        return cls(Posed.batch(shapes, t, pad), np.repeat(np.arange(len(t)), per), len(t))
+
+
+#: each probe's own object of :meth:`CollisionWorld.slot_collides` (a name or None per probe), or None
+Owners = Union[Sequence[Union[str, None]], None]
+#: a yes/no answer per probe; the names of the objects each probe hits
+Bools = np.ndarray
+Names = list[set[str]]
+
+
 def _grouped(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     n = len(lo)
     size = -(-n // GROUP) * GROUP
@@ -487,13 +518,19 @@ EXACT_PLAIN = 32
 EXACT_BLOCK = 512
 
 
+#: marks of :func:`_exact`: a bool array, and for each candidate pair the index of its mark
+Marks = tuple[np.ndarray, np.ndarray]
+
+
 def _exact(
-    a: Posed, b: Posed, i: np.ndarray, j: np.ndarray, tolerance: float, stop: bool, skip: np.ndarray | None = None
+    a: Posed, b: Posed, i: np.ndarray, j: np.ndarray, tolerance: float, stop: bool, marks: Marks | None = None
 ) -> list[int]:
     """coal's narrowphase on the candidate pairs (a's piece i[k], b's piece j[k]): the k of the pairs that
     collide (within ``tolerance``, coal's security margin: the module docstring's semantics), in order, the
-    first one only with ``stop``.  ``skip`` (a bool array over b's pieces): pairs whose b piece is marked are
-    passed over, and a colliding one marks it (which-objects queries need one contact per object).
+    first one only with ``stop``.  ``marks`` (a bool array, and each pair's index into it: b's piece, or the
+    pair's probe and object): pairs whose mark is set are passed over, and a colliding one sets it
+    (which-objects queries need one contact per object; many probes at once one per probe, or per probe and
+    object).
 
     The first :data:`EXACT_PLAIN` pairs go to coal as they are (a yes/no query that collides mostly stops
     among them); the others, in blocks of :data:`EXACT_BLOCK`, only where the two pieces' oriented boxes
@@ -508,7 +545,8 @@ def _exact(
         k = np.arange(start, end)
         if start:
             k = k[_oriented_meet(a, b, i[k], j[k], 2 * tolerance)]
-        out.extend(int(k[x]) for x in _narrow(a, b, i[k], j[k], tolerance, stop, skip))
+        chosen = None if marks is None else (marks[0], marks[1][k])
+        out.extend(int(k[x]) for x in _narrow(a, b, i[k], j[k], tolerance, stop, chosen))
         if stop and out:
             break
         start = end
@@ -527,7 +565,7 @@ def _oriented_meet(a: Posed, b: Posed, i: np.ndarray, j: np.ndarray, grow: float
 
 
 def _narrow(
-    a: Posed, b: Posed, i: np.ndarray, j: np.ndarray, tolerance: float, stop: bool, skip: np.ndarray | None
+    a: Posed, b: Posed, i: np.ndarray, j: np.ndarray, tolerance: float, stop: bool, marks: Marks | None
 ) -> list[int]:
     """:func:`_exact` on pairs it has chosen: each call is a prebuilt ``ComputeCollision`` of the two
     geometries (cached on the first shape), b's shape placed in a's frame: no coal object is moved or
@@ -542,9 +580,9 @@ def _narrow(
     rel_pos = (inv_rot @ (tb[:, :3, 3:] - ta[:, :3, 3:]))[..., 0]
     out: list[int] = []
     ka, kb = a.kind[i].tolist(), b.kind[j].tolist()
-    jl = j.tolist()
+    skip, at = (None, []) if marks is None else (marks[0], marks[1].tolist())
     for k in range(len(ka)):
-        if skip is not None and skip[jl[k]]:
+        if skip is not None and skip[at[k]]:
             continue
         result.clear()
         relative.setRotation(rel_rot[k])
@@ -554,7 +592,7 @@ def _narrow(
             if stop:
                 break
             if skip is not None:
-                skip[jl[k]] = True
+                skip[at[k]] = True
     return out
 
 
@@ -834,7 +872,43 @@ class CollisionWorld:
         """:meth:`probe_hits` (or :meth:`sweep_hits` for C configurations) in the batched form."""
         return self.probe_hits(Posed.batch(shapes, transforms, self.tolerance), against, ignore)
 
+    def slot_collides(self, probes: Probes, against: Against = None, ignore: Against = (), own: Owners = None) -> Bools:
+        """Many probes asked at once (:class:`Probes`): for each, whether one of its pieces hits a selected
+        object, the probe's ``own`` object excepted (``own[s]``: an object name or None, one per probe).  A
+        (count,) bool array, the answers :meth:`probe_collides` gives each probe alone (with ``own[s]`` added to
+        ``ignore``): the same candidate pairs (one broadphase for all) and the same narrowphase, a probe's pairs
+        passed over once one of them collides.  Phase 1 checks the approaches of a round of queries this way."""
+        done = self._slotted(probes, against, ignore, own, hits=False)
+        return done
+
+    def slot_hits(self, probes: Probes, against: Against = None, ignore: Against = (), own: Owners = None) -> Names:
+        """:meth:`slot_collides` answering :meth:`probe_hits` for each probe: the selected objects (but its
+        ``own``) some piece of the probe hits."""
+        done = self._slotted(probes, against, ignore, own, hits=True)
+        names = [self._order[k].name for k in self._select(against, ignore, ()).tolist()]
+        return [{names[c] for c in np.flatnonzero(row).tolist()} for row in done]
+
     # -------------------------------------------------------------------------------------- internals
+
+    def _slotted(self, probes: Probes, against: Against, ignore: Against, own: Owners, hits: bool) -> np.ndarray:
+        """:meth:`slot_collides` ((count,) bools) or, with ``hits``, which selected objects each probe hits
+        ((count, selected) bools)."""
+        sel = self._select(against, ignore, ())
+        n = len(sel)
+        probe, count = probes.pieces, probes.count
+        done = np.zeros((count, n) if hits else count, dtype=bool)
+        if not n or not len(probe):
+            return done
+        chosen = self._world().rows(sel)
+        i, j = overlaps(probe, chosen)
+        s = probes.slots[i]
+        if own is not None:  # each probe's own object (its column among the selected; -1: not selected)
+            column = {self._order[k].name: c for c, k in enumerate(sel.tolist())}
+            mine = np.array([-1 if o is None else column.get(o, -1) for o in own], dtype=np.intp)
+            keep = mine[s] != j
+            i, j, s = i[keep], j[keep], s[keep]
+        _exact(probe, chosen, i, j, self.tolerance, stop=False, marks=(done.reshape(-1), s * n + j if hits else s))
+        return done
 
     def _probe(self, shapes: Probe | Posed) -> Posed:
         return shapes if isinstance(shapes, Posed) else Posed.of(shapes, self.tolerance)
@@ -865,7 +939,7 @@ class CollisionWorld:
             return posed_collide(pieces, chosen, self.tolerance)
         i, j = overlaps(pieces, chosen)
         skip = np.zeros(len(sel), dtype=bool)
-        _exact(pieces, chosen, i, j, self.tolerance, stop=False, skip=skip)
+        _exact(pieces, chosen, i, j, self.tolerance, stop=False, marks=(skip, j))
         return {self._order[int(k)].name for k in sel[skip]}
 
     def _tree_collides(self, tree: _Tree, objs: list[Any]) -> bool:

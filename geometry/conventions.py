@@ -129,12 +129,16 @@ def lattice_offsets(grid: int) -> list[tuple[float, float]]:
 
 
 def refine(configs: Array, sub: int = 4) -> Array:
-    """Configurations with ``sub - 1`` more interpolated between consecutive ones (the validator's
-    resolution), so facts and grounding agree with what the validator checks."""
-    if len(configs) < 2:
+    """Configurations (..., C, dof) with ``sub - 1`` more interpolated between consecutive ones (the
+    validator's resolution), so facts and grounding agree with what the validator checks; leading axes are
+    paths refined alike.  Row ``sub * k`` is configuration ``k`` itself."""
+    n = configs.shape[-2]
+    if n < 2:
         return configs
     s = np.linspace(0.0, 1.0, sub + 1)[:-1, None]
-    return np.concatenate([a[None] * (1 - s) + b[None] * s for a, b in zip(configs[:-1], configs[1:])] + [configs[-1:]])
+    a, b = configs[..., :-1, None, :], configs[..., 1:, None, :]
+    between = (a * (1 - s) + b * s).reshape(configs.shape[:-2] + ((n - 1) * sub, configs.shape[-1]))
+    return np.concatenate([between, configs[..., -1:, :]], axis=-2)
 
 
 def seed_for(*parts: str, seed: int = 0) -> int:

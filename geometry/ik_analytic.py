@@ -167,8 +167,8 @@ def solve_many(
     answers = _pick(model, targets, refs, owner, rows, tol_pos, tol_rot, misses)
     todo = np.array([i for i in range(len(targets)) if i not in answers], dtype=int)
     if len(todo):
-        owner, rows = _grid_rows(franka_ik_q7, e, refs, todo, chain, calls)
-        answers.update(_pick(model, targets, refs, owner, rows, tol_pos, tol_rot, misses))
+        on_grid, grid_rows = _grid_rows(franka_ik_q7, e, refs, todo, chain, calls)
+        answers.update(_pick(model, targets, refs, on_grid, grid_rows, tol_pos, tol_rot, misses))
     out = []
     for i in range(len(targets)):
         if i in answers:
@@ -206,8 +206,8 @@ def reaches(
     found = set(_pick(model, targets, refs, owner, rows, tol_pos, tol_rot, misses, fill=True))
     todo = np.array([i for i in range(len(targets)) if i not in found], dtype=int)
     if len(todo):
-        owner, rows = _grid_rows(franka_ik_q7, e, refs, todo, chain, calls)
-        found |= set(_pick(model, targets, refs, owner, rows, tol_pos, tol_rot, misses, fill=True))
+        on_grid, grid_rows = _grid_rows(franka_ik_q7, e, refs, todo, chain, calls)
+        found |= set(_pick(model, targets, refs, on_grid, grid_rows, tol_pos, tol_rot, misses, fill=True))
     return [i in found for i in range(len(targets))]
 
 
@@ -254,24 +254,27 @@ def _grid_rows(
     todo: NDArray[np.int_],
     chain: PandaChain,
     calls: NDArray[np.int_],
-) -> tuple[list[int], list[Array]]:
+) -> tuple[list[int], Array]:
     """The branches of targets ``todo`` with q7 locked at the grid's values where the elbow triangle closes,
     at most :data:`Q7_CALLS` of them evenly spread (ends included); with the target each belongs to
-    (``calls`` counted up in place)."""
+    (``calls`` counted up in place).  The branches come as one (N, 7) array, in the order GeoFIK gave them,
+    but for those with two joints or more blanked, which no caller can use (:func:`_pick`, :func:`recover`)."""
     closes = _closes(e[todo], np.broadcast_to(chain.grid, (len(todo), len(chain.grid))))
     owner: list[int] = []
-    rows: list[Array] = []
-    for k, i in enumerate(todo):
-        r, rot = e[i, :3, 3].tolist(), e[i, :3, :3].ravel().tolist()
+    flat: list[list[float]] = []
+    for k, i in enumerate(todo.tolist()):
+        r, rot, q1 = e[i, :3, 3].tolist(), e[i, :3, :3].ravel().tolist(), float(refs[i, 0])
         where = np.flatnonzero(closes[k])
         if len(where) > Q7_CALLS:
             where = where[np.linspace(0, len(where) - 1, Q7_CALLS).round().astype(int)]
-        for s in where:
-            calls[i] += 1
-            sols, n = franka_ik_q7(r, rot, float(chain.grid[s]), float(refs[i, 0]))
-            owner += [int(i)] * n
-            rows += [np.asarray(row, dtype=float) for row in sols[:n]]
-    return owner, rows
+        calls[i] += len(where)
+        for q7 in chain.grid[where].tolist():
+            sols, n = franka_ik_q7(r, rot, q7, q1)
+            owner += [i] * n
+            flat += sols[:n]
+    rows = np.array(flat, dtype=float).reshape(-1, 7)
+    usable = np.isnan(rows).sum(axis=1) <= 1
+    return np.asarray(owner, dtype=int)[usable].tolist(), rows[usable]
 
 
 def _pick(
@@ -279,7 +282,7 @@ def _pick(
     targets: Array,
     refs: Array,
     owner: list[int],
-    rows: list[Array],
+    rows: list[Array] | Array,
     tol_pos: float,
     tol_rot: float,
     misses: Array,
@@ -289,7 +292,7 @@ def _pick(
     their target to the tolerances; the nearest to its ``refs`` row per target (the first of equally near
     ones), with its position and rotation errors.  ``misses`` keeps the errors of the nearest rejected
     branch per target.  ``fill``: a joint GeoFIK blanked is filled in first (:func:`recover`)."""
-    if not rows:
+    if not len(rows):
         return {}
     cand = np.array(rows, dtype=float).reshape(-1, 7)
     who = np.array(owner, dtype=int)

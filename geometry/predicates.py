@@ -31,12 +31,12 @@ from __future__ import annotations
 
 import itertools
 import time
-from typing import Callable, TypeVar
+from typing import Callable, Sequence, TypeVar
 
 import numpy as np
 
 from mrgc.geometry.arm import Arm
-from mrgc.geometry.collision import Posed, posed_collide, scene_world
+from mrgc.geometry.collision import Posed, Probes, posed_collide, scene_world
 from mrgc.geometry.conventions import APPROACH_SAMPLES, ARM_PLACE_LIFT, lattice_offsets, refine, seed_for
 from mrgc.geometry.facts import FactsResult, HandoverConfig, RobotFacts
 from mrgc.geometry.grasps import finger_opening, fits, grasp_transform, pregrasp_transform
@@ -58,6 +58,12 @@ DISTINCT_CONFIG = 0.1  # rad: configurations closer than this in every joint cou
 
 J = TypeVar("J")
 R = TypeVar("R")
+#: a query of :meth:`RobotEvaluator._solve`: (object, grasp, object pose, held, key)
+Query = tuple[str, str, np.ndarray, bool, str]
+#: an IK branch of a query: (query, grasp transform, grasp configuration, pre-grasp configuration or None)
+Branch = tuple[Query, np.ndarray, np.ndarray, "np.ndarray | None"]
+#: a query's answer: the approach path and the movable objects it hits
+Answer = tuple[np.ndarray, set[str]]
 
 
 class RobotEvaluator:
@@ -125,32 +131,13 @@ class RobotEvaluator:
         """The finger opening while approaching or holding ``obj`` with ``grasp``."""
         return finger_opening(self.scene.grasp(grasp), self.scene.body(obj).shape)
 
-    def _free(self, qs: np.ndarray, ignore: tuple[str, ...], opening: float | None, against: str = "fixed") -> bool:
-        """Whether the arm at configurations ``qs`` (fingers ``opening`` apart) is free of itself (the link
-        pairs :attr:`~mrgc.geometry.kinematics.RobotModel.self_collision_pairs` keeps apart) and of the
-        ``against`` objects but ``ignore``."""
-        shapes, _ = self.arm.probes
-        self.out.collision_checks += 1
-        transforms = self.arm.link_transforms(qs, opening)
-        if self.arm.self_collides_at(transforms):
-            return False
-        return not self.world.batch_collides(shapes, transforms, against=against, ignore=ignore)
-
-    def _swept_hits(self, qs: np.ndarray, ignore: tuple[str, ...], opening: float | None) -> set[str]:
-        shapes, _ = self.arm.probes
-        self.out.collision_checks += 1
-        return self.world.batch_hits(shapes, self.arm.link_transforms(qs, opening), against="movable", ignore=ignore)
-
     @staticmethod
     def _approach(q_pre: np.ndarray, q: np.ndarray) -> np.ndarray:
+        """The approach from pre-grasp ``q_pre`` to grasp ``q`` ((dof,) each, or (N, dof) for N approaches):
+        APPROACH_SAMPLES configurations on the joint-space line, (..., APPROACH_SAMPLES, dof)."""
         s = np.linspace(0.0, 1.0, APPROACH_SAMPLES)[:, None]
-        return q_pre[None] * (1 - s) + q[None] * s
-
-    def _object_hits(self, obj: str, shape: object, g_t: np.ndarray, path: np.ndarray, pose: np.ndarray) -> set[str]:
-        """Movable objects hit by the held object along the approach and at its placement."""
-        obj_poses = self.arm.tool_world(path) @ np.linalg.inv(g_t)
-        probes = [(shape, p) for p in obj_poses] + [(shape, pose)]
-        return self.world.probe_hits(probes, against="movable", ignore=(obj,))
+        out: np.ndarray = q_pre[..., None, :] * (1 - s) + q[..., None, :] * s
+        return out
 
     def _solve(
         self, queries: list[tuple[str, str, np.ndarray, bool, str]], want_free: bool
@@ -204,11 +191,10 @@ class RobotEvaluator:
             )
             for k, q_pre in zip(asked, solved):
                 pres[k] = q_pre
-            for k, ((i, g, q), q_pre) in enumerate(zip(ok, pres)):
-                if none[k]:
-                    settled.add(i)
-                    continue
-                answer, final = self._branch(queries[i], g, q, q_pre, want_free)
+            branches = [(i, g, q, q_pre) for k, ((i, g, q), q_pre) in enumerate(zip(ok, pres)) if not none[k]]
+            settled.update(i for k, (i, _, _) in enumerate(ok) if none[k])
+            answers = self._branches([(queries[i], g, q, q_pre) for i, g, q, q_pre in branches], want_free)
+            for (i, _, _, _), (answer, final) in zip(branches, answers):
                 if final:
                     settled.add(i)
                 if answer is not None and (i not in found or (found[i][1] and not answer[1])):
@@ -221,33 +207,86 @@ class RobotEvaluator:
             ]
         return found
 
-    def _branch(
-        self,
-        query: tuple[str, str, np.ndarray, bool, str],
-        g: np.ndarray,
-        q: np.ndarray,
-        q_pre: np.ndarray | None,
-        want_free: bool,
-    ) -> tuple[tuple[np.ndarray, set[str]] | None, bool]:
-        """One IK branch's answer to a query of :meth:`_solve` (grasp transform ``g``, grasp configuration
-        ``q``, pre-grasp ``q_pre`` or None): the approach path and the movable objects it hits, or None when it
-        fails; and whether no other branch can do better (the query is settled)."""
-        obj, grasp, pose, held, _ = query
-        if q_pre is None:  # the pre-grasp, the same tool pose on every branch: settled when no branch reaches it
-            return None, self.arm.no_branch(pose @ pregrasp_transform(g))
-        opening = self.opening(obj, grasp)
-        path = self._approach(q_pre, q)
-        if not self._free(refine(path), (obj,), opening):
-            return None, self._hand_hits(path, (obj,), opening, "fixed")
-        if held:  # the object in hand, along the approach, must stay clear of fixed objects too
-            shape = self.scene.body(obj).shape
-            in_hand = self.arm.tool_world(refine(path)) @ np.linalg.inv(g)
-            if self.world.probe_collides([(shape, t) for t in in_hand], against="fixed"):
-                return None, False
-        hits = self._swept_hits(path, (obj,), opening)
-        if held:
-            hits |= self._object_hits(obj, self.scene.body(obj).shape, g, path, pose)
-        return (path, hits), bool(hits) and want_free and self._hand_hits(path, (obj,), opening, "movable")
+    def _branches(self, items: list[Branch], want_free: bool) -> list[tuple[Answer | None, bool]]:
+        """The answers of IK branches to queries of :meth:`_solve`, each item (query, grasp transform ``g``,
+        grasp configuration ``q``, pre-grasp ``q_pre`` or None): the approach path and the movable objects it
+        hits, or None when the branch fails; and whether no other branch can do better (the query is settled).
+
+        A branch fails when its approach (pre-grasp → grasp, refined to the validator's resolution) hits the arm
+        itself or a fixed object, or, with the object in hand (a placement), the object hits a fixed one; else
+        its hits are the movable objects the arm's links hit along the approach, and the object in hand hits
+        along it and at its placement.  The items are checked together, each check once for all of them (one
+        forward kinematics, one self-collision check, one query per world selection:
+        :meth:`~mrgc.geometry.collision.CollisionWorld.slot_collides`): the answers each would get alone."""
+        out: list[tuple[Answer | None, bool]] = [(None, False)] * len(items)
+        for k, (query, g, _, q_pre) in enumerate(items):
+            if q_pre is None:  # the pre-grasp, the same tool pose on every branch: settled when no branch reaches it
+                out[k] = (None, self.arm.no_branch(query[2] @ pregrasp_transform(g)))
+        live = [k for k, item in enumerate(items) if item[3] is not None]
+        if not live:
+            return out
+        queries = [items[k][0] for k in live]
+        objs = [query[0] for query in queries]
+        openings: list[float | None] = [self.opening(query[0], query[1]) for query in queries]
+        pres = [q_pre for _, _, _, q_pre in items if q_pre is not None]
+        paths = self._approach(np.stack(pres), np.stack([items[k][2] for k in live]))
+        dense = refine(paths)  # (n, D, dof): row sub * i is the path's configuration i
+        sub = (dense.shape[1] - 1) // (APPROACH_SAMPLES - 1)
+        transforms = self._link_transforms(dense, openings)  # (n, D, L, 4, 4)
+        self.out.collision_checks += len(live)
+        clear = self._arm_clear(transforms, objs)
+        for x in np.flatnonzero(~clear).tolist():
+            out[live[x]] = (None, self._hand_hits(paths[x], (objs[x],), openings[x], "fixed"))
+        # the object in hand (placements), along the approach, must stay clear of fixed objects too
+        held = [x for x in np.flatnonzero(clear).tolist() if queries[x][3]]
+        tools = self.arm.tool_world(dense[held]) if held else np.zeros((0, dense.shape[1], 4, 4))
+        in_hand = {x: t @ np.linalg.inv(items[live[x]][1]) for x, t in zip(held, tools)}
+        stuck = self.world.slot_collides(self._objects([(objs[x], in_hand[x]) for x in held]), "fixed")
+        for x in np.asarray(held, dtype=int)[stuck].tolist():
+            clear[x] = False
+            out[live[x]] = (None, False)
+        ok = np.flatnonzero(clear).tolist()
+        if not ok:
+            return out
+        self.out.collision_checks += len(ok)
+        along = transforms[ok, ::sub]  # the links at the path's configurations
+        probes = Probes.batch(self.arm.probes[0], along, self.world.tolerance)
+        hits = self.world.slot_hits(probes, "movable", own=[objs[x] for x in ok])
+        carried = [(c, x) for c, x in enumerate(ok) if x in in_hand]  # the object along it and at its placement
+        poses = [(objs[x], np.concatenate([in_hand[x][::sub], queries[x][2][None]])) for _, x in carried]
+        more = self.world.slot_hits(self._objects(poses), "movable", own=[objs[x] for _, x in carried])
+        for (c, _), m in zip(carried, more):
+            hits[c] |= m
+        for c, x in enumerate(ok):
+            final = bool(hits[c]) and want_free and self._hand_hits(paths[x], (objs[x],), openings[x], "movable")
+            out[live[x]] = ((paths[x], hits[c]), final)
+        return out
+
+    def _arm_clear(self, transforms: np.ndarray, objs: list[str]) -> np.ndarray:
+        """For each path of probed-link ``transforms`` (n, C, L, 4, 4), whether the arm is free of itself (the
+        link pairs :attr:`~mrgc.geometry.kinematics.RobotModel.self_collision_pairs` keeps apart) and of the
+        fixed objects at every configuration (object ``objs[i]`` aside): an (n,) bool array."""
+        n, _, links = transforms.shape[:3]
+        selfhit = self.arm.self_colliding_at(transforms.reshape(-1, links, 4, 4)).reshape(n, -1)
+        clear = np.logical_not(selfhit.any(axis=1))
+        rest = np.flatnonzero(clear)
+        if len(rest):
+            probes = Probes.batch(self.arm.probes[0], transforms[rest], self.world.tolerance)
+            clear[rest] = ~self.world.slot_collides(probes, "fixed", own=[objs[x] for x in rest.tolist()])
+        return clear
+
+    def _objects(self, poses: list[tuple[str, np.ndarray]]) -> Probes:
+        """Objects at poses, one probe each ((object, (C, 4, 4) world poses) pairs)."""
+        return Probes.of([[(self.scene.body(obj).shape, t) for t in ts] for obj, ts in poses], self.world.tolerance)
+
+    def _link_transforms(self, qs: np.ndarray, openings: Sequence[float | None]) -> np.ndarray:
+        """The probed links' world transforms ((Q, C, L, 4, 4)) of Q paths ``qs`` (Q, C, dof), path q with the
+        fingers ``openings[q]`` apart: one forward kinematics per distinct opening."""
+        out = np.empty(qs.shape[:2] + (len(self.arm.probes[0]), 4, 4))
+        for opening in dict.fromkeys(openings):
+            rows = [k for k, o in enumerate(openings) if o == opening]
+            out[rows] = self.arm.link_transforms(qs[rows], opening)
+        return out
 
     def _hand_hits(self, path: np.ndarray, ignore: tuple[str, ...], opening: float | None, against: str) -> bool:
         """Whether the hand (:attr:`Arm.hand <mrgc.geometry.arm.Arm.hand>`) at the first or last configuration of
@@ -362,32 +401,56 @@ class RobotEvaluator:
                 start = rng.uniform(model.lower, model.upper)
             todo = [i for i in todo if len(self.out.handover.get(keys[i], ())) < HANDOVER_CONFIGS]
             qs = self._ik([tools[i] for i in todo], "handover", q_init=start, attempt=attempt)
-            for i, q in zip(todo, qs):
-                if q is not None:
-                    self._keep_handover(keys[i], q)
+            self._keep_handovers([(keys[i], q) for i, q in zip(todo, qs) if q is not None])
             if not attempt:  # no retry for a target no branch reaches (the analytic search: Panda arms only)
                 missed = [i for i, q in zip(todo, qs) if q is None]
                 none = {i for i, n in zip(missed, self.arm.no_branches([tools[i] for i in missed])) if n}
                 todo = [i for i in todo if i not in none]
 
-    def _keep_handover(self, key: tuple[str, str, str], q: np.ndarray) -> None:
-        """Keep ``q`` as a handover configuration of ``key`` if it is free of itself and of the fixed objects
-        (arms at home aside) and differs from those kept."""
-        kept = self.out.handover.setdefault(key, [])
-        if any(np.max(np.abs(c.q - q)) < DISTINCT_CONFIG for c in kept):
+    def _keep_handovers(self, found: list[tuple[tuple[str, str, str], np.ndarray]]) -> None:
+        """Keep each (key, q) of ``found``, in order, as a handover configuration of its key if it differs from
+        those kept and is free of itself and of the fixed objects (arms at home aside), with the movable
+        objects its links and the object held at the point hit.  The collision checks of all of them run
+        together (as :meth:`_branches`'), the answers those of one configuration at a time."""
+        kept = {key: self.out.handover.setdefault(key, []) for key, _ in found}
+        fresh = [k for k, (key, q) in enumerate(found) if self._distinct(kept[key], q)]
+        if not fresh:
             return
-        shapes, _ = self.arm.probes
-        self.out.collision_checks += 1
-        transforms = self.arm.link_transforms(q[None], self.opening(key[0], key[2]))
-        if self.arm.self_collides_at(transforms):
-            return
-        hits = self.world.batch_hits(shapes, transforms, against="fixed", ignore=(key[0],))
-        if all(h.startswith("@") for h in hits):  # only arms at home: fine if the partner is the one hit
-            obj = key[0]
-            held = (self.scene.body(obj).shape, translation(*self.scene.handover_points[key[1]]))
-            movables = self.world.batch_hits(shapes, transforms, against="movable", ignore=(obj,))
-            movables |= self.world.probe_hits([held], against="movable", ignore=(obj,))
-            kept.append(HandoverConfig(q, frozenset(h[1:].split(":")[0] for h in hits), frozenset(movables)))
+        objs = [found[k][0][0] for k in fresh]
+        points = [found[k][0][1] for k in fresh]
+        openings = [self.opening(obj, found[k][0][2]) for obj, k in zip(objs, fresh)]
+        transforms = self._link_transforms(np.stack([found[k][1] for k in fresh])[:, None], openings)[:, 0]
+        shapes, tolerance = self.arm.probes[0], self.world.tolerance
+        good = ~self.arm.self_colliding_at(transforms)
+        clear: dict[int, frozenset[str]] = {}  # fresh index -> the arms at home its links hit (nothing else)
+        ok = np.flatnonzero(good)
+        if len(ok):
+            probes = Probes.batch(shapes, transforms[ok], tolerance)
+            fixed = self.world.slot_hits(probes, "fixed", own=[objs[x] for x in ok.tolist()])
+            for x, hits in zip(ok.tolist(), fixed):
+                if all(h.startswith("@") for h in hits):  # only arms at home: fine if the partner is the one hit
+                    clear[x] = frozenset(h[1:].split(":")[0] for h in hits)
+        movables: dict[int, set[str]] = {}
+        if clear:
+            rows = sorted(clear)
+            own = [objs[x] for x in rows]
+            hit = self.world.slot_hits(Probes.batch(shapes, transforms[rows], tolerance), "movable", own=own)
+            held = [(objs[x], translation(*self.scene.handover_points[points[x]])[None]) for x in rows]
+            more = self.world.slot_hits(self._objects(held), "movable", own=own)
+            movables = {x: h | m for x, h, m in zip(rows, hit, more)}
+        fresh_at = {k: x for x, k in enumerate(fresh)}
+        for k, (key, q) in enumerate(found):
+            at = fresh_at.get(k)
+            if at is None or not self._distinct(kept[key], q):  # as one at a time: a twin of one kept meanwhile
+                continue
+            self.out.collision_checks += 1
+            if at in clear:
+                kept[key].append(HandoverConfig(q, clear[at], frozenset(movables[at])))
+
+    @staticmethod
+    def _distinct(kept: list[HandoverConfig], q: np.ndarray) -> bool:
+        """Whether ``q`` differs from every configuration of ``kept`` (by :data:`DISTINCT_CONFIG` in a joint)."""
+        return not any(np.max(np.abs(c.q - q)) < DISTINCT_CONFIG for c in kept)
 
 
 def _robot_worker(args: tuple[SceneSpec, str, int]) -> RobotFacts:

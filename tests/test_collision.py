@@ -695,7 +695,33 @@ def test_the_oriented_box_cut_keeps_every_colliding_pair(seed: int, spread: floa
     pa, pb = Posed.of(a), Posed.of(b)  # type: ignore[arg-type]
     i, j = overlaps(pa, pb)
     assume(len(i) > collision.EXACT_PLAIN + 10)
-    marks = (lambda: np.zeros(len(pb), dtype=bool)) if skipping else (lambda: None)
+    marks = (lambda: (np.zeros(len(pb), dtype=bool), j)) if skipping else (lambda: None)
     every = collision._narrow(pa, pb, i, j, TOLERANCE, False, marks())
     assert collision._exact(pa, pb, i, j, TOLERANCE, False, marks()) == every
     assert collision._exact(pa, pb, i, j, TOLERANCE, True) == every[:1]
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**31 - 1), st.integers(1, 12), st.sampled_from([0.15, 0.4, 1.0]), st.booleans())
+def test_many_probes_at_once_get_the_answers_each_gets_alone(seed: int, count: int, spread: float, own: bool) -> None:
+    """``slot_collides`` and ``slot_hits`` (the pieces of ``count`` probes in one set, each piece tagged with its
+    probe) answer each probe as ``probe_collides`` and ``probe_hits`` of its pieces alone, with the probe's own
+    object (when it has one) ignored: random boxes, spheres and hulls against a world of fixed and movable
+    ones, large probes among small (the broadphase's grouped path and its direct one)."""
+    from mrgc.geometry.collision import Posed, Probes
+
+    rng = np.random.default_rng(seed)
+    world = CollisionWorld()
+    for k, (shape, t) in enumerate(_random_pieces(rng, 30, spread)):
+        world.add(f"b{k}", shape, t, "fixed" if k % 3 == 0 else "movable")  # type: ignore[arg-type]
+    probes = [_random_pieces(rng, int(rng.integers(1, 60)), spread) for _ in range(count)]
+    mine = [f"b{int(rng.integers(0, 30))}" if own and rng.random() < 0.7 else None for _ in probes]
+    together = Probes.of(probes)  # type: ignore[arg-type]
+    for against in ("fixed", "movable", None):
+        yes = world.slot_collides(together, against, ignore="b1", own=mine)
+        which = world.slot_hits(together, against, ignore="b1", own=mine)
+        for k, probe in enumerate(probes):
+            ignore = ("b1",) if mine[k] is None else ("b1", mine[k])
+            assert yes[k] == world.probe_collides(Posed.of(probe), against, ignore), (against, k)  # type: ignore[arg-type]
+            assert which[k] == world.probe_hits(probe, against, ignore), (against, k)  # type: ignore[arg-type]
+    assert not world.slot_collides(together, "nothing").any()

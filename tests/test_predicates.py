@@ -224,3 +224,36 @@ def test_phase_1_asks_the_numeric_solver_only_what_a_branch_reaches(monkeypatch:
     from mrgc.geometry.ik_analytic import panda_chain, reaches
 
     assert all(reaches(m, panda_chain(m), t[None], np.zeros((1, 7)), ik.TOL_POS, ik.TOL_ROT)[0] for m, t in asked)
+
+
+@pytest.mark.parametrize("name", ["pa5.mrg", "pa3-handover.mrg"])
+def test_branches_checked_together_get_the_answers_each_gets_alone(name: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    """geometry/predicates.py: phase 1 checks the IK branches of a round together (one forward kinematics,
+    one self-collision check, one world query per selection for all of them) and each gets the answer it gets
+    checked alone: the same approach, the same movable objects hit, the same settled flag, for every round of
+    a whole phase 1 (picks, placements into goal and start regions; places that fail, hit or come out clean)."""
+    from mrgc.geometry.predicates import RobotEvaluator
+
+    rounds: list[tuple[RobotEvaluator, list, bool, list]] = []  # type: ignore[type-arg]
+    together = RobotEvaluator._branches
+
+    def recording(self, items, want_free):  # type: ignore[no-untyped-def]
+        answers = together(self, items, want_free)
+        rounds.append((self, items, want_free, answers))
+        return answers
+
+    monkeypatch.setattr(RobotEvaluator, "_branches", recording)
+    scene = scene_from_problem(parse_file(PACKAGING / name).problem())
+    compute_facts(scene, workers=1)
+    monkeypatch.setattr(RobotEvaluator, "_branches", together)
+    kinds = set()
+    for ev, items, want_free, answers in rounds:
+        for item, (answer, final) in zip(items, answers):
+            alone, final_alone = ev._branches([item], want_free)[0]
+            assert final == final_alone
+            assert (answer is None) == (alone is None)
+            if answer is not None and alone is not None:
+                assert np.array_equal(answer[0], alone[0]) and answer[1] == alone[1]
+            kinds.add("fails" if answer is None else "hits" if answer[1] else "clean")
+    assert len(rounds) > 5 and max(len(items) for _, items, _, _ in rounds) > 10
+    assert kinds == {"fails", "hits", "clean"}

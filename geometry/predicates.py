@@ -86,6 +86,7 @@ class RobotEvaluator:
         self.seed = seed
         self.out = RobotFacts()
         self.current = {m.name: r.name for m in scene.movable for r in scene.regions if inside(r, m.shape, m.pose)}
+        self._grasp_ts: dict[tuple[str, str], np.ndarray] = {}
 
     # ------------------------------------------------------------ primitives
     def _ik(
@@ -127,6 +128,16 @@ class RobotEvaluator:
         spec = self.scene.grasp_specs.get(grasp)
         return spec is not None and fits(spec, self.scene.body(obj).shape, self.arm.spec.kind)
 
+    def grasp_t(self, obj: str, grasp: str) -> np.ndarray:
+        """The tool pose in ``obj``'s frame for ``grasp`` (:func:`~mrgc.geometry.grasps.grasp_transform`), made
+        once per (object, grasp) and read-only."""
+        key = (obj, grasp)
+        t = self._grasp_ts.get(key)
+        if t is None:
+            t = self._grasp_ts[key] = grasp_transform(self.scene.grasp(grasp), self.scene.body(obj).shape)
+            t.setflags(write=False)
+        return t
+
     def opening(self, obj: str, grasp: str) -> float:
         """The finger opening while approaching or holding ``obj`` with ``grasp``."""
         return finger_opening(self.scene.grasp(grasp), self.scene.body(obj).shape)
@@ -157,25 +168,18 @@ class RobotEvaluator:
         found: dict[int, tuple[np.ndarray, set[str]]] = {}
         settled: set[int] = set()  # the hand hits what made the answer fail or unclean: no other branch helps
         todo = list(range(len(queries)))
+        blocked: dict[int, bool] = {}  # a placement whose object hits a fixed object there (asked once a query)
         for attempt in range(IK_SEEDS):
             if not todo:
                 break
-            g_ts = [
-                grasp_transform(self.scene.grasp(queries[i][1]), self.scene.body(queries[i][0]).shape) for i in todo
-            ]
+            g_ts = [self.grasp_t(queries[i][0], queries[i][1]) for i in todo]
             qs = self._ik([queries[i][2] @ g for i, g in zip(todo, g_ts)], "grasp", attempt=attempt)
             unsolvable = {i for i, q in zip(todo, qs) if q is None}  # IK with restarts failed: no retry
-            ok = [
-                (i, g, q)
-                for i, g, q in zip(todo, g_ts, qs)
-                if q is not None
-                and not (
-                    queries[i][3]
-                    and self.world.probe_collides(
-                        [(self.scene.body(queries[i][0]).shape, queries[i][2])], against="fixed"
-                    )
-                )
-            ]
+            for i, q in zip(todo, qs):
+                if q is not None and i not in blocked:
+                    obj, _, pose, held, _ = queries[i]
+                    blocked[i] = held and self.world.probe_collides([(self.scene.body(obj).shape, pose)], "fixed")
+            ok = [(i, g, q) for i, g, q in zip(todo, g_ts, qs) if q is not None and not blocked[i]]
             tools = [queries[i][2] @ pregrasp_transform(g) for i, g, _ in ok]
             # a pre-grasp no branch reaches (the analytic search, from the grasp's configuration) is settled
             # without a numeric solve: it would fail, restarts and all, and so would every retry
@@ -381,7 +385,6 @@ class RobotEvaluator:
         may hit an arm waiting at home or the partner's links where another branch of the arm does not."""
         keys, tools = [], []
         for obj in self.scene.goal:
-            body = self.scene.body(obj)
             for point in self.scene.handover_of.get(obj, ()):
                 if point not in self.scene.handover_points:
                     continue
@@ -391,7 +394,7 @@ class RobotEvaluator:
                 for g in self.scene.grasps[obj]:
                     if self.usable(obj, g):
                         keys.append((obj, point, g))
-                        tools.append(pose @ grasp_transform(self.scene.grasp(g), body.shape))
+                        tools.append(pose @ self.grasp_t(obj, g))
         model = self.arm.model
         todo = list(range(len(keys)))
         for attempt in range(HANDOVER_STARTS):

@@ -1,11 +1,18 @@
 """Phase 1 (geometric facts) on the packaging benchmark scenes, and the cost of one configuration check.
 
     python benchmarks/phase1.py --repeat 5
+    python benchmarks/phase1.py --cpu pa10 --seeds 0 1 2 3 4 5 --repeat 7
 
 Each repeat runs in a fresh process (no warm IK cache, robot models loaded from scratch), timing
 ``compute_facts`` with its default worker count (one process per robot, at most one per core).  The
 configuration check is one Panda configuration (all its link hulls) against the PA10 scene (table and
 10 boxes), amortised over 2,000 random configurations.
+
+``--cpu PRESET``: the CPU seconds of phase 1 on the suite's generated instances (``mrgc generate packaging
+--preset PRESET --seed S``), in this process and one worker (``compute_facts(scene, workers=1)``: what the
+robots' workers spend together), the robot models built first, the IK cache cleared before each repeat; the
+median and the minimum of the repeats after the first.  CPU seconds on a shared machine grow with the other
+cores' load: compare two trees in one sitting, alternately.
 """
 
 from __future__ import annotations
@@ -81,11 +88,45 @@ def config_check(n: int = 2000) -> float:
     return check, with_fk
 
 
+def phase1_cpu(name: str, seed: int, repeat: int) -> tuple[float, float, int]:
+    """Median and minimum CPU seconds of phase 1 (one worker) on instance ``seed`` of preset ``name``, and its
+    fact count."""
+    from mrgc import parse_string
+    from mrgc.generate import preset
+    from mrgc.geometry.arm import Arm
+    from mrgc.geometry.ik import clear_ik_cache
+    from mrgc.geometry.kinds import approaches
+    from mrgc.geometry.predicates import compute_facts
+    from mrgc.geometry.scene import scene_from_problem
+
+    text = preset(name, seed)
+    scene = scene_from_problem(parse_string(text, f"{name}-s{seed}.mrg", str(ROOT / "domains" / "packaging")).problem())
+    for spec in scene.robots:
+        if approaches(spec.kind):
+            _ = Arm(spec).hulls  # the models and their hulls, built once per process as a plan builds them
+    times, facts = [], 0
+    for _ in range(repeat + 1):
+        clear_ik_cache()
+        t0 = time.process_time()
+        facts = len(compute_facts(scene, seed=0, workers=1).facts)
+        times.append(time.process_time() - t0)
+    return statistics.median(times[1:]), min(times[1:]), facts
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--scenes", nargs="+", default=SCENES)
+    ap.add_argument("--cpu", metavar="PRESET", help="CPU seconds of phase 1 on a preset's generated instances")
+    ap.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2, 3, 4, 5])
     args = ap.parse_args()
+    if args.cpu:
+        print("| instance | facts | phase 1 CPU median (s) | min (s) |")
+        print("| --- | ---: | ---: | ---: |")
+        for seed in args.seeds:
+            med, low, facts = phase1_cpu(args.cpu, seed, args.repeat)
+            print(f"| {args.cpu}-s{seed} | {facts} | {med:.3f} | {low:.3f} |", flush=True)
+        return
     print(
         "| scene | robots | objects | facts | IK solves | workers | phase 1 median (s) | min (s) | incl. imports (s) |"
     )

@@ -518,8 +518,8 @@ EXACT_PLAIN = 32
 EXACT_BLOCK = 512
 
 
-#: marks of :func:`_exact`: a bool array, and for each candidate pair the index of its mark
-Marks = tuple[np.ndarray, np.ndarray]
+#: marks of :func:`_exact`: a bool array, and for each candidate pair the index of its mark (None: b's piece)
+Marks = tuple[np.ndarray, Union[np.ndarray, None]]
 
 
 def _exact(
@@ -527,8 +527,8 @@ def _exact(
 ) -> list[int]:
     """coal's narrowphase on the candidate pairs (a's piece i[k], b's piece j[k]): the k of the pairs that
     collide (within ``tolerance``, coal's security margin: the module docstring's semantics), in order, the
-    first one only with ``stop``.  ``marks`` (a bool array, and each pair's index into it: b's piece, or the
-    pair's probe and object): pairs whose mark is set are passed over, and a colliding one sets it
+    first one only with ``stop``.  ``marks`` (a bool array, and each pair's index into it, or None for b's
+    piece): pairs whose mark is set are passed over, and a colliding one sets it
     (which-objects queries need one contact per object; many probes at once one per probe, or per probe and
     object).
 
@@ -545,7 +545,7 @@ def _exact(
         k = np.arange(start, end)
         if start:
             k = k[_oriented_meet(a, b, i[k], j[k], 2 * tolerance)]
-        chosen = None if marks is None else (marks[0], marks[1][k])
+        chosen = marks if marks is None or marks[1] is None else (marks[0], marks[1][k])
         out.extend(int(k[x]) for x in _narrow(a, b, i[k], j[k], tolerance, stop, chosen))
         if stop and out:
             break
@@ -580,7 +580,7 @@ def _narrow(
     rel_pos = (inv_rot @ (tb[:, :3, 3:] - ta[:, :3, 3:]))[..., 0]
     out: list[int] = []
     ka, kb = a.kind[i].tolist(), b.kind[j].tolist()
-    skip, at = (None, []) if marks is None else (marks[0], marks[1].tolist())
+    skip, at = (None, []) if marks is None else (marks[0], (j if marks[1] is None else marks[1]).tolist())
     for k in range(len(ka)):
         if skip is not None and skip[at[k]]:
             continue
@@ -939,7 +939,7 @@ class CollisionWorld:
             return posed_collide(pieces, chosen, self.tolerance)
         i, j = overlaps(pieces, chosen)
         skip = np.zeros(len(sel), dtype=bool)
-        _exact(pieces, chosen, i, j, self.tolerance, stop=False, marks=(skip, j))
+        _exact(pieces, chosen, i, j, self.tolerance, stop=False, marks=(skip, None))
         return {self._order[int(k)].name for k in sel[skip]}
 
     def _tree_collides(self, tree: _Tree, objs: list[Any]) -> bool:

@@ -695,7 +695,7 @@ def test_the_oriented_box_cut_keeps_every_colliding_pair(seed: int, spread: floa
     pa, pb = Posed.of(a), Posed.of(b)  # type: ignore[arg-type]
     i, j = overlaps(pa, pb)
     assume(len(i) > collision.EXACT_PLAIN + 10)
-    marks = (lambda: (np.zeros(len(pb), dtype=bool), j)) if skipping else (lambda: None)
+    marks = (lambda: (np.zeros(len(pb), dtype=bool), None)) if skipping else (lambda: None)
     every = collision._narrow(pa, pb, i, j, TOLERANCE, False, marks())
     assert collision._exact(pa, pb, i, j, TOLERANCE, False, marks()) == every
     assert collision._exact(pa, pb, i, j, TOLERANCE, True) == every[:1]

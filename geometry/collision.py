@@ -388,8 +388,9 @@ class Probes:
 
 #: each probe's own object of :meth:`CollisionWorld.slot_collides` (a name or None per probe), or None
 Owners = Union[Sequence[Union[str, None]], None]
-#: a yes/no answer per probe; the names of the objects each probe hits
+#: a yes/no answer per probe (a bool array)
 Bools = np.ndarray
+#: the names of the objects each probe hits, one set per probe
 Names = list[set[str]]
 
 
@@ -876,10 +877,11 @@ class CollisionWorld:
         """Many probes asked at once (:class:`Probes`): for each, whether one of its pieces hits a selected
         object, the probe's ``own`` object excepted (``own[s]``: an object name or None, one per probe).  A
         (count,) bool array, the answers :meth:`probe_collides` gives each probe alone (with ``own[s]`` added to
-        ``ignore``): the same candidate pairs (one broadphase for all) and the same narrowphase, a probe's pairs
-        passed over once one of them collides.  Phase 1 checks the approaches of a round of queries this way."""
-        done = self._slotted(probes, against, ignore, own, hits=False)
-        return done
+        ``ignore``): the same candidate pairs (one broadphase for all), coal's narrowphase deciding each
+        (:func:`_exact`: past its first pairs only those whose oriented boxes meet, the others cannot collide),
+        a probe's pairs passed over once one of them collides.  Phase 1 checks the approaches of a round of
+        queries this way."""
+        return self._slotted(probes, against, ignore, own, hits=False)
 
     def slot_hits(self, probes: Probes, against: Against = None, ignore: Against = (), own: Owners = None) -> Names:
         """:meth:`slot_collides` answering :meth:`probe_hits` for each probe: the selected objects (but its

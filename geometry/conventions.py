@@ -128,7 +128,12 @@ def lattice_offsets(grid: int) -> list[tuple[float, float]]:
     return sorted(((float(a), float(b)) for a in ticks for b in ticks), key=lambda ab: (ab[0] ** 2 + ab[1] ** 2, ab))
 
 
-def refine(configs: Array, sub: int = 4) -> Array:
+#: configurations :func:`refine` puts per step of a path (the validator's resolution): row ``REFINE * k`` of a
+#: refined path is its configuration ``k``
+REFINE = 4
+
+
+def refine(configs: Array, sub: int = REFINE) -> Array:
     """Configurations (..., C, dof) with ``sub - 1`` more interpolated between consecutive ones (the
     validator's resolution), so facts and grounding agree with what the validator checks; leading axes are
     paths refined alike.  Row ``sub * k`` is configuration ``k`` itself."""

@@ -37,7 +37,7 @@ import numpy as np
 
 from mrgc.geometry.arm import Arm
 from mrgc.geometry.collision import Posed, Probes, posed_collide, scene_world
-from mrgc.geometry.conventions import APPROACH_SAMPLES, ARM_PLACE_LIFT, lattice_offsets, refine, seed_for
+from mrgc.geometry.conventions import APPROACH_SAMPLES, ARM_PLACE_LIFT, REFINE, lattice_offsets, refine, seed_for
 from mrgc.geometry.facts import FactsResult, HandoverConfig, RobotFacts
 from mrgc.geometry.grasps import finger_opening, fits, grasp_transform, pregrasp_transform
 from mrgc.geometry.ik import solve_ik_many
@@ -150,9 +150,7 @@ class RobotEvaluator:
         out: np.ndarray = q_pre[..., None, :] * (1 - s) + q[..., None, :] * s
         return out
 
-    def _solve(
-        self, queries: list[tuple[str, str, np.ndarray, bool, str]], want_free: bool
-    ) -> dict[int, tuple[np.ndarray, set[str]]]:
+    def _solve(self, queries: list[Query], want_free: bool) -> dict[int, Answer]:
         """Batched grasp + pre-grasp IK and collision checks for (object, grasp, object pose, held, key)
         queries; the approach path and the movable objects it hits for each query that is reachable.
 
@@ -165,7 +163,7 @@ class RobotEvaluator:
         answer when the analytic solver has no branch for that tool pose either (:meth:`Arm.no_branch
         <mrgc.geometry.arm.Arm.no_branch>`).
         """
-        found: dict[int, tuple[np.ndarray, set[str]]] = {}
+        found: dict[int, Answer] = {}
         settled: set[int] = set()  # the hand hits what made the answer fail or unclean: no other branch helps
         todo = list(range(len(queries)))
         blocked: dict[int, bool] = {}  # a placement whose object hits a fixed object there (asked once a query)
@@ -219,9 +217,12 @@ class RobotEvaluator:
         A branch fails when its approach (pre-grasp → grasp, refined to the validator's resolution) hits the arm
         itself or a fixed object, or, with the object in hand (a placement), the object hits a fixed one; else
         its hits are the movable objects the arm's links hit along the approach, and the object in hand hits
-        along it and at its placement.  The items are checked together, each check once for all of them (one
-        forward kinematics, one self-collision check, one query per world selection:
-        :meth:`~mrgc.geometry.collision.CollisionWorld.slot_collides`): the answers each would get alone."""
+        along it and at its placement.  The items are checked together: one forward kinematics, one
+        self-collision check, and one kernel query for all of them per world selection and kind of piece (the
+        arm's links, the object in hand: :meth:`~mrgc.geometry.collision.CollisionWorld.slot_collides`), the
+        answers each would get alone; only the hand checks of the branches that fail or hit something
+        (:meth:`_hand_hits`) and the pre-grasps without an answer (:meth:`Arm.no_branch
+        <mrgc.geometry.arm.Arm.no_branch>`) are asked branch by branch."""
         out: list[tuple[Answer | None, bool]] = [(None, False)] * len(items)
         for k, (query, g, _, q_pre) in enumerate(items):
             if q_pre is None:  # the pre-grasp, the same tool pose on every branch: settled when no branch reaches it
@@ -234,8 +235,7 @@ class RobotEvaluator:
         openings: list[float | None] = [self.opening(query[0], query[1]) for query in queries]
         pres = [q_pre for _, _, _, q_pre in items if q_pre is not None]
         paths = self._approach(np.stack(pres), np.stack([items[k][2] for k in live]))
-        dense = refine(paths)  # (n, D, dof): row sub * i is the path's configuration i
-        sub = (dense.shape[1] - 1) // (APPROACH_SAMPLES - 1)
+        dense = refine(paths, REFINE)  # (n, D, dof): row REFINE * i is the path's configuration i
         transforms = self._link_transforms(dense, openings)  # (n, D, L, 4, 4)
         self.out.collision_checks += len(live)
         clear = self._arm_clear(transforms, objs)
@@ -243,8 +243,7 @@ class RobotEvaluator:
             out[live[x]] = (None, self._hand_hits(paths[x], (objs[x],), openings[x], "fixed"))
         # the object in hand (placements), along the approach, must stay clear of fixed objects too
         held = [x for x in np.flatnonzero(clear).tolist() if queries[x][3]]
-        tools = self.arm.tool_world(dense[held]) if held else np.zeros((0, dense.shape[1], 4, 4))
-        in_hand = {x: t @ np.linalg.inv(items[live[x]][1]) for x, t in zip(held, tools)}
+        in_hand = {x: t @ np.linalg.inv(items[live[x]][1]) for x, t in zip(held, self.arm.tool_world(dense[held]))}
         stuck = self.world.slot_collides(self._objects([(objs[x], in_hand[x]) for x in held]), "fixed")
         for x in np.asarray(held, dtype=int)[stuck].tolist():
             clear[x] = False
@@ -253,11 +252,11 @@ class RobotEvaluator:
         if not ok:
             return out
         self.out.collision_checks += len(ok)
-        along = transforms[ok, ::sub]  # the links at the path's configurations
+        along = transforms[ok, ::REFINE]  # the links at the path's configurations
         probes = Probes.batch(self.arm.probes[0], along, self.world.tolerance)
         hits = self.world.slot_hits(probes, "movable", own=[objs[x] for x in ok])
         carried = [(c, x) for c, x in enumerate(ok) if x in in_hand]  # the object along it and at its placement
-        poses = [(objs[x], np.concatenate([in_hand[x][::sub], queries[x][2][None]])) for _, x in carried]
+        poses = [(objs[x], np.concatenate([in_hand[x][::REFINE], queries[x][2][None]])) for _, x in carried]
         more = self.world.slot_hits(self._objects(poses), "movable", own=[objs[x] for _, x in carried])
         for (c, _), m in zip(carried, more):
             hits[c] |= m

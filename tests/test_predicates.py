@@ -226,12 +226,39 @@ def test_phase_1_asks_the_numeric_solver_only_what_a_branch_reaches(monkeypatch:
     assert all(reaches(m, panda_chain(m), t[None], np.zeros((1, 7)), ik.TOL_POS, ik.TOL_ROT)[0] for m, t in asked)
 
 
+def _one_branch(ev, item, want_free):  # type: ignore[no-untyped-def]
+    """One IK branch's answer checked on its own with the single-probe queries (phase 1 before session 21)."""
+    from mrgc.geometry.conventions import refine
+    from mrgc.geometry.grasps import pregrasp_transform
+
+    (obj, grasp, pose, held, _), g, q, q_pre = item
+    if q_pre is None:
+        return None, ev.arm.no_branch(pose @ pregrasp_transform(g))
+    opening, shape, shapes = ev.opening(obj, grasp), ev.scene.body(obj).shape, ev.arm.probes[0]
+    path = ev._approach(q_pre, q)
+    links = ev.arm.link_transforms(refine(path), opening)
+    if ev.arm.self_collides_at(links) or ev.world.batch_collides(shapes, links, against="fixed", ignore=(obj,)):
+        return None, ev._hand_hits(path, (obj,), opening, "fixed")
+    if held and ev.world.probe_collides(
+        [(shape, t) for t in ev.arm.tool_world(refine(path)) @ np.linalg.inv(g)], against="fixed"
+    ):
+        return None, False
+    hits = ev.world.batch_hits(shapes, ev.arm.link_transforms(path, opening), against="movable", ignore=(obj,))
+    if held:
+        carried = [(shape, t) for t in ev.arm.tool_world(path) @ np.linalg.inv(g)] + [(shape, pose)]
+        hits |= ev.world.probe_hits(carried, against="movable", ignore=(obj,))
+    return (path, hits), bool(hits) and want_free and ev._hand_hits(path, (obj,), opening, "movable")
+
+
 @pytest.mark.parametrize("name", ["pa5.mrg", "pa3-handover.mrg"])
-def test_branches_checked_together_get_the_answers_each_gets_alone(name: str, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_branches_checked_together_answer_as_the_checks_one_at_a_time(
+    name: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
     """geometry/predicates.py: phase 1 checks the IK branches of a round together (one forward kinematics,
-    one self-collision check, one world query per selection for all of them) and each gets the answer it gets
-    checked alone: the same approach, the same movable objects hit, the same settled flag, for every round of
-    a whole phase 1 (picks, placements into goal and start regions; places that fail, hit or come out clean)."""
+    one self-collision check, one kernel query per selection for all of them) and each gets the answer its
+    own checks give, written out one branch at a time with the single-probe queries: the same approach, the
+    same movable objects hit, the same settled flag, for every round of a whole phase 1 (picks, placements into
+    goal and start regions; branches that fail, hit or come out clean, pre-grasps without an answer)."""
     from mrgc.geometry.predicates import RobotEvaluator
 
     rounds: list[tuple[RobotEvaluator, list, bool, list]] = []  # type: ignore[type-arg]
@@ -243,13 +270,11 @@ def test_branches_checked_together_get_the_answers_each_gets_alone(name: str, mo
         return answers
 
     monkeypatch.setattr(RobotEvaluator, "_branches", recording)
-    scene = scene_from_problem(parse_file(PACKAGING / name).problem())
-    compute_facts(scene, workers=1)
-    monkeypatch.setattr(RobotEvaluator, "_branches", together)
+    compute_facts(scene_from_problem(parse_file(PACKAGING / name).problem()), workers=1)
     kinds = set()
     for ev, items, want_free, answers in rounds:
         for item, (answer, final) in zip(items, answers):
-            alone, final_alone = ev._branches([item], want_free)[0]
+            alone, final_alone = _one_branch(ev, item, want_free)
             assert final == final_alone
             assert (answer is None) == (alone is None)
             if answer is not None and alone is not None:

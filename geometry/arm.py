@@ -162,16 +162,22 @@ class Arm:
         """The :meth:`held_collides_at` checks made so far, by held shape."""
         return {}
 
+    @cached_property
+    def _base_poses(self) -> np.ndarray:
+        """The world poses of the mount's solid links (:attr:`base_hulls`), (B, 4, 4)."""
+        return np.stack([pose for _, _, pose in self.base_hulls]) if self.base_hulls else np.zeros((0, 4, 4))
+
     def _with_base(self, transforms: np.ndarray) -> np.ndarray:
         """The probed links' transforms (C, L, 4, 4) with the mount's solid links' (fixed) in front."""
         t = np.asarray(transforms, dtype=float).reshape(-1, len(self.probes[1]), 4, 4)
-        if not self.base_hulls:
+        base = self._base_poses
+        if not len(base):
             return t
-        base = np.broadcast_to(np.stack([pose for _, _, pose in self.base_hulls]), (len(t), len(self.base_hulls), 4, 4))
-        return np.concatenate([base, t], axis=1)
+        return np.concatenate([np.broadcast_to(base, (len(t),) + base.shape), t], axis=1)
 
     def ee_target(self, tool_world: np.ndarray) -> np.ndarray:
-        """The end-effector pose (base frame) that puts the tool centre point at ``tool_world``."""
+        """The end-effector pose (base frame) that puts the tool centre point at ``tool_world`` (a 4×4, or
+        (..., 4, 4) for many)."""
         target: np.ndarray = self.base_inv @ tool_world @ self.tcp_inv
         return target
 
@@ -207,7 +213,7 @@ class Arm:
         chain = panda_chain(self.model)
         if chain is None or not tool_worlds:
             return [False] * len(tool_worlds)
-        targets = np.stack([self.ee_target(t) for t in tool_worlds])
+        targets = self.ee_target(np.stack(tool_worlds))
         if starts is not None:
             return [not ok for ok in reaches(self.model, chain, targets, starts, TOL_POS, TOL_ROT)]
         # from home, remembered per target (grounding asks again for the same poses, skeleton after skeleton)
@@ -274,7 +280,7 @@ class Arm:
         poses = None
         if held is not None:
             shape, in_tool = held
-            poses = np.stack([tool @ in_tool for tool in self.tool_world(configs)])
+            poses = self.tool_world(configs) @ in_tool
             shapes.append(shape)
             kind = np.concatenate([kind, np.full(len(configs), len(shapes) - 1)])
             flat = np.concatenate([flat, poses])

@@ -105,7 +105,7 @@ class RobotEvaluator:
         the approach between the two stays on its line."""
         if not tool_poses:
             return []
-        targets = np.stack([self.arm.ee_target(t) for t in tool_poses])
+        targets = self.arm.ee_target(np.stack(tool_poses))
         self.out.ik_solves += len(targets)
         start = self.arm.home if q_init is None else q_init
         one_start = np.ndim(start) == 1

@@ -320,7 +320,7 @@ class Posed:
         out = self._parts.get(box)
         if out is not None:
             return out
-        keep = np.flatnonzero(np.all(self.lo <= hi, axis=1) & np.all(lo <= self.hi, axis=1))
+        keep = np.flatnonzero(_boxes_overlap(self.lo, self.hi, lo, hi))
         out = self if len(keep) == len(self.kind) else self.rows(keep)
         if len(self._parts) >= 16:
             del self._parts[next(iter(self._parts))]
@@ -402,10 +402,21 @@ def _grouped(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return plo.reshape(-1, GROUP, 3).min(axis=1), phi.reshape(-1, GROUP, 3).max(axis=1)
 
 
+def _boxes_overlap(alo: np.ndarray, ahi: np.ndarray, blo: np.ndarray, bhi: np.ndarray) -> np.ndarray:
+    """Whether boxes ``[alo, ahi]`` and ``[blo, bhi]`` (arrays (..., 3), broadcast together) meet: on every axis
+    neither lies beyond the other (touching counts).  Axis by axis, not ``np.all(..., axis=-1)``: numpy's
+    reduction over an axis of three costs more than the comparisons (a broadphase of 187 pieces against 30:
+    441 -> 75 µs)."""
+    out: np.ndarray = (alo[..., 0] <= bhi[..., 0]) & (blo[..., 0] <= ahi[..., 0])
+    for k in (1, 2):
+        out &= alo[..., k] <= bhi[..., k]
+        out &= blo[..., k] <= ahi[..., k]
+    return out
+
+
 def _meet(alo: np.ndarray, ahi: np.ndarray, blo: np.ndarray, bhi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The index pairs (i, j) whose boxes meet, every pair tested."""
-    gap = np.maximum(alo[:, None, :] - bhi[None, :, :], blo[None, :, :] - ahi[:, None, :])
-    i, j = np.nonzero(gap.max(axis=2) <= 0)
+    """The index pairs (i, j) whose boxes meet, every pair tested (i major)."""
+    i, j = np.nonzero(_boxes_overlap(alo[:, None], ahi[:, None], blo[None], bhi[None]))
     return i, j
 
 
@@ -451,7 +462,7 @@ def _opened(a: Posed, b: Posed, ga: np.ndarray, gb: np.ndarray) -> tuple[np.ndar
     jb, ok_b = _members(b, gb, a, ga)
     g, p, q = np.nonzero(ok_a[:, :, None] & ok_b[:, None, :])
     i, j = ia[g, p], jb[g, q]
-    keep = np.all(a.lo[i] <= b.hi[j], axis=1) & np.all(b.lo[j] <= a.hi[i], axis=1)
+    keep = _boxes_overlap(a.lo[i], a.hi[i], b.lo[j], b.hi[j])
     return i[keep], j[keep]
 
 
@@ -465,7 +476,7 @@ def _members(a: Posed, ga: np.ndarray, b: Posed, gb: np.ndarray) -> tuple[np.nda
     idx = np.minimum(idx, na - 1)
     blo, bhi = b.coarse() if nb > GROUP else (b.lo, b.hi)
     lo, hi = a.lo[idx], a.hi[idx]  # (K, S, 3)
-    meet = np.all(lo <= bhi[gb][:, None, :], axis=2) & np.all(blo[gb][:, None, :] <= hi, axis=2)
+    meet = _boxes_overlap(lo, hi, blo[gb][:, None, :], bhi[gb][:, None, :])
     return idx, exists & meet
 
 
@@ -643,7 +654,7 @@ def _tree_probe(a: Posed, b: Posed, tolerance: float) -> bool:
     shapes, kind, transforms = a.shapes, a.kind, a.transforms
     if len(a) > GROUP:  # a batch: only its pieces whose boxes meet the box around all of b
         glo, ghi = b.coarse()
-        near = np.flatnonzero(np.all(a.lo <= ghi.max(axis=0), axis=1) & np.all(glo.min(axis=0) <= a.hi, axis=1))
+        near = np.flatnonzero(_boxes_overlap(a.lo, a.hi, glo.min(axis=0), ghi.max(axis=0)))
         kind, transforms = kind[near], transforms[near]
     for k, t in zip(kind.tolist(), transforms):
         obj = shapes[k].coal_object
@@ -659,10 +670,10 @@ def _near(small: Posed, large: Posed) -> tuple[np.ndarray, np.ndarray]:
     groups, then its pieces, that meet the box around all of ``small`` first; then the pairs."""
     lo, hi = small.lo.min(axis=0), small.hi.max(axis=0)
     glo, ghi = large.coarse()
-    groups = np.flatnonzero(np.all(glo <= hi, axis=1) & np.all(lo <= ghi, axis=1))
+    groups = np.flatnonzero(_boxes_overlap(glo, ghi, lo, hi))
     j = (groups[:, None] * GROUP + np.arange(GROUP)[None, :]).ravel()
     j = j[j < len(large)]
-    j = j[np.all(large.lo[j] <= hi, axis=1) & np.all(lo <= large.hi[j], axis=1)]
+    j = j[_boxes_overlap(large.lo[j], large.hi[j], lo, hi)]
     i, k = _meet(small.lo, small.hi, large.lo[j], large.hi[j])
     return i, j[k]
 
@@ -684,7 +695,7 @@ def paired_collide(a: Posed, a_slot: np.ndarray, b: Posed, b_slot: np.ndarray, t
         return False
     i = np.repeat(np.arange(len(a_slot)), count)
     j = np.repeat(sb - (np.cumsum(count) - count), count) + np.arange(total)
-    keep = np.all(a.lo[i] <= b.hi[j], axis=1) & np.all(b.lo[j] <= a.hi[i], axis=1)
+    keep = _boxes_overlap(a.lo[i], a.hi[i], b.lo[j], b.hi[j])
     return bool(_exact(a, b, i[keep], j[keep], tolerance, stop=True))
 
 

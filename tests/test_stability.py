@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 import pytest
 import validator_plans as vp
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from support import run_cli
 
@@ -67,6 +67,7 @@ def test_a_box_centred_on_a_larger_box_is_stable(
 
 @PROPERTY
 @given(a=sides, b=sides, A=sides, B=sides, share=st.floats(0.0, 0.999), yaw=yaws, x0=places, y0=places)
+@example(a=0.020000000000000004, b=1.0, A=0.02, B=1.0, share=0.5, yaw=0.0, x0=1.0, y0=0.0)  # 1 ulp past the edge
 def test_a_box_shifted_over_the_edge_topples_exactly_there(
     a: float, b: float, A: float, B: float, share: float, yaw: float, x0: float, y0: float
 ) -> None:
@@ -84,8 +85,8 @@ def test_a_box_shifted_over_the_edge_topples_exactly_there(
     assert s.margin == pytest.approx(want, abs=1e-9)
     if abs(want - s.required) > 1e-9:
         assert s.stable == (want >= s.required)
-    if dx > A / 2:
-        assert not s.stable and s.margin < 0
+    if dx > A / 2:  # past the edge: toppling (a centre a rounding error past it has a margin of 0, not < 0)
+        assert not s.stable and (s.margin < 0 or dx - A / 2 <= 1e-9)
 
 
 @pytest.mark.parametrize(("dx", "stable"), [(0.5 - MARGIN - 1e-6, True), (0.5 - MARGIN + 1e-6, False), (0.5, False)])

@@ -117,7 +117,9 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--scenes", nargs="+", default=SCENES)
-    ap.add_argument("--cpu", metavar="PRESET", help="CPU seconds of phase 1 on a preset's generated instances")
+    from mrgc.generate import PRESETS
+
+    ap.add_argument("--cpu", metavar="PRESET", choices=sorted(PRESETS), help="phase 1's CPU on a preset's instances")
     ap.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2, 3, 4, 5])
     args = ap.parse_args()
     if args.cpu:

@@ -45,3 +45,23 @@ def test_planning_refuses_what_is_neither_a_name_nor_a_file(tmp_path: Path) -> N
         out = run("--problems", "pa5", item, cwd=tmp_path)
         assert out.returncode == 2 and out.stdout == ""
         assert out.stderr.startswith(f"planning.py: error: --problems {item}: {why} (shipped: pa-basic")
+
+
+def test_phase1_cpu_times_the_generated_instances_of_a_preset(tmp_path: Path) -> None:
+    """``benchmarks/phase1.py --cpu PRESET --seeds ...``: one row per generated instance with its fact count (that
+    of ``compute_facts`` on the same instance) and CPU seconds; an unknown preset is refused by argparse."""
+    from mrgc import parse_string
+    from mrgc.generate import preset
+    from mrgc.geometry.predicates import compute_facts
+    from mrgc.geometry.scene import scene_from_problem
+
+    script = ROOT / "benchmarks" / "phase1.py"
+    cmd = [sys.executable, str(script), "--cpu", "pa5", "--seeds", "3", "--repeat", "1"]
+    out = subprocess.run(cmd, capture_output=True, text=True, cwd=tmp_path, timeout=300)
+    assert out.returncode == 0, out.stderr
+    row = out.stdout.splitlines()[-1].split("|")
+    problem = parse_string(preset("pa5", 3), "pa5-s3.mrg", str(ROOT / "domains" / "packaging")).problem()
+    assert row[1].strip() == "pa5-s3" and int(row[2]) == len(compute_facts(scene_from_problem(problem)).facts)
+    assert 0 < float(row[4]) <= float(row[3])
+    bad = subprocess.run([sys.executable, str(script), "--cpu", "pa55"], capture_output=True, text=True, timeout=60)
+    assert bad.returncode == 2 and "invalid choice: 'pa55'" in bad.stderr

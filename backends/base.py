@@ -22,7 +22,11 @@ class BackendInfo:
 
     ``features`` are the optional model features it translates natively (the others are lowered to rows);
     ``exports`` the file extensions ``export`` writes; ``module`` / ``distribution`` the import name and the
-    pip name of its library.
+    pip name of its library.  ``grow_horizon``: an encoding whose one model covers every makespan up to the
+    horizon limit (time-of-move) is still solved one horizon at a time, T = T0, T0 + 1, ..., as the loop
+    encodings are (the same skeleton keys in the same order; a model bounded near the makespan is proved
+    optimal far sooner by CP-SAT, HiGHS and pysmt's bound tightening, docs/compiler.md); False where
+    loading a model costs more than the larger search (z3's Python API).
     """
 
     name: str
@@ -33,6 +37,7 @@ class BackendInfo:
     exports: tuple[str, ...] = ()
     encodings: tuple[str, ...] = tuple(ENCODINGS)
     install: str = ""
+    grow_horizon: bool = True
 
     @property
     def pip(self) -> str:

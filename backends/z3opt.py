@@ -34,6 +34,7 @@ class Z3Backend(Backend):
         distribution="z3-solver",
         features=frozenset({Feature.CONDITIONAL, Feature.AT_MOST_ONE, Feature.LEXICOGRAPHIC}),
         exports=("smt2",),
+        grow_horizon=False,  # a model per horizon costs z3 a load each (docs/compiler.md, "time-of-move")
     )
 
     def _load(self, model: SkeletonModel) -> None:

@@ -3,9 +3,13 @@
 "Distinct" means a different *set of actions*: after each skeleton a cut excludes its action set at every
 horizon (a cut on the schedule would only exclude one ordering of the same plan).  For horizon-loop
 encodings the horizon grows T = T0, T0+1, ... up to the limit, carrying the cuts into each new model; a
-model of horizon T yields skeletons with exactly T non-empty steps, cheapest first.  For time-of-move one
-model covers every makespan up to the limit.  ``next(k)`` returns the next k skeletons and keeps the solver,
-the horizon and the cuts, so asking again continues where it stopped.
+model of horizon T yields skeletons with exactly T non-empty steps, cheapest first.  A time-of-move model
+covers every makespan up to its horizon; it too is solved one horizon at a time unless its solver says
+otherwise (``grow_horizon``): since its objective ranks makespan first, the model of horizon T yields the
+skeletons of makespan T once those of smaller makespans are used up (its infeasibility moves T on), the same
+keys in the same order as one model up to the limit, from a model whose bounds are tight (6-arm, 40-object
+packaging: 0.16 s per skeleton instead of 5 s with CP-SAT, docs/compiler.md).  ``next(k)`` returns the next
+k skeletons and keeps the solver, the horizon and the cuts, so asking again continues where it stopped.
 
 Beyond the paper, actions may be *deferred* (:meth:`SkeletonGenerator.defer`; the planner defers an action
 whose grounding keeps failing): the skeletons that hold none of them come first, and when those are used
@@ -51,13 +55,22 @@ class Batch:
 
 
 class SkeletonGenerator:
-    """Enumerates the skeletons of ``graph`` with ``encoding``, solving with solvers from ``make_solver``."""
+    """Enumerates the skeletons of ``graph`` with ``encoding``, solving with solvers from ``make_solver``;
+    ``grow_horizon``: an encoding without a horizon loop is solved one horizon at a time all the same
+    (module docstring), else in one model up to the limit."""
 
     def __init__(
-        self, graph: TaskGraph, encoding: Encoding, make_solver: Callable[[], Solver], max_makespan: int | None = None
+        self,
+        graph: TaskGraph,
+        encoding: Encoding,
+        make_solver: Callable[[], Solver],
+        max_makespan: int | None = None,
+        grow_horizon: bool = True,
     ) -> None:
         self.graph = prune(graph)
         self.encoding = encoding
+        #: one model per horizon T0, T0 + 1, ... (else one model of horizon ``limit``)
+        self.loop = encoding.horizon_loop or grow_horizon
         self.make_solver = make_solver
         # a skeleton moves each object at most once and at least one per step: no makespan exceeds the
         # number of objects, so a larger limit changes nothing but the size of time-indexed models
@@ -104,7 +117,7 @@ class SkeletonGenerator:
 
     def _load(self) -> None:
         t0 = time.perf_counter()
-        self.encoded = self.encoding.build(self.graph, self.horizon if self.encoding.horizon_loop else self.limit)
+        self.encoded = self.encoding.build(self.graph, self.horizon if self.loop else self.limit)
         self.solver = self.make_solver()
         self.solver.load(self.encoded.model)
         cuts = self._cuts(self.encoded)
@@ -142,7 +155,7 @@ class SkeletonGenerator:
                 self.solver.add_rows([self.encoded.cut(chosen, name=f"cut{len(self.found) - 1}")])
                 out.append(skel)
             elif sol.status == SolveStatus.INFEASIBLE:
-                if not self.encoding.horizon_loop:
+                if not self.loop:
                     self.done = True
                     continue
                 self.horizon += 1

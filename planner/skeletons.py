@@ -131,7 +131,9 @@ class SkeletonSource:
         self.graph: TaskGraph = build_task_graph(facts, must, moved)
         self.reasons = explain_infeasible(self.graph, facts)
         self.graph_seconds = time.perf_counter() - t0
-        self.generator = SkeletonGenerator(self.graph, enc, lambda: cls(seed=seed), max_makespan)
+        self.generator = SkeletonGenerator(
+            self.graph, enc, lambda: cls(seed=seed), max_makespan, grow_horizon=cls.info.grow_horizon
+        )
         if self.reasons:
             self.generator.done = True
 

@@ -22,8 +22,10 @@ from hypothesis import HealthCheck, assume, event, given, settings
 from hypothesis import strategies as st
 
 from mrgc import cli, parse_file, parse_string
+from mrgc.backends.registry import backend_class
 from mrgc.compiler.diagnose import explain_infeasible, explain_waits, orderable
-from mrgc.compiler.enumerate import BatchOutcome
+from mrgc.compiler.encodings import get_encoding
+from mrgc.compiler.enumerate import BatchOutcome, SkeletonGenerator
 from mrgc.compiler.facts import FactBase
 from mrgc.compiler.task_graph import Action, build_task_graph
 from mrgc.language.model import Problem
@@ -163,6 +165,38 @@ def test_deferred_actions_come_last_and_no_skeleton_is_lost(case: SymbolicCase, 
     first = [s.key for s, d in zip(got[1:], late) if not d]
     last = [s.key for s, d in zip(got[1:], late) if d]
     assert first == sorted(first) and last == sorted(last), where
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@given(problems(), st.sampled_from([None, 1, 2]))
+def test_time_of_move_one_horizon_at_a_time_enumerates_as_one_model_does(case: SymbolicCase, limit: Any) -> None:
+    """Time-of-move solved one horizon at a time (``grow_horizon``, CP-SAT's and HiGHS' default) and in one
+    model up to the limit (z3's): both enumerate, to the end, every feasible action set of the oracle once,
+    at its minimum makespan, in (makespan, moved) order; the horizon loop's infeasible models move it on."""
+    problem, text = case.problem(), case.text
+    sets = oracle.feasible_action_sets(reference_graph(problem))
+    assume(len(sets) <= 40)
+    cap = limit if limit is not None else max(1, len(problem.movable))
+    wanted = {a: m for a, m in sets.items() if m <= cap}
+    graph = build_task_graph(FactBase.from_problem(problem), must_move(problem))
+    for grow in (True, False):
+        generator = SkeletonGenerator(
+            graph, get_encoding("time-of-move"), lambda: backend_class("cpsat")(), limit, grow_horizon=grow
+        )
+        got = []
+        while True:
+            batch = generator.next(3)
+            got += batch.skeletons
+            if batch.outcome is not BatchOutcome.ENOUGH:
+                break
+        where = f"grow_horizon={grow}, limit {limit}\n{text}"
+        assert batch.outcome is BatchOutcome.EXHAUSTED, where
+        assert [s.key for s in got] == sorted((m, len(a)) for a, m in wanted.items()), where
+        assert {s.actions: s.makespan for s in got} == wanted, where
+        if grow and got and got[-1].makespan:  # a model per horizon from T0 to the last skeleton's makespan
+            assert generator.stats["models"] >= got[-1].makespan - generator.first_horizon + 1, where
+        if not grow:
+            assert generator.stats["models"] <= 1, where
 
 
 # ---------------------------------------------------------------- the oracle is not vacuous

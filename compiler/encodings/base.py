@@ -30,7 +30,9 @@ class Encoding(ABC):
     """Builds the skeleton model of a task graph for a horizon.
 
     With ``horizon_loop`` the generator builds one model per horizon T = 1, 2, ... (a model's skeletons
-    have exactly T non-empty steps); without it, one model covers every makespan up to the limit.
+    have exactly T non-empty steps); without it, one model of horizon T covers every makespan up to T, so
+    one model up to the limit would do (the generator grows the horizon anyway for most solvers,
+    :mod:`mrgc.compiler.enumerate`).
     """
 
     name: str = ""

@@ -7,6 +7,8 @@ selected action, and every obstacle of a selected action moves; pick obstacles s
 objects it handles occupy distinct steps (no-overlap of unit tasks).  The objective is lexicographic:
 makespan, then number of moved objects.  At an optimum no step is empty (an empty step could be squeezed
 out, lowering the makespan), so the model ranks skeletons exactly like the horizon loop of the paper.
+One model of horizon H covers every makespan up to H; the skeleton generator still builds one per horizon
+H = T0, T0 + 1, ... for most solvers (:mod:`mrgc.compiler.enumerate`, ``grow_horizon``).
 """
 
 from __future__ import annotations
@@ -21,7 +23,8 @@ from mrgc.compiler.task_graph import TaskGraph
 
 
 class TimeOfMoveEncoding(Encoding):
-    """The time-of-move encoding (module docstring): one integer step per object, no horizon loop."""
+    """The time-of-move encoding (module docstring): one integer step per object; a model of horizon H holds
+    every skeleton of makespan at most H (no horizon loop needed, :attr:`horizon_loop` False)."""
 
     name = "time-of-move"
     horizon_loop = False

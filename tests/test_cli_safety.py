@@ -310,7 +310,10 @@ def alive(pid: int) -> bool:
 )
 def test_a_signal_during_phase_1_kills_every_worker(tmp_path: Path, sig: int, code: int, word: str) -> None:
     (tmp_path / "domain.mrg").write_bytes((PACKAGING / "domain.mrg").read_bytes())
-    (tmp_path / "P.mrg").write_bytes((PACKAGING / "pa10.mrg").read_bytes())
+    # pa18-4arms: a phase 1 of many seconds, so that the signal sent 0.3 s after its workers started still
+    # finds it running on a machine loaded enough to delay this test's own sleep (pa10's phase 1 of ~1 s
+    # had ended first there: "interrupted (SIGINT)" without the activity, a full suite at load 7)
+    (tmp_path / "P.mrg").write_bytes((PACKAGING / "pa18-4arms.mrg").read_bytes())
     before = snapshot(tmp_path)
     proc = subprocess.Popen(
         [*MRGC, "facts", "P.mrg", "-o", "facts.mrg", "--workers", "2"],

@@ -22,7 +22,7 @@ from mrgc.geometry.answers import Answer, GroundStatus
 from mrgc.geometry.collision import TOLERANCE, Posed, posed_collide
 from mrgc.geometry.conventions import ARM_PLACE_LIFT, lattice_offsets, seed_for
 from mrgc.geometry.grasps import grasp_transform
-from mrgc.geometry.robot import Volume
+from mrgc.geometry.robot import Sweep
 from mrgc.geometry.scene import Body as SceneBody
 from mrgc.geometry.scene import half_extents, inside
 from mrgc.geometry.step_world import StepWorld
@@ -41,7 +41,7 @@ class Placements(StepWorld):
         obj: str,
         region: str | SceneBody,
         avoid: Iterable[str] = (),
-        volume: Volume | None = None,
+        volume: Sweep | None = None,
         samples: int = 200,
         key: str = "",
         skip: int = 0,
@@ -66,7 +66,7 @@ class Placements(StepWorld):
         obj: str,
         region: str | SceneBody,
         avoid: Iterable[str] = (),
-        volume: Volume | None = None,
+        volume: Sweep | None = None,
         samples: int = 200,
         key: str = "",
         packed: bool = False,
@@ -119,7 +119,7 @@ class Placements(StepWorld):
             yield pose
 
     def crowded_out(
-        self, objs: Iterable[str], region: str, avoid: Iterable[str] = (), volume: Volume | None = None, key: str = ""
+        self, objs: Iterable[str], region: str, avoid: Iterable[str] = (), volume: Sweep | None = None, key: str = ""
     ) -> str | None:
         """The first of ``objs`` that has no free pose left in ``region`` (the candidates and checks of a
         packed :meth:`placements`: fixed objects, ``avoid``, ``volume``), or None when each has one; objects

@@ -33,17 +33,20 @@ touches.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Mapping, Protocol, Sequence, runtime_checkable
+from typing import Mapping, Protocol, Sequence, Union, runtime_checkable
 
 import numpy as np
 
-from mrgc.geometry.collision import CollisionShape
+from mrgc.geometry.collision import CollisionShape, Posed
 from mrgc.language.model import GraspSpec, Shape
 
 #: collision shapes at world transforms: what a robot (and what it holds) occupies
 Volume = list[tuple[CollisionShape, np.ndarray]]
 #: a volume as the queries read it (what other robots sweep meanwhile, ``busy``): any sequence of pieces
 Pieces = Sequence[tuple[CollisionShape, np.ndarray]]
+#: a volume to keep clear of (V_fut): pieces, or a set the kernel already reads (a grounded suffix's, kept
+#: compact: :meth:`Posed.join <mrgc.geometry.collision.Posed.join>`)
+Sweep = Union[Pieces, Posed]
 #: a held object: its collision shape and its pose in the robot's holding frame (:meth:`Robot.hold`)
 Held = tuple[CollisionShape, np.ndarray]
 

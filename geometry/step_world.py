@@ -286,7 +286,9 @@ class _VolumeCache:
         #: (the list, its length then, its conversion, its pieces then)
         self.kept: list[tuple[Pieces, int, Posed, tuple[tuple[CollisionShape, np.ndarray], ...]]] = []
 
-    def posed(self, volume: Pieces) -> Posed:
+    def posed(self, volume: Pieces | Posed) -> Posed:
+        if isinstance(volume, Posed):
+            return volume  # already the kernel's (a grounded suffix's volume: :meth:`Posed.join`)
         for k, (held, n, posed, _) in enumerate(self.kept):
             if held is volume and n == len(volume):
                 if k:

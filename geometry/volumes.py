@@ -19,7 +19,7 @@ from typing import Callable, Iterable
 import numpy as np
 
 from mrgc.geometry.collision import CollisionShape, Posed
-from mrgc.geometry.robot import Held, Volume
+from mrgc.geometry.robot import Held, Sweep, Volume
 from mrgc.geometry.step_world import StepWorld
 
 
@@ -134,7 +134,7 @@ class Volumes(StepWorld):
         obj, grasp = holding
         return self.shape(obj), self._grip(robot, obj, grasp)[1]
 
-    def hits(self, volume: Volume, among: Iterable[str] | str = "movable", ignore: Iterable[str] = ()) -> set[str]:
+    def hits(self, volume: Sweep, among: Iterable[str] | str = "movable", ignore: Iterable[str] = ()) -> set[str]:
         """The objects of ``among`` (names or a group) that ``volume`` overlaps."""
         self.queries += 1
         return self.world.probe_hits(volume, against=_against(among), ignore=tuple(ignore))

@@ -47,7 +47,7 @@ from mrgc.planner.outcome import Failure
 
 if TYPE_CHECKING:
     from mrgc.geometry.grounding import Grounder
-    from mrgc.geometry.robot import Volume
+    from mrgc.geometry.robot import Sweep
 
 #: a part of an action that can be doomed: ("pick", object, robot) or ("place", object, region, robot)
 Part = tuple[str, ...]
@@ -92,7 +92,7 @@ class DoomedActions:
         self.static_picks: dict[tuple[str, str, str], Failure] = {}
         self.probes: dict[tuple[Action, frozenset[str], tuple[int, ...]], Failure | None] = {}
         self._alive: dict[tuple[int, ...], tuple[Any, ...]] = {}
-        self._volume: Volume = []
+        self._volume: Sweep = []
         #: probes made and skeletons failed by one (the search's statistics)
         self.probed = 0
         self.doomed = 0
@@ -112,7 +112,7 @@ class DoomedActions:
             self.suspects
         )
 
-    def first(self, skeleton: Skeleton, later: Iterable[str], suffix: list[Any], volume: Volume) -> Failure | None:
+    def first(self, skeleton: Skeleton, later: Iterable[str], suffix: list[Any], volume: Sweep) -> Failure | None:
         """The failure of the latest step of ``skeleton`` holding a doomed action (its step and action set),
         when the objects ``later`` (the suffix's) are moved after the skeleton; None when no probe fails."""
         known = self._static(skeleton)

@@ -71,7 +71,9 @@ class GroundedStep:
     """A grounded joint action: its actions, the volume it sweeps, and the objects it moves."""
 
     actions: list[PlannedAction]
-    volume: Volume
+    #: every sample of every motion of the step, and its objects at their placements, as the collision kernel
+    #: reads it (kept compact: a search holds the volumes of every step its nodes grounded)
+    volume: Posed
     moved: tuple[str, ...]
 
 
@@ -229,7 +231,7 @@ class ReverseGrounder:
                 continue
             key = (tuple(id(s) for s in suffix), a.obj, a.region)
             if key not in self._full:  # the suffix is kept with the answer: its steps' ids stay theirs
-                volume = [p for s in suffix for p in s.volume]
+                volume = swept(suffix)
                 free = self.g.placements(
                     a.obj, a.region, volume=volume or None, samples=DEAD_END_SAMPLES, key="dead-end", packed=True
                 )
@@ -242,7 +244,7 @@ class ReverseGrounder:
         fut_objs = {o for s in suffix for o in s.moved}
         skel_objs = set(skeleton.moved)
         out_objs = set(self.movable) - fut_objs - skel_objs
-        volume: Volume = [p for s in suffix for p in s.volume]
+        volume = swept(suffix)
         grounded: list[GroundedStep] = []
         self._plan = _Retiming([list(step) for step in skeleton.steps], order)
         doomed = self.doomed.first(skeleton, fut_objs, suffix, volume)
@@ -264,9 +266,7 @@ class ReverseGrounder:
                 # M* as the paper defines it: every movable object not moved in S' that obstructs the whole
                 # grounded sequence S' (this call's steps *and* the older suffix: an object the suffix hits
                 # was to be moved by a step of this skeleton that is now discarded)
-                blockers = self.g.hits(
-                    [p for s in steps for p in s.volume], among=sorted(o for o in self.movable if o not in moved)
-                )
+                blockers = self.g.hits(swept(steps), among=sorted(o for o in self.movable if o not in moved))
                 must = {o for o in self.goal if o not in moved} | blockers
                 return self._plan.told(
                     Grounding(
@@ -279,13 +279,13 @@ class ReverseGrounder:
                 )
             self._plan.commit()
             grounded[:0] = strict
-            volume = volume + [p for s in strict for p in s.volume]
+            volume = swept(strict, volume)
             fut_objs |= moved_objects(strict)  # re-timed actions left for an earlier step
         return self._plan.told(Grounding(Outcome.SUCCESS, grounded + suffix))
 
     # ------------------------------------------------------------ one joint action
     def _steps(
-        self, step: tuple[Action, ...], avoid: set[str], v_fut: Volume, key: str, index: int
+        self, step: tuple[Action, ...], avoid: set[str], v_fut: Posed, key: str, index: int
     ) -> list[GroundedStep] | Failure:
         """Ground one skeleton step; when its robots get in each other's way (an action collides with what
         another robot of the step sweeps in the same phase), split it: the failing action alone one step
@@ -323,7 +323,7 @@ class ReverseGrounder:
                 head = self._steps(
                     earlier,
                     avoid | {a.obj for a in later},
-                    v_fut + [p for s in tail for p in s.volume],
+                    swept(tail, v_fut),
                     f"{key}:early",
                     index,
                 )
@@ -336,7 +336,7 @@ class ReverseGrounder:
         return done
 
     def _relay_steps(
-        self, step: tuple[Action, ...], avoid: set[str], v_fut: Volume, key: str, index: int
+        self, step: tuple[Action, ...], avoid: set[str], v_fut: Posed, key: str, index: int
     ) -> list[GroundedStep] | Failure:
         """A skeleton step holding relays (beyond the paper) as two plan steps: the step's other actions with
         each relay setting its object down at a spot of its ``via`` region, then the relays' onward moves
@@ -359,7 +359,7 @@ class ReverseGrounder:
             before, self.grounded = self.grounded, self.grounded | set(spots)
             self._forced = spots
             try:
-                head = self._steps(first, avoid, v_fut + [p for s in tail for p in s.volume], f"{key}:down:{k}", index)
+                head = self._steps(first, avoid, swept(tail, v_fut), f"{key}:down:{k}", index)
             finally:
                 self.grounded, self._forced = before, {}
             if isinstance(head, Failure):
@@ -372,7 +372,7 @@ class ReverseGrounder:
         return last
 
     def _spots(
-        self, relays: list[Action], avoid: set[str], v_fut: Volume, key: str, k: int
+        self, relays: list[Action], avoid: set[str], v_fut: Posed, key: str, k: int
     ) -> dict[str, np.ndarray] | Failure:
         """For each relay, its k-th free spot in its ``via`` region (clear of ``avoid`` at their poses, of
         ``v_fut`` and of the spots chosen before) where its first robot sets the object down with its grasp
@@ -389,7 +389,7 @@ class ReverseGrounder:
                 g.comfortable(a.pick_robot, a.obj, a.pick_grasp), g.comfortable(a.place_robot, a.obj, a.place_grasp)
             )
             for pose in g.placements(
-                a.obj, where, avoid=others, volume=v_fut + taken, key=key, packed=True, prefer=both
+                a.obj, where, avoid=others, volume=_plus(v_fut, taken), key=key, packed=True, prefer=both
             ):
                 self._on_time()
                 tried += 1
@@ -409,7 +409,7 @@ class ReverseGrounder:
         return out
 
     def ground_step(
-        self, step: tuple[Action, ...], avoid: set[str], v_fut: Volume, key: str, index: int = 0
+        self, step: tuple[Action, ...], avoid: set[str], v_fut: Posed, key: str, index: int = 0
     ) -> GroundedStep | Failure:
         """One joint action grounded on its own (the unit the baselines search over, planner/baselines/): the
         actions of ``step`` in one plan step, clear of the objects ``avoid`` where the grounder has them (their
@@ -419,7 +419,7 @@ class ReverseGrounder:
         return self._step(step, avoid, {a.obj for a in step}, v_fut, key, index)
 
     def _step(
-        self, step: tuple[Action, ...], avoid: set[str], same: set[str], v_fut: Volume, key: str, index: int = 0
+        self, step: tuple[Action, ...], avoid: set[str], same: set[str], v_fut: Posed, key: str, index: int = 0
     ) -> GroundedStep | Failure:
         # where each robot of the step is in each phase follows from its role (the execution model)
         self.g.step(roles((a.pick_robot, a.place_robot) for a in step), self.full)
@@ -429,7 +429,7 @@ class ReverseGrounder:
             self.g.step({})
 
     def _actions(
-        self, step: tuple[Action, ...], avoid: set[str], same: set[str], v_fut: Volume, key: str, index: int
+        self, step: tuple[Action, ...], avoid: set[str], same: set[str], v_fut: Posed, key: str, index: int
     ) -> GroundedStep | Failure:
         actions: list[PlannedAction] = []
         step_volume: Volume = []
@@ -440,11 +440,11 @@ class ReverseGrounder:
             avoid_a = sorted((avoid | same) - {a.obj})
             # what the other robots of the step sweep or occupy in each phase: this action keeps clear of it
             busy = _swept_by_others(motions, (a.pick_robot, a.place_robot))
-            action = self._action(a, avoid_a, v_fut + step_volume, f"{key}:{a.obj}", placed, busy)
+            action = self._action(a, avoid_a, _plus(v_fut, step_volume), f"{key}:{a.obj}", placed, busy)
             if isinstance(action, Failure) and action.detail == BUSY:
                 # kept clear of the whole of what the others sweep (when they pass ignored), it fails: then as
                 # they pass, the sample-paired comparison below (the validator's) decides
-                timed = self._action(a, avoid_a, v_fut + step_volume, f"{key}:{a.obj}", placed, {})
+                timed = self._action(a, avoid_a, _plus(v_fut, step_volume), f"{key}:{a.obj}", placed, {})
                 action = action if isinstance(timed, Failure) else timed
             if isinstance(action, Failure):
                 self.doomed.failed(a, action)
@@ -468,7 +468,7 @@ class ReverseGrounder:
             step_volume.append((self.g.shape(a.obj), np.array(action.place_pose)))
             placed[a.obj] = np.array(action.place_pose)
             actions.append(action)
-        return GroundedStep(actions, step_volume, tuple(a.obj for a in step))
+        return GroundedStep(actions, Posed.of(step_volume), tuple(a.obj for a in step))
 
     def _motions(self, action: PlannedAction) -> Motions:
         """Each robot's volume at every sample of every phase of a planned action, approaches on the
@@ -553,7 +553,7 @@ class ReverseGrounder:
         self,
         a: Action,
         avoid: list[str],
-        v_fut: Volume,
+        v_fut: Posed,
         key: str,
         placed: dict[str, np.ndarray] | None = None,
         busy: dict[str, Volume] | None = None,
@@ -610,7 +610,7 @@ class ReverseGrounder:
         start: np.ndarray,
         lift: bool,
         avoid: list[str],
-        v_fut: Volume,
+        v_fut: Posed,
         key: str,
         placed: dict[str, np.ndarray] | None,
         busy: dict[str, Volume],
@@ -701,7 +701,7 @@ class ReverseGrounder:
         a: Action,
         planned: PlannedAction,
         avoid: list[str],
-        v_fut: Volume,
+        v_fut: Posed,
         placed: dict[str, np.ndarray],
         key: str,
     ) -> Failure | None:
@@ -713,7 +713,7 @@ class ReverseGrounder:
         if not still:
             return None
         mine = [p for phases in self._motions(planned).values() for vols in phases.values() for v in vols for p in v]
-        crowded = self.g.crowded_out(still, planned.region, avoid, v_fut + mine, key)
+        crowded = self.g.crowded_out(still, planned.region, avoid, _plus(v_fut, mine), key)
         if crowded is None:
             return None
         return Failure(0, "", f"placement: leaves no free pose of {crowded} in {planned.region}")
@@ -826,7 +826,7 @@ class ReverseGrounder:
         self,
         a: Action,
         avoid: list[str],
-        v_fut: Volume,
+        v_fut: Posed,
         key: str,
         placed: dict[str, np.ndarray],
         busy: dict[str, Volume],
@@ -1059,6 +1059,17 @@ def _path_of(action: PlannedAction, phase: str) -> tuple[str, str | None, bool]:
         "giver-home": (action.pick_robot, action.pick_grasp, False),
     }
     return table[phase]
+
+
+def swept(steps: Iterable[GroundedStep], before: Posed | None = None) -> Posed:
+    """The volume ``steps`` sweep (their volumes one after the other: V_fut of the step before them), after
+    ``before``'s pieces when given; a new set, whatever caches the queries of it grow stay with it."""
+    return Posed.join([*([before] if before is not None else []), *(s.volume for s in steps)])
+
+
+def _plus(volume: Posed, pieces: Volume) -> Posed:
+    """``volume`` and then ``pieces`` (``volume`` itself when there are none: its caches go on)."""
+    return Posed.join([volume, Posed.of(pieces, volume.pad)]) if pieces else volume
 
 
 def _swept_by_others(motions: Motions, robots: tuple[str, ...]) -> dict[str, Volume]:

@@ -679,6 +679,36 @@ def test_a_set_extended_by_pieces_is_the_set_of_all_its_pieces(seed: int, n_a: i
     assert converted == ([] if made is not None else [len(a) + len(b)])
 
 
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**31 - 1), st.lists(st.integers(0, 80), min_size=0, max_size=4), st.sampled_from([1, 2, 3]))
+def test_joined_sets_are_the_set_of_all_their_pieces(seed: int, sizes: list[int], kinds: int) -> None:
+    """``Posed.join`` (a grounded suffix's volume from its steps' sets) holds the pieces of its parts in order:
+    the distinct shapes in order of first appearance, the same rows, the boxes ``Posed.of`` makes of all the
+    pieces (to rounding: a part of one shape bounds it another way), and the same answers against a probe; it
+    is a new set whose queries grow no cache on its parts, and the parts are left as they were."""
+    from mrgc.geometry.collision import Posed, posed_collide
+
+    rng = np.random.default_rng(seed)
+    pool = _random_pieces(rng, 12, 0.5)
+    pieces = [[pool[k] for k in rng.integers(0, len(pool), n) if k % 3 < kinds] for n in sizes]
+    parts = [Posed.of(p) for p in pieces]  # type: ignore[arg-type]
+    before = [(p.kind.copy(), p.transforms.copy(), p.lo.copy()) for p in parts]
+    joined = Posed.join(parts)
+    whole = Posed.of([x for p in pieces for x in p])  # type: ignore[misc]
+    assert joined is not whole and all(joined is not p for p in parts)
+    assert [id(s) for s in joined.shapes] == [id(s) for s in whole.shapes]
+    assert np.array_equal(joined.kind, whole.kind) and np.array_equal(joined.transforms, whole.transforms)
+    assert np.allclose(joined.lo, whole.lo, atol=1e-12) and np.allclose(joined.hi, whole.hi, atol=1e-12)
+    probe = Posed.of(_random_pieces(rng, 5, 0.5))  # type: ignore[arg-type]
+    assert posed_collide(joined, probe) == posed_collide(whole, probe)
+    assert posed_collide(probe, joined) == posed_collide(probe, whole)
+    joined.within(np.full(3, -0.2), np.full(3, 0.2))
+    for p, (kind, transforms, lo) in zip(parts, before):
+        assert not p._parts and p._tree is None  # the union's caches are its own
+        assert np.array_equal(p.kind, kind) and np.array_equal(p.transforms, transforms)
+        assert np.array_equal(p.lo, lo)
+
+
 @settings(max_examples=40, deadline=None)
 @given(st.integers(0, 2**31 - 1), st.sampled_from([0.1, 0.25, 0.6]), st.booleans())
 def test_the_oriented_box_cut_keeps_every_colliding_pair(seed: int, spread: float, skipping: bool) -> None:

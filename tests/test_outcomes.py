@@ -21,7 +21,9 @@ from mrgc import __version__, cli, parse_file
 from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action
 from mrgc.geometry.answers import BUSY, Answer, GroundStatus
+from mrgc.geometry.collision import CollisionShape, Posed, collision_shape
 from mrgc.geometry.stances import Stance
+from mrgc.language.model import Box
 from mrgc.planfile.format import PlannedAction, file_sha256
 from mrgc.planner.ground import GroundedStep, Outcome, ReverseGrounder
 from mrgc.planner.outcome import EXIT_CODES, PlanStatus
@@ -208,7 +210,8 @@ def test_a_plan_the_validator_rejects_is_a_failure_fed_back() -> None:
 # ------------------------------------------------------------------ M* as the paper defines it
 class ScriptedGrounder:
     """Answers the reverse grounder's geometric queries from a script: picks of an object fail while any
-    object of ``blocked_by[obj]`` must be avoided; volumes are tokens, and ``hits`` reads them."""
+    object of ``blocked_by[obj]`` must be avoided; volumes are tokens (a shape each, at the origin), and
+    ``hits`` reads them."""
 
     def __init__(
         self,
@@ -225,6 +228,15 @@ class ScriptedGrounder:
         self.poses = {m: np.eye(4) for m in movable}
         self.steps: list[list[str]] = []
         self.cut = False  # no query of the script stops at a deadline
+        self.tokens: dict[str, CollisionShape] = {}
+        self.named: dict[int, str] = {}  # a token's shape (its id) -> its name
+
+    def token(self, name: str) -> CollisionShape:
+        """The shape standing for token ``name`` (one per name: boxes of distinct sizes)."""
+        if name not in self.tokens:
+            shape = self.tokens[name] = collision_shape(Box(0.01 * (1 + len(self.tokens)), 0.01, 0.01))
+            self.named[id(shape)] = name
+        return self.tokens[name]
 
     def robot(self, robot: str) -> Any:
         return SimpleNamespace(approaches=True, parks=False)  # the script's robots are arms
@@ -299,18 +311,19 @@ class ScriptedGrounder:
         return None
 
     def arm_volume(self, robot: str, configs: np.ndarray, holding: Any = None, grasp: Any = None) -> list[Any]:
-        return [(f"arm:{robot}:{holding[0] if holding else ''}", None)]
+        return [(self.token(f"arm:{robot}:{holding[0] if holding else ''}"), np.eye(4))]
 
     def volumes(self, robot: str, configs: np.ndarray, holding: Any = None, fingers: Any = None) -> list[Any]:
         return [self.arm_volume(robot, configs, holding, fingers)]  # one token volume for the whole motion
 
-    def shape(self, obj: str) -> str:
-        return f"shape:{obj}"
+    def shape(self, obj: str) -> CollisionShape:
+        return self.token(f"shape:{obj}")
 
-    def hits(self, volume: list[Any], among: Any = "movable", ignore: Any = ()) -> set[str]:
+    def hits(self, volume: Any, among: Any = "movable", ignore: Any = ()) -> set[str]:
+        shapes = [volume.shapes[k] for k in volume.kind] if isinstance(volume, Posed) else [s for s, _ in volume]
         out: set[str] = set()
-        for token, _ in volume:
-            out |= self.sweeps.get(token, set())
+        for shape in shapes:
+            out |= self.sweeps.get(self.named[id(shape)], set())
         return out & set(among)
 
 
@@ -321,7 +334,8 @@ def test_m_star_keeps_the_blockers_of_an_older_suffix() -> None:
     sweeps = {"suffix-volume": {"b"}, "arm:r1:": {"d"}}
     grounder = ScriptedGrounder(movable, blocked_by={"c": {"d"}}, sweeps=sweeps)
     reverse = ReverseGrounder(grounder, {"g": "goal"})  # type: ignore[arg-type]
-    suffix = [GroundedStep([PlannedAction("g", "goal", "r1", "r1", "top", "top")], [("suffix-volume", None)], ("g",))]
+    swept = Posed.of([(grounder.token("suffix-volume"), np.eye(4))])
+    suffix = [GroundedStep([PlannedAction("g", "goal", "r1", "r1", "top", "top")], swept, ("g",))]
     skeleton = Skeleton(
         ((Action("b", "start", "r1", "r1", "top", "top"),), (Action("c", "start", "r1", "r1", "top", "top"),))
     )

@@ -17,7 +17,7 @@ from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action
 from mrgc.planfile.format import PlannedAction, file_sha256
 from mrgc.planfile.reader import read_plan
-from mrgc.planner.ground import GroundedStep, Grounding, Outcome
+from mrgc.planner.ground import GroundedStep, Grounding, Outcome, swept
 from mrgc.planner.mcts import MCTS
 from mrgc.planner.search import plan_problem
 from mrgc.validator.validate import validate
@@ -110,7 +110,7 @@ SKEL_CLEAR = Skeleton(((A2,), (A1,)))
 
 
 def step_of(action: Action) -> GroundedStep:
-    return GroundedStep([PlannedAction(action.obj, action.region, "r1", "r1", "top", "top")], [], (action.obj,))
+    return GroundedStep([PlannedAction(action.obj, action.region, "r1", "r1", "top", "top")], swept(()), (action.obj,))
 
 
 def feeder(skeletons: list[Skeleton]):  # type: ignore[no-untyped-def]

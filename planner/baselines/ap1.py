@@ -45,6 +45,7 @@ from mrgc.planner.outcome import Failure, PlanStatus, Why
 from mrgc.planner.search import planned_action
 
 if TYPE_CHECKING:  # the grounding loads numpy and the geometry: the command line reads Ap1's declaration
+    from mrgc.geometry.collision import Posed
     from mrgc.planner.ground import GroundedStep
 
 #: joint-action groundings the first depth-first run may make; every restart doubles it
@@ -89,7 +90,7 @@ class GeometricSteps:
         fut: set[str],
         free: set[str],
         strict: bool,
-        v_fut: list[Any],
+        v_fut: Posed,
         key: str,
         index: int,
     ) -> Attempt | Failure:
@@ -117,13 +118,13 @@ class SymbolicSteps:
         fut: set[str],
         free: set[str],
         strict: bool,
-        v_fut: list[Any],
+        v_fut: Posed,
         key: str,
         index: int,
     ) -> Attempt | Failure:
         """Ground the step ``actions`` against the future volume (reverse search): an :class:`Attempt` or the
         :class:`~mrgc.planner.outcome.Failure` that stopped it."""
-        from mrgc.planner.ground import GroundedStep, label
+        from mrgc.planner.ground import GroundedStep, label, swept
 
         facts, same = self.facts, {a.obj for a in actions}
         hits: set[str] = set()
@@ -144,7 +145,7 @@ class SymbolicSteps:
         if strict and hits:
             return Failure(index, " + ".join(label(a) for a in actions), "obstructed", tuple(sorted(hits)))
         planned = [planned_action(a) for a in actions]
-        return Attempt(GroundedStep(planned, [], tuple(a.obj for a in actions)), hits)
+        return Attempt(GroundedStep(planned, swept(()), tuple(a.obj for a in actions)), hits)
 
 
 @dataclass
@@ -211,11 +212,11 @@ class Ap1Search:
             return suffix if self.accept(suffix) else None
         state = (pending, signature)
         self.stats["nodes"] += 1
-        from mrgc.planner.ground import moved_objects
+        from mrgc.planner.ground import moved_objects, swept
 
         fut = moved_objects(suffix)
         free = set(self.facts.objects) - fut - set(pending)
-        v_fut = [p for s in suffix for p in s.volume]
+        v_fut = swept(suffix)
         index = -(len(suffix) + 1)
         tag = hashlib.sha256(repr(state).encode()).hexdigest()[:16]
         for j, primary in enumerate(pending):
@@ -258,7 +259,7 @@ class Ap1Search:
         fut: set[str],
         free: set[str],
         strict: bool,
-        v_fut: list[Any],
+        v_fut: Posed,
         key: str,
         index: int,
     ) -> Attempt:
@@ -292,7 +293,7 @@ class Ap1Search:
         fut: set[str],
         free: set[str],
         strict: bool,
-        v_fut: list[Any],
+        v_fut: Posed,
         key: str,
         index: int,
         record: bool,

@@ -205,11 +205,13 @@ class ForwardSteps:
         """Ground ``actions`` as step ``index`` after the steps ``done``."""
         import numpy as np
 
+        from mrgc.planner.ground import swept
+
         poses = {a.object: np.array(a.place_pose) for step in done for a in step if a.place_pose is not None}
         same = {a.obj for a in actions}
         with self.grounder.moved(poses):
             self.ground_steps.grounded = set(poses)
-            got = self.ground_steps.ground_step(actions, self.movable - same, [], key, index)
+            got = self.ground_steps.ground_step(actions, self.movable - same, swept(()), key, index)
         if self.grounder.cut:
             raise DeadlineReached()
         return got if isinstance(got, Failure) else got.actions

@@ -230,6 +230,7 @@ class ScriptedGrounder:
         self.cut = False  # no query of the script stops at a deadline
         self.tokens: dict[str, CollisionShape] = {}
         self.named: dict[int, str] = {}  # a token's shape (its id) -> its name
+        self.asked: list[tuple[str, str, object]] = []  # (query, object, its avoid or its key), in order
 
     def token(self, name: str) -> CollisionShape:
         """The shape standing for token ``name`` (one per name: boxes of distinct sizes)."""
@@ -252,6 +253,7 @@ class ScriptedGrounder:
         yield
 
     def pick(self, robot: str, obj: str, grasp: str, avoid: Any = (), busy: Any = (), after: Any = ()) -> Answer:
+        self.asked.append(("pick", obj, frozenset(avoid)))
         hit = self.blocked_by.get(obj, set()) & set(avoid)
         if hit:
             return Answer(GroundStatus.COLLISION, blockers=hit)
@@ -302,6 +304,7 @@ class ScriptedGrounder:
         packed: bool = False,
         prefer: Any = None,
     ) -> Any:
+        self.asked.append(("placement", obj, key))
         yield np.eye(4)
 
     def comfortable(self, robot: str, obj: str, grasp: str) -> Any:
@@ -368,6 +371,13 @@ def test_a_step_whose_robots_collide_is_split(monkeypatch: pytest.MonkeyPatch) -
     assert grounder.steps[0] == ["r1", "r2"]  # the whole step first
     assert ["r2"] in grounder.steps and ["r1"] in grounder.steps
     assert grounder.steps[-1] == []  # forgotten after each step
+    # each part kept clear of the whole step's other objects and drew with the step's key, as the unsplit
+    # step did: an action in the same place of a part asks the same questions (remembered answers)
+    picks = [(obj, avoid) for query, obj, avoid in grounder.asked if query == "pick"]
+    assert {obj for obj, _ in picks} == {"a", "b"} and len(picks) > 2
+    assert all({"a", "b"} - {obj} <= avoid for obj, avoid in picks)  # type: ignore[operator]
+    keys = {obj: {key for query, o, key in grounder.asked if query == "placement" and o == obj} for obj in "ab"}
+    assert all(len(k) == 1 for k in keys.values()), keys
 
 
 def test_a_step_is_not_split_for_other_failures(monkeypatch: pytest.MonkeyPatch) -> None:

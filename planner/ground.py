@@ -452,22 +452,27 @@ class ReverseGrounder:
         for a in step:
             self._on_time()
             avoid_a = sorted((avoid | same) - {a.obj})
-            # what the other robots of the step sweep or occupy in each phase: this action keeps clear of it
-            busy = _swept_by_others(motions, (a.pick_robot, a.place_robot))
-            action = self._action(a, avoid_a, _plus(v_fut, step_volume), f"{key}:{a.obj}", placed, busy)
-            if isinstance(action, Failure) and action.detail == BUSY:
-                # kept clear of the whole of what the others sweep (when they pass ignored), it fails: then as
-                # they pass, the sample-paired comparison below (the validator's) decides
-                timed = self._action(a, avoid_a, _plus(v_fut, step_volume), f"{key}:{a.obj}", placed, {})
-                action = action if isinstance(timed, Failure) else timed
+            volume = _plus(v_fut, step_volume)
+            # first as if the step's other robots were not there: as they pass, the sample-paired comparison
+            # (the validator's) decides
+            action = self._action(a, avoid_a, volume, f"{key}:{a.obj}", placed, {})
             if isinstance(action, Failure):
                 self.doomed.failed(a, action)
-                if action.detail == BUSY:  # name the step's robots in the way, and what they carry
-                    action = replace(action, bodies=_others_of(actions, a))
                 return replace(action, step=index, action=label(a))
             moves = self._motions(action)
             mine = _joined(moves, self._stood(action))
             clash = _robots_collide(mine, motions)
+            if clash:
+                # then keeping clear of the whole of what the others sweep or occupy in each phase
+                busy = _swept_by_others(motions, (a.pick_robot, a.place_robot))
+                kept = self._action(a, avoid_a, volume, f"{key}:{a.obj}", placed, busy)
+                if isinstance(kept, Failure) and kept.detail != BUSY:
+                    self.doomed.failed(a, kept)
+                if not isinstance(kept, Failure):
+                    kept_moves = self._motions(kept)
+                    again = _joined(kept_moves, self._stood(kept))
+                    if _robots_collide(again, motions) is None:
+                        action, moves, mine, clash = kept, kept_moves, again, None
             if clash:
                 phase, robots = clash
                 return Failure(index, label(a), f"{phase}: robots of the step collide", robots)
@@ -1094,15 +1099,6 @@ def _swept_by_others(motions: Motions, robots: tuple[str, ...]) -> dict[str, Vol
             for phase, samples in phases.items():
                 busy.setdefault(phase, []).extend(p for vol in samples for p in vol)
     return busy
-
-
-def _others_of(actions: list[PlannedAction], a: Action) -> tuple[str, ...]:
-    """The robots of the step's actions grounded before ``a`` (other than ``a``'s) and the objects they
-    move: what an action that keeps clear of them (``busy``) was kept from."""
-    mine = {a.pick_robot, a.place_robot}
-    return tuple(
-        sorted({n for p in actions if not mine & {p.pick_robot, p.place_robot} for n in (p.object, *p.robots())})
-    )
 
 
 def _joined(moves: Motions, stood: Motions) -> Motions:

@@ -45,10 +45,10 @@ NEIGHBOURHOOD = 0.10
 #: several placements; 20,000 (motion.MAX_CHECKS) let one grounding run for minutes on a loaded machine
 TRANSFER_CHECKS = 4_000
 #: the budget when the path must also keep clear of what the step's other robots sweep meanwhile (``busy``):
-#: that search is the optimistic first try (the grounding then tries the motion against the other robots as
-#: they pass, sample by sample) and among four or five arms of one step it rarely ends: on PA18 with 5 arms
-#: (seed 7) 43 such searches spent 1,750 checks each, none found a path, 40 of the grounding's 55 s of CPU;
-#: those that succeed on PA10 and PA18 with 3-4 arms used 162-866 checks
+#: the grounding asks for that search only when its motion, searched as if the others were not there, meets
+#: them as they pass (sample by sample), and among four or five arms of one step it rarely ends: on PA18 with
+#: 5 arms (seed 7) 43 such searches spent 1,750 checks each, none found a path, 40 of the grounding's 55 s of
+#: CPU; those that succeed on PA10 and PA18 with 3-4 arms used 162-866 checks
 BUSY_TRANSFER_CHECKS = 2_000
 #: joint-space distance (rad) between the states an arm's path search checks when a finer path is asked
 #: for (:meth:`ArmPaths.arm_path`): the path found is checked again, densely, before it is used

@@ -270,13 +270,14 @@ class StepWorld:
 
 class _VolumeCache:
     """Volumes as the collision kernel reads them (:class:`~mrgc.geometry.collision.Posed`), converted once
-    per list: the last few lists asked for (the same list object, unchanged) are kept with their conversion.
-    The reverse search's volumes grow by concatenation into new lists (``v_fut + step_volume``, a suffix's
-    volume and then each earlier step's): a list that begins with the pieces of a kept one (the same piece
-    objects, as many as it had then) converts only the rest (:meth:`Posed.extended
-    <mrgc.geometry.collision.Posed.extended>`, equal to the bit to converting the whole list; on the 6-arm,
-    40-object instance, converting whole suffix volumes again was 12 % of the grounding's time).  Nothing is
-    copied into coal."""
+    per list: the last few lists asked for (the same list object, unchanged) are kept with their conversion;
+    a volume given as a ``Posed`` already is the kernel's (a grounded suffix's V_fut: :meth:`Posed.join
+    <mrgc.geometry.collision.Posed.join>`).  Lists that grow by concatenation into new lists (what a step's
+    other robots sweep, as its actions are grounded one after the other; until session 23 also V_fut, then
+    a list): a list that begins with the pieces of a kept one (the same piece objects, as many as it had
+    then) converts only the rest (:meth:`Posed.extended <mrgc.geometry.collision.Posed.extended>`, equal to
+    the bit to converting the whole list; on the 6-arm, 40-object instance, converting whole suffix volumes
+    again was 12 % of the grounding's time).  Nothing is copied into coal."""
 
     SIZE = 8
     #: a kept list this long or longer is worth looking for at the front of a new one

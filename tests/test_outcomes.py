@@ -231,6 +231,7 @@ class ScriptedGrounder:
         self.tokens: dict[str, CollisionShape] = {}
         self.named: dict[int, str] = {}  # a token's shape (its id) -> its name
         self.asked: list[tuple[str, str, object]] = []  # (query, object, its avoid or its key), in order
+        self.busy: list[tuple[str, bool]] = []  # each pick's object and whether it kept clear of others' sweeps
 
     def token(self, name: str) -> CollisionShape:
         """The shape standing for token ``name`` (one per name: boxes of distinct sizes)."""
@@ -254,6 +255,7 @@ class ScriptedGrounder:
 
     def pick(self, robot: str, obj: str, grasp: str, avoid: Any = (), busy: Any = (), after: Any = ()) -> Answer:
         self.asked.append(("pick", obj, frozenset(avoid)))
+        self.busy.append((obj, bool(busy)))
         hit = self.blocked_by.get(obj, set()) & set(avoid)
         if hit:
             return Answer(GroundStatus.COLLISION, blockers=hit)
@@ -378,6 +380,32 @@ def test_a_step_whose_robots_collide_is_split(monkeypatch: pytest.MonkeyPatch) -
     assert all({"a", "b"} - {obj} <= avoid for obj, avoid in picks)  # type: ignore[operator]
     keys = {obj: {key for query, o, key in grounder.asked if query == "placement" and o == obj} for obj in "ab"}
     assert all(len(k) == 1 for k in keys.values()), keys
+
+
+@pytest.mark.parametrize("clash", [False, True])
+def test_an_action_keeps_clear_of_the_others_whole_sweep_only_after_a_clash(
+    monkeypatch: pytest.MonkeyPatch, clash: bool
+) -> None:
+    """Each action of a step is grounded first as if the step's other robots were not there (the sample-paired
+    comparison decides); only when that comparison finds a clash is it grounded again keeping clear of all
+    they sweep, and kept when that one passes the comparison."""
+    import mrgc.planner.ground as ground_module
+
+    compared: list[bool] = []
+
+    def phases_collide(a: Any, b: Any) -> str:  # the first comparison of b's pick clashes (when asked to)
+        compared.append(True)
+        return "pick" if clash and len(compared) == 1 else ""
+
+    monkeypatch.setattr(ground_module, "_phases_collide", phases_collide)
+    grounder = ScriptedGrounder(["a", "b"], blocked_by={}, sweeps={})
+    reverse = ReverseGrounder(grounder, {"a": "goal", "b": "goal"})  # type: ignore[arg-type]
+    skeleton = Skeleton(
+        ((Action("a", "goal", "r1", "r1", "top", "top"), Action("b", "goal", "r2", "r2", "top", "top")),)
+    )
+    result = reverse.ground(skeleton, [])
+    assert result.outcome is Outcome.SUCCESS and [s.moved for s in result.steps] == [("a", "b")]
+    assert grounder.busy == ([("a", False), ("b", False), ("b", True)] if clash else [("a", False), ("b", False)])
 
 
 def test_a_step_is_not_split_for_other_failures(monkeypatch: pytest.MonkeyPatch) -> None:

@@ -330,18 +330,20 @@ def test_a_database_of_the_first_schema_is_read_and_upgraded_in_place(tmp_path: 
 
 
 def test_a_run_over_its_memory_limit_is_recorded_as_memout(tmp_path: Path) -> None:
-    """A packaging run passes 120 MiB for seconds (coal, phase 1, the referee's pybullet world; its peak was
-    151 MiB on 2026-12-03, since the planner no longer loads pybullet's own Panda to check it); a symbolic
-    one, ending at about 30 MiB within a second, made the outcome depend on where the samples fell."""
+    """A packaging run passes 100 MiB for a second or more (coal, phase 1, the referee's pybullet world; its
+    peak was 165 MiB on 2026-12-04, since grounded steps keep compact volumes: 120 MiB, the limit before, was
+    passed for a few tenths of a second at the end of a PA10 run on a busy machine, and a full suite saw
+    it solve); a symbolic one, ending at about 30 MiB within a second, made the outcome depend on where the
+    samples fell."""
     packaging_copy(tmp_path / "g", "pa10")
     study = write_study(
         tmp_path / "s.yaml",
-        "study: mem\nlimits: {memory: 120MB}\ninstances: [{file: g/pa10.mrg}]\nmethods: [{name: Ours}]\n",
+        "study: mem\nlimits: {memory: 100MB}\ninstances: [{file: g/pa10.mrg}]\nmethods: [{name: Ours}]\n",
     )
     run_study(str(study), str(tmp_path / "r.db"))
     (r,) = rows(tmp_path / "r.db")
-    assert r["status"] == "memout" and not r["success"] and r["peak_mb"] > 120  # type: ignore[operator]
-    assert "memory limit of 120 MiB" in str(r["detail"])
+    assert r["status"] == "memout" and not r["success"] and r["peak_mb"] > 100  # type: ignore[operator]
+    assert "memory limit of 100 MiB" in str(r["detail"])
 
 
 def test_a_crashing_run_is_recorded_as_a_crash_with_its_stderr(tmp_path: Path) -> None:

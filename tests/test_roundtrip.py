@@ -165,10 +165,12 @@ def test_generated_names_are_names(tree: ast.SourceFile) -> None:
 
 
 def test_strategy_reaches_every_section_kind() -> None:
-    """The tree strategy really generates each section kind and value kind (a guard against a dead strategy)."""
+    """The tree strategy really generates each section kind and value kind (a guard against a dead strategy).
+    Derandomized: the same 200 trees every run (random ones missed the rare ``regions`` section once in a full
+    suite, 2026-12-04)."""
     seen: set[str] = set()
 
-    @settings(max_examples=200, deadline=None, database=None)
+    @settings(max_examples=200, deadline=None, database=None, derandomize=True)
     @given(source_files)
     def collect(tree: ast.SourceFile) -> None:
         for d in tree.definitions:

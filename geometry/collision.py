@@ -214,6 +214,19 @@ def _thicken(pts: np.ndarray) -> np.ndarray:
     return np.concatenate(out) if len(out) > 1 else pts
 
 
+def _merged(shapes: list[CollisionShape], index: dict[int, int], more: Sequence[CollisionShape]) -> np.ndarray:
+    """Where each of ``more`` is in ``shapes`` (the distinct shapes so far; ``index``: their ids -> position),
+    the ones not there yet appended in order: the index of each of ``more`` (``shapes`` and ``index`` grow)."""
+    remap = np.empty(len(more), dtype=np.intp)
+    for j, shape in enumerate(more):
+        k = index.get(id(shape))
+        if k is None:
+            k = index[id(shape)] = len(shapes)
+            shapes.append(shape)
+        remap[j] = k
+    return remap
+
+
 #: a kernel query tests every pair of pieces directly when there are at most this many; above it, the pieces
 #: are first grouped (:data:`GROUP` consecutive ones) and only the pairs of groups whose boxes meet are opened
 DIRECT_PAIRS = 1 << 14
@@ -271,15 +284,8 @@ class Posed:
         makes them), without converting this set's pieces again; None where :meth:`of` would take its
         one-shape way (every piece one shape) or this set is empty."""
         more, kind_more, transforms = _arrays(pieces)
-        index = {id(s): k for k, s in enumerate(self.shapes)}
         shapes = list(self.shapes)
-        remap = np.empty(len(more), dtype=np.intp)
-        for j, shape in enumerate(more):
-            k = index.get(id(shape))
-            if k is None:
-                k = index[id(shape)] = len(shapes)
-                shapes.append(shape)
-            remap[j] = k
+        remap = _merged(shapes, {id(s): k for k, s in enumerate(shapes)}, more)
         if len(shapes) == 1 or not len(self.kind):
             return None
         tail = Posed(shapes, remap[kind_more], transforms, self.pad)  # boxes by the shapes' table, as of() does
@@ -305,16 +311,7 @@ class Posed:
         out.pad = pads.pop() if pads else TOLERANCE
         index: dict[int, int] = {}
         out.shapes = []
-        kinds = []
-        for p in parts:
-            remap = np.empty(len(p.shapes), dtype=np.intp)
-            for j, shape in enumerate(p.shapes):
-                k = index.get(id(shape))
-                if k is None:
-                    k = index[id(shape)] = len(out.shapes)
-                    out.shapes.append(shape)
-                remap[j] = k
-            kinds.append(remap[p.kind])
+        kinds = [_merged(out.shapes, index, p.shapes)[p.kind] for p in parts]
         if len(parts) == 1:  # the arrays shared (never written to), the caches its own
             only = parts[0]
             out.kind, out.transforms, out.lo, out.hi = kinds[0], only.transforms, only.lo, only.hi

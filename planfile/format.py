@@ -129,6 +129,24 @@ class PlannedAction:
         what = f"sets down {self.object} in" if self.relay else f"moves {self.object} to"
         return f"{who} {what} {self.region} ({grasp})"
 
+    def path_robot(self, name: str) -> str:
+        """The robot that moves on path ``name``: the giver on its way to the object, to the exchange and
+        home from it (``to-pick``, ``to-handover``, ``giver-home``), the place robot on the others."""
+        return self.pick_robot if name in ("to-pick", "to-handover", "giver-home") else self.place_robot
+
+    def waits(self) -> list[tuple[str, int, int]]:
+        """The paths on which the robot stands still, at the start or at the end, while another robot of the
+        step passes (the validator replays a phase's configurations equally spaced in time: a repeated one is
+        time standing still): (path name, configurations repeated at its start, at its end), for the paths
+        that repeat any."""
+        out = []
+        for name, path in self.paths.items():
+            first = next((i for i, q in enumerate(path) if q != path[0]), len(path)) - 1
+            last = next((i for i, q in enumerate(reversed(path)) if q != path[-1]), len(path)) - 1
+            if len(path) > 1 and (first > 0 or last > 0) and first < len(path) - 1:
+                out.append((name, first, last))
+        return out
+
     def to_json(self) -> dict[str, Any]:
         """The action as the plan's JSON holds it."""
         out: dict[str, Any] = {

@@ -17,6 +17,7 @@ objects not moved in S' plus the M_out objects that obstruct S'; otherwise it fa
 from __future__ import annotations
 
 import enum
+import math
 import time
 from contextlib import ExitStack
 from dataclasses import dataclass, field, replace
@@ -50,6 +51,10 @@ RELAY_TRIES = 3  # spots tried per relay (the k-th spot both of its robots reach
 DEAD_END_SAMPLES = 400
 #: paths replayed in another path's phase (the validator's execution model): name -> phase
 PATH_PHASE = {"taker-to-handover": "to-handover"}
+#: the waits an action's robot may make in a phase where it meets another robot of its step, tried in turn
+#: (:func:`_waiting`): the share of the phase it stands still, at the path's start (> 0: it sets out late) or
+#: at its end (< 0: it arrives early and stands there)
+WAITS = (0.5, -0.5, 0.75, -0.75)
 #: a skeleton's order constraints: an action's obstacles, (object, strict) (``TaskGraph.obstacles``)
 Order = Callable[[Action], list[tuple[str, bool]]]
 #: each robot's volume at every sample of every phase of its motions (one volume for a phase it stands still
@@ -461,7 +466,8 @@ class ReverseGrounder:
                 return replace(action, step=index, action=label(a))
             moves = self._motions(action)
             mine = _joined(moves, self._stood(action))
-            clash = _robots_collide(mine, motions)
+            # where they meet, first one waiting while the other passes
+            clash, mine = _waiting(action, mine, motions, _robots_collide(mine, motions))
             if clash:
                 # then keeping clear of the whole of what the others sweep or occupy in each phase
                 busy = _swept_by_others(motions, (a.pick_robot, a.place_robot))
@@ -471,7 +477,8 @@ class ReverseGrounder:
                 if not isinstance(kept, Failure):
                     kept_moves = self._motions(kept)
                     again = _joined(kept_moves, self._stood(kept))
-                    if _robots_collide(again, motions) is None:
+                    missed, again = _waiting(kept, again, motions, _robots_collide(again, motions))
+                    if missed is None:
                         action, moves, mine, clash = kept, kept_moves, again, None
             if clash:
                 phase, robots = clash
@@ -1070,14 +1077,14 @@ def _path_of(action: PlannedAction, phase: str) -> tuple[str, str | None, bool]:
     """Whose a path of ``action`` is, the grasp its fingers are at (None: fully open) and whether it holds the
     object: the transfers hold it, the transits are empty-handed (a giver's fingers as it let go)."""
     table = {
-        "to-handover": (action.pick_robot, action.pick_grasp, True),
-        "to-place": (action.place_robot, action.place_grasp, True),
-        "to-pick": (action.pick_robot, None, False),
-        "taker-to-handover": (action.place_robot, None, False),
-        "home": (action.place_robot, None, False),
-        "giver-home": (action.pick_robot, action.pick_grasp, False),
+        "to-handover": (action.pick_grasp, True),
+        "to-place": (action.place_grasp, True),
+        "to-pick": (None, False),
+        "taker-to-handover": (None, False),
+        "home": (None, False),
+        "giver-home": (action.pick_grasp, False),
     }
-    return table[phase]
+    return (action.path_robot(phase), *table[phase])
 
 
 def swept(steps: Iterable[GroundedStep], before: Posed | None = None) -> Posed:
@@ -1108,6 +1115,46 @@ def _joined(moves: Motions, stood: Motions) -> Motions:
         for phase, volumes in phases.items():
             out.setdefault(robot, {}).setdefault(phase, volumes)
     return out
+
+
+def _waiting(
+    action: PlannedAction, mine: Motions, motions: Motions, clash: tuple[str, tuple[str, ...]] | None
+) -> tuple[tuple[str, tuple[str, ...]] | None, Motions]:
+    """Where ``action``'s motions ``mine`` meet another robot of the step (``clash``, :func:`_robots_collide`'s
+    answer), the robot of the action that moves in that phase waits (:data:`WAITS`): it stands still at the
+    path's first configuration before setting out, or at its last after arriving, for a share of the phase,
+    so that the two pass one after the other (the validator replays a phase's configurations equally spaced
+    in time: a repeated configuration is time standing still).  Phase by phase until none clashes; a wait
+    is kept only when it clears the phase it is made in.  The clash left (None when every one was waited
+    out) and the motions as they are then; ``action``'s paths get the waits only when they cleared every
+    clash.  A phase in which both robots of a handover move, or the action moves on no path of its own (an
+    approach, an exchange), is not waited in."""
+    mine = {robot: dict(phases) for robot, phases in mine.items()}
+    pads: dict[str, int] = {}  # path name -> configurations added (> 0 before it, < 0 after it)
+    while clash is not None:
+        phase = clash[0]
+        names = [n for n in action.paths if PATH_PHASE.get(n, n) == phase]
+        if len(names) != 1 or names[0] in pads:
+            return clash, mine
+        robot = _path_of(action, names[0])[0]
+        samples = mine[robot][phase]
+        if len(samples) < 2:
+            return clash, mine
+        for share in WAITS:
+            n = math.ceil(abs(share) * (len(samples) - 1) / (1 - abs(share)))
+            waited = [samples[0]] * n + samples if share > 0 else samples + [samples[-1]] * n
+            if not any(_phases_collide({phase: waited}, theirs) for o, theirs in motions.items() if o != robot):
+                pads[names[0]] = n if share > 0 else -n
+                mine[robot][phase] = waited
+                break
+        else:
+            return clash, mine
+        clash = _robots_collide(mine, motions)
+    for name, n in pads.items():
+        path = action.paths[name]
+        still = [list(path[0] if n > 0 else path[-1]) for _ in range(abs(n))]
+        action.paths[name] = still + path if n > 0 else path + still
+    return None, mine
 
 
 def _robots_collide(mine: Motions, motions: Motions) -> tuple[str, tuple[str, ...]] | None:

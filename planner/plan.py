@@ -147,10 +147,21 @@ class Plan:
             )
         ]
         for i, step in enumerate(self.steps, 1):
-            lines.append(f"  step {i}: " + "; ".join(a.describe() for a in step))
+            lines.append(f"  step {i}: " + "; ".join(a.describe() + _waits_text(a) for a in step))
         if self.why is not None and self.status is not PlanStatus.SOLVED:
             lines += self.why.lines()
         return lines
+
+
+def _waits_text(action: PlannedAction) -> str:
+    """`` (r2 waits at the start of to-place, 75 % of it)`` for an action whose robot waits for another of its
+    step (:meth:`~mrgc.planfile.format.PlannedAction.waits`); '' when none does."""
+    parts = []
+    for name, first, last in action.waits():
+        where, k = ("start", first) if first else ("end", last)
+        share = round(100 * k / (len(action.paths[name]) - 1))
+        parts.append(f"{action.path_robot(name)} waits at the {where} of {name}, {share} % of it")
+    return f" ({'; '.join(parts)})" if parts else ""
 
 
 def moved_text(steps: list[list[str]]) -> str:

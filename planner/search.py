@@ -147,7 +147,8 @@ def _search(context: Context, sources: _Sources, deadline: float) -> Result:
 class _Timing:
     """How the grounded plans' steps compare with their skeletons' (``-v`` and the plan's statistics): per
     grounded sequence (a node's suffix, a full plan) the skeletons' makespan it grounds, the actions re-timed
-    into an earlier skeleton step, and the steps split because robots were in each other's way."""
+    into an earlier skeleton step, and the steps split because robots were in each other's way; a plan's
+    ``waits`` count the paths on which a robot waits for another of its step (``ground._waiting``)."""
 
     def __init__(self) -> None:
         self.of_steps: dict[int, tuple[int, int, int]] = {}  # id(steps) -> (skeleton makespan, retimed, split)
@@ -164,7 +165,14 @@ class _Timing:
         if steps is None or id(steps) not in self.of_steps:
             return {}
         span, retimed, split = self.of_steps[id(steps)]
-        return {"makespan": len(steps), "skeleton_makespan": span, "retimed_actions": retimed, "split_steps": split}
+        waits = sum(len(a.waits()) for step in steps for a in step.actions)
+        return {
+            "makespan": len(steps),
+            "skeleton_makespan": span,
+            "retimed_actions": retimed,
+            "split_steps": split,
+            "waits": waits,
+        }
 
 
 class _Skeletons:

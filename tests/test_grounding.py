@@ -441,11 +441,12 @@ def test_a_base_path_blocked_only_by_another_robot_of_the_step_says_so() -> None
             assert g.base_path("r1", start, goal, avoid=["door"], busy=r2_in_doorway).detail == ""
 
 
-def test_two_carts_through_one_doorway_split_their_step_naming_each_other() -> None:
+def test_two_carts_through_one_doorway_pass_one_after_the_other_in_their_step() -> None:
     """The skeleton the compiler gives bo-one-doorway carries both goal boxes through the doorway in step 3;
     the carts' drives collide there (before: "carry to the placement: no path", no bodies, every makespan-3
-    skeleton failed and the search took 217 groundings to reach makespan 4).  The step is split, one cart
-    after the other, and the failure it got around names both robots."""
+    skeleton failed and the search took 217 groundings to reach makespan 4; then the step was split, one
+    cart after the other).  Now one cart waits while the other passes, in the same step: its path repeats
+    its first or last configuration, and nothing was split."""
     problem = parse_file(DOORWAY).problem()
     g = Grounder(scene_from_problem(problem), seed=0)
     steps = (
@@ -458,20 +459,87 @@ def test_two_carts_through_one_doorway_split_their_step_naming_each_other() -> N
     )
     grounding = ReverseGrounder(g, dict(problem.goal_regions)).ground(Skeleton(steps), [])
     assert grounding.outcome is Outcome.SUCCESS, grounding.reason
-    assert [len(s.actions) for s in grounding.steps] == [1, 1, 1, 1]
-    assert {s.actions[0].object for s in grounding.steps[2:]} == {"g1", "g2"}
-    (resolved,) = grounding.resolved
-    assert resolved.step == 3 and {"r1", "r2"} <= set(resolved.bodies)
+    assert [len(s.actions) for s in grounding.steps] == [1, 1, 2]
+    waits = [(a.object, w) for a in grounding.steps[2].actions for w in a.waits()]
+    assert waits and not grounding.resolved, (waits, grounding.resolved)
+
+
+def _crossing(y0: float, n: int = 5) -> tuple[list[list[float]], list[Any]]:
+    """A path of ``n`` configurations along y from ``y0`` to ``-y0`` at x = 0.5 (a 0.1 m box as its volume at
+    each), and the volumes; beside ``_across``, which crosses it at (0.5, 0) half-way."""
+    box = _box(0.1)
+    ys = np.linspace(y0, -y0, n)
+    return [[0.5, float(y), 0.0] for y in ys], [[(box, translation(0.5, float(y), 0.0))] for y in ys]
+
+
+def _across(n: int = 5) -> list[Any]:
+    box = _box(0.1)
+    return [[(box, translation(float(x), 0.0, 0.0))] for x in np.linspace(0.0, 1.0, n)]
+
+
+@functools.lru_cache(maxsize=None)
+def _box(side: float) -> CollisionShape:
+    from mrgc.geometry.collision import collision_shape
+    from mrgc.language.model import Box
+
+    return collision_shape(Box(side, side, side))
+
+
+def test_a_robot_waits_while_another_of_its_step_passes() -> None:
+    """Two robots of a step cross at the same moment of a phase: the one of the action being grounded waits
+    (its path's first configuration repeated: half the phase standing still), which clears the comparison;
+    the other robot's motion is untouched."""
+    from mrgc.planfile.format import PlannedAction
+    from mrgc.planner.ground import _robots_collide, _waiting
+
+    path, volumes = _crossing(1.0)
+    action = PlannedAction("b", "goal", "r2", "r2", "top", "top", paths={"to-place": [list(q) for q in path]})
+    theirs = _across()
+    mine, motions = {"r2": {"to-place": volumes}}, {"r1": {"to-place": theirs}}
+    clash = _robots_collide(mine, motions)
+    assert clash == ("to-place", ("r1", "r2"))
+    left, waited = _waiting(action, mine, motions, clash)
+    assert left is None and _robots_collide(waited, motions) is None
+    assert action.waits() == [("to-place", 4, 0)] and action.paths["to-place"][4:] == path
+    assert motions["r1"]["to-place"] is theirs and len(theirs) == 5
+
+
+@pytest.mark.parametrize("case", ["standing", "approach", "both-move"])
+def test_no_wait_where_waiting_cannot_help_or_would_desynchronise_a_handover(case: str) -> None:
+    """No wait (the clash is returned, the paths untouched) when the other robot stands still in the phase
+    (no moment is free of it), in an approach (its configurations are the motion model's) or where both
+    robots of a handover move (a wait would change when they meet)."""
+    from mrgc.planfile.format import PlannedAction
+    from mrgc.planner.ground import _waiting
+
+    path, volumes = _crossing(1.0)
+    others: dict[str, dict[str, list[Any]]] = {"r1": {"to-place": _across()}}
+    action = PlannedAction("b", "goal", "r2", "r2", "top", "top", paths={"to-place": [list(q) for q in path]})
+    phase = "to-place"
+    if case == "standing":
+        others = {"r1": {"to-place": [[(_box(0.1), translation(0.5, 0.0, 0.0))]]}}
+    elif case == "approach":
+        phase, others = "place", {"r1": {"place": _across()}}
+    else:
+        action = PlannedAction(
+            "b", "goal", "r2", "r3", "top", "top", paths={"to-handover": path, "taker-to-handover": path}
+        )
+        phase, others = "to-handover", {"r1": {"to-handover": _across()}}
+    mine = {"r2": {phase: volumes}}
+    before = {k: [list(q) for q in v] for k, v in action.paths.items()}
+    left, _ = _waiting(action, mine, others, (phase, ("r1", "r2")))
+    assert left == (phase, ("r1", "r2")) and action.paths == before and not action.waits()
 
 
 def test_a_variation_of_the_doorway_is_solved_and_valid() -> None:
     """tests/data/bo-one-doorway-north.mrg: the doorway off-centre, other boxes; solved (one cart through
-    the doorway after the other) and valid."""
+    the doorway after the other, in one step: one waits) and valid."""
     path = ROOT / "tests" / "data" / "bo-one-doorway-north.mrg"
     plan = mrgc.plan(str(path), seed=0, time_limit=600)
     assert plan.status is mrgc.PlanStatus.SOLVED, plan.summary()
     assert mrgc.validate(str(path), plan).ok
-    assert plan.stats["skeleton_makespan"] == 3 and plan.stats["split_steps"] == 1 and len(plan.steps) == 4
+    assert plan.stats["skeleton_makespan"] == 3 and plan.stats["split_steps"] == 0 and len(plan.steps) == 3
+    assert plan.stats["waits"] >= 1  # one cart waits in the doorway step while the other passes
 
 
 def test_three_arms_keep_their_parallel_steps() -> None:

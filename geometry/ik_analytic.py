@@ -138,6 +138,12 @@ def _chain(key: str, model: RobotModel) -> PandaChain | None:
     )
 
 
+def load_solver() -> None:
+    """Load GeoFIK's module now: a process about to fork workers that will solve shares it with them
+    instead of each loading its own."""
+    import geofikpy  # noqa: F401
+
+
 def solve_many(
     model: RobotModel, chain: PandaChain, targets: Array, refs: Array, tol_pos: float, tol_rot: float
 ) -> list[Answer]:

@@ -494,6 +494,19 @@ def _relays(
     return out, ik, checks
 
 
+def _load_shared(scene: SceneSpec) -> None:
+    """Load here, before the workers fork, what each of them would otherwise load for itself: numpy's random
+    generators (the IK restarts, placements and handover starts draw from them; about 18 ms of CPU an
+    import) and, for arms with a Panda's kinematics, the analytic IK's chain and solver module.  Forked
+    workers share them; this process needs the generators afterwards anyway (grounding)."""
+    import numpy.random  # noqa: F401  (numpy loads it on first use of np.random)
+
+    from mrgc.geometry.ik_analytic import load_solver, panda_chain
+
+    if any(approaches(spec.kind) and panda_chain(Arm(spec).model) is not None for spec in scene.robots):
+        load_solver()
+
+
 def _map(fn: Callable[[J], R], jobs: list[J], workers: int, deadline: float | None) -> list[R] | None:
     """The jobs in ``workers`` processes (:mod:`mrgc.workers`); with a ``deadline`` (a ``time.perf_counter``
     value), None when it passes first."""
@@ -517,6 +530,7 @@ def compute_facts(
     for spec in scene.robots:  # every arm's model and link hulls built here: errors surface once, forked workers
         if approaches(spec.kind):  # share them (and the pybullet check of its URDF), grounding reuses them
             _ = Arm(spec).hulls
+    _load_shared(scene)
     per_robot = _map(_robot_worker, jobs, n, deadline)
     t_robots = time.perf_counter() - t0
     facts: set[Fact] = set()

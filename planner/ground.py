@@ -1190,21 +1190,33 @@ def _phases_collide(mine: dict[str, list[Volume]], theirs: dict[str, list[Volume
 
 def _paired(a: list[Volume], b: list[Volume]) -> bool:
     """Whether sample ``i * len(a) // n`` of ``a`` collides with sample ``i * len(b) // n`` of ``b`` for some
-    ``i < n = max(len(a), len(b))`` (the validator's pairing of two motions)."""
+    ``i < n = max(len(a), len(b))`` (the validator's pairing of two motions).  One query of the kernel, each
+    of ``a``'s volumes in it once (a volume repeated, a robot standing still while it waits, is one slot
+    against everything of ``b`` it meets meanwhile), each of ``b``'s once per volume of ``a`` it meets."""
     n = max(len(a), len(b))
     a_pieces: Volume = []
-    b_pieces: Volume = []
     a_slot: list[int] = []
-    b_slot: list[int] = []
+    slot_of: dict[int, int] = {}  # id of a's volume -> its slot
+    met: dict[int, dict[int, Volume]] = {}  # slot -> id of b's volume -> that volume
     for i in range(n):
         va, vb = a[i * len(a) // n], b[i * len(b) // n]
-        if va and vb:
+        if not va or not vb:
+            continue
+        slot = slot_of.get(id(va))
+        if slot is None:
+            slot = slot_of[id(va)] = len(slot_of)
             a_pieces += va
-            b_pieces += vb
-            a_slot += [i] * len(va)
-            b_slot += [i] * len(vb)
+            a_slot += [slot] * len(va)
+            met[slot] = {}
+        met[slot].setdefault(id(vb), vb)
     if not a_pieces:
         return False
+    b_pieces: Volume = []
+    b_slot: list[int] = []
+    for slot in range(len(slot_of)):
+        for vb in met[slot].values():
+            b_pieces += vb
+            b_slot += [slot] * len(vb)
     return paired_collide(Posed.of(a_pieces), np.array(a_slot), Posed.of(b_pieces), np.array(b_slot))
 
 

@@ -950,3 +950,30 @@ def test_a_handover_whose_carry_to_one_point_fails_is_tried_at_the_next(tmp_path
     neither = ReverseGrounder(g, {"o1": "bin-b"}).ground(skeleton, [], key="neither")
     assert neither.outcome is Outcome.FAIL and neither.failures
     assert neither.failures[0].check == "carry to the handover by r1: no path"
+
+
+@settings(max_examples=80, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    st.lists(st.tuples(st.integers(0, 4), st.integers(0, 2)), min_size=1, max_size=9),
+    st.lists(st.tuples(st.integers(0, 4), st.integers(0, 2)), min_size=1, max_size=9),
+    st.integers(0, 6),
+    st.booleans(),
+)
+def test_paired_motions_collide_as_their_samples_pair_by_pair(
+    xs_a: list[tuple[int, int]], xs_b: list[tuple[int, int]], wait: int, late: bool
+) -> None:
+    """The comparison of two motions (one kernel query, a repeated volume once) says what testing each
+    sample pair ``i * len // n`` on its own says, also when one motion waits (its first or last volume
+    repeated) or stands still."""
+    from mrgc.geometry.collision import pieces_collide
+    from mrgc.planner.ground import _paired
+
+    def volumes(xs: list[tuple[int, int]]) -> list[Any]:
+        return [[(_box(0.1), translation(0.08 * x, 0.3 * y, 0.0))] if y < 2 else [] for x, y in xs]
+
+    a, b = volumes(xs_a), volumes(xs_b)
+    a = [a[0]] * wait + a if late else a + [a[-1]] * wait  # the same volume object repeated: a wait
+    n = max(len(a), len(b))
+    expected = any(pieces_collide(a[i * len(a) // n], b[i * len(b) // n]) for i in range(n))
+    assert _paired(a, b) is expected
+    assert _paired(b, a) is expected

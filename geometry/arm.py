@@ -255,7 +255,7 @@ class Arm:
         open), then the held object (shape, pose in the tool frame) at each; and the links' world transforms
         ((C, L, 4, 4), for :meth:`self_collides_at`)."""
         shapes, kind, flat, transforms, _ = self._pieces(configs, held, opening)
-        return [(shapes[k], t) for k, t in zip(kind.tolist(), flat)], transforms
+        return list(zip(map(shapes.__getitem__, kind.tolist()), list(flat))), transforms
 
     def posed(
         self, configs: np.ndarray, held: Held | None = None, opening: float | None = None

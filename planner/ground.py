@@ -453,6 +453,7 @@ class ReverseGrounder:
         actions: list[PlannedAction] = []
         step_volume: Volume = []
         motions: Motions = {}  # robot -> phase -> volume at each sample
+        owners: Owners = {}  # whose path each motion of a phase is
         placed: dict[str, np.ndarray] = {}  # objects of this step already placed by its earlier actions
         for a in step:
             self._on_time()
@@ -467,7 +468,7 @@ class ReverseGrounder:
             moves = self._motions(action)
             mine = _joined(moves, self._stood(action))
             # where they meet, first one waiting while the other passes
-            clash, mine = _waiting(action, mine, motions, _robots_collide(mine, motions))
+            clash, mine = _waiting(action, mine, motions, _robots_collide(mine, motions), owners)
             if clash:
                 # then keeping clear of the whole of what the others sweep or occupy in each phase
                 busy = _swept_by_others(motions, (a.pick_robot, a.place_robot))
@@ -477,7 +478,7 @@ class ReverseGrounder:
                 if not isinstance(kept, Failure):
                     kept_moves = self._motions(kept)
                     again = _joined(kept_moves, self._stood(kept))
-                    missed, again = _waiting(kept, again, motions, _robots_collide(again, motions))
+                    missed, again = _waiting(kept, again, motions, _robots_collide(again, motions), owners)
                     if missed is None:
                         action, moves, mine, clash = kept, kept_moves, again, None
             if clash:
@@ -485,6 +486,7 @@ class ReverseGrounder:
                 return Failure(index, label(a), f"{phase}: robots of the step collide", robots)
             for robot, phases in mine.items():
                 motions.setdefault(robot, {}).update(phases)
+            owners.update({(action.path_robot(n), PATH_PHASE.get(n, n)): (action, n) for n in action.paths})
             # the step's volume is every sample of every motion (where a robot stands still is the end of one)
             for phases in moves.values():
                 for samples in phases.values():
@@ -1117,20 +1119,40 @@ def _joined(moves: Motions, stood: Motions) -> Motions:
     return out
 
 
+#: whose path made a robot's motion in a phase of the step: (robot, phase) -> (the action, the path's name)
+Owners = dict[tuple[str, str], tuple[PlannedAction, str]]
+
+
+def _pad(path: list[Any], n: int) -> list[Any]:
+    """``path`` standing still ``n`` configurations at its start (n > 0) or ``-n`` at its end (n < 0)."""
+    still = [path[0] if n > 0 else path[-1]] * abs(n)
+    return still + path if n > 0 else path + still
+
+
 def _waiting(
-    action: PlannedAction, mine: Motions, motions: Motions, clash: tuple[str, tuple[str, ...]] | None
+    action: PlannedAction,
+    mine: Motions,
+    motions: Motions,
+    clash: tuple[str, tuple[str, ...]] | None,
+    owners: Owners | None = None,
 ) -> tuple[tuple[str, tuple[str, ...]] | None, Motions]:
     """Where ``action``'s motions ``mine`` meet another robot of the step (``clash``, :func:`_robots_collide`'s
     answer), the robot of the action that moves in that phase waits (:data:`WAITS`): it stands still at the
     path's first configuration before setting out, or at its last after arriving, for a share of the phase,
     so that the two pass one after the other (the validator replays a phase's configurations equally spaced
-    in time: a repeated configuration is time standing still).  Phase by phase until none clashes; a wait
-    is kept only when it clears the phase it is made in.  The clash left (None when every one was waited
-    out) and the motions as they are then; ``action``'s paths get the waits only when they cleared every
-    clash.  A phase in which both robots of a handover move, or the action moves on no path of its own (an
-    approach, an exchange), is not waited in."""
+    in time: a repeated configuration is time standing still).  When no share clears the phase and the
+    other robot moves there on a path of an earlier action of the step (``owners``), the two take the phase
+    one after the other: the other hurries through the first half and stands at its path's end, this one
+    stands at its start meanwhile and takes the second half, or the other way round; every other robot of the
+    step is compared with both again.  Phase by phase until none clashes; a wait is kept only when it clears
+    the phase it is made in.  The clash left (None when every one was waited out) and the motions as they
+    are then; the paths (``action``'s, and the earlier actions' with ``motions`` in step) get the waits only
+    when they cleared every clash.  A phase in which both robots of a handover move, or the action moves on
+    no path of its own (an approach, an exchange), is not waited in."""
     mine = {robot: dict(phases) for robot, phases in mine.items()}
+    theirs = {robot: dict(phases) for robot, phases in motions.items()}
     pads: dict[str, int] = {}  # path name -> configurations added (> 0 before it, < 0 after it)
+    their_pads: dict[tuple[str, str], int] = {}  # (robot, phase) of an earlier action -> the same
     while clash is not None:
         phase = clash[0]
         names = [n for n in action.paths if PATH_PHASE.get(n, n) == phase]
@@ -1142,19 +1164,61 @@ def _waiting(
             return clash, mine
         for share in WAITS:
             n = math.ceil(abs(share) * (len(samples) - 1) / (1 - abs(share)))
-            waited = [samples[0]] * n + samples if share > 0 else samples + [samples[-1]] * n
-            if not any(_phases_collide({phase: waited}, theirs) for o, theirs in motions.items() if o != robot):
+            waited = _pad(samples, n if share > 0 else -n)
+            if not any(_phases_collide({phase: waited}, their) for o, their in theirs.items() if o != robot):
                 pads[names[0]] = n if share > 0 else -n
                 mine[robot][phase] = waited
                 break
         else:
-            return clash, mine
-        clash = _robots_collide(mine, motions)
+            turns = _in_turn(robot, samples, phase, clash[1], theirs, owners or {}, their_pads)
+            if turns is None:
+                return clash, mine
+            pads[names[0]], (other, n_other) = turns
+            mine[robot][phase] = _pad(samples, pads[names[0]])
+            theirs[other][phase] = _pad(theirs[other][phase], n_other)
+            their_pads[(other, phase)] = n_other
+        clash = _robots_collide(mine, theirs)
     for name, n in pads.items():
-        path = action.paths[name]
-        still = [list(path[0] if n > 0 else path[-1]) for _ in range(abs(n))]
-        action.paths[name] = still + path if n > 0 else path + still
+        action.paths[name] = [list(q) for q in _pad(action.paths[name], n)]
+    for (other, phase), n in their_pads.items():
+        owner, name = (owners or {})[(other, phase)]
+        owner.paths[name] = [list(q) for q in _pad(owner.paths[name], n)]
+        motions[other][phase] = theirs[other][phase]
     return None, mine
+
+
+def _in_turn(
+    robot: str,
+    samples: list[Volume],
+    phase: str,
+    robots: tuple[str, ...],
+    theirs: Motions,
+    owners: Owners,
+    done: dict[tuple[str, str], int],
+) -> tuple[int, tuple[str, int]] | None:
+    """:func:`_waiting`'s last resort: ``robot`` (its ``samples`` in ``phase``) and the other robot of the
+    clash (``robots``) take the phase in turn, each standing still while the other moves; the pads of the
+    two paths (``robot``'s, then (the other, its)), or None when the other's motion there is no path of an
+    earlier action of the step (or is padded already, or shared with its partner in a handover), or neither
+    order clears the phase against every robot of the step."""
+    other = next((r for r in robots if r != robot), None)
+    if other is None or (other, phase) not in owners or (other, phase) in done:
+        return None
+    owner, name = owners[(other, phase)]
+    if sum(PATH_PHASE.get(n, n) == phase for n in owner.paths) != 1:
+        return None
+    their = theirs[other][phase]
+    if len(their) < 2:
+        return None
+    for mine_n, their_n in ((len(their) - 1, -(len(samples) - 1)), (-(len(their) - 1), len(samples) - 1)):
+        me, it = _pad(samples, mine_n), _pad(their, their_n)
+        rest = {o: m for o, m in theirs.items() if o not in (robot, other)}
+        if _phases_collide({phase: me}, {phase: it}):
+            continue
+        if any(_phases_collide({phase: me}, m) or _phases_collide({phase: it}, m) for m in rest.values()):
+            continue
+        return mine_n, (other, their_n)
+    return None
 
 
 def _robots_collide(mine: Motions, motions: Motions) -> tuple[str, tuple[str, ...]] | None:

@@ -977,3 +977,44 @@ def test_paired_motions_collide_as_their_samples_pair_by_pair(
     expected = any(pieces_collide(a[i * len(a) // n], b[i * len(b) // n]) for i in range(n))
     assert _paired(a, b) is expected
     assert _paired(b, a) is expected
+
+
+def test_two_robots_of_a_step_take_a_phase_in_turn_when_no_wait_of_one_clears_it(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """No wait of the action's robot alone clearing the phase (none allowed here), the two robots take it in
+    turn: the earlier action's robot hurries through the first half and stands at its path's end while the
+    other stands at its start, or the other way round; both paths carry their waits, the step's motions
+    the other's, and every robot of the step was compared with both.  A third robot standing in the way of
+    both orders leaves the clash."""
+    import mrgc.planner.ground as ground_module
+    from mrgc.planfile.format import PlannedAction
+    from mrgc.planner.ground import _robots_collide, _waiting
+
+    monkeypatch.setattr(ground_module, "WAITS", ())
+    path, volumes = _crossing(1.0)
+    across = [[float(x), 0.0, 0.0] for x in np.linspace(0.0, 1.0, 5)]
+    earlier = PlannedAction("a", "goal", "r1", "r1", "top", "top", paths={"to-place": [list(q) for q in across]})
+    action = PlannedAction("b", "goal", "r2", "r2", "top", "top", paths={"to-place": [list(q) for q in path]})
+    motions = {"r1": {"to-place": _across()}}
+    owners = {("r1", "to-place"): (earlier, "to-place")}
+    mine = {"r2": {"to-place": volumes}}
+    clash = _robots_collide(mine, motions)
+    assert clash is not None
+    assert _waiting(action, mine, motions, clash)[0] == clash  # without owners: nothing to take in turn
+    left, waited = _waiting(action, mine, motions, clash, owners)
+    assert left is None and _robots_collide(waited, motions) is None
+    (mine_wait,), (their_wait,) = action.waits(), earlier.waits()
+    assert {mine_wait[1:], their_wait[1:]} == {(4, 0), (0, 4)}  # one sets out late, the other arrives early
+    assert len(motions["r1"]["to-place"]) == 9 and len(action.paths["to-place"]) == 9
+
+    # a third robot standing where both orders put one of them: no turn clears it, nothing changes
+    action = PlannedAction("b", "goal", "r2", "r2", "top", "top", paths={"to-place": [list(q) for q in path]})
+    earlier = PlannedAction("a", "goal", "r1", "r1", "top", "top", paths={"to-place": [list(q) for q in across]})
+    motions = {"r1": {"to-place": _across()}, "r3": {"to-place": [[(_box(0.1), translation(0.5, 1.0, 0.0))]]}}
+    owners = {("r1", "to-place"): (earlier, "to-place")}
+    mine = {"r2": {"to-place": volumes}}
+    clash = _robots_collide(mine, motions)
+    assert clash is not None
+    left, _ = _waiting(action, mine, motions, clash, owners)
+    assert left is not None and not action.waits() and not earlier.waits() and len(motions["r1"]["to-place"]) == 5

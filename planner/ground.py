@@ -434,7 +434,8 @@ class ReverseGrounder:
         actions of ``step`` in one plan step, clear of the objects ``avoid`` where the grounder has them (their
         initial poses, or those :meth:`Grounder.moved <mrgc.geometry.grounding.Grounder.moved>` gives them),
         of each other and of the volume ``v_fut``; ``key`` seeds its sampling, ``index`` numbers its failure.
-        No splitting, re-timing or relays (those are the skeleton grounding's, :meth:`ground`)."""
+        No splitting, re-timing or relays (those are the skeleton grounding's, :meth:`ground`); its robots do
+        wait for each other within the step (:func:`_waiting`), as in :meth:`ground`."""
         return self._step(step, avoid, {a.obj for a in step}, v_fut, key, index)
 
     def _step(

@@ -494,16 +494,16 @@ def _relays(
     return out, ik, checks
 
 
-def _load_shared(scene: SceneSpec) -> None:
+def _load_shared(panda: bool) -> None:
     """Load here, before the workers fork, what each of them would otherwise load for itself: numpy's random
     generators (the IK restarts, placements and handover starts draw from them; about 18 ms of CPU an
-    import) and, for arms with a Panda's kinematics, the analytic IK's chain and solver module.  Forked
+    import) and, with an arm of a Panda's kinematics (``panda``), the analytic IK's solver module.  Forked
     workers share them; this process needs the generators afterwards anyway (grounding)."""
     import numpy.random  # noqa: F401  (numpy loads it on first use of np.random)
 
-    from mrgc.geometry.ik_analytic import load_solver, panda_chain
+    if panda:
+        from mrgc.geometry.ik_analytic import load_solver
 
-    if any(approaches(spec.kind) and panda_chain(Arm(spec).model) is not None for spec in scene.robots):
         load_solver()
 
 
@@ -527,10 +527,15 @@ def compute_facts(
     robots = [r.name for r in scene.robots]
     n = worker_count(workers, len(robots))
     jobs = [(scene, r, seed) for r in robots]
-    for spec in scene.robots:  # every arm's model and link hulls built here: errors surface once, forked workers
-        if approaches(spec.kind):  # share them (and the pybullet check of its URDF), grounding reuses them
-            _ = Arm(spec).hulls
-    _load_shared(scene)
+    from mrgc.geometry.ik_analytic import panda_chain
+
+    panda = False
+    for spec in scene.robots:  # every arm's model, link hulls and Panda reading built here: errors surface once,
+        if approaches(spec.kind):  # forked workers share them (and the pybullet check of its URDF), grounding too
+            arm = Arm(spec)
+            _ = arm.hulls
+            panda |= panda_chain(arm.model) is not None
+    _load_shared(panda)
     per_robot = _map(_robot_worker, jobs, n, deadline)
     t_robots = time.perf_counter() - t0
     facts: set[Fact] = set()

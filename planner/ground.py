@@ -1150,6 +1150,8 @@ def _waiting(
     are then; the paths (``action``'s, and the earlier actions' with ``motions`` in step) get the waits only
     when they cleared every clash.  A phase in which both robots of a handover move, or the action moves on
     no path of its own (an approach, an exchange), is not waited in."""
+    if clash is None:
+        return None, mine
     mine = {robot: dict(phases) for robot, phases in mine.items()}
     theirs = {robot: dict(phases) for robot, phases in motions.items()}
     pads: dict[str, int] = {}  # path name -> configurations added (> 0 before it, < 0 after it)
@@ -1159,7 +1161,7 @@ def _waiting(
         names = [n for n in action.paths if PATH_PHASE.get(n, n) == phase]
         if len(names) != 1 or names[0] in pads:
             return clash, mine
-        robot = _path_of(action, names[0])[0]
+        robot = action.path_robot(names[0])
         samples = mine[robot][phase]
         if len(samples) < 2:
             return clash, mine
@@ -1211,12 +1213,12 @@ def _in_turn(
     their = theirs[other][phase]
     if len(their) < 2:
         return None
+    rest = [m for o, m in theirs.items() if o not in (robot, other)]
     for mine_n, their_n in ((len(their) - 1, -(len(samples) - 1)), (-(len(their) - 1), len(samples) - 1)):
         me, it = _pad(samples, mine_n), _pad(their, their_n)
-        rest = {o: m for o, m in theirs.items() if o not in (robot, other)}
         if _phases_collide({phase: me}, {phase: it}):
             continue
-        if any(_phases_collide({phase: me}, m) or _phases_collide({phase: it}, m) for m in rest.values()):
+        if any(_phases_collide({phase: me}, m) or _phases_collide({phase: it}, m) for m in rest):
             continue
         return mine_n, (other, their_n)
     return None

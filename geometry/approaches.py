@@ -29,6 +29,7 @@ from mrgc.geometry.conventions import APPROACH_SAMPLES, PATH_RESOLUTION, seed_fo
 from mrgc.geometry.grasps import APPROACH, fits, grasp_transform, pregrasp_transform
 from mrgc.geometry.ik import IKResult, solve_ik_many
 from mrgc.geometry.robot import Pieces, Volume
+from mrgc.geometry.stances import Stance
 from mrgc.geometry.step_world import named_body
 from mrgc.geometry.transforms import translation
 from mrgc.geometry.volumes import Volumes
@@ -99,6 +100,7 @@ class Approaches(Volumes):
         busy: Pieces = (),
         from_home: bool = True,
         after: Pieces = (),
+        partner: tuple[str, ...] = (),
     ) -> Answer:
         spec = self.scene.grasp_specs.get(grasp)
         arm = self.arm(robot)
@@ -148,17 +150,14 @@ class Approaches(Volumes):
                 if self._hand_hits(robot, configs, (obj, grasp), avoid):
                     break  # the hand, where the grasp puts it in every attempt: no other branch helps
                 continue
-            if (moving is not None and posed_collide(posed, moving)) or (
-                after and self._standing_clash(robot, obj, grasp, configs[-1], after)
-            ):
-                # another robot of the step moves there meanwhile, or moves (or stands) where the arm stands
-                # afterwards: another IK seed
-                status, clash = GroundStatus.COLLISION, ("moving", volume)
+            clash = self._step_clash(robot, (obj, grasp), configs, posed, moving, after, partner)
+            if clash is not None:
+                status = GroundStatus.COLLISION
                 continue
             return Answer(GroundStatus.OK, pose=pose, configs=configs)
         detail = ""
         if clash is not None and not blockers:
-            detail = self._clash_detail(robot, phase, clash, ignore=() if held else (obj,))
+            detail = self._clash_detail(robot, phase, clash, ignore=() if held else (obj,), partner=partner)
         return Answer(status, blockers=blockers, detail=detail, static=static)
 
     def _hand_hits(self, robot: str, configs: np.ndarray, grip: tuple[str, str], avoid: tuple[str, ...]) -> bool:
@@ -176,6 +175,40 @@ class Approaches(Volumes):
         is there too then (placed, or held by the taker)."""
         volume = self.arm_volume(robot, q[None], holding=(obj, grasp))
         return posed_collide(Posed.of(volume), self._volumes.posed(after))
+
+    def _step_clash(
+        self,
+        robot: str,
+        grip: tuple[str, str],
+        configs: np.ndarray,
+        posed: Posed,
+        moving: Posed | None,
+        after: Pieces,
+        partner: tuple[str, ...],
+    ) -> tuple[str, Volume] | None:
+        """What an approach ``configs`` (swept as ``posed``) of ``robot`` to ``grip`` (object, grasp) meets of the
+        step's other robots, as ``(kind, volume)``: ``moving`` when another robot of the step moves there
+        meanwhile, or moves or stands where the arm stands afterwards (``after``); ``partner`` when the arm at
+        its exchange, holding the object, hits its handover partner at home then (``partner``: that arm's world
+        group, :meth:`_at_home_then`); None when neither."""
+        obj, grasp = grip
+        if (moving is not None and posed_collide(posed, moving)) or (
+            after and self._standing_clash(robot, obj, grasp, configs[-1], after)
+        ):
+            return "moving", []
+        if partner:
+            holding = self.arm_volume(robot, configs[-1:], holding=grip)
+            if self.world.probe_collides(Posed.of(holding), against=partner):
+                return "partner", holding
+        return None
+
+    def _at_home_then(self, partner: str, phase: str) -> tuple[str, ...]:
+        """The world group of ``partner``'s home links when the execution model has it at home in ``phase`` of
+        the declared step (:meth:`step`), else nothing."""
+        if self.stance(partner, phase) is not Stance.HOME or self.robot(partner).parks:
+            return ()
+        self._homes()
+        return (f"home:{partner}",)
 
     def _static_clash(self, robot: str, obj: str, volume: Posed, held: bool) -> bool:
         """Whether an approach volume hits what never moves: a fixed body or another arm's base link."""
@@ -253,15 +286,20 @@ class Approaches(Volumes):
             return None
         return configs if on_the_line(arm, tool, configs[-2], configs[-1]) else None
 
-    def _clash_detail(self, robot: str, phase: str, clash: tuple[str, Volume], ignore: tuple[str, ...]) -> str:
+    def _clash_detail(
+        self, robot: str, phase: str, clash: tuple[str, Volume], ignore: tuple[str, ...], partner: tuple[str, ...] = ()
+    ) -> str:
         """Name what a volume collided with besides the avoided objects: fixed bodies, other arms at home
-        (their links are named ``@<arm>:<i>``) or standing still (``~<arm>:<stance>:<i>``), or the other robots
-        of the step."""
+        (their links are named ``@<arm>:<i>``) or standing still (``~<arm>:<stance>:<i>``), the handover
+        partner at home (``partner``: its group), or the other robots of the step."""
         kind, volume = clash
         if kind == "moving":
             return BUSY
         if kind == "self":
             return SELF
+        if kind == "partner":
+            hit = self.world.probe_hits(Posed.of(volume), against=partner)
+            return "hits " + ", ".join(sorted({named_body(h) for h in hit})) + ", its handover partner"
         hit = self.world.probe_hits(volume, against=("fixed", *self._others(robot, phase)), ignore=ignore)
         named = sorted({named_body(h) for h in hit})
         return "hits " + ", ".join(named) if named else ""
@@ -314,11 +352,26 @@ class Approaches(Volumes):
         worlds: list[Posed] = []  # the taker's configurations, as the kernel reads them
         later = after or {}
 
+        # each arm at its exchange while its partner is still (or already) at home: the giver arrives at the
+        # end of to-handover, where a taker without a path to its exchange (``--motions configurations``) waits
+        # at home; the taker leaves for its place at the start of to-place, the giver home by then
+        partner = {giver: self._at_home_then(taker, "to-handover"), taker: self._at_home_then(giver, "to-place")}
+
         def exchange(arm: str, grasp: str, attempt: int) -> Answer:
             key = f"handover:{point}" + (f":{attempt}" if attempt else "")
             first = attempt == 0
             return self._approach(
-                arm, obj, grasp, pose, key, avoid, approach=False, busy=busy, from_home=first, after=later.get(arm, ())
+                arm,
+                obj,
+                grasp,
+                pose,
+                key,
+                avoid,
+                approach=False,
+                busy=busy,
+                from_home=first,
+                after=later.get(arm, ()),
+                partner=partner[arm],
             )
 
         for attempt in range(HANDOVER_PAIRS):

@@ -14,12 +14,11 @@ from mrgc.language.model import Fact
 
 @dataclass(frozen=True)
 class HandoverConfig:
-    """One configuration of an arm holding a goal object at a handover point, free of the fixed objects;
-    ``homes``: the other arms whose links at home it hits; ``movables``: the movable objects (at their initial
-    poses) its links or the object it holds there hit (``occludes-handover``)."""
+    """One configuration of an arm holding a goal object at a handover point, free of the fixed objects and
+    of every other arm at home; ``movables``: the movable objects (at their initial poses) its links or the
+    object it holds there hit (``occludes-handover``)."""
 
     q: np.ndarray
-    homes: frozenset[str]
     movables: frozenset[str] = frozenset()
 
 

@@ -15,7 +15,10 @@ For every robot R (in parallel, one process per robot when there are cores to sp
 - ``enable-goal-handover M g1 g2 R1 R2`` (goal objects): at some handover point of M, R1 holding M with
   g1 and R2 holding it with g2 are both collision-free with respect to the fixed objects and to each other
   (up to HANDOVER_CONFIGS distinct IK solutions per arm are tried in pairs: one branch of an arm may reach
-  into a waiting arm or into its partner where another does not);
+  into a waiting arm where another does not).  A configuration reaching into its partner's home is left out
+  too: under the default motion model the giver arrives at its exchange while the taker still waits at home
+  (it has no path there), and in both models the giver is back home when the taker leaves its exchange for
+  the place (docs/validator.md, "What a plan means");
 - ``occludes-handover M1 M g1 g2 R1 R2`` (beyond the paper): M1 is hit by R1's or R2's links, or by M held
   at the point, at the exchange of that handover, for the pair of configurations (over every handover point)
   that hits the fewest movable objects; none when a pair hits none (a handover point above the start region
@@ -411,7 +414,7 @@ class RobotEvaluator:
 
     def _keep_handovers(self, found: list[tuple[tuple[str, str, str], np.ndarray]]) -> None:
         """Keep each (key, q) of ``found``, in order, as a handover configuration of its key if it differs from
-        those kept and is free of itself and of the fixed objects (arms at home aside), with the movable
+        those kept and is free of itself, of the fixed objects and of the arms at home, with the movable
         objects its links and the object held at the point hit.  The collision checks of all of them run
         together (as :meth:`_branches`'), the answers those of one configuration at a time."""
         kept = {key: self.out.handover.setdefault(key, []) for key, _ in found}
@@ -424,14 +427,12 @@ class RobotEvaluator:
         transforms = self._link_transforms(np.stack([found[k][1] for k in fresh])[:, None], openings)[:, 0]
         shapes, tolerance = self.arm.probes[0], self.world.tolerance
         good = ~self.arm.self_colliding_at(transforms)
-        clear: dict[int, frozenset[str]] = {}  # fresh index -> the arms at home its links hit (nothing else)
+        clear: set[int] = set()  # fresh indices whose links hit nothing fixed, no arm at home (its partner's too)
         ok = np.flatnonzero(good)
         if len(ok):
             probes = Probes.batch(shapes, transforms[ok], tolerance)
             fixed = self.world.slot_hits(probes, "fixed", own=[objs[x] for x in ok.tolist()])
-            for x, hits in zip(ok.tolist(), fixed):
-                if all(h.startswith("@") for h in hits):  # only arms at home: fine if the partner is the one hit
-                    clear[x] = frozenset(h[1:].split(":")[0] for h in hits)
+            clear = {x for x, hits in zip(ok.tolist(), fixed) if not hits}
         movables: dict[int, set[str]] = {}
         if clear:
             rows = sorted(clear)
@@ -447,7 +448,7 @@ class RobotEvaluator:
                 continue
             self.out.collision_checks += 1
             if at in clear:
-                kept[key].append(HandoverConfig(q, clear[at], frozenset(movables[at])))
+                kept[key].append(HandoverConfig(q, frozenset(movables[at])))
 
     @staticmethod
     def _distinct(kept: list[HandoverConfig], q: np.ndarray) -> bool:
@@ -611,8 +612,8 @@ def _exchange_hits(
     taker: tuple[str, str, list[HandoverConfig]],
 ) -> frozenset[str] | None:
     """The movable objects hit at the pair of the two arms' exchange configurations (robot, grasp,
-    configurations) that hits the fewest, among the pairs whose arms do not collide (an arm may reach into
-    the other one's home only: that one is at the exchange); None when every pair collides."""
+    configurations) that hits the fewest, among the pairs whose arms do not collide; None when every pair
+    collides."""
     (r1, g1, c1s), (r2, g2, c2s) = giver, taker
     shape = scene.body(obj).shape
     w1, w2 = finger_opening(scene.grasp(g1), shape), finger_opening(scene.grasp(g2), shape)
@@ -622,11 +623,7 @@ def _exchange_hits(
             hits = c1.movables | c2.movables
             if best is not None and (len(hits), sorted(hits)) >= (len(best), sorted(best)):
                 continue
-            if (
-                c1.homes <= {r2}
-                and c2.homes <= {r1}
-                and not posed_collide(arms.at(r1, c1.q, w1), arms.at(r2, c2.q, w2))
-            ):
+            if not posed_collide(arms.at(r1, c1.q, w1), arms.at(r2, c2.q, w2)):
                 best = hits
     return best
 

@@ -368,6 +368,41 @@ def test_the_grounder_knows_where_each_arm_of_the_step_is_in_each_phase(pa3: Gro
     assert "home:r1" in pa3._others("r2", "handover")  # no step: every other arm at home
 
 
+@functools.lru_cache(maxsize=1)
+def _six_arms_seed_8() -> Grounder:
+    from mrgc.generate import packaging
+
+    text = packaging(robots=6, goals=10, others=30, seed=8)
+    return Grounder(scene_from_problem(mrgc.parse_string(text, "big-8.mrg").problem()), seed=0)
+
+
+@pytest.mark.parametrize("full", [False, True])
+def test_an_exchange_is_clear_of_its_partner_at_home_when_the_model_puts_it_there(full: bool) -> None:
+    """6 arms, 40 objects, generated seed 8: handover point h1 lies 0.19 m from r2's base.  r3's first exchange
+    holding o13 there (top-x) reaches into r2 at home, where the default motion model keeps the taker until
+    the handover phase: the giver's carry to it then had no valid goal, and the search failed 51 of its 80
+    groundings on ``carry to the handover by r3: no path`` (300 s, time limit).  Each arm's exchange is now
+    drawn clear of its partner where the model has it at home then: the taker while the giver arrives (not
+    under ``--motions full``: it moves to its exchange meanwhile), the giver when the taker leaves."""
+    g = _six_arms_seed_8()
+    g.step({"r3": "giver", "r2": "taker"}, full)
+    try:
+        for point in ("h1", "h2"):
+            ans = g.handover("o13", point, "r3", "top-x", "r2", "side-y-")
+            if not ans.ok:
+                assert ans.status is GroundStatus.COLLISION and ans.detail.startswith("hits")
+                continue
+            assert ans.configs is not None
+            giver = g.arm_volume("r3", ans.configs[:1], holding=("o13", "top-x"))
+            taker = g.arm_volume("r2", ans.configs[1:], holding=("o13", "side-y-"))
+            assert g.world.probe_collides(Posed.of(giver), against=("home:r2",)) is (full and point == "h1")
+            assert not g.world.probe_collides(Posed.of(taker), against=("home:r3",))
+        if not full:  # no exchange at h1 is clear of both r2 and r1 at home
+            assert not g.handover("o13", "h1", "r3", "top-x", "r2", "side-y-").ok
+    finally:
+        g.step({})
+
+
 def test_a_giver_lets_go_backing_its_fingers_off_the_object_the_taker_holds(pa3: Grounder) -> None:
     """The taker stands at its exchange holding the object while the giver withdraws home, the giver's
     fingers at the grasp's opening (the validator's giver-home phase): the giver's path first backs straight

@@ -299,7 +299,8 @@ class Approaches(Volumes):
             return SELF
         if kind == "partner":
             hit = self.world.probe_hits(Posed.of(volume), against=partner)
-            return "hits " + ", ".join(sorted({named_body(h) for h in hit})) + ", its handover partner"
+            names = sorted({named_body(h) for h in hit}) or [f"{g.split(':', 1)[1]} at home" for g in partner]
+            return "hits " + ", ".join(names) + ", its handover partner"
         hit = self.world.probe_hits(volume, against=("fixed", *self._others(robot, phase)), ignore=ignore)
         named = sorted({named_body(h) for h in hit})
         return "hits " + ", ".join(named) if named else ""

@@ -169,13 +169,6 @@ class Approaches(Volumes):
         hand = self.arm(robot).hand_volume(configs[[0, -1]], opening)
         return bool(hand) and self.world.probe_collides(Posed.of(hand), against=avoid)
 
-    def _standing_clash(self, robot: str, obj: str, grasp: str, q: np.ndarray, after: Pieces) -> bool:
-        """Whether ``robot`` standing at ``q`` holding ``obj`` hits ``after``: what the step's other robots do
-        in the later phases it stands there (:meth:`step`).  Held: where it has let the object go, the object
-        is there too then (placed, or held by the taker)."""
-        volume = self.arm_volume(robot, q[None], holding=(obj, grasp))
-        return posed_collide(Posed.of(volume), self._volumes.posed(after))
-
     def _step_clash(
         self,
         robot: str,
@@ -190,16 +183,19 @@ class Approaches(Volumes):
         step's other robots, as ``(kind, volume)``: ``moving`` when another robot of the step moves there
         meanwhile, or moves or stands where the arm stands afterwards (``after``); ``partner`` when the arm at
         its exchange, holding the object, hits its handover partner at home then (``partner``: that arm's world
-        group, :meth:`_at_home_then`); None when neither."""
-        obj, grasp = grip
-        if (moving is not None and posed_collide(posed, moving)) or (
-            after and self._standing_clash(robot, obj, grasp, configs[-1], after)
-        ):
+        group, :meth:`_at_home_then`); None when neither.  Where it stands, the arm is checked holding the object
+        (where it has let the object go, the object is there too then: placed, or held by the taker), its volume
+        made once for both checks."""
+        if moving is not None and posed_collide(posed, moving):
             return "moving", []
-        if partner:
-            holding = self.arm_volume(robot, configs[-1:], holding=grip)
-            if self.world.probe_collides(Posed.of(holding), against=partner):
-                return "partner", holding
+        if not (after or partner):
+            return None
+        standing = self.arm_volume(robot, configs[-1:], holding=grip)
+        here = Posed.of(standing)
+        if after and posed_collide(here, self._volumes.posed(after)):
+            return "moving", []
+        if partner and self.world.probe_collides(here, against=partner):
+            return "partner", standing
         return None
 
     def _at_home_then(self, partner: str, phase: str) -> tuple[str, ...]:

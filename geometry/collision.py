@@ -298,12 +298,13 @@ class Posed:
         return out
 
     @classmethod
-    def join(cls, parts: Sequence["Posed"]) -> "Posed":
-        """The pieces of ``parts`` one after the other, as a new set (nothing cached yet, so that a query
-        of the union grows no tree or part on the sets it was joined from): their boxes as they were made,
-        the distinct shapes in order of first appearance.  The parts must share their pad (an empty union
-        has :data:`TOLERANCE`).  A grounded step keeps its volume as one set, and a suffix's volume is the
-        join of its steps' (arrays of 184 bytes a piece instead of a list of (shape, 4×4 view) pairs)."""
+    def join(cls, given: Sequence["Posed | Packed"]) -> "Posed":
+        """The pieces of ``given`` one after the other, as a new set (nothing cached yet, so that a query
+        of the union grows no tree or part on the sets it was joined from): their boxes as they were made
+        (a :class:`Packed` set's made again, the same), the distinct shapes in order of first appearance.
+        The parts must share their pad (an empty union has :data:`TOLERANCE`).  A grounded step keeps its
+        volume packed, and a suffix's volume is the join of its steps'."""
+        parts = [p.posed() if isinstance(p, Packed) else p for p in given]
         pads = {p.pad for p in parts}
         if len(pads) > 1:
             raise ValueError(f"sets of different pads {sorted(pads)} cannot be joined")
@@ -394,6 +395,46 @@ class Posed:
             manager.setup()
             self._tree = (pad, manager, objects)
         return self._tree[1]
+
+
+@dataclass(frozen=True, eq=False)
+class Packed:
+    """A :class:`Posed` set kept for later in less memory: what a grounded step sweeps, which a search holds
+    for every step its nodes grounded (the 6-arm, 40-object instances: some 11,000 pieces a step, a million
+    after 30 nodes).  The shapes, which of them each piece is (``kind``, int32), where (``rows``: the top
+    three rows of each 4×4 transform, whose last row is (0, 0, 0, 1); the whole transforms when one is not)
+    and the pad: 100 bytes a piece where a :class:`Posed` holds 184 (its boxes and 4×4 transforms), the boxes
+    made again when it is read (:meth:`posed`: bit for bit the ones :class:`Posed` made from the same rows)."""
+
+    shapes: tuple[CollisionShape, ...]
+    kind: np.ndarray
+    rows: np.ndarray
+    pad: float
+
+    @classmethod
+    def of(cls, posed: Posed) -> "Packed":
+        """``posed``'s pieces, packed."""
+        t = posed.transforms
+        affine = bool(np.all(t[:, 3] == _BOTTOM))
+        rows = np.ascontiguousarray(t[:, :3]) if affine else t.copy()
+        return cls(tuple(posed.shapes), posed.kind.astype(np.int32), rows, posed.pad)
+
+    def __len__(self) -> int:
+        return len(self.kind)
+
+    def posed(self) -> Posed:
+        """The pieces as a :class:`Posed` set again (new arrays, nothing cached)."""
+        if self.rows.shape[1] == 4:
+            transforms = self.rows
+        else:
+            transforms = np.empty((len(self.rows), 4, 4))
+            transforms[:, :3] = self.rows
+            transforms[:, 3] = _BOTTOM
+        return Posed(self.shapes, self.kind.astype(np.intp), transforms, self.pad)
+
+
+#: the last row of an affine 4×4 transform
+_BOTTOM = np.array([0.0, 0.0, 0.0, 1.0])
 
 
 @dataclass(frozen=True, eq=False)

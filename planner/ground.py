@@ -28,7 +28,7 @@ import numpy as np
 from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action
 from mrgc.geometry.answers import BUSY, SELF, Answer, GroundStatus
-from mrgc.geometry.collision import Posed, paired_collide, pieces_collide
+from mrgc.geometry.collision import Packed, Posed, paired_collide, pieces_collide
 from mrgc.geometry.conventions import refine
 from mrgc.geometry.grounding import Grounder
 from mrgc.geometry.relays import spot_region
@@ -76,9 +76,9 @@ class GroundedStep:
     """A grounded joint action: its actions, the volume it sweeps, and the objects it moves."""
 
     actions: list[PlannedAction]
-    #: every sample of every motion of the step, and its objects at their placements, as the collision kernel
-    #: reads it (kept compact: a search holds the volumes of every step its nodes grounded)
-    volume: Posed
+    #: every sample of every motion of the step, and its objects at their placements, packed (a search holds
+    #: the volumes of every step its nodes grounded; :func:`swept` joins them for the kernel)
+    volume: Packed
     moved: tuple[str, ...]
 
 
@@ -497,7 +497,7 @@ class ReverseGrounder:
             step_volume.append((self.g.shape(a.obj), np.array(action.place_pose)))
             placed[a.obj] = np.array(action.place_pose)
             actions.append(action)
-        return GroundedStep(actions, Posed.of(step_volume), tuple(a.obj for a in step))
+        return GroundedStep(actions, Packed.of(Posed.of(step_volume)), tuple(a.obj for a in step))
 
     def _motions(self, action: PlannedAction) -> Motions:
         """Each robot's volume at every sample of every phase of a planned action, approaches on the

@@ -602,6 +602,38 @@ def test_a_large_set_probed_often_answers_as_before_through_its_tree(seed: int, 
     assert len(seen) == 2 or n_probe == 120  # both answers occur (a batch of 120 pieces mostly collides)
 
 
+@settings(max_examples=30, deadline=None)
+@given(st.integers(0, 2**31 - 1), st.lists(st.integers(0, 40), min_size=1, max_size=4), st.booleans())
+def test_a_packed_set_reads_back_bit_for_bit(seed: int, sizes: list[int], skewed: bool) -> None:
+    """A grounded step's volume is kept packed (its transforms' top rows, no boxes): read back, and joined
+    with others as a suffix's volume is, it gives the very arrays the unpacked sets give (kinds, transforms
+    and the boxes made again from them, bit for bit), so packing changes no answer; a transform whose last
+    row is not (0, 0, 0, 1) is kept whole.  It takes less memory than the set it packs."""
+    from mrgc.geometry.collision import Packed, Posed
+
+    rng = np.random.default_rng(seed)
+    sets = []
+    for n in sizes:
+        pieces = _random_pieces(rng, n, 1.0)
+        if skewed and pieces:
+            pieces[0][1][3, :3] = 1e-3  # not affine
+        sets.append(Posed.of(pieces))  # type: ignore[arg-type]
+    packed = [Packed.of(p) for p in sets]
+    for p, k in zip(sets, packed):
+        back = k.posed()
+        for name in ("kind", "transforms", "lo", "hi"):
+            assert np.array_equal(getattr(back, name), getattr(p, name)), name
+        assert back.shapes == p.shapes and back.pad == p.pad and len(k) == len(p)
+        if len(p) > 1 and not skewed:
+            assert k.kind.nbytes + k.rows.nbytes < 0.6 * sum(
+                getattr(p, n).nbytes for n in ("kind", "transforms", "lo", "hi")
+            )
+    joined, again = Posed.join(sets), Posed.join(packed)
+    for name in ("kind", "transforms", "lo", "hi"):
+        assert np.array_equal(getattr(joined, name), getattr(again, name)), name
+    assert [id(s) for s in joined.shapes] == [id(s) for s in again.shapes]
+
+
 def test_a_small_probe_tests_every_pose_of_a_shape_it_holds_twice() -> None:
     """A small probe (up to SMALL_PROBE pieces, through the selection's coal tree) with one shape at several
     poses (an object along a path): the pose that collides is found wherever it is in the probe, as a list

@@ -18,7 +18,7 @@ from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action
 from mrgc.geometry.answers import Answer, GroundStatus
 from mrgc.geometry.arm_paths import joint_line
-from mrgc.geometry.collision import CollisionShape, CollisionWorld, Posed
+from mrgc.geometry.collision import CollisionShape, CollisionWorld, Packed, Posed
 from mrgc.geometry.conventions import PATH_RESOLUTION, to_se2
 from mrgc.geometry.grounding import Grounder
 from mrgc.geometry.kinematics import Link
@@ -802,10 +802,11 @@ def test_a_suffix_leaving_a_goal_object_no_room_in_its_goal_region_is_a_dead_end
     reverse = ReverseGrounder(pa3, {"o1": "bin-b"})
     skeleton = Skeleton(((Action("o1", "bin-b", "r1", "r2", "top", "top"),),))
     full = Failure(1, "r1->r2 moves o1", "placement: no free pose of o1 in bin-b")
-    walled = [GroundedStep([], Posed.of(_wall(pa3, "bin-b")), ("o2",))]
+    walled = [GroundedStep([], Packed.of(Posed.of(_wall(pa3, "bin-b"))), ("o2",))]
     why = reverse.dead_end(full, skeleton, walled)
     assert "no free pose of o1 in bin-b" in why and "1 step(s)" in why
-    assert reverse.dead_end(full, skeleton, [GroundedStep([], Posed.of(_wall(pa3, "bin-b")[:1]), ("o2",))]) == ""
+    one = [GroundedStep([], Packed.of(Posed.of(_wall(pa3, "bin-b")[:1])), ("o2",))]
+    assert reverse.dead_end(full, skeleton, one) == ""
     assert reverse.dead_end(Failure(1, "r1->r2 moves o1", "place by r2: no inverse kinematics"), skeleton, walled) == ""
     assert ReverseGrounder(pa3, {"o1": "bin-a"}).dead_end(full, skeleton, walled) == ""
 

@@ -21,7 +21,7 @@ from mrgc import __version__, cli, parse_file
 from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action
 from mrgc.geometry.answers import BUSY, Answer, GroundStatus
-from mrgc.geometry.collision import CollisionShape, Posed, collision_shape
+from mrgc.geometry.collision import CollisionShape, Packed, Posed, collision_shape
 from mrgc.geometry.stances import Stance
 from mrgc.language.model import Box
 from mrgc.planfile.format import PlannedAction, file_sha256
@@ -340,7 +340,7 @@ def test_m_star_keeps_the_blockers_of_an_older_suffix() -> None:
     grounder = ScriptedGrounder(movable, blocked_by={"c": {"d"}}, sweeps=sweeps)
     reverse = ReverseGrounder(grounder, {"g": "goal"})  # type: ignore[arg-type]
     swept = Posed.of([(grounder.token("suffix-volume"), np.eye(4))])
-    suffix = [GroundedStep([PlannedAction("g", "goal", "r1", "r1", "top", "top")], swept, ("g",))]
+    suffix = [GroundedStep([PlannedAction("g", "goal", "r1", "r1", "top", "top")], Packed.of(swept), ("g",))]
     skeleton = Skeleton(
         ((Action("b", "start", "r1", "r1", "top", "top"),), (Action("c", "start", "r1", "r1", "top", "top"),))
     )

@@ -15,6 +15,7 @@ from support import ROOT
 from mrgc import __version__, cli, parse_file
 from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action
+from mrgc.geometry.collision import Packed
 from mrgc.planfile.format import PlannedAction, file_sha256
 from mrgc.planfile.reader import read_plan
 from mrgc.planner.ground import GroundedStep, Grounding, Outcome, swept
@@ -110,7 +111,8 @@ SKEL_CLEAR = Skeleton(((A2,), (A1,)))
 
 
 def step_of(action: Action) -> GroundedStep:
-    return GroundedStep([PlannedAction(action.obj, action.region, "r1", "r1", "top", "top")], swept(()), (action.obj,))
+    planned = PlannedAction(action.obj, action.region, "r1", "r1", "top", "top")
+    return GroundedStep([planned], Packed.of(swept(())), (action.obj,))
 
 
 def feeder(skeletons: list[Skeleton]):  # type: ignore[no-untyped-def]

@@ -102,7 +102,7 @@ class GeometricSteps:
         if isinstance(step, Failure):
             return step
         among = sorted(free - same)
-        hits = self.grounder.hits(step.volume, among=among) if among and not strict else set()
+        hits = self.grounder.hits(step.volume.posed(), among=among) if among and not strict else set()
         return Attempt(step, hits)
 
 
@@ -124,6 +124,7 @@ class SymbolicSteps:
     ) -> Attempt | Failure:
         """Ground the step ``actions`` against the future volume (reverse search): an :class:`Attempt` or the
         :class:`~mrgc.planner.outcome.Failure` that stopped it."""
+        from mrgc.geometry.collision import Packed
         from mrgc.planner.ground import GroundedStep, label, swept
 
         facts, same = self.facts, {a.obj for a in actions}
@@ -145,7 +146,7 @@ class SymbolicSteps:
         if strict and hits:
             return Failure(index, " + ".join(label(a) for a in actions), "obstructed", tuple(sorted(hits)))
         planned = [planned_action(a) for a in actions]
-        return Attempt(GroundedStep(planned, swept(()), tuple(a.obj for a in actions)), hits)
+        return Attempt(GroundedStep(planned, Packed.of(swept(())), tuple(a.obj for a in actions)), hits)
 
 
 @dataclass

@@ -10,12 +10,27 @@ their parser and runs it.
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from typing import Callable, Sequence
 
-from mrgc import commands
-from mrgc.errors import InputError, MrgcError
-from mrgc.exits import ExitCode
+
+def _one_blas_thread() -> None:
+    """Run numpy's OpenBLAS on one thread unless the environment says otherwise (``OPENBLAS_NUM_THREADS``).
+
+    mrgc's linear algebra is 4x4 transforms and 7x7 solves, far below what OpenBLAS splits over threads, yet
+    its pool starts one thread per core when numpy is imported and they wake and spin on its calls: about
+    70 ms of CPU at import and 0.06-0.25 s over a PA5-BO8 run on 2 cores, for nothing (the plans are the
+    same bit for bit; docs/benchmarks.md, "Session 27").  Read by OpenBLAS once, when numpy loads, so this
+    runs before any module that imports numpy; worker processes inherit it."""
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+
+_one_blas_thread()
+
+from mrgc import commands  # noqa: E402  (after the BLAS setting: commands may import numpy)
+from mrgc.errors import InputError, MrgcError  # noqa: E402
+from mrgc.exits import ExitCode  # noqa: E402
 
 
 def build_parser() -> argparse.ArgumentParser:

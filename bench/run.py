@@ -56,7 +56,8 @@ class StudySummary:
 
 
 def study_tasks(study: Study, work: str) -> tuple[list[RunTask], dict[str, tuple[str, int]]]:
-    """Every run of the study in study order, and the methods skipped with their reason and run count."""
+    """Every run of the study in study order (each with ``--no-cache`` unless the study's ``facts_cache`` is
+    ``shared``), and the methods skipped with their reason and run count."""
     diags, skip = check_methods(study)
     if diags:
         raise InputError(diags, {study.path: study.text})
@@ -73,7 +74,8 @@ def study_tasks(study: Study, work: str) -> tuple[list[RunTask], dict[str, tuple
                     skipped[m.name] = (why, n + 1)
                     continue
                 out_dir = os.path.join(work, study.name, "runs", re.sub(r"[^A-Za-z0-9_.+-]", "-", m.name))
-                tasks.append(RunTask(study.name, inst, m.name, tuple(method_args(m)), seed, m.limits, out_dir))
+                args = (*method_args(m), *(("--no-cache",) if study.facts_cache == "own" else ()))
+                tasks.append(RunTask(study.name, inst, m.name, args, seed, m.limits, out_dir))
     return tasks, skipped
 
 

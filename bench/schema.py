@@ -13,7 +13,7 @@ import re
 from dataclasses import replace
 from typing import Any
 
-from mrgc.bench.study import E_STUDY_READ, E_STUDY_SCHEMA, InstanceSpec, Limits, Method, Study
+from mrgc.bench.study import E_STUDY_READ, E_STUDY_SCHEMA, FACTS_CACHE, InstanceSpec, Limits, Method, Study
 from mrgc.errors import Diagnostic, InputError, Span
 
 _NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.+-]*$")
@@ -22,7 +22,7 @@ _SIZE = re.compile(r"^\s*(\d+(?:\.\d+)?)\s*([KMGT]i?B?|)\s*$", re.IGNORECASE)
 _UNITS = {"": 1.0, "k": 1 / 1024, "m": 1.0, "g": 1024.0, "t": 1024.0**2}
 _MAX_BYTES = 1 << 20
 
-STUDY_KEYS = ("study", "description", "seeds", "limits", "instances", "methods")
+STUDY_KEYS = ("study", "description", "seeds", "limits", "facts_cache", "instances", "methods")
 LIMIT_KEYS = ("time", "wall", "memory")
 METHOD_KEYS = ("name", "planner", "compile", "backend", "encoding", "options", "limits", "only")
 FILE_KEYS = ("file", "name", "problem")
@@ -208,12 +208,24 @@ class Reader:
         description = self.scalar(top["description"][1], "description", (str,)) if "description" in top else ""
         seeds = self.seeds(top["seeds"][1], "seeds") if "seeds" in top else (0,)
         limits = self.limits(top["limits"][1], Limits()) if "limits" in top else Limits()
+        facts_cache = self.facts_cache(top["facts_cache"][1]) if "facts_cache" in top else "own"
         instances = self.instances(top["instances"][1]) if "instances" in top else []
         self.set_names = [i.name for i in instances]
         methods = self.methods(top["methods"][1], limits or Limits()) if "methods" in top else []
         if name is None or seeds is None or limits is None or self.diags:
             return None
-        return Study(name, self.path, "", tuple(instances), tuple(methods), seeds, limits, description or "")
+        return Study(
+            name, self.path, "", tuple(instances), tuple(methods), seeds, limits, description or "", facts_cache
+        )
+
+    def facts_cache(self, node: Any) -> str:
+        """The study's ``facts_cache`` (a key of :data:`~mrgc.bench.study.FACTS_CACHE`), "own" with an error
+        when it is another value."""
+        value = self.value(node)
+        if value not in FACTS_CACHE:
+            self.error(node, f"facts_cache must be one of {', '.join(FACTS_CACHE)}")
+            return "own"
+        return str(value)
 
     def limits(self, node: Any, base: Limits) -> Limits | None:
         """``base`` with the limits the node gives; None when it is not a mapping."""

@@ -8,6 +8,7 @@ A study is a YAML file read with pyyaml's safe loader (plain data only: no tags 
     description: free text        # optional
     seeds: 0..1                   # planner seeds of every run: an integer, "a..b" (inclusive) or a list
     limits: {time: 60, memory: 4GB}   # per run (see Limits); a method may override them
+    facts_cache: own              # optional: own (default) or shared, see FACTS_CACHE
     instances:                    # one entry per instance set (a row group of the report)
       - file: ../domains/packaging/pa5.mrg     # relative to the study file
       - glob: ../domains/symbolic/c*.mrg      # every match is an instance of the set
@@ -38,6 +39,15 @@ from mrgc.errors import Span
 
 #: diagnostic codes of study files
 E_STUDY_READ, E_STUDY_SCHEMA = "E600", "E601"
+
+#: the values of a study's ``facts_cache`` and what each means for its runs.  ``own`` (the default): every run
+#: computes its own phase 1 (the runner adds ``--no-cache``), so a run costs the same whichever method ran on
+#: the instance before it; ``shared``: runs read and fill mrgc's facts cache (docs/geometry.md, "The facts
+#: cache"), so only the first run on each instance pays for phase 1 (studies of skeleton generation alone).
+FACTS_CACHE = {
+    "own": "every run computes its own phase 1",
+    "shared": "runs on the same instance share phase 1 through the facts cache",
+}
 
 
 @dataclass(frozen=True)
@@ -124,6 +134,7 @@ class Study:
     seeds: tuple[int, ...] = (0,)
     limits: Limits = Limits()
     description: str = ""
+    facts_cache: str = "own"  # a key of FACTS_CACHE
 
     @property
     def folder(self) -> str:

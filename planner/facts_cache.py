@@ -17,8 +17,8 @@ every one of them goes through, looks here first and stores what a complete phas
   into place), so readers never see half a file.
 - **Never a partial phase 1**: a phase 1 cut short by a deadline (``complete`` False) is not stored.
 - **Bypass**: ``--no-cache`` on ``plan``, ``compile``, ``facts``, ``graph`` and ``render`` (neither read
-  nor written), or ``MRGC_NO_CACHE=1`` in the environment (what ``mrgc bench`` passes its runs with
-  ``--no-cache``).  Delete the folder to empty the cache.
+  nor written; ``mrgc bench`` gives it to every run unless the study says ``facts_cache: shared``), or
+  ``MRGC_NO_CACHE=1`` in the environment.  Delete the folder to empty the cache.
 
 Cached facts are the same list phase 1 returns (sorted); the statistics say ``cached: 1`` and the seconds
 of the lookup, and keep ``computed_seconds``, the phase 1 that made them.

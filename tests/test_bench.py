@@ -163,6 +163,33 @@ def test_a_valid_study_and_its_methods_as_mrgc_command_lines() -> None:
     assert "is a flag" in text and "set by the study itself" in text
 
 
+def test_each_run_computes_its_own_phase_1_unless_the_study_shares_the_facts_cache(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # the runs' processes inherit this environment: the cache on, in a folder of this test's own
+    monkeypatch.delenv("MRGC_NO_CACHE", raising=False)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    packaging_copy(tmp_path / "p", "pa3-place-obstacle")
+    entries = tmp_path / "cache" / "mrgc" / "facts"
+    for sharing, stored in (("", 0), ("facts_cache: own\n", 0), ("facts_cache: shared\n", 1)):
+        study = write_study(
+            tmp_path / "s.yaml",
+            f"study: cache{len(sharing)}\nlimits: {{time: 60}}\n{sharing}"
+            "instances: [{file: p/pa3-place-obstacle.mrg}]\nmethods: [{name: O, backend: mip}]\n",
+        )
+        db = tmp_path / f"r{len(sharing)}.db"
+        run_study(str(study), str(db))
+        (row,) = rows(db)
+        assert row["success"], row["stderr_tail"]
+        assert str(row["command"]).endswith(" --no-cache") == (stored == 0), row["command"]
+        assert len(list(entries.glob("*.json")) if entries.is_dir() else []) == stored, sharing
+    with pytest.raises(InputError) as err:
+        parse_study("study: x\nfacts_cache: yes\ninstances: [{file: a.mrg}]\nmethods: [{name: O}]\n", "s.yaml")
+    (diag,) = err.value.diagnostics
+    assert diag.code == "E601" and diag.span is not None and (diag.span.line, diag.span.column) == (2, 14)
+    assert "facts_cache must be one of own, shared" in diag.message
+
+
 @given(st.integers(0, 10**6), st.integers(0, 50))
 def test_seed_ranges_are_inclusive(a: int, n: int) -> None:
     assert parse_seeds(f"{a}..{a + n}") == tuple(range(a, a + n + 1))

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -80,3 +81,20 @@ def test_installed_script(good: Path) -> None:
     assert version.returncode == 0 and version.stdout.strip() == f"mrgc {__version__}"
     res = subprocess.run([exe, "check", str(good)], capture_output=True, text=True)
     assert res.returncode == 0, res.stderr
+
+
+@pytest.mark.parametrize("given, threads", [(None, "1"), ("2", "2")])
+def test_the_command_runs_numpy_s_blas_on_one_thread_unless_told_otherwise(given: str | None, threads: str) -> None:
+    # what numpy's OpenBLAS reads when it loads, and the threads its pool started (this interpreter's tasks)
+    probe = (
+        "import os, mrgc.cli, numpy; "
+        "print(os.environ['OPENBLAS_NUM_THREADS'], len(os.listdir('/proc/self/task')), len(os.sched_getaffinity(0)))"
+    )
+    env = {k: v for k, v in os.environ.items() if k != "OPENBLAS_NUM_THREADS"}
+    if given is not None:
+        env["OPENBLAS_NUM_THREADS"] = given
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, env=env, timeout=60)
+    seen, tasks, cores = out.stdout.split()
+    assert seen == threads, out.stderr
+    # OpenBLAS starts one thread fewer than it uses (the caller's is one), at most one per core
+    assert int(tasks) == min(int(threads), int(cores)), f"{tasks} threads on {cores} cores, asked {threads}"

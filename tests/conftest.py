@@ -22,6 +22,11 @@ from pathlib import Path
 
 import pytest
 
+# numpy's OpenBLAS on one thread, as the mrgc command runs it (cli.py): the suite's two workers would
+# otherwise each start a BLAS thread per core that spins beside the other worker.  Set before any module
+# of the tests imports numpy (OpenBLAS reads it once, when numpy loads).
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
 # The facts cache (planner/facts_cache.py) of the test session is its own, never the user's: a fresh
 # XDG_CACHE_HOME, removed at exit, inherited by the mrgc processes tests start.  It is also off by default,
 # so that no test's outcome depends on which tests ran before it (a deadline that cuts phase 1 short, the

@@ -17,7 +17,7 @@ colliding with each other (:data:`HANDOVER_PAIRS` rounds of drawing).
 
 from __future__ import annotations
 
-from typing import Callable, Iterable, Mapping
+from typing import Callable, Iterable, Iterator, Mapping
 
 import numpy as np
 
@@ -335,19 +335,45 @@ class Approaches(Volumes):
         avoid: Iterable[str] = (),
         busy: Pieces = (),
         after: Mapping[str, Pieces] | None = None,
+        skip: int = 0,
     ) -> Answer:
         """Both arms' configurations holding ``obj`` at handover point ``point`` (configs: giver, taker), free
         of ``busy`` (what the step's other robots do in the handover phase), each arm's also of ``after[arm]``
-        (what they do in the later phases it stands at its exchange: :meth:`step`)."""
+        (what they do in the later phases it stands at its exchange: :meth:`step`).  ``skip``: the pair after
+        the first ``skip`` free pairs, in the order they are drawn (other branches of the arms at the same
+        point, for a carry that cannot reach the first); the failure when there are no more."""
         pose = translation(*self.scene.handover_points[point])
+        ended: list[Answer] = []  # why the pairs ran out
+        pairs = self._exchange_pairs(obj, pose, point, (giver, g1), (taker, g2), avoid, busy, after or {}, ended)
+        for n, pair in enumerate(pairs):
+            if n == skip:
+                return Answer(GroundStatus.OK, pose=pose, configs=pair)
+        return ended[0]
+
+    def _exchange_pairs(
+        self,
+        obj: str,
+        pose: np.ndarray,
+        point: str,
+        giving: tuple[str, str],
+        taking: tuple[str, str],
+        avoid: Iterable[str],
+        busy: Pieces,
+        later: Mapping[str, Pieces],
+        ended: list[Answer],
+    ) -> Iterator[np.ndarray]:
+        """The free pairs of exchange configurations (giver, taker) for :meth:`handover`, in the order they are
+        drawn; when they run out, why (the deadline, one arm never getting there, the two arms colliding at
+        every exchange drawn) is appended to ``ended``."""
+        (giver, g1), (taker, g2) = giving, taking
         # as in phase 1, a handover is checked at the exchange configurations (no approach).  Each round draws
         # one more free exchange configuration of each arm (the first from home, the others from seeded
         # random starts: from home IK finds the same solution every time) and tries it against every
-        # configuration of the other arm drawn so far, until a pair does not collide
+        # configuration of the other arm drawn so far
         found: dict[str, list[np.ndarray]] = {giver: [], taker: []}
         failed = Answer(GroundStatus.COLLISION)
         worlds: list[Posed] = []  # the taker's configurations, as the kernel reads them
-        later = after or {}
+        free = 0
 
         # each arm at its exchange while its partner is still (or already) at home: the giver arrives at the
         # end of to-handover, where a taker without a path to its exchange (``--motions configurations``) waits
@@ -356,7 +382,6 @@ class Approaches(Volumes):
 
         def exchange(arm: str, grasp: str, attempt: int) -> Answer:
             key = f"handover:{point}" + (f":{attempt}" if attempt else "")
-            first = attempt == 0
             return self._approach(
                 arm,
                 obj,
@@ -366,14 +391,15 @@ class Approaches(Volumes):
                 avoid,
                 approach=False,
                 busy=busy,
-                from_home=first,
+                from_home=attempt == 0,
                 after=later.get(arm, ()),
                 partner=partner[arm],
             )
 
         for attempt in range(HANDOVER_PAIRS):
             if self.late():
-                return Answer(GroundStatus.TIME_LIMIT)
+                ended.append(Answer(GroundStatus.TIME_LIMIT))
+                return
             a, b = exchange(giver, g1, attempt), exchange(taker, g2, attempt)
             if not b.ok:
                 failed = b
@@ -384,7 +410,8 @@ class Approaches(Volumes):
                 worlds.append(world)
                 for q in found[giver]:  # the new taker configuration against the giver's earlier ones
                     if not posed_collide(Posed.of(self.arm_volume(giver, q[None], grasp=(obj, g1))), world):
-                        return Answer(GroundStatus.OK, pose=pose, configs=np.stack([q, b.configs[-1]]))
+                        free += 1
+                        yield np.stack([q, b.configs[-1]])
             if not a.ok:
                 failed = a
             else:
@@ -393,7 +420,11 @@ class Approaches(Volumes):
                 volume = Posed.of(self.arm_volume(giver, a.configs[-1:], grasp=(obj, g1)))
                 for q, world in zip(found[taker], worlds):  # the new giver configuration against every taker's
                     if not posed_collide(volume, world):
-                        return Answer(GroundStatus.OK, pose=pose, configs=np.stack([a.configs[-1], q]))
-        if not (found[giver] and found[taker]):  # one arm never got there: why (its last attempt)
-            return Answer(failed.status, blockers=failed.blockers, detail=failed.detail)
-        return Answer(GroundStatus.COLLISION, detail="the two arms collide at every exchange drawn")
+                        free += 1
+                        yield np.stack([a.configs[-1], q])
+        if free:
+            ended.append(Answer(GroundStatus.COLLISION, detail=f"no free exchange but the {free} drawn before"))
+        elif not (found[giver] and found[taker]):  # one arm never got there: why (its last attempt)
+            ended.append(Answer(failed.status, blockers=failed.blockers, detail=failed.detail))
+        else:
+            ended.append(Answer(GroundStatus.COLLISION, detail="the two arms collide at every exchange drawn"))

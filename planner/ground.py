@@ -45,6 +45,10 @@ PLACEMENT_TRIES = 6  # placements sampled per place before the step gives up
 OUT_OF_REACH_TRIES = 30
 #: other regions an obstacle with no reachable place in its own may be parked in, nearest first
 PARKING_REGIONS = 2
+#: exchanges tried per handover point when the giver's carry to one fails: another branch of the arms at the
+#: same point is often an easy carry where the first (the solution nearest home) is not (6-arm seed 0: r5's
+#: first exchange at h5 is reached by no RRTConnect path of 64,000 checks, its second by the joint line)
+EXCHANGE_TRIES = 3
 RELAY_TRIES = 3  # spots tried per relay (the k-th spot both of its robots reach at the k-th try)
 #: random placements (beyond the lattice and the packing grid) a goal region is searched with before a suffix is
 #: called a dead end for want of room in it (:meth:`ReverseGrounder.dead_end`)
@@ -770,35 +774,45 @@ class ReverseGrounder:
             a.pick_robot: self._after(busy, a.pick_robot, Stance.EXCHANGE),
             a.place_robot: self._after(busy, a.place_robot, Stance.RECEIVED),
         }
-        failures: list[tuple[Failure, GroundStatus]] = []
+        failures: list[tuple[Failure, GroundStatus, bool]] = []
         for point in self.g.scene.handover_of.get(a.obj, ()):
             if point not in self.g.scene.handover_points:
                 continue
-            self._on_time()
-            hand = self._exchange(a, point, avoid, busy.get("handover", []), after)
-            if isinstance(hand, tuple):
-                failures.append(hand)
-                continue
-            assert hand.configs is not None
-            giver = g.transfer(
-                a.pick_robot,
-                a.obj,
-                a.pick_grasp,
-                grasped,
-                hand.configs[0],
-                avoid,
-                lift=True,
-                busy=busy.get("to-handover", []),
-                phase="to-handover",
-            )
-            if not giver.ok:
-                failures.append((_failed(f"carry to the handover by {a.pick_robot}", giver), giver.status))
-                continue
-            planned.handover_point = point
-            planned.configs["handover"] = _configs(hand.configs)
-            planned.paths["to-handover"] = _configs(np.array(giver.path))
-            taker: np.ndarray = hand.configs[1]
-            return taker
+            carried: tuple[Failure, GroundStatus, bool] | None = None  # the first carry to this point that failed
+            tried: list[np.ndarray] = []  # the giver's exchange configurations no carry reached
+            for k in range(EXCHANGE_TRIES):
+                self._on_time()
+                hand = self._exchange(a, point, avoid, busy.get("handover", []), after, skip=k)
+                if isinstance(hand, tuple):
+                    if k == 0:
+                        failures.append((*hand, False))
+                    break  # no exchange here, or no other pair than those tried
+                assert hand.configs is not None
+                if any(np.array_equal(hand.configs[0], q) for q in tried):
+                    continue  # the same giver configuration with another taker's: the same carry
+                giver = g.transfer(
+                    a.pick_robot,
+                    a.obj,
+                    a.pick_grasp,
+                    grasped,
+                    hand.configs[0],
+                    avoid,
+                    lift=True,
+                    busy=busy.get("to-handover", []),
+                    phase="to-handover",
+                )
+                if not giver.ok:
+                    tried.append(hand.configs[0])
+                    if carried is None:
+                        carried = (_failed(f"carry to the handover by {a.pick_robot}", giver), giver.status, True)
+                    continue
+                planned.handover_point = point
+                planned.configs["handover"] = _configs(hand.configs)
+                planned.paths["to-handover"] = _configs(np.array(giver.path))
+                taker: np.ndarray = hand.configs[1]
+                return taker
+            if carried is not None:
+                failures.append(carried)
         if not failures:
             return Failure(0, "", f"handover: no handover point usable for {a.obj}")
         return _telling(failures)
@@ -912,10 +926,11 @@ class ReverseGrounder:
         return last
 
     def _exchange(
-        self, a: Action, point: str, avoid: list[str], busy: Volume, after: dict[str, Volume]
+        self, a: Action, point: str, avoid: list[str], busy: Volume, after: dict[str, Volume], skip: int = 0
     ) -> Answer | tuple[Failure, GroundStatus]:
-        """Both arms' exchange configurations for ``a`` at handover point ``point`` (giver, taker), or the
-        failure there with its query's status (two arms colliding named as such)."""
+        """Both arms' exchange configurations for ``a`` at handover point ``point`` (giver, taker), the pair
+        after the first ``skip`` free ones (:meth:`Grounder.handover <mrgc.geometry.approaches.Approaches.handover>`),
+        or the failure there with its query's status (two arms colliding named as such)."""
         ans = self.g.handover(
             a.obj,
             point,
@@ -926,6 +941,7 @@ class ReverseGrounder:
             avoid=avoid,
             busy=busy,
             after=after,
+            skip=skip,
         )
         if ans.ok:
             return ans
@@ -1048,23 +1064,27 @@ def _static(failure: Failure, static: bool) -> Failure:
     return failure if failure.static == static else replace(failure, static=static)
 
 
-def _telling(failures: list[tuple[Failure, GroundStatus]]) -> Failure:
+def _telling(failures: list[tuple[Failure, GroundStatus, bool]]) -> Failure:
     """Of an action's failures at each of its handover points (the exchange's there, or the giver's carry to
-    it; each with its query's status), the one that
-    says most about what would let it
-    through: another robot of the step in the way (the step's robots' passes are then compared sample by
-    sample, or the step is split), else bodies in the way (objects to move first, or the two arms), else
+    it; each with its query's status and whether the exchange there was found), the one that says most about
+    what would let it through: another robot of the step in the way (the step's robots' passes are then
+    compared sample by sample, or the step is split), else bodies in the way (objects to move first, or the
+    two arms), else the carry to a point whose exchange was found (the only point that got that far), else
     anything but a point out of the arms' reach, else the last.  The last point's failure alone hid the
     others': on the 6-arm, 40-object instance one handover failed 42 times as "handover at h5: no inverse
     kinematics" (h5 is out of reach for that grasp pair) where another robot of the step was in the way at
-    h1, the point in reach; the step was never split."""
+    h1, the point in reach; the step was never split.  And an exchange that fails at a point hid the carry
+    that failed at the point where the exchange exists: seed 0's first skeleton failed as "handover at h3:
+    collision: hits r6 at home" (no exchange at h3 in phase 1 either) where the giver's carry to h5 found no
+    path."""
     for telling in (
-        lambda f, _: f.detail == BUSY,
-        lambda f, _: bool(f.bodies),
-        lambda _, status: status is not GroundStatus.NO_IK,
+        lambda f, _, __: f.detail == BUSY,
+        lambda f, _, __: bool(f.bodies),
+        lambda _, __, exchanged: exchanged,
+        lambda _, status, __: status is not GroundStatus.NO_IK,
     ):
-        for f, status in failures:
-            if telling(f, status):
+        for f, status, exchanged in failures:
+            if telling(f, status, exchanged):
                 return f
     return failures[-1][0]
 

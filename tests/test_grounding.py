@@ -25,7 +25,7 @@ from mrgc.geometry.kinematics import Link
 from mrgc.geometry.scene import inside, scene_from_problem
 from mrgc.geometry.stances import PHASES, Stance, stance
 from mrgc.geometry.transforms import translation
-from mrgc.planner.ground import Outcome, ReverseGrounder
+from mrgc.planner.ground import EXCHANGE_TRIES, Outcome, ReverseGrounder
 
 
 @pytest.fixture()
@@ -956,16 +956,18 @@ def test_a_contact_segment_off_the_approach_line_is_refused(pa3: Grounder, q: li
 def test_a_handover_failing_at_every_point_tells_the_failure_that_can_be_acted_on() -> None:
     """An action's handover fails at each of its points: the failure reported is the one another robot of the
     step caused (the step's passes are compared, or the step is split), else one with bodies in the way
-    (objects to move), else any but a point out of reach, else the last; never merely the last point's, which
-    for a point out of the arms' reach hid why the reachable one failed."""
+    (objects to move), else the carry to a point whose exchange was found, else any but a point out of
+    reach, else the last; never merely the last point's, which for a point out of the arms' reach hid why
+    the reachable one failed, nor an exchange's collision at one point over the carry to the point where the
+    exchange exists."""
     from mrgc.geometry.answers import BUSY
     from mrgc.planner.ground import _telling
     from mrgc.planner.outcome import Failure
 
     def at(
         point: str, status: GroundStatus, bodies: tuple[str, ...] = (), detail: str = ""
-    ) -> tuple[Failure, GroundStatus]:
-        return Failure(0, "", f"handover at {point}: {status.value}", bodies, detail), status
+    ) -> tuple[Failure, GroundStatus, bool]:
+        return Failure(0, "", f"handover at {point}: {status.value}", bodies, detail), status, False
 
     far = at("h5", GroundStatus.NO_IK)
     busy = at("h1", GroundStatus.COLLISION, detail=BUSY)
@@ -976,6 +978,9 @@ def test_a_handover_failing_at_every_point_tells_the_failure_that_can_be_acted_o
     assert _telling([fixed, far]) is fixed[0] and _telling([far, fixed]) is fixed[0]
     nearer = at("h1", GroundStatus.NO_IK)
     assert _telling([nearer, far]) is far[0] and _telling([far]) is far[0]
+    carry = (Failure(0, "", "carry to the handover by r5: no path"), GroundStatus.NO_PATH, True)
+    assert _telling([nearer, fixed, far, carry]) is carry[0] and _telling([fixed, carry, busy]) is busy[0]
+    assert _telling([carry, blocked]) is blocked[0]
 
 
 def test_a_handover_whose_carry_to_one_point_fails_is_tried_at_the_next(tmp_path: Path) -> None:
@@ -994,15 +999,17 @@ def test_a_handover_whose_carry_to_one_point_fails_is_tried_at_the_next(tmp_path
     g = Grounder(scene_from_problem(parse_file(path).problem()), seed=0)
     assert g.scene.handover_of["o1"] == ("h0", "h1")
     refused: set[str] = set()
-    exchanges: dict[str, np.ndarray] = {}
+    exchanges: dict[str, list[np.ndarray]] = {}  # every giver configuration of a free exchange pair at each point
     for point in ("h0", "h1"):
-        hand = g.handover("o1", point, "r1", "top", "r2", "side-x+")
-        assert hand.ok and hand.configs is not None, point
-        exchanges[point] = hand.configs[0]
+        for k in range(EXCHANGE_TRIES):
+            hand = g.handover("o1", point, "r1", "top", "r2", "side-x+", skip=k)
+            assert hand.ok and hand.configs is not None or k > 0, point
+            if hand.configs is not None:
+                exchanges.setdefault(point, []).append(hand.configs[0])
     transfer = g.transfer
 
     def carry(robot: str, obj: str, grasp: str, start: np.ndarray, goal: np.ndarray, *args: Any, **kw: Any) -> Answer:
-        if any(np.allclose(goal, exchanges[p]) for p in refused):
+        if any(np.allclose(goal, q) for p in refused for q in exchanges[p]):
             return Answer(GroundStatus.NO_PATH)
         return transfer(robot, obj, grasp, start, goal, *args, **kw)
 
@@ -1018,6 +1025,45 @@ def test_a_handover_whose_carry_to_one_point_fails_is_tried_at_the_next(tmp_path
     neither = ReverseGrounder(g, {"o1": "bin-b"}).ground(skeleton, [], key="neither")
     assert neither.outcome is Outcome.FAIL and neither.failures
     assert neither.failures[0].check == "carry to the handover by r1: no path"
+
+
+def test_a_handover_whose_carry_to_one_exchange_fails_tries_another_at_the_same_point(tmp_path: Path) -> None:
+    """planner/ground.py ``ReverseGrounder._hand_over``: when the giver's carry to the first free exchange at a
+    point fails, the next free exchange pairs there (other branches of the arms, ``Grounder.handover(skip=k)``)
+    are tried before the next point, each giver configuration once.  6-arm seed 0: no RRTConnect path of
+    64,000 checks reaches r5's first exchange at h5; the joint line reaches its second."""
+    text = (ROOT / "domains" / "packaging" / "pa3-handover.mrg").read_text(encoding="utf-8")
+    path = tmp_path / "one-point.mrg"
+    path.write_text(text, encoding="utf-8")
+    domain = ROOT / "domains" / "packaging" / "domain.mrg"
+    (tmp_path / "domain.mrg").write_text(domain.read_text(encoding="utf-8"), encoding="utf-8")
+    g = Grounder(scene_from_problem(parse_file(path).problem()), seed=0)
+    point = g.scene.handover_of["o1"][0]
+    pairs = [g.handover("o1", point, "r1", "top", "r2", "side-x+", skip=k) for k in range(EXCHANGE_TRIES + 2)]
+    free = [p.configs for p in pairs if p.ok and p.configs is not None]
+    assert len(free) >= 2 and not np.array_equal(free[0], free[1])
+    assert pairs[0].ok and np.array_equal(
+        pairs[0].configs, g.handover("o1", point, "r1", "top", "r2", "side-x+").configs
+    )
+    givers = {tuple(np.round(f[0], 9)) for f in free}
+    transfer = g.transfer
+    asked: list[np.ndarray] = []
+
+    def carry(robot: str, obj: str, grasp: str, start: np.ndarray, goal: np.ndarray, *args: Any, **kw: Any) -> Answer:
+        asked.append(goal)
+        if np.array_equal(goal, free[0][0]):  # only the first exchange is out of the carry's way
+            return Answer(GroundStatus.NO_PATH)
+        return transfer(robot, obj, grasp, start, goal, *args, **kw)
+
+    g.transfer = carry  # type: ignore[method-assign]
+    skeleton = Skeleton(((Action("o1", "bin-b", "r1", "r2", "top", "side-x+"),),))
+    grounded = ReverseGrounder(g, {"o1": "bin-b"}).ground(skeleton, [], key="second")
+    assert grounded.outcome is Outcome.SUCCESS, grounded.reason
+    (planned,) = grounded.steps[0].actions
+    assert planned.handover_point == point
+    giver = np.array(planned.configs["handover"][0])
+    assert not np.allclose(giver, free[0][0]) and tuple(np.round(giver, 9)) in givers
+    assert np.array_equal(asked[0], free[0][0]) and len(asked) == len({tuple(q) for q in map(tuple, asked)})
 
 
 @settings(max_examples=80, deadline=None, suppress_health_check=[HealthCheck.too_slow])

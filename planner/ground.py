@@ -47,7 +47,7 @@ OUT_OF_REACH_TRIES = 30
 PARKING_REGIONS = 2
 #: exchanges tried per handover point when the giver's carry to one fails: another branch of the arms at the
 #: same point is often an easy carry where the first (the solution nearest home) is not (6-arm seed 0: r5's
-#: first exchange at h5 is reached by no RRTConnect path of 64,000 checks, its second by the joint line)
+#: first exchange at h5 is reached by no RRTConnect path of 64,000 checks, its second in 0.03 s)
 EXCHANGE_TRIES = 3
 RELAY_TRIES = 3  # spots tried per relay (the k-th spot both of its robots reach at the k-th try)
 #: random placements (beyond the lattice and the packing grid) a goal region is searched with before a suffix is

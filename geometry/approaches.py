@@ -101,7 +101,6 @@ class Approaches(Volumes):
         from_home: bool = True,
         after: Pieces = (),
         partner: tuple[str, ...] = (),
-        skip: int = 0,
     ) -> Answer:
         spec = self.scene.grasp_specs.get(grasp)
         arm = self.arm(robot)
@@ -154,9 +153,6 @@ class Approaches(Volumes):
             clash = self._step_clash(robot, (obj, grasp), configs, posed, moving, after, partner)
             if clash is not None:
                 status = GroundStatus.COLLISION
-                continue
-            if skip:  # a free approach, but one of those the caller has tried already
-                skip -= 1
                 continue
             return Answer(GroundStatus.OK, pose=pose, configs=configs)
         detail = ""
@@ -323,13 +319,10 @@ class Approaches(Volumes):
         avoid: Iterable[str] = (),
         busy: Pieces = (),
         after: Pieces = (),
-        skip: int = 0,
     ) -> Answer:
         """Approach configurations for ``robot`` holding ``obj`` with ``grasp`` to put it at ``pose`` (``busy``
-        and ``after`` as for :meth:`pick`).  ``skip``: the free approach after the first ``skip`` ones, in the
-        order the IK attempts draw them (another branch of the arm, for a carry that cannot reach the first);
-        a failure when there are no more."""
-        return self._approach(robot, obj, grasp, pose, "place", avoid, held=True, busy=busy, after=after, skip=skip)
+        and ``after`` as for :meth:`pick`)."""
+        return self._approach(robot, obj, grasp, pose, "place", avoid, held=True, busy=busy, after=after)
 
     def handover(
         self,

@@ -49,8 +49,6 @@ PARKING_REGIONS = 2
 #: same point is often an easy carry where the first (the solution nearest home) is not (6-arm seed 0: r5's
 #: first exchange at h5 is reached by no RRTConnect path of 64,000 checks, its second in 0.03 s)
 EXCHANGE_TRIES = 3
-#: free approaches to one placement (branches of the arm) its carry is tried to before the next placement
-PLACE_BRANCHES = 2
 RELAY_TRIES = 3  # spots tried per relay (the k-th spot both of its robots reach at the k-th try)
 #: random placements (beyond the lattice and the packing grid) a goal region is searched with before a suffix is
 #: called a dead end for want of room in it (:meth:`ReverseGrounder.dead_end`)
@@ -683,7 +681,15 @@ class ReverseGrounder:
             if spot in self._dead_spots:
                 continue  # failed before on what never moves: fails again, and costs no try
             looked += 1
-            place = self._approach_place(a, pose, avoid, busy)
+            place = g.place(
+                a.place_robot,
+                a.obj,
+                a.place_grasp,
+                pose,
+                avoid=avoid,
+                busy=busy.get("place", []),
+                after=self._after(busy, a.place_robot, Stance.PLACED),
+            )
             if not place.ok:
                 last = _failed(f"place by {a.place_robot}", place)
                 tried += place.status is not GroundStatus.NO_IK
@@ -693,57 +699,6 @@ class ReverseGrounder:
                 continue
             static = False
             tried += 1
-            place, carry = self._carry_to_place(a, pose, place, start, lift, avoid, busy)
-            if not carry.ok:
-                last = _failed(f"carry to the placement by {a.place_robot}", carry)
-                continue
-            assert place.configs is not None
-            planned.region = region
-            planned.place_pose = _matrix(pose)
-            planned.configs["place"] = _configs(place.configs)
-            planned.paths["to-place"] = _configs(np.array(carry.path))
-            # the arm's empty-handed motions (``full``), and room left in the bin for what comes before
-            after = self._transits(a, planned, avoid, busy, {**(placed or {}), a.obj: pose}) if self.full else None
-            after = after or self._crowds(a, planned, avoid, v_fut, placed or {}, key)
-            if after:
-                last = after
-                continue
-            return planned
-        assert last is not None
-        return _static(last, static)
-
-    def _approach_place(
-        self, a: Action, pose: np.ndarray, avoid: list[str], busy: dict[str, Volume], skip: int = 0
-    ) -> Answer:
-        """The free approach of ``a``'s placing arm to put its object at ``pose`` (the one after ``skip`` of
-        them: :meth:`Grounder.place <mrgc.geometry.approaches.Approaches.place>`), clear of what the step's
-        other robots do then and while it stands there."""
-        after = self._after(busy, a.place_robot, Stance.PLACED)
-        return self.g.place(
-            a.place_robot, a.obj, a.place_grasp, pose, avoid=avoid, busy=busy.get("place", []), after=after, skip=skip
-        )
-
-    def _carry_to_place(
-        self,
-        a: Action,
-        pose: np.ndarray,
-        place: Answer,
-        start: np.ndarray,
-        lift: bool,
-        avoid: list[str],
-        busy: dict[str, Volume],
-    ) -> tuple[Answer, Answer]:
-        """The carry of ``a``'s object from ``start`` to the free approach ``place`` at ``pose``; when it fails,
-        to the next free approaches there (other branches of the arm, :data:`PLACE_BRANCHES` in all) before
-        the caller moves on to another placement.  The approach the carry reached (else the first) and the
-        carry (else the first carry's failure)."""
-        g = self.g
-        first: tuple[Answer, Answer] | None = None
-        for k in range(PLACE_BRANCHES):
-            if k:
-                place = self._approach_place(a, pose, avoid, busy, skip=k)
-                if not place.ok:
-                    break  # no other free approach to this placement
             assert place.configs is not None
             carry = g.transfer(
                 a.place_robot,
@@ -757,11 +712,22 @@ class ReverseGrounder:
                 lower=True,
                 phase="to-place",
             )
-            if carry.ok:
-                return place, carry
-            first = first or (place, carry)
-        assert first is not None
-        return first
+            if not carry.ok:
+                last = _failed(f"carry to the placement by {a.place_robot}", carry)
+                continue
+            planned.region = region
+            planned.place_pose = _matrix(pose)
+            planned.configs["place"] = _configs(place.configs)
+            planned.paths["to-place"] = _configs(np.array(carry.path))
+            # the arm's empty-handed motions (``full``), and room left in the bin for what comes before
+            after = self._transits(a, planned, avoid, busy, {**(placed or {}), a.obj: pose}) if self.full else None
+            after = after or self._crowds(a, planned, avoid, v_fut, placed or {}, key)
+            if after:
+                last = after
+                continue
+            return planned
+        assert last is not None
+        return _static(last, static)
 
     def _crowds(
         self,

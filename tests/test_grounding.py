@@ -1027,37 +1027,6 @@ def test_a_handover_whose_carry_to_one_point_fails_is_tried_at_the_next(tmp_path
     assert neither.failures[0].check == "carry to the handover by r1: no path"
 
 
-def test_a_place_whose_carry_to_the_first_approach_fails_tries_another_branch_at_the_same_spot(pa3: Grounder) -> None:
-    """planner/ground.py ``ReverseGrounder._carry_to_place``: when the carry to a placement's first free
-    approach fails, the next free approach to the same placement (another branch of the arm,
-    ``Grounder.place(..., skip=1)``) is carried to before the next placement is drawn; a carry that reaches
-    neither leaves the failure as before, the first carry's."""
-    g = pa3
-    place, transfer = g.place, g.transfer
-    firsts: list[np.ndarray] = []  # the first free approach of every placement asked
-    seconds: list[np.ndarray] = []
-
-    def placing(robot: str, obj: str, grasp: str, pose: np.ndarray, *args: Any, **kw: Any) -> Answer:
-        ans = place(robot, obj, grasp, pose, *args, **kw)
-        if ans.ok and ans.configs is not None:
-            (seconds if kw.get("skip", 0) else firsts).append(ans.configs[0])
-        return ans
-
-    def carry(robot: str, obj: str, grasp: str, start: np.ndarray, goal: np.ndarray, *args: Any, **kw: Any) -> Answer:
-        if kw.get("phase") == "to-place" and any(np.array_equal(goal, q) for q in firsts):
-            return Answer(GroundStatus.NO_PATH)  # no first branch of any placement is reached
-        return transfer(robot, obj, grasp, start, goal, *args, **kw)
-
-    g.place, g.transfer = placing, carry  # type: ignore[method-assign]
-    skeleton = Skeleton(((Action("o2", "bin-a", "r1", "r1", "top", "top"),),))
-    grounded = ReverseGrounder(g, {"o2": "bin-a"}).ground(skeleton, [], key="second-branch")
-    assert grounded.outcome is Outcome.SUCCESS, grounded.reason
-    assert firsts and seconds
-    (planned,) = grounded.steps[0].actions
-    chosen = np.array(planned.configs["place"][0])
-    assert any(np.allclose(chosen, q) for q in seconds) and not any(np.allclose(chosen, q) for q in firsts)
-
-
 def test_a_handover_whose_carry_to_one_exchange_fails_tries_another_at_the_same_point(tmp_path: Path) -> None:
     """planner/ground.py ``ReverseGrounder._hand_over``: when the giver's carry to the first free exchange at a
     point fails, the next free exchange pairs there (other branches of the arms, ``Grounder.handover(skip=k)``)

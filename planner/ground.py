@@ -778,7 +778,6 @@ class ReverseGrounder:
         for point in self.g.scene.handover_of.get(a.obj, ()):
             if point not in self.g.scene.handover_points:
                 continue
-            carried: tuple[Failure, GroundStatus, bool] | None = None  # the first carry to this point that failed
             tried: list[np.ndarray] = []  # the giver's exchange configurations no carry reached
             for k in range(EXCHANGE_TRIES):
                 self._on_time()
@@ -801,18 +800,15 @@ class ReverseGrounder:
                     busy=busy.get("to-handover", []),
                     phase="to-handover",
                 )
-                if not giver.ok:
+                if not giver.ok:  # each carry's failure kept: another robot of the step may be in one's way only
                     tried.append(hand.configs[0])
-                    if carried is None:
-                        carried = (_failed(f"carry to the handover by {a.pick_robot}", giver), giver.status, True)
+                    failures.append((_failed(f"carry to the handover by {a.pick_robot}", giver), giver.status, True))
                     continue
                 planned.handover_point = point
                 planned.configs["handover"] = _configs(hand.configs)
                 planned.paths["to-handover"] = _configs(np.array(giver.path))
                 taker: np.ndarray = hand.configs[1]
                 return taker
-            if carried is not None:
-                failures.append(carried)
         if not failures:
             return Failure(0, "", f"handover: no handover point usable for {a.obj}")
         return _telling(failures)

@@ -20,7 +20,7 @@ def _one_blas_thread() -> None:
 
     mrgc's linear algebra is 4x4 transforms and 7x7 solves, far below what OpenBLAS splits over threads, yet
     its pool starts one thread per core when numpy is imported and they wake and spin on its calls: about
-    70 ms of CPU at import and 0.06-0.25 s over a PA5-BO8 run on 2 cores, for nothing (the plans are the
+    70 ms of CPU at import and 0.05-0.21 s over a PA5-BO8 run on 2 cores, for nothing (the plans are the
     same bit for bit; docs/benchmarks.md, "Session 27").  Read by OpenBLAS once, when numpy loads, so this
     runs before any module that imports numpy; worker processes inherit it."""
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")

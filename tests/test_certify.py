@@ -18,7 +18,7 @@ from mrgc.geometry.scene import half_extents, scene_from_problem
 from mrgc.validator.bounds import arm_bounds
 from mrgc.validator.certify import Certifier, Phase, interval_rate
 from mrgc.validator.fk import ArmChain, axis_reach, centres, motion_spheres, pack
-from mrgc.validator.phase_bounds import face_bound
+from mrgc.validator.phase_bounds import face_bound, face_bounds
 from mrgc.validator.sweep import CAP, Pair
 from mrgc.validator.world import ReplayScene
 
@@ -198,6 +198,42 @@ def test_the_face_bound_never_exceeds_pybullets_distance(panda: Any, seed: int) 
                 if (link, -1) in got:
                     assert lb[i] <= got[(link, -1)] + 1e-6, (name, r.links[link], lb[i], got[(link, -1)])
     rs.set_config("r1", home)
+
+
+def _rotation(q: np.ndarray) -> np.ndarray:
+    w, x, y, z = q / np.linalg.norm(q)
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.integers(0, 2**31 - 1), st.integers(1, 6), st.integers(1, 5), st.integers(1, 12))
+def test_the_face_bounds_of_many_boxes_are_each_boxs_own(seed: int, n: int, times: int, spheres: int) -> None:
+    """:func:`~mrgc.validator.phase_bounds.face_bounds` (every box at once, the certifier's path) gives for
+    each box what the face planes of that box alone give: the spheres in the box's frame, their signed
+    distances from its six faces, the least per element and the largest over the faces."""
+    rng = np.random.default_rng(seed)
+    centre = rng.normal(size=(n, 3))
+    rot = np.stack([_rotation(rng.normal(size=4)) for _ in range(n)])
+    half = rng.uniform(0.01, 0.5, (n, 3))
+    world = rng.normal(size=(times, spheres, 3))
+    radius = rng.uniform(0.0, 0.1, spheres)
+    first = np.unique(np.concatenate([[0], rng.integers(0, spheres, 3)]))
+    got = face_bounds(centre, rot, half, world, radius, first)
+    assert got.shape == (times, len(first), n)
+    for b in range(n):
+        local = (world - centre[b]) @ rot[b]
+        faces = np.concatenate([local - half[b], -local - half[b]], axis=2) - radius[None, :, None]
+        want = np.array(
+            [[faces[t, lo:hi].min(axis=0).max() for lo, hi in zip(first, [*first[1:], spheres])] for t in range(times)]
+        )
+        assert np.allclose(got[:, :, b], want, atol=1e-12)
+        assert np.allclose(face_bound(centre[b], rot[b], half[b], world, radius, first), want, atol=1e-12)
 
 
 @settings(max_examples=15, deadline=None)

@@ -327,6 +327,11 @@ class ActionReader:
     def check_configs(self, t: int, robot: str, what: str, qs: Any, obj: str) -> bool:
         """Each configuration has one value per joint, lies in the world and within the joint limits."""
         rr = self.rs.robots[robot]
+        if all(len(q) == rr.dof for q in qs):  # the usual case, checked at once; the loop below says what is wrong
+            v = np.asarray(qs, dtype=float)
+            out = (v < rr.lower - LIMIT_TOL) | (v > rr.upper + LIMIT_TOL) | (np.abs(v) > WORLD)
+            if not out.any() and not (rr.planar and np.abs(v[:, :2]).max(initial=0.0) > WORLD):
+                return True
         ok = True
         for i, q in enumerate(qs, 1):
             if len(q) != rr.dof:

@@ -188,10 +188,11 @@ class PhaseBounds(Spheres):
             spheres[i] = self._arm_rates(i, rot, pos, centre, rate)
         lb = self._bound(centre) - FK_PAD
         for i, world in spheres.items():
-            for box, subs, local in self.faces.get(i, ()):
-                lb[:, subs] = np.maximum(
-                    lb[:, subs], self._face_bound(box, world, self.packed[i][1])[:, local] - FK_PAD
-                )
+            if i in self.faces:
+                boxes, subs, which, local = self.faces[i]
+                packed = self.packed[i][1]
+                bound = face_bounds(self.centre[boxes], self.rot[boxes], self.half[boxes], world, packed[2], packed[3])
+                lb[:, subs] = np.maximum(lb[:, subs], bound[:, local, which] - FK_PAD)
         return lb, rate
 
     def _planar(self, i: int, q: np.ndarray, centre: np.ndarray) -> None:
@@ -245,23 +246,20 @@ class PhaseBounds(Spheres):
             return float(self.still[i][k, column - at]) + FK_PAD
         return float("inf")
 
-    def _face_pairs(self) -> dict[int, list[tuple[int, np.ndarray, np.ndarray]]]:
-        """For each arm track: the boxes that stand still which its elements (links, carried object) are
-        paired with, each with those sub-pairs and the positions of their elements in the track's packed
-        elements (:meth:`_face_bound`)."""
-        out: dict[int, list[tuple[int, np.ndarray, np.ndarray]]] = {}
+    def _face_pairs(self) -> dict[int, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
+        """For each arm track paired with boxes that stand still: those boxes (elements, (B,)), the sub-pairs
+        of its elements (links, carried object) with them (N,), and for each sub-pair its box (a position in
+        the first array) and its element's position in the track's packed elements (:func:`face_bounds`)."""
+        out: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = {}
         for i, (elems, _) in self.packed.items():
             where = {int(e): k for k, e in enumerate(elems.tolist())}
             subs = np.flatnonzero(self.box[self.b] & np.isin(self.a, elems))
-            for box in np.unique(self.b[subs]).tolist():
-                mine = subs[self.b[subs] == box]
-                local = np.array([where[int(e)] for e in self.a[mine]], dtype=int)
-                out.setdefault(i, []).append((int(box), mine, local))
+            if not len(subs):
+                continue
+            boxes, which = np.unique(self.b[subs], return_inverse=True)
+            local = np.array([where[int(e)] for e in self.a[subs]], dtype=int)
+            out[i] = (boxes, subs, which.reshape(-1), local)
         return out
-
-    def _face_bound(self, box: int, world: np.ndarray, packed: tuple[np.ndarray, ...]) -> np.ndarray:
-        """:func:`face_bound` of box element ``box`` and packed motion spheres centred at ``world``."""
-        return face_bound(self.centre[box], self.rot[box], self.half[box], world, packed[2], packed[3])
 
 
 def _configs_at(configs: np.ndarray, t: np.ndarray, planar: bool) -> np.ndarray:
@@ -301,7 +299,18 @@ def face_bound(
     signed distance from a box is at least its distance from each face plane (inside: exactly the largest),
     the least plane distance over a convex hull is at a vertex, which a motion sphere holds, and for two
     convex shapes that overlap, the overlap along a face normal is at least the penetration depth."""
-    local = np.einsum("tsj,ji->tsi", world - centre, rot)  # in the box's frame
-    faces = np.concatenate([local - half, -local - half], axis=2) - radius[None, :, None]  # (T, spheres, 6)
-    out: np.ndarray = np.minimum.reduceat(faces, first, axis=1).max(axis=2)
+    out: np.ndarray = face_bounds(centre[None], rot[None], half[None], world, radius, first)[..., 0]
+    return out
+
+
+def face_bounds(
+    centre: np.ndarray, rot: np.ndarray, half: np.ndarray, world: np.ndarray, radius: np.ndarray, first: np.ndarray
+) -> np.ndarray:
+    """:func:`face_bound` of B boxes at once (``centre`` (B, 3), ``rot`` (B, 3, 3), ``half`` (B, 3)): (T,
+    elements, B).  The spheres' coordinates in every box's frame come from one matrix product."""
+    n, (t, s, _) = len(centre), world.shape
+    axes = np.swapaxes(rot, 0, 1).reshape(3, 3 * n)  # column 3b + i: box b's axis i
+    local = (world.reshape(-1, 3) @ axes).reshape(t, s, n, 3) - np.einsum("bj,bji->bi", centre, rot)
+    faces = np.concatenate([local - half, -local - half], axis=3) - radius[None, :, None, None]  # (T, S, B, 6)
+    out: np.ndarray = np.minimum.reduceat(faces, first, axis=1).max(axis=3)
     return out

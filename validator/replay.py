@@ -167,21 +167,19 @@ class _PairList:
         a_rows = {links[0]: a.rows[links[0]]} if links else a.rows
         b_rows = {links[1]: b.rows[links[1]]} if links else b.rows
         same = a.track >= 0 and a.track == b.track
-        subs, rows, ends = [], [], []
-        for la, ra in a_rows.items():
-            if a.robot and la in skip:
-                continue
-            for lb, rb in b_rows.items():
-                if b.robot and lb in skip:
-                    continue
-                rows.append(ra * (rb == 0) + rb * (ra == 0) if same else ra + rb)
-                subs.append((la, lb))
-                ends.append((until or {}).get(la if a.robot else lb, (np.inf, 0.0)))
-        if subs:
-            self.pairs.append(
-                Pair(subs, np.array(rows), np.array([e[0] for e in ends]), np.array([e[1] for e in ends]))
-            )
-            self.sides.append((a, b, links, kind))
+        a_links = [la for la in a_rows if not (a.robot and la in skip)]
+        b_links = [lb for lb in b_rows if not (b.robot and lb in skip)]
+        if not a_links or not b_links:
+            return
+        ra = np.array([a_rows[la] for la in a_links])[:, None]  # (A, 1, C)
+        rb = np.array([b_rows[lb] for lb in b_links])[None]  # (1, B, C)
+        rows = ra * (rb == 0) + rb * (ra == 0) if same else ra + rb
+        subs = [(la, lb) for la in a_links for lb in b_links]
+        ends = [(until or {}).get(la if a.robot else lb, (np.inf, 0.0)) for la, lb in subs]
+        self.pairs.append(
+            Pair(subs, rows.reshape(len(subs), -1), np.array([e[0] for e in ends]), np.array([e[1] for e in ends]))
+        )
+        self.sides.append((a, b, links, kind))
 
 
 class _PhaseWorld:

@@ -124,6 +124,7 @@ class ReplayScene:
         self.models: dict[str, RobotModel] = {}
         self._owner: dict[int, str] = {}
         self._margin: dict[tuple[int, int], float] = {}  # (body, link) -> MESH_MARGIN for mesh shapes
+        self._margins: dict[int, dict[int, float]] = {}  # body -> link -> its margin (from _margin, on first ask)
         self._shaped: dict[int, tuple[int, ...]] = {}  # body -> its links with collision shapes
         #: getClosestPoints calls made so far
         self.queries = 0
@@ -399,14 +400,13 @@ class ReplayScene:
     ) -> Callable[[], dict[tuple[int, int], float]]:
         """:meth:`link_distances` of ``a`` and ``b`` as a function of no arguments, everything it needs to
         look up done once (the sweep asks one pair many times)."""
-        pb, cid, margin = self.pb, self.cid, self._margin
+        pb, cid = self.pb, self.cid
         ba = self.robots[a].body if a in self.robots else self.bodies[a]
         bb = self.robots[b].body if b in self.robots else self.bodies[b]
         extra = float(max_distance) + 2 * MESH_MARGIN
         links = {} if links_a is None else {"linkIndexA": links_a[0], "linkIndexB": links_a[1]}
         skip_a, skip_b = self._mount(a, b), self._mount(b, a)
-        margin_a = {link: m for (body, link), m in margin.items() if body == ba}
-        margin_b = {link: m for (body, link), m in margin.items() if body == bb}
+        margin_a, margin_b = self._body_margins(ba), self._body_margins(bb)
 
         def probe() -> dict[tuple[int, int], float]:
             pts = pb.getClosestPoints(ba, bb, extra, physicsClientId=cid, **links)
@@ -422,6 +422,13 @@ class ReplayScene:
             return out
 
         return probe
+
+    def _body_margins(self, body: int) -> dict[int, float]:
+        """The margins of ``body``'s mesh links (link -> MESH_MARGIN), gathered once per body."""
+        out = self._margins.get(body)
+        if out is None:
+            out = self._margins[body] = {link: m for (b, link), m in self._margin.items() if b == body}
+        return out
 
     def _mount(self, a: str, b: str) -> frozenset[int]:
         """The links of ``a`` exempt from contact with ``b``: an arm's mount when ``b`` is a fixed object."""

@@ -24,7 +24,7 @@ from mrgc.geometry.answers import BUSY, Answer, GroundStatus
 from mrgc.geometry.collision import Posed, posed_collide
 from mrgc.geometry.conventions import PATH_RESOLUTION, seed_for
 from mrgc.geometry.grasps import APPROACH
-from mrgc.geometry.ik import solve_ik_many
+from mrgc.geometry.ik import IKResult, solve_ik_many
 from mrgc.geometry.motion import MAX_CHECKS, plan_joint_path
 from mrgc.geometry.robot import Pieces
 from mrgc.geometry.scene import half_extents
@@ -425,21 +425,40 @@ class ArmPaths(Volumes):
         self, robot: str, q: np.ndarray, height: float = TRANSFER_LIFT, direction: np.ndarray | None = None
     ) -> np.ndarray | None:
         """Configurations moving the tool straight along ``direction`` (world, a unit vector; default up) from
-        its pose at ``q`` by up to ``height`` (one per centimetre, each solved from the one before, as far as
-        none fails or jumps; None when not even the first centimetre can be solved)."""
+        its pose at ``q`` by up to ``height``, one per centimetre, as far as none fails or jumps (None when not
+        even the first centimetre can be solved).  Every centimetre is first solved from ``q`` in one batch
+        (a third of the time of solving each from the one before); from the first that fails or jumps from the
+        one before, each is solved from the one before, as far as that goes."""
         arm = self.arm(robot)
         tool = arm.tool_world(q[None])[0]
-        way = (0.0, 0.0, 1.0) if direction is None else tuple(float(v) for v in direction)
+        way = np.array((0.0, 0.0, 1.0) if direction is None else direction, dtype=float)
+        steps = np.arange(1, round(height / 0.01) + 1) * 0.01
+        if self.late() or not len(steps):
+            return None
+        targets = arm.ee_target(np.stack([translation(*(way * dz)) @ tool for dz in steps]))
         out = [q]
-        for dz in np.arange(1, round(height / 0.01) + 1) * 0.01:
+        for ik in solve_ik_many(arm.model, targets, 0, q_init=np.repeat(q[None], len(steps), axis=0), restarts=0):
+            nxt = _following(ik, out[-1])
+            if nxt is None:
+                break
+            out.append(nxt)
+        for target in targets[len(out) - 1 :]:
             if self.late():
                 break
-            target = arm.ee_target(translation(way[0] * dz, way[1] * dz, way[2] * dz) @ tool)
             ik = solve_ik_many(arm.model, target[None], 0, q_init=out[-1], restarts=0)[0]
-            if not ik.solved or ik.q is None or float(np.abs(ik.q - out[-1]).max()) > 0.2:
+            nxt = _following(ik, out[-1])
+            if nxt is None:
                 break  # as high as the arm goes straight up (at the edge of its reach: less)
-            out.append(ik.q)
+            out.append(nxt)
         return np.array(out) if len(out) > 1 else None
+
+
+def _following(ik: IKResult, before: np.ndarray) -> np.ndarray | None:
+    """A straight motion's next configuration: the one ``ik`` solved, when no joint is farther than 0.2 rad
+    from ``before``; else None."""
+    if not ik.solved or ik.q is None or float(np.abs(ik.q - before).max()) > 0.2:
+        return None
+    return ik.q
 
 
 def joint_line(configs: np.ndarray, step: float) -> np.ndarray:

@@ -21,6 +21,7 @@ from mrgc.geometry.arm_paths import joint_line
 from mrgc.geometry.collision import CollisionShape, CollisionWorld, Packed, Posed
 from mrgc.geometry.conventions import PATH_RESOLUTION, to_se2
 from mrgc.geometry.grounding import Grounder
+from mrgc.geometry.ik import solve_ik_many
 from mrgc.geometry.kinematics import Link
 from mrgc.geometry.scene import inside, scene_from_problem
 from mrgc.geometry.stances import PHASES, Stance, stance
@@ -260,6 +261,36 @@ def test_a_placement_that_leaves_no_room_for_an_earlier_object_is_passed_over(tm
     assert plan.status is mrgc.PlanStatus.SOLVED, plan.summary()
     report = mrgc.validate(str(path), plan)
     assert report.ok, report.lines()
+
+
+@pytest.mark.parametrize(("direction", "height"), [((0, 0, 1), 0.08), ((0.6, 0, 0.8), 0.12), ((0, 0, 1), 1.2)])
+def test_a_straight_motion_puts_the_tool_on_its_line_every_centimetre(
+    pa3: Grounder, direction: tuple[float, float, float], height: float
+) -> None:
+    """An arm's straight motion (the lift, a descent backwards): from the grasp of o1, the tool at the k-th
+    configuration stands k cm along the direction, turned as at the start (to the solver's tolerances), and no
+    joint moves more than 0.2 rad between two; asked for 1.2 m up, beyond its reach, it stops where the next
+    centimetre, solved from the last configuration, is not followed."""
+    pick = pa3.pick("r1", "o1", "top", avoid=["o2", "o3"])
+    assert pick.ok and pick.configs is not None
+    q, way = pick.configs[-1], np.array(direction, dtype=float)
+    path = pa3._lift("r1", q, height, way)
+    assert path is not None and np.allclose(path[0], q)
+    arm = pa3.arm("r1")
+    tools = arm.tool_world(path)
+    for k, tool in enumerate(tools):
+        assert np.linalg.norm(tool[:3, 3] - (tools[0][:3, 3] + 0.01 * k * way)) < 2e-4
+        assert np.abs(tool[:3, :3] - tools[0][:3, :3]).max() < 2e-3
+    assert np.abs(np.diff(path, axis=0)).max() <= 0.2
+    full = round(height / 0.01) + 1
+    if height < 0.3:
+        assert len(path) == full  # within reach: every centimetre
+    else:
+        assert 10 < len(path) < full
+        tool = arm.tool_world(path[-1:])[0]  # the next centimetre from the last is not followed either
+        target = arm.ee_target(translation(*(0.01 * way)) @ tool)
+        nxt = solve_ik_many(arm.model, target[None], 0, q_init=path[-1], restarts=0)[0]
+        assert not nxt.solved or nxt.q is None or np.abs(nxt.q - path[-1]).max() > 0.2
 
 
 def test_a_carry_crosses_the_table_above_what_may_stand_there() -> None:

@@ -83,6 +83,39 @@ def test_installed_script(good: Path) -> None:
     assert res.returncode == 0, res.stderr
 
 
+def test_the_command_leaves_its_start_up_objects_to_the_collector_again_when_it_ends(
+    good: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``mrgc plan`` freezes the objects that exist when it starts for the run (the collector's full passes
+    skip them) and unfreezes them when it ends: an in-process caller keeps nothing frozen."""
+    import gc
+
+    from mrgc import api
+
+    seen: list[int] = []
+    real = api.plan
+
+    def plan(*args: object, **kwargs: object) -> object:
+        seen.append(gc.get_freeze_count())
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(api, "plan", plan)
+    before = gc.get_freeze_count()
+    assert cli.main(["plan", str(good), "-o", str(tmp_path / "plan.json")]) == 0
+    assert len(seen) == 1 and seen[0] > before + 1000  # the modules, the problem, the command line
+    assert gc.get_freeze_count() == before
+
+
+def test_the_command_spares_the_interpreter_s_exit_its_full_collection() -> None:
+    # an exit handler registered before mrgc.cli loads runs after the command's own (last in, first out)
+    probe = (
+        "import atexit, gc; atexit.register(lambda: print(gc.get_freeze_count() > 1000, flush=True)); "
+        "import mrgc.cli; print(gc.get_freeze_count(), flush=True)"
+    )
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=60)
+    assert out.stdout.split() == ["0", "True"], out.stderr
+
+
 @pytest.mark.parametrize("given, threads", [(None, "1"), ("2", "2")])
 def test_the_command_runs_numpy_s_blas_on_one_thread_unless_told_otherwise(given: str | None, threads: str) -> None:
     # what numpy's OpenBLAS reads when it loads, and the threads its pool started (this interpreter's tasks)

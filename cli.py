@@ -30,7 +30,8 @@ _one_blas_thread()
 
 
 def _no_collection_at_exit() -> None:
-    """Spare the interpreter's exit its full garbage collection: ``gc.freeze()`` as the last exit handler.
+    """Spare the interpreter's exit its full garbage collection: ``gc.freeze()`` as the last exit handler,
+    unless OMPL was loaded.
 
     When a command returns, Python's shutdown walks every object the run made (tens of thousands: modules,
     models, the search's records) looking for reference cycles to free, memory the process is about to give
@@ -38,13 +39,20 @@ def _no_collection_at_exit() -> None:
     presets, each run before, after, after, before: median CPU 4.8 % lower, docs/benchmarks.md, "Session 28").
     Frozen, they are left out of that pass (objects are still freed by their reference counts as modules
     are torn down; only cycles among them are not looked for, which Python does not promise to collect at
-    exit anyway).  Registered once, when the command's module loads, so it runs after the exit handlers
+    exit anyway).  OMPL's bindings (nanobind) count their objects still alive when they unload and print a
+    page of "leaked" warnings when cycles holding them were not collected, so a run that planned a path with
+    OMPL (:mod:`mrgc.geometry.motion`, loaded on its first path) keeps the collection: a run long enough to
+    need one.  Registered once, when the command's module loads, so it runs after the exit handlers
     registered later (multiprocessing's, which reaps workers); an in-process caller of :func:`main` (the
     tests) is unaffected until its own interpreter exits."""
     import atexit
     import gc
 
-    atexit.register(gc.freeze)
+    def freeze_unless_ompl() -> None:
+        if "ompl" not in sys.modules:
+            gc.freeze()
+
+    atexit.register(freeze_unless_ompl)
 
 
 _no_collection_at_exit()

@@ -65,3 +65,24 @@ def test_phase1_cpu_times_the_generated_instances_of_a_preset(tmp_path: Path) ->
     assert 0 < float(row[4]) <= float(row[3])
     bad = subprocess.run([sys.executable, str(script), "--cpu", "pa55"], capture_output=True, text=True, timeout=60)
     assert bad.returncode == 2 and "invalid choice: 'pa55'" in bad.stderr
+
+
+def test_abba_plans_each_instance_with_both_trees_in_turn(tmp_path: Path) -> None:
+    """``benchmarks/abba.py``: four runs per instance (A, B, B, A), each tree's CPU times, and per instance set
+    the medians and ratios, and whether the four plans are the same (one tree twice here: they are)."""
+    tree = tmp_path / "tree"
+    tree.mkdir()
+    (tree / "mrgc").symlink_to(ROOT, target_is_directory=True)
+    problem = ROOT / "domains" / "symbolic" / "chain-3.mrg"
+    cmd = [sys.executable, str(ROOT / "benchmarks" / "abba.py"), "--a", str(tree), "--b", str(tree)]
+    out = subprocess.run(
+        [*cmd, "--out", str(tmp_path / "out"), str(problem)], capture_output=True, text=True, timeout=300
+    )
+    assert out.returncode == 0, out.stderr
+    lines = out.stdout.splitlines()
+    assert [line.split()[:2] for line in lines[:4]] == [["chain-3", s] for s in "abba"]
+    assert all(float(line.split()[2]) > 0 for line in lines[:4])
+    assert lines[4].startswith("chain: 1 instances, median CPU A ") and lines[4].endswith("same plans on 1")
+    assert sorted(p.name for p in (tmp_path / "out").glob("*.json")) == [
+        f"chain-3-{k}{s}.json" for k, s in enumerate("abba")
+    ]

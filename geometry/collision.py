@@ -701,7 +701,18 @@ def posed_collide(a: Posed, b: Posed, tolerance: float = TOLERANCE) -> bool:
     if len(b) <= GROUP:
         j, i = _near(b, a)
         return bool(_exact(a, b, i, j, tolerance, stop=True))
+    if len(a) * len(b) <= DIRECT_YES_NO:
+        i, j = _meet(a.lo, a.hi, b.lo, b.hi)
+        return bool(_exact(a, b, i, j, tolerance, stop=True))
     return any(_exact(a, b, i, j, tolerance, stop=True) for i, j in _chunks(a, b))
+
+
+#: a yes/no query (:func:`posed_collide`) of two sets of more than :data:`GROUP` pieces tests every pair of
+#: boxes directly up to this many pairs (the grouped broadphase only above): an RRTConnect edge's states
+#: against a world's objects (about 700 pieces against 75) are mostly answered "collides", and their pairs
+#: in the probe's order find it sooner than the group pairs' chunks.  Measured on the 6-arm instance of seed
+#: 2: 7,356 such queries, 6.7 -> 3.1 s of CPU (the same answers); its first 15 groundings 91.4 -> 79.4 s.
+DIRECT_YES_NO = 1 << 17
 
 
 #: a set of at least TREE_MIN pieces (another arm's sweep, a step's busy volume, a suffix's sweep around a

@@ -547,11 +547,12 @@ def _pairwise(a: list[tuple[object, np.ndarray]], b: list[tuple[object, np.ndarr
     return False
 
 
-@pytest.mark.parametrize("n_a, n_b", [(1, 5), (12, 30), (40, 600), (8, 3000), (3000, 8)])
+@pytest.mark.parametrize("n_a, n_b", [(1, 5), (12, 30), (40, 600), (8, 3000), (3000, 8), (200, 1000)])
 def test_the_kernel_agrees_with_pairwise_coal(n_a: int, n_b: int) -> None:
-    """The kernel's answers (numpy broadphase, direct or grouped, or a few pieces against a large set;
-    coal's narrowphase on the pairs left) are those of testing every pair with coal, on random boxes,
-    spheres and hulls near each other."""
+    """The kernel's answers (numpy broadphase, direct or grouped, or a few pieces against a large set; a
+    yes/no query of two sets direct up to DIRECT_YES_NO pairs (40 x 600), grouped above (200 x 1000); coal's
+    narrowphase on the pairs left) are those of testing every pair with coal, on random boxes, spheres and
+    hulls near each other."""
     from mrgc.geometry.collision import Posed, overlaps, pieces_collide, posed_collide
 
     rng = np.random.default_rng(n_a * 1000 + n_b)

@@ -41,8 +41,8 @@ def _no_collection_at_exit() -> None:
     are torn down; only cycles among them are not looked for, which Python does not promise to collect at
     exit anyway).  OMPL's bindings (nanobind) count their objects still alive when they unload and print a
     page of "leaked" warnings when cycles holding them were not collected, so a run that planned a path with
-    OMPL (:mod:`mrgc.geometry.motion`, loaded on its first path) keeps the collection: a run long enough to
-    need one.  Registered once, when the command's module loads, so it runs after the exit handlers
+    OMPL (:mod:`mrgc.geometry.motion`, loaded on its first path; 5 of the 20 PA5 presets) keeps the
+    collection, as before.  Registered once, when the command's module loads, so it runs after the exit handlers
     registered later (multiprocessing's, which reaps workers); an in-process caller of :func:`main` (the
     tests) is unaffected until its own interpreter exits."""
     import atexit

@@ -685,9 +685,10 @@ def _narrow(
 
 
 def posed_collide(a: Posed, b: Posed, tolerance: float = TOLERANCE) -> bool:
-    """Whether some piece of ``a`` collides with some piece of ``b`` (within ``tolerance``); large sets are
-    opened a chunk of groups at a time, stopping at the first collision; a large ``b`` asked again and again
-    answers through its tree (:data:`TREE_MIN`)."""
+    """Whether some piece of ``a`` collides with some piece of ``b`` (within ``tolerance``): every pair of
+    boxes tested directly up to :data:`DIRECT_YES_NO` pairs, larger sets opened a chunk of groups at a time,
+    stopping at the first collision; a large ``b`` asked again and again answers through its tree
+    (:data:`TREE_MIN`)."""
     if len(b) >= TREE_MIN and len(a) <= min(TREE_PIECES, len(b)):
         b._probed += 1
         if b._probed > max(TREE_AFTER, len(b) // TREE_AMORTISED):
@@ -711,7 +712,8 @@ def posed_collide(a: Posed, b: Posed, tolerance: float = TOLERANCE) -> bool:
 #: boxes directly up to this many pairs (the grouped broadphase only above): an RRTConnect edge's states
 #: against a world's objects (about 700 pieces against 75) are mostly answered "collides", and their pairs
 #: in the probe's order find it sooner than the group pairs' chunks.  Measured on the 6-arm instance of seed
-#: 2: 7,356 such queries, 6.7 -> 3.1 s of CPU (the same answers); its first 15 groundings 91.4 -> 79.4 s.
+#: 2: 7,356 such queries, 6.7 -> 3.1 s of CPU (the same answers); its first 15 groundings 91.4 -> 79.4 s,
+#: its 40th 283 -> 274 s; the other 6-arm seeds and the PA10/BO8 presets within noise (docs/benchmarks.md).
 DIRECT_YES_NO = 1 << 17
 
 

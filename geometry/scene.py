@@ -9,6 +9,7 @@ from __future__ import annotations
 import os
 import weakref
 from dataclasses import dataclass, field
+from typing import Callable
 
 import numpy as np
 
@@ -196,11 +197,22 @@ def inside(region: Body, shape: Shape, pose: np.ndarray, tol: float = 1e-6) -> b
     Cylinders and spheres are tested by their bounding boxes, which makes the test conservative (an
     object reported inside is inside).  A region must be a box.
     """
+    return inside_test(region, shape, tol)(pose)
+
+
+def inside_test(region: Body, shape: Shape, tol: float = 1e-6) -> Callable[[np.ndarray], bool]:
+    """:func:`inside` of ``shape`` in ``region`` as a function of the pose, what does not depend on it (the
+    shape's outline, the region's inverse pose) computed once: the same answers, for a caller that asks
+    many poses (the placements of an object in a region)."""
     if not isinstance(region.shape, Box):
-        return False
+        return lambda pose: False
     pts = outline(shape)
-    world = pts @ pose[:3, :3].T + pose[:3, 3]
     inv = np.linalg.inv(region.pose)
-    local = world @ inv[:3, :3].T + inv[:3, 3]
     half = half_extents(region.shape) + tol
-    return bool(np.all(np.abs(local) <= half))
+
+    def test(pose: np.ndarray) -> bool:
+        world = pts @ pose[:3, :3].T + pose[:3, 3]
+        local = world @ inv[:3, :3].T + inv[:3, 3]
+        return bool(np.all(np.abs(local) <= half))
+
+    return test

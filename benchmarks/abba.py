@@ -10,7 +10,8 @@ instance in a row is a few per cent faster (the files it reads are in the page c
 warm), so a comparison that always runs B second favours B by about 3 % (docs/benchmarks.md, "Session 28").
 Each tree's time on an instance is the mean of its two runs; the report gives, per instance set (the file
 name up to its first ``-``), both medians and the median and mean of the per-instance ratios B / A, and
-whether each instance's four plans have the same steps.  The runs' logs, plans and times go to ``--out``.
+whether each instance's four plans have the same steps (a run that wrote no plan counts as a difference).
+The runs' logs, plans and times go to ``--out``.
 """
 
 from __future__ import annotations
@@ -59,10 +60,11 @@ def main() -> None:
         for k, side in enumerate("abba"):
             cpu, steps = run(getattr(args, side), problem, args.out / f"{name}-{k}{side}", options)
             times[side].append(cpu)
-            plans.append(json.dumps(steps, sort_keys=True))
-            print(f"{name} {side} {cpu:.3f}", flush=True)
+            plans.append(None if steps is None else json.dumps(steps, sort_keys=True))
+            missing = "" if steps is not None else " (no plan file: see its log)"
+            print(f"{name} {side} {cpu:.3f}{missing}", flush=True)
         a, b = statistics.mean(times["a"]), statistics.mean(times["b"])
-        sets[name.split("-")[0]].append((a, b, len(set(plans)) == 1))
+        sets[name.split("-")[0]].append((a, b, None not in plans and len(set(plans)) == 1))
     for key, rows in sets.items():
         ratios = [b / a for a, b, _ in rows]
         print(

@@ -141,16 +141,36 @@ class Arm:
         ``transforms`` (C, L, 4, 4), the :attr:`hand`'s excepted: the hand and its fingers hold it where the
         grasp puts them, the same all along a motion (the validator's ``collision-self-held``: a carry that
         swings the object into the arm's base or shoulder)."""
-        kept = self._held_checks.get(id(shape))
-        if kept is None:
+        check = self._held_check(shape, self._held_checks, with_links=False)
+        return check.collides(self._with_base(transforms, poses))
+
+    def collides_with_itself_at(
+        self, transforms: np.ndarray, shape: CollisionShape | None = None, poses: np.ndarray | None = None
+    ) -> bool:
+        """:meth:`self_collides_at` or, holding an object of ``shape`` at ``poses``, :meth:`held_collides_at`:
+        the same answer from one check of both sets of pairs (the links' pairs, then the held object's; one
+        clearance), whose bounding spheres are placed once for both."""
+        if shape is None or poses is None:
+            return self.self_collides_at(transforms)
+        check = self._held_check(shape, self._both_checks, with_links=True)
+        return check.collides(self._with_base(transforms, poses))
+
+    def _held_check(
+        self, shape: CollisionShape, kept: dict[int, tuple[CollisionShape, PairCheck]], with_links: bool
+    ) -> PairCheck:
+        """The pair check of the solid links ([mount] + probes, :attr:`_self_check`'s order) and a held object
+        of ``shape`` after them: the held object's pairs (every link but the :attr:`hand`'s), after the links'
+        own pairs when ``with_links``; made once per shape into ``kept``."""
+        made = kept.get(id(shape))
+        if made is None:
             hand = {self.probes[1][i] for i in self.hand}
             links = [k for k in self.model.mount if k in self.hulls] + self.probes[1]
             pairs = [(len(links), j) for j, k in enumerate(links) if k not in hand]
+            if with_links:
+                pairs = [(int(a), int(b)) for a, b in self._self_check.pairs.tolist()] + pairs
             check = PairCheck([self.hulls[k] for k in links] + [shape], pairs, SELF_CLEARANCE)
-            kept = self._held_checks[id(shape)] = (shape, check)  # the shape kept alive: its id stays its own
-        check = kept[1]
-        t = self._with_base(transforms)
-        return check.collides(np.concatenate([t, np.asarray(poses, dtype=float).reshape(len(t), 1, 4, 4)], axis=1))
+            made = kept[id(shape)] = (shape, check)  # the shape kept alive: its id stays its own
+        return made[1]
 
     @cached_property
     def _no_branch_memo(self) -> dict[bytes, bool]:
@@ -163,17 +183,25 @@ class Arm:
         return {}
 
     @cached_property
+    def _both_checks(self) -> dict[int, tuple[CollisionShape, PairCheck]]:
+        """The :meth:`collides_with_itself_at` checks made so far, by held shape."""
+        return {}
+
+    @cached_property
     def _base_poses(self) -> np.ndarray:
         """The world poses of the mount's solid links (:attr:`base_hulls`), (B, 4, 4)."""
         return np.stack([pose for _, _, pose in self.base_hulls]) if self.base_hulls else np.zeros((0, 4, 4))
 
-    def _with_base(self, transforms: np.ndarray) -> np.ndarray:
-        """The probed links' transforms (C, L, 4, 4) with the mount's solid links' (fixed) in front."""
+    def _with_base(self, transforms: np.ndarray, poses: np.ndarray | None = None) -> np.ndarray:
+        """The probed links' transforms (C, L, 4, 4) with the mount's solid links' (fixed) in front, and a
+        held object's ``poses`` (C, 4, 4) after them when given."""
         t = np.asarray(transforms, dtype=float).reshape(-1, len(self.probes[1]), 4, 4)
         base = self._base_poses
-        if not len(base):
-            return t
-        return np.concatenate([np.broadcast_to(base, (len(t),) + base.shape), t], axis=1)
+        parts = [np.broadcast_to(base, (len(t),) + base.shape)] if len(base) else []
+        parts.append(t)
+        if poses is not None:
+            parts.append(np.asarray(poses, dtype=float).reshape(len(t), 1, 4, 4))
+        return parts[0] if len(parts) == 1 else np.concatenate(parts, axis=1)
 
     def ee_target(self, tool_world: np.ndarray) -> np.ndarray:
         """The end-effector pose (base frame) that puts the tool centre point at ``tool_world`` (a 4×4, or
@@ -264,7 +292,8 @@ class Arm:
         pieces in the same order, made from the arrays without a list of pieces between), the links' world
         transforms (C, L, 4, 4), and the held object's world poses (C, 4, 4; None when it holds nothing)."""
         shapes, kind, flat, transforms, poses = self._pieces(configs, held, opening)
-        return Posed(shapes, kind, flat, TOLERANCE), transforms, poses
+        boxes = self._boxes(held[0] if held is not None else None)
+        return Posed(shapes, kind, flat, TOLERANCE, boxes=boxes), transforms, poses
 
     def _pieces(
         self, configs: np.ndarray, held: Held | None, opening: float | None
@@ -274,17 +303,54 @@ class Arm:
         (C, L, 4, 4) and the held object's poses (C, 4, 4; None when it holds nothing)."""
         configs = np.atleast_2d(configs)
         shapes: list[CollisionShape] = list(self.probes[0])
-        transforms = self.link_transforms(configs, opening)
-        kind = np.tile(np.arange(len(shapes)), len(configs))
+        fingers = None if opening is None else self.model.finger_value(opening)
+        frames = fk_world(self.model, configs, self.base, fingers)  # every link's: the end effector's too
+        transforms = frames[:, self.probes[1]]
+        kind = self._kind(len(configs), held is not None)
         flat = transforms.reshape(-1, 4, 4)
         poses = None
         if held is not None:
             shape, in_tool = held
-            poses = self.tool_world(configs) @ in_tool
+            poses = frames[:, self.model.ee_link] @ self.tcp @ in_tool  # the tool pose (:meth:`tool_world`)
             shapes.append(shape)
-            kind = np.concatenate([kind, np.full(len(configs), len(shapes) - 1)])
             flat = np.concatenate([flat, poses])
         return shapes, kind, flat, transforms, poses
+
+    def _kind(self, configs: int, holding: bool) -> np.ndarray:
+        """Which shape each piece of :meth:`_pieces` is: the probes' indices at each of ``configs``
+        configurations in turn, then (``holding``) the held object's index (after the probes') at each; kept
+        read-only for the few counts motion checks ask for (one configuration, a motion's batches)."""
+        key = (configs, holding)
+        kind = self._kinds.get(key)
+        if kind is None:
+            links = len(self.probes[0])
+            kind = np.tile(np.arange(links), configs)
+            if holding:
+                kind = np.concatenate([kind, np.full(configs, links)])
+            kind.setflags(write=False)
+            if len(self._kinds) < 256:
+                self._kinds[key] = kind
+        return kind
+
+    @cached_property
+    def _kinds(self) -> dict[tuple[int, bool], np.ndarray]:
+        """:meth:`_kind`'s arrays by (configurations, holding)."""
+        return {}
+
+    def _boxes(self, held: CollisionShape | None) -> np.ndarray:
+        """The :attr:`CollisionShape.box` of each shape of :meth:`_pieces` stacked ((S, 2, 3)): the probes', then
+        the held object's; made once per held shape."""
+        key = id(held) if held is not None else None
+        kept = self._boxes_of.get(key)
+        if kept is None:
+            boxes = np.stack([s.box for s in self.probes[0]] + ([held.box] if held is not None else []))
+            kept = self._boxes_of[key] = (held, boxes)  # the shape kept alive: its id stays its own
+        return kept[1]
+
+    @cached_property
+    def _boxes_of(self) -> dict[int | None, tuple[CollisionShape | None, np.ndarray]]:
+        """:meth:`_boxes`' arrays by held shape (its id; None: nothing held)."""
+        return {}
 
     def volumes(self, configs: np.ndarray, held: Held | None = None, opening: float | None = None) -> list[Volume]:
         """:meth:`volume` at each of ``configs`` separately (one volume per configuration: a motion's samples,

@@ -247,7 +247,16 @@ class Posed:
 
     __slots__ = ("shapes", "kind", "transforms", "lo", "hi", "pad", "_coarse", "_tree", "_probed", "_parts")
 
-    def __init__(self, shapes: Sequence[CollisionShape], kind: np.ndarray, transforms: np.ndarray, pad: float) -> None:
+    def __init__(
+        self,
+        shapes: Sequence[CollisionShape],
+        kind: np.ndarray,
+        transforms: np.ndarray,
+        pad: float,
+        boxes: np.ndarray | None = None,
+    ) -> None:
+        """``boxes``: the shapes' :attr:`CollisionShape.box` stacked ((S, 2, 3)), from a caller that keeps them
+        (an arm's links: :meth:`Arm.posed <mrgc.geometry.arm.Arm.posed>`); None: stacked here."""
         self.shapes = list(shapes)
         self.pad = pad
         self.kind = np.asarray(kind, dtype=np.intp)
@@ -264,7 +273,7 @@ class Posed:
             mid = rot @ self.shapes[0].center
             reach = np.abs(rot) @ (self.shapes[0].half + pad)
         else:
-            table = np.stack([s.box for s in self.shapes])[self.kind]  # (N, 2, 3)
+            table = (np.stack([s.box for s in self.shapes]) if boxes is None else boxes)[self.kind]  # (N, 2, 3)
             mid = (rot @ table[:, 0, :, None])[..., 0]
             reach = (np.abs(rot) @ (table[:, 1, :, None] + pad))[..., 0]
         mid += self.transforms[:, :3, 3]

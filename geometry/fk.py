@@ -12,6 +12,7 @@ the chain alone.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Union
 
@@ -174,7 +175,7 @@ def fk(model: RobotModel, q: np.ndarray, base: BasePose = None, fingers: float |
     q = _as_q(model, q)
     p = plan(model)
     batch = q.shape[:-1]
-    flat = q.reshape(int(np.prod(batch)), model.dof)  # (a chain of 0 joints too)
+    flat = q.reshape(math.prod(batch), model.dof)  # (a chain of 0 joints too)
     if p.all_rev:
         local = p.ob + np.sin(flat)[..., None, None] * p.a - np.cos(flat)[..., None, None] * p.b  # (N, dof, 4, 4)
     else:
@@ -183,8 +184,14 @@ def fk(model: RobotModel, q: np.ndarray, base: BasePose = None, fingers: float |
     out = np.empty((flat.shape[0], len(model.links), 4, 4))
     bt = base_transform(base)
     out[:, 0] = np.eye(4) if bt is None else bt
-    for k, parent, ci, const in _steps(model, p, fingers):
-        np.matmul(out[:, parent], local[:, ci] if const is None else const, out=out[:, k])
+    steps = _steps(model, p, fingers)
+    if flat.shape[0] == 1:  # one configuration (a motion check's): 4x4 products, the same numbers, less indexing
+        one, own = out[0], local[0]
+        for k, parent, ci, const in steps:
+            np.matmul(one[parent], own[ci] if const is None else const, out=one[k])
+    else:
+        for k, parent, ci, const in steps:
+            np.matmul(out[:, parent], local[:, ci] if const is None else const, out=out[:, k])
     return out.reshape(batch + out.shape[1:])
 
 

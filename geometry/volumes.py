@@ -101,10 +101,7 @@ class Volumes(StepWorld):
     ) -> bool:
         """Whether the arm at its probed links' ``transforms`` collides with itself, or the object of ``shape``
         it holds at ``poses`` (None: it holds nothing) with the arm holding it."""
-        arm = self.arm(robot)
-        if arm.self_collides_at(transforms):
-            return True
-        return shape is not None and poses is not None and arm.held_collides_at(transforms, shape, poses)
+        return self.arm(robot).collides_with_itself_at(transforms, shape, poses)
 
     def _arm_volume(
         self, robot: str, configs: np.ndarray, holding: tuple[str, str] | None, grasp: tuple[str, str] | None

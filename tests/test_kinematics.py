@@ -247,6 +247,22 @@ def test_fk_batches(panda) -> None:
         F.fk(panda, np.zeros(6))
 
 
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(u=st.lists(unit_floats(7), min_size=2, max_size=6), opening=st.none() | st.floats(0.0, 0.1))
+def test_fk_of_one_configuration_is_its_row_of_a_batch_to_the_bit(panda, toy, u, opening) -> None:
+    """geometry/fk.py: one configuration takes 4x4 products (a motion check's case) where a batch takes stacked
+    ones; the frames are the same numbers to the last bit, with a base pose and the fingers at an opening."""
+    base = np.eye(4)
+    base[:3, 3] = [0.3, -0.2, 0.1]
+    for model in (panda, toy):
+        qs = np.stack([in_limits(model, v[: model.dof]) for v in u])
+        fingers = None if opening is None or model is toy else model.finger_value(opening)
+        batch = F.fk(model, qs, base, fingers)
+        for k, q in enumerate(qs):
+            assert np.array_equal(F.fk(model, q[None], base, fingers)[0], batch[k])
+            assert np.array_equal(F.fk(model, q, base, fingers), batch[k])
+
+
 def test_jacobian_matches_finite_differences(panda, toy) -> None:
     rng = np.random.default_rng(1)
     for model in (panda, toy):

@@ -190,6 +190,31 @@ def test_the_check_agrees_with_pybullet_on_random_configurations(pa10: SceneSpec
     assert arm.self_colliding(qs, 0.04).tolist() == one_by_one
 
 
+def test_one_check_of_the_arm_and_what_it_holds_answers_as_the_two_checks(pa10: SceneSpec) -> None:
+    """geometry/arm.py ``collides_with_itself_at`` (the motion checks' form): holding each of three objects
+    with a grasp each, at 400 configurations one by one and in batches of 25, the same verdict as the links'
+    own check or the held object's; the held object's poses of :meth:`Arm.posed` are the tool poses of
+    ``tool_world`` carrying it (to 1e-12 m: computed from the links' frames, not a second chain)."""
+    g = Grounder(pa10, seed=0)
+    arm = g.arm("r1")
+    rng = np.random.default_rng(3)
+    qs = rng.uniform(arm.model.lower, arm.model.upper, (400, arm.model.dof))
+    held_any = 0
+    for obj, grasp in (("o1", "top"), ("o5", "side-x+"), ("o9", "side-y-")):
+        held = g._held("r1", (obj, grasp))
+        assert held is not None
+        opening = g._grip("r1", obj, grasp)[0]
+        for k in list(range(400)) + [slice(s, s + 25) for s in range(0, 400, 25)]:
+            _, links, poses = arm.posed(qs[k] if isinstance(k, slice) else qs[k : k + 1], held, opening)
+            assert poses is not None
+            two = arm.self_collides_at(links) or arm.held_collides_at(links, held[0], poses)
+            assert arm.collides_with_itself_at(links, held[0], poses) == two
+            held_any += not arm.self_collides_at(links) and two
+        tools = arm.tool_world(qs) @ held[1]
+        assert np.allclose(arm.posed(qs, held, opening)[2], tools, rtol=0, atol=1e-12)
+    assert held_any > 0  # some configurations are refused for the held object alone
+
+
 def test_an_ik_answer_in_self_collision_is_refused() -> None:
     """pa-basic: o2 stands so near r1's base that every IK solution of its side-y- approach folds link6 into
     link0 (60 random-start solves: none free).  Phase 1 drops the fact it used to give, grounding answers

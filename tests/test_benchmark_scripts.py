@@ -86,3 +86,20 @@ def test_abba_plans_each_instance_with_both_trees_in_turn(tmp_path: Path) -> Non
     assert sorted(p.name for p in (tmp_path / "out").glob("*.json")) == [
         f"chain-3-{k}{s}.json" for k, s in enumerate("abba")
     ]
+
+
+def test_motion_state_costs_each_stage_of_a_motion_check(tmp_path: Path) -> None:
+    """``benchmarks/motion_state.py FILE --states N``: the instance, robot and number of states (and how many of
+    them hit the world), then a row per stage with its microseconds per state."""
+    script = ROOT / "benchmarks" / "motion_state.py"
+    pa10 = ROOT / "domains" / "packaging" / "pa10.mrg"
+    cmd = [sys.executable, str(script), str(pa10), "--robot", "r2", "--states", "60"]
+    out = subprocess.run(cmd, capture_output=True, text=True, cwd=tmp_path, timeout=300)
+    assert out.returncode == 0, out.stderr
+    lines = out.stdout.splitlines()
+    head = lines[0].split(", ")
+    assert head[0] == "pa10.mrg" and head[1].startswith("r2 holding ") and head[2] == "60 states"
+    assert 0 <= int(head[3].split()[0]) <= 60
+    rows = [line.strip("|").split("|") for line in lines[3:]]
+    assert len(rows) == 5 and rows[-1][0].strip() == "a state of a motion check (Volumes.free_posed)"
+    assert all(float(r[1]) > 0 for r in rows)

@@ -293,6 +293,36 @@ def test_a_straight_motion_puts_the_tool_on_its_line_every_centimetre(
         assert not nxt.solved or nxt.q is None or np.abs(nxt.q - path[-1]).max() > 0.2
 
 
+@settings(max_examples=200, deadline=None)
+@given(
+    points=st.integers(1, 12),
+    start=st.integers(0, 3),
+    blocked=st.sets(st.integers(0, 200), max_size=4),
+    seed=st.integers(0, 2**16),
+)
+def test_a_straight_motion_is_free_as_far_as_its_centimetres_one_by_one_say(
+    points: int, start: int, blocked: set[int], seed: int
+) -> None:
+    """geometry/arm_paths.py ``_free_run`` (lifts and descents): asking the whole rest of a straight motion in one
+    batch first, then centimetre by centimetre when something is in the way, ends where the centimetres one by
+    one end, for any configurations and any states in the way (``hits`` finds a state blocked by its values)."""
+    from mrgc.geometry.arm_paths import _free_run
+
+    rng = np.random.default_rng(seed)
+    up = np.cumsum(rng.uniform(-0.05, 0.05, (points, 3)), axis=0)
+    line = joint_line(up, PATH_RESOLUTION)
+    marks = {line[k].tobytes() for k in blocked if k < len(line)}
+
+    def hits(configs: np.ndarray) -> set[str] | None:
+        return {"x"} if any(c.tobytes() in marks for c in configs) else None
+
+    top = min(start, points - 1)
+    one_by_one = top
+    while one_by_one + 1 < len(up) and hits(joint_line(up[one_by_one : one_by_one + 2], PATH_RESOLUTION)) is None:
+        one_by_one += 1
+    assert _free_run(up, hits, top) == one_by_one
+
+
 def test_a_carry_crosses_the_table_above_what_may_stand_there() -> None:
     """pa18-4arms, r4 carrying o1 from its pick to a placement in start: between the lift and the descent, the
     plain joint-space line sags the held box to 7 cm above the table, below the top of the tallest object that

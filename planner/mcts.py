@@ -81,17 +81,6 @@ class Node:
         """The edges not yet known to fail."""
         return [e for e in self.edges if not e.dead]
 
-    @property
-    def ready_edges(self) -> list[Edge]:
-        """The open edges but the unvisited ones whose skeleton the source now keeps back (``more.postponed``,
-        when the source says: one holding an action deferred after the source gave it, which it would now
-        give after the skeletons without such actions)."""
-        postponed = getattr(self.more, "postponed", None)
-        edges = self.open_edges
-        if postponed is None:
-            return edges
-        return [e for e in edges if e.visits or e.child is not None or not postponed(e.skeleton)]
-
 
 @dataclass
 class SearchResult:
@@ -166,14 +155,13 @@ class MCTS:
         while True:
             short = self.k - len(node.edges) if node.visits else 0  # a visited node's K skeletons, made lazily
             wider = short <= 0 and self._wider(node)
-            # beyond the paper: more skeletons before giving up, and before an edge the source now keeps back
-            if not node.ready_edges or short > 0 or wider:
+            if not node.open_edges or short > 0 or wider:  # beyond the paper: more skeletons before giving up
                 t0 = time.perf_counter()
                 before = len(node.edges)
-                node.refill(short if short > 0 and node.open_edges else 1 if wider or node.open_edges else self.k)
+                node.refill(short if short > 0 and node.open_edges else 1 if wider else self.k)
                 self.stats["skeleton_seconds"] += time.perf_counter() - t0
                 self.stats["skeletons"] += len(node.edges) - before
-            edges = node.ready_edges or node.open_edges
+            edges = node.open_edges
             if not edges:
                 if path:
                     path[-1][1].dead = True  # nothing left below this edge
@@ -210,7 +198,7 @@ class MCTS:
         another skeleton of its own: that subtree's node asked its source for more, failure after failure,
         and the search never came back up (the 6-arm, 40-object instance of seed 6: the root's 5 skeletons
         used up at 83 s, then the rest of the run's 208 under the suffix of 8 steps the fifth had grounded)."""
-        edges = node.ready_edges
+        edges = node.open_edges
         if node.exhausted or not edges or any(e.visits == 0 for e in edges):
             return False
         fresh = self.c * node.edges[-1].prior * math.sqrt(node.visits)

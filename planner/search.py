@@ -203,16 +203,6 @@ class _Skeletons:
         self.outcome = batch.outcome
         return batch.skeletons
 
-    def postponed(self, skel: Skeleton) -> bool:
-        """Whether ``skel`` (given by this source) holds a deferred action that the source keeps back (not
-        released by a lifted deferral): given before the deferral, it would now come after the others, so the
-        search grounds it only when its node has nothing else (:attr:`Node.ready_edges
-        <mrgc.planner.mcts.Node.ready_edges>`)."""
-        if not self.deferrals.deferred:
-            return False
-        released = self.source.generator.released_actions()
-        return any(self.deferrals.covers(a) and a not in released for step in skel.steps for a in step)
-
     @property
     def infeasible(self) -> bool:
         """The source gave no skeleton and has none: the skeleton model is infeasible at every horizon."""

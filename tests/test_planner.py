@@ -257,43 +257,6 @@ def _distinct(prefix: str, objs: tuple[str, ...] = ("o2",)):  # type: ignore[no-
     return more
 
 
-def test_skeletons_given_before_a_deferral_wait_for_those_without_the_deferred_action() -> None:
-    """planner/mcts.py ``Node.ready_edges``: a source that says which of its skeletons it now keeps back
-    (``postponed``: holding an action deferred after it gave them) sees them grounded only once its node has
-    nothing else: the search asks for a fresh skeleton first (one without the deferred action), and grounds a
-    kept-back one when the source has no other left.  Here the root's first batch (k = 3) holds two skeletons
-    with grasp "bad", deferred when the first of them fails; the third of the batch and the two the source
-    gives next go before the other "bad" one, which is grounded last (the source then exhausted)."""
-    bad = [Skeleton(((Action("o1", "goal", "r1", "r1", "bad", f"t{i}"),),)) for i in range(2)]
-    good = [Skeleton(((Action("o1", "goal", "r1", "r1", f"g{i}", "top"),),)) for i in range(3)]
-    queue = [bad[0], bad[1], good[0], good[1], good[2]]
-    deferred: set[str] = set()
-    order: list[Skeleton] = []
-
-    class Source:
-        def __call__(self, k: int) -> list[Skeleton]:
-            out, queue[:] = queue[:k], queue[k:]
-            return out
-
-        def postponed(self, skel: Skeleton) -> bool:
-            return any(a.pick_grasp in deferred for step in skel.steps for a in step)
-
-    def ground(skel: Skeleton, suffix: list[GroundedStep]) -> Grounding:
-        order.append(skel)
-        if skel.steps[0][0].pick_grasp == "bad":
-            deferred.add("bad")
-        return Grounding(Outcome.FAIL)
-
-    source = Source()
-    result = MCTS(ground, lambda n, m: source, {"o1"}, k=3).run(deadline=float("inf"))
-    assert result.steps is None
-    assert order == [bad[0], good[0], good[1], good[2], bad[1]]
-    # without ``postponed`` the batch is grounded in the order the source gave it
-    queue[:], deferred, order[:] = [bad[0], bad[1], good[0], good[1], good[2]], set(), []
-    MCTS(ground, lambda n, m: feeder(queue), {"o1"}, k=3).run(deadline=float("inf"))
-    assert order == [bad[0], bad[1], good[0], good[1], good[2]]
-
-
 def test_a_node_gets_another_skeleton_when_the_subtree_below_its_edges_keeps_failing() -> None:
     """planner/mcts.py, progressive widening: the root's only skeleton grounds a suffix whose node has an
     endless supply of skeletons that all fail; without widening the root (its k = 1 skeleton made, the edge

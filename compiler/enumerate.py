@@ -98,10 +98,6 @@ class SkeletonGenerator:
         cuts = [enc.cut(s, name=f"cut{i}") for i, s in enumerate(self.found)]
         return cuts + _out(enc, self.deferred)
 
-    def released_actions(self) -> set[Action]:
-        """The actions whose deferral was lifted (they come wherever their skeletons' order puts them)."""
-        return {self.graph.actions[i] for i in self.released}
-
     def defer(self, actions: Iterable[Action]) -> None:
         """Keep ``actions`` (those of this graph; others are ignored) out of the skeletons given next, until
         no other skeleton is left; no effect on an action released before (its deferral lifted) or once

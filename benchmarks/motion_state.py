@@ -60,6 +60,9 @@ def main() -> None:
         path = args.file or _default_instance(folder)
         problem = parse_file(path).problem()
     g = Grounder(scene_from_problem(problem), seed=0)
+    arms = sorted(r.name for r in g.scene.robots if r.kind.base == "fixed")
+    if args.robot not in arms:
+        ap.error(f"--robot {args.robot}: not an arm of {os.path.basename(path)} (its arms: {', '.join(arms)})")
     robot, arm = args.robot, g.arm(args.robot)
     obj = problem.movable[0].name
     grasp = sorted(g.scene.grasp_specs)[0]

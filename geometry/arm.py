@@ -217,9 +217,12 @@ class Arm:
     def link_transforms(self, q: np.ndarray, opening: float | None = None) -> np.ndarray:
         """World transforms of the probed links: ``q.shape[:-1] + (L, 4, 4)``, the fingers ``opening``
         metres apart (None: fully open, as the URDF's upper limits)."""
-        _, index = self.probes
+        return self._frames(q, opening)[..., self.probes[1], :, :]
+
+    def _frames(self, q: np.ndarray, opening: float | None) -> np.ndarray:
+        """World frames of every link at ``q`` (``q.shape[:-1] + (links, 4, 4)``), the fingers ``opening`` apart."""
         fingers = None if opening is None else self.model.finger_value(opening)
-        return fk_world(self.model, q, self.base, fingers)[..., index, :, :]
+        return fk_world(self.model, q, self.base, fingers)
 
     def no_branch(self, tool_world: np.ndarray) -> bool:
         """Whether the analytic solver (:mod:`mrgc.geometry.ik_analytic`; arms with a Panda's kinematics only,
@@ -303,8 +306,7 @@ class Arm:
         (C, L, 4, 4) and the held object's poses (C, 4, 4; None when it holds nothing)."""
         configs = np.atleast_2d(configs)
         shapes: list[CollisionShape] = list(self.probes[0])
-        fingers = None if opening is None else self.model.finger_value(opening)
-        frames = fk_world(self.model, configs, self.base, fingers)  # every link's: the end effector's too
+        frames = self._frames(configs, opening)  # every link's: the end effector's too
         transforms = frames[:, self.probes[1]]
         kind = self._kind(len(configs), held is not None)
         flat = transforms.reshape(-1, 4, 4)

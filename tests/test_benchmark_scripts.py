@@ -103,3 +103,7 @@ def test_motion_state_costs_each_stage_of_a_motion_check(tmp_path: Path) -> None
     rows = [line.strip("|").split("|") for line in lines[3:]]
     assert len(rows) == 5 and rows[-1][0].strip() == "a state of a motion check (Volumes.free_posed)"
     assert all(float(r[1]) > 0 for r in rows)
+    bad = subprocess.run([*cmd[:3], "--robot", "r9"], capture_output=True, text=True, cwd=tmp_path, timeout=120)
+    assert bad.returncode == 2 and bad.stderr.splitlines()[-1] == (
+        "motion_state.py: error: --robot r9: not an arm of pa10.mrg (its arms: r1, r2)"
+    )

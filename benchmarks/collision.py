@@ -11,7 +11,7 @@ batch runs the same query ``--repeat`` times; the per-call time is the batch tim
 
 The kernel rows (issue 22): a batch of 50 configurations of a 7-link chain against the scene in one query
 (``batch_collides``, per configuration), and two swept volumes (300 configurations × 7 links each, the size
-of a transfer) against each other, as a whole (``posed_collide``) and sample by sample (``paired_collide``).
+of a transfer) against each other, as a whole (``posed_collide``) and sample by sample (``grouped_collide``).
 """
 
 from __future__ import annotations
@@ -31,7 +31,7 @@ from mrgc.geometry.collision import (
     ConvexHull,
     Posed,
     collision_shape,
-    paired_collide,
+    grouped_collide,
     posed_collide,
 )
 from mrgc.geometry.transforms import rot_z, rpy_matrix, translation
@@ -156,14 +156,14 @@ def main(argv: list[str] | None = None) -> None:
         )
         for i in range(min(batches, 20))
     ]
-    slot = np.repeat(np.arange(300), 7)
+    starts, diagonal = np.arange(0, 2101, 7), np.repeat(np.arange(300), 2).reshape(-1, 2)
     row(
         "kernel: volume vs volume, 2 × 2,100 pieces, `posed_collide`",
         lambda i: posed_collide(*volumes[i % len(volumes)]),
     )
     row(
-        "kernel: the same, sample by sample, `paired_collide`",
-        lambda i: paired_collide(volumes[i % len(volumes)][0], slot, volumes[i % len(volumes)][1], slot),
+        "kernel: the same, sample by sample, `grouped_collide`",
+        lambda i: grouped_collide(volumes[i % len(volumes)][0], starts, volumes[i % len(volumes)][1], starts, diagonal),
     )
 
     # colliding_with: which of the 20 objects does one object hit

@@ -783,16 +783,33 @@ def pieces_collide(a: Probe, b: Probe, tolerance: float = TOLERANCE) -> bool:
     return posed_collide(Posed.of(a), Posed.of(b), tolerance)
 
 
-def paired_collide(a: Posed, a_slot: np.ndarray, b: Posed, b_slot: np.ndarray, tolerance: float = TOLERANCE) -> bool:
-    """Whether a piece of ``a`` collides with a piece of ``b`` *in the same slot* (``a_slot`` (N,) and
-    ``b_slot`` (M,), both ascending): two motions compared sample by sample, slot = the sample pair."""
-    sb = np.searchsorted(b_slot, a_slot, "left")
-    count = np.searchsorted(b_slot, a_slot, "right") - sb
-    total = int(count.sum())
-    if not total:
+def grouped_collide(
+    a: Posed, a_start: np.ndarray, b: Posed, b_start: np.ndarray, pairs: np.ndarray, tolerance: float = TOLERANCE
+) -> bool:
+    """Whether a piece of group ``k`` of ``a`` collides with a piece of group ``m`` of ``b`` for some row
+    ``(k, m)`` of ``pairs`` ((P, 2)).  A group is a run of consecutive pieces: group ``k`` of ``a`` is pieces
+    ``a_start[k]:a_start[k + 1]`` (``a_start`` ascending from 0 to ``len(a)``, no group empty), and so for
+    ``b``.  Two motions compared sample by sample: a group is one sample's volume, each sample once however
+    often it meets the other's, ``pairs`` the samples that meet in time.  Pairs of groups whose boxes (the
+    union of their pieces') do not meet are passed over before any pair of pieces is formed."""
+    if not len(pairs):
         return False
-    i = np.repeat(np.arange(len(a_slot)), count)
-    j = np.repeat(sb - (np.cumsum(count) - count), count) + np.arange(total)
+    a_start, b_start = np.asarray(a_start, dtype=np.intp), np.asarray(b_start, dtype=np.intp)
+    if (np.diff(a_start) <= 0).any() or (np.diff(b_start) <= 0).any():
+        raise ValueError("grouped_collide: every group needs a piece")
+    k, m = np.asarray(pairs, dtype=np.intp).reshape(-1, 2).T
+    a_lo, a_hi = np.minimum.reduceat(a.lo, a_start[:-1]), np.maximum.reduceat(a.hi, a_start[:-1])
+    b_lo, b_hi = np.minimum.reduceat(b.lo, b_start[:-1]), np.maximum.reduceat(b.hi, b_start[:-1])
+    meet = _boxes_overlap(a_lo[k], a_hi[k], b_lo[m], b_hi[m])
+    k, m = k[meet], m[meet]
+    if not len(k):
+        return False
+    na, nb = np.diff(a_start)[k], np.diff(b_start)[m]
+    size = na * nb
+    which = np.repeat(np.arange(len(k)), size)
+    within = np.arange(int(size.sum())) - np.repeat(np.cumsum(size) - size, size)
+    i = a_start[k][which] + within // nb[which]
+    j = b_start[m][which] + within % nb[which]
     keep = _boxes_overlap(a.lo[i], a.hi[i], b.lo[j], b.hi[j])
     return bool(_exact(a, b, i[keep], j[keep], tolerance, stop=True))
 

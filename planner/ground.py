@@ -28,7 +28,7 @@ import numpy as np
 from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action
 from mrgc.geometry.answers import BUSY, SELF, Answer, GroundStatus
-from mrgc.geometry.collision import Packed, Posed, paired_collide, pieces_collide
+from mrgc.geometry.collision import Packed, Posed, grouped_collide, pieces_collide
 from mrgc.geometry.conventions import refine
 from mrgc.geometry.grounding import Grounder
 from mrgc.geometry.relays import spot_region
@@ -1273,34 +1273,35 @@ def _phases_collide(mine: dict[str, list[Volume]], theirs: dict[str, list[Volume
 
 def _paired(a: list[Volume], b: list[Volume]) -> bool:
     """Whether sample ``i * len(a) // n`` of ``a`` collides with sample ``i * len(b) // n`` of ``b`` for some
-    ``i < n = max(len(a), len(b))`` (the validator's pairing of two motions).  One query of the kernel, each
-    of ``a``'s volumes in it once (a volume repeated, a robot standing still while it waits, is one slot
-    against everything of ``b`` it meets meanwhile), each of ``b``'s once per volume of ``a`` it meets."""
+    ``i < n = max(len(a), len(b))`` (the validator's pairing of two motions).  One query of the kernel
+    (:func:`~mrgc.geometry.collision.grouped_collide`): each distinct volume of either motion in it once (a
+    volume repeated, a robot standing still while it waits, is one group), the pairs of volumes that meet in
+    time, and of those only the pairs whose volumes' boxes meet opened piece by piece."""
     n = max(len(a), len(b))
-    a_pieces: Volume = []
-    a_slot: list[int] = []
-    slot_of: dict[int, int] = {}  # id of a's volume -> its slot
-    met: dict[int, dict[int, Volume]] = {}  # slot -> id of b's volume -> that volume
+    groups: tuple[dict[int, int], dict[int, int]] = ({}, {})  # id of a volume -> its group, per motion
+    volumes: tuple[list[Volume], list[Volume]] = ([], [])
+    pairs: dict[tuple[int, int], None] = {}
     for i in range(n):
         va, vb = a[i * len(a) // n], b[i * len(b) // n]
         if not va or not vb:
             continue
-        slot = slot_of.get(id(va))
-        if slot is None:
-            slot = slot_of[id(va)] = len(slot_of)
-            a_pieces += va
-            a_slot += [slot] * len(va)
-            met[slot] = {}
-        met[slot].setdefault(id(vb), vb)
-    if not a_pieces:
+        ka, kb = (_group(v, groups[s], volumes[s]) for s, v in ((0, va), (1, vb)))
+        pairs[(ka, kb)] = None
+    if not pairs:
         return False
-    b_pieces: Volume = []
-    b_slot: list[int] = []
-    for slot in range(len(slot_of)):
-        for vb in met[slot].values():
-            b_pieces += vb
-            b_slot += [slot] * len(vb)
-    return paired_collide(Posed.of(a_pieces), np.array(a_slot), Posed.of(b_pieces), np.array(b_slot))
+    (pa, sa), (pb, sb) = (
+        (Posed.of([p for v in vs for p in v]), np.cumsum([0] + [len(v) for v in vs])) for vs in volumes
+    )
+    return grouped_collide(pa, sa, pb, sb, np.array(list(pairs), dtype=np.intp))
+
+
+def _group(volume: Volume, groups: dict[int, int], volumes: list[Volume]) -> int:
+    """The group of ``volume`` in :func:`_paired`'s query, a new one for a volume not seen before."""
+    k = groups.get(id(volume))
+    if k is None:
+        k = groups[id(volume)] = len(volumes)
+        volumes.append(volume)
+    return k
 
 
 def moved_objects(steps: Iterable[GroundedStep]) -> set[str]:

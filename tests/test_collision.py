@@ -653,16 +653,53 @@ def test_a_small_probe_tests_every_pose_of_a_shape_it_holds_twice() -> None:
     assert not world.probe_collides([(box, translation(0.5 + 0.1 * i, 0, 0)) for i in range(3)])  # type: ignore[misc]
 
 
-def test_paired_collide_tests_only_pieces_of_the_same_slot() -> None:
-    """Two motions compared sample by sample: pieces of different samples never count."""
-    from mrgc.geometry.collision import Posed, paired_collide
+def test_grouped_collide_tests_only_pieces_of_the_paired_groups() -> None:
+    """Two motions compared sample by sample: pieces of groups that are not paired never count."""
+    from mrgc.geometry.collision import Posed, grouped_collide
 
     box = collision_shape(Box(0.1, 0.1, 0.1))
     a = Posed.of([(box, translation(0, 0, 0)), (box, translation(1, 0, 0))])
     b = Posed.of([(box, translation(1, 0, 0)), (box, translation(0, 0, 0))])
-    assert not paired_collide(a, np.array([0, 1]), b, np.array([0, 1]))  # each sample apart from its pair
-    assert paired_collide(a, np.array([0, 1]), b, np.array([1, 1]))  # sample 1 of a against both of b
-    assert paired_collide(a, np.array([0, 0]), b, np.array([0, 0]))
+    one_each = np.array([0, 1, 2])
+    assert not grouped_collide(a, one_each, b, one_each, np.array([[0, 0], [1, 1]]))  # each apart from its pair
+    assert grouped_collide(a, one_each, b, one_each, np.array([[1, 0], [1, 1]]))  # a's second against both
+    assert grouped_collide(a, np.array([0, 2]), b, np.array([0, 2]), np.array([[0, 0]]))  # one group each
+    assert not grouped_collide(a, one_each, b, one_each, np.zeros((0, 2), dtype=int))
+    with pytest.raises(ValueError, match="every group needs a piece"):
+        grouped_collide(a, np.array([0, 0, 2]), b, one_each, np.array([[1, 1]]))
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.lists(st.lists(st.tuples(st.integers(0, 6), st.integers(0, 3)), min_size=1, max_size=4), min_size=1, max_size=5),
+    st.lists(st.lists(st.tuples(st.integers(0, 6), st.integers(0, 3)), min_size=1, max_size=4), min_size=1, max_size=5),
+    st.data(),
+)
+def test_grouped_collide_answers_as_each_pair_of_groups_on_its_own(
+    groups_a: list[list[tuple[int, int]]], groups_b: list[list[tuple[int, int]]], data: st.DataObject
+) -> None:
+    """One query of paired groups says what testing each pair of groups alone says (pieces_collide)."""
+    from mrgc.geometry.collision import Posed, grouped_collide, pieces_collide
+
+    shapes = [collision_shape(Box(0.1, 0.1, 0.1)), collision_shape(Sphere(0.06))]
+
+    def pieces(group: list[tuple[int, int]]) -> list:  # type: ignore[type-arg]
+        return [(shapes[y % 2], translation(0.09 * x, 0.07 * y, 0.0)) for x, y in group]
+
+    va, vb = [pieces(g) for g in groups_a], [pieces(g) for g in groups_b]
+    pairs = data.draw(
+        st.lists(st.tuples(st.integers(0, len(va) - 1), st.integers(0, len(vb) - 1)), max_size=8, unique=True)
+    )
+    expected = any(pieces_collide(va[k], vb[m]) for k, m in pairs)
+    starts = [np.cumsum([0] + [len(v) for v in vs]) for vs in (va, vb)]
+    got = grouped_collide(
+        Posed.of([p for v in va for p in v]),
+        starts[0],
+        Posed.of([p for v in vb for p in v]),
+        starts[1],
+        np.array(pairs, dtype=int).reshape(-1, 2),
+    )
+    assert got is expected
 
 
 def _same_posed(a: object, b: object) -> bool:

@@ -328,3 +328,15 @@ def test_a_cart_placement_as_the_planner_writes_it_is_valid(
     """The planner's grounding sets boxes down 6 mm up (ARM_PLACE_LIFT), the planar model 1 mm: both rest."""
     path, _, plan = room
     assert _validate(tmp_path, path, _place(plan, translation(0, 0, 0.005)), capsys)[0] == 0
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.lists(st.tuples(st.integers(-3, 3), st.integers(-3, 3)), max_size=16))
+def test_distinct_rows_are_numpys_unique_rows(points: list[tuple[int, int]]) -> None:
+    """The support polygon's points, deduplicated and sorted by x then y without numpy.ma: what
+    ``np.unique(axis=0)`` gives, zeros of either sign one point."""
+    from mrgc.validator.stability import _distinct_rows
+
+    pts = np.array(points, dtype=float).reshape(-1, 2) * 0.5
+    pts[pts == 0.0] = np.where(np.arange((pts == 0.0).sum()) % 2, -0.0, 0.0)
+    assert np.array_equal(_distinct_rows(pts), np.unique(pts, axis=0).reshape(-1, 2))

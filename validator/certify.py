@@ -225,7 +225,9 @@ class Certifier:
 
     def _ask(self, rows: np.ndarray, subs: np.ndarray) -> None:
         """Ask pybullet for the pairs of sub-pairs ``subs`` at time rows ``rows`` (each time set once)."""
-        want = np.unique(np.stack([rows, self.pair_of[subs]], axis=1), axis=0)
+        many = len(self.ph.pairs)  # (time row, pair) pairs as one key each: np.unique(axis=0) loads numpy.ma
+        key = np.unique(rows.astype(np.int64) * many + self.pair_of[subs])
+        want = np.stack([key // many, key % many], axis=1)
         times = np.unique(want[:, 0])
         if self.asked + len(times) > self.max_times:
             raise _Unsure

@@ -324,10 +324,13 @@ class ReverseGrounder:
             return done
         alone = next(a for a in step if label(a) == done.action)
         rest = tuple(a for a in step if a is not alone)
-        # first the same actions over the skeleton's steps: the failing action in an earlier step
+        # first the same actions over the skeleton's steps: the failing action in an earlier step, else
+        # (its robots busy in every earlier step) the action of the robot it met there
         mark = self._plan.mark()
-        if self._plan.retime(alone, index):
-            again = self._steps(rest, avoid, v_fut, key, index, same)
+        for moved in _retimable(alone, step, done):
+            if not self._plan.retime(moved, index):
+                continue
+            again = self._steps(tuple(a for a in step if a is not moved), avoid, v_fut, key, index, same)
             if not isinstance(again, Failure):
                 self._plan.noted.append(done)
                 return again
@@ -1302,6 +1305,15 @@ def _group(volume: Volume, groups: dict[int, int], volumes: list[Volume]) -> int
         k = groups[id(volume)] = len(volumes)
         volumes.append(volume)
     return k
+
+
+def _retimable(alone: Action, step: tuple[Action, ...], failure: Failure) -> list[Action]:
+    """The actions of ``step`` that :meth:`ReverseGrounder._steps` tries to re-time into an earlier step when
+    ``alone`` failed on another robot of the step (``failure``): ``alone``, then the actions of the robots
+    the failure names that ``alone`` does not use (the two robots of a clash: moving either apart settles it;
+    PA5-s15's `r2 moves o3` had no earlier step with r2 free, `r1 moves o2` had)."""
+    met = set(failure.bodies) - set(alone.robots)
+    return [alone] + [b for b in step if b is not alone and met & set(b.robots)]
 
 
 def moved_objects(steps: Iterable[GroundedStep]) -> set[str]:

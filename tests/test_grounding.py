@@ -1154,6 +1154,43 @@ def test_paired_motions_collide_as_their_samples_pair_by_pair(
     assert _paired(b, a) is expected
 
 
+def test_a_clash_re_times_the_failing_action_first_then_the_other_robots_action() -> None:
+    """Two robots of a step in each other's way: the failing action is re-timed first, then the actions of
+    the robot it met (not the step's uninvolved ones); a failure that names no robot re-times the failing
+    action only."""
+    from mrgc.compiler.task_graph import Action
+    from mrgc.planner.ground import _retimable
+    from mrgc.planner.outcome import Failure
+
+    o2 = Action("o2", "bin-a", "r1", "r1", "top", "top")
+    o3 = Action("o3", "bin-b", "r2", "r2", "side-y+", "side-y+")
+    o4 = Action("o4", "bin-c", "r3", "r4", "top", "top")  # a handover of two robots not in the clash
+    clash = Failure(2, "r2 moves o3 to bin-b (side-y+)", "to-place: robots of the step collide", ("r1", "r2"))
+    assert _retimable(o3, (o2, o3, o4), clash) == [o3, o2]
+    assert _retimable(o3, (o2, o3, o4), Failure(2, "", "carry: no path", ("o7",))) == [o3]
+
+
+def test_a_clash_settled_by_re_timing_the_other_robots_action_keeps_the_skeletons_makespan() -> None:
+    """PA5-s15 (the preset, seed 15): a skeleton whose step 2 has r1 place o2 while r2 picks o3, which
+    collide at r2's pick.  r2 is busy in step 1 (o1), so o3 cannot go earlier; r1 is free there, so o2 is
+    re-timed into step 1 and the plan keeps the skeleton's two steps (the step was split into three
+    before, one robot after the other)."""
+    from mrgc import parse_string
+    from mrgc.generate import preset
+
+    problem = parse_string(preset("pa5", 15), "pa5-s15.mrg", str(ROOT / "domains" / "packaging")).problem()
+    g = Grounder(scene_from_problem(problem), seed=0)
+    steps = (
+        (Action("o1", "bin-c", "r2", "r2", "side-y+", "side-y+"),),
+        (Action("o2", "bin-a", "r1", "r1", "top", "top"), Action("o3", "bin-b", "r2", "r2", "side-y+", "side-y+")),
+    )
+    grounding = ReverseGrounder(g, dict(problem.goal_regions)).ground(Skeleton(steps), [], order=lambda a: [])
+    assert grounding.outcome is Outcome.SUCCESS, grounding.reason
+    assert [sorted(a.object for a in s.actions) for s in grounding.steps] == [["o1", "o2"], ["o3"]]
+    assert grounding.retimed == [("r1 moves o2 to bin-a (top)", 2, 1)]
+    assert [f.bodies for f in grounding.resolved] == [("r1", "r2")]
+
+
 def test_two_robots_of_a_step_take_a_phase_in_turn_when_no_wait_of_one_clears_it(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:

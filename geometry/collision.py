@@ -795,8 +795,9 @@ def grouped_collide(
     if not len(pairs):
         return False
     a_start, b_start = np.asarray(a_start, dtype=np.intp), np.asarray(b_start, dtype=np.intp)
-    if (np.diff(a_start) <= 0).any() or (np.diff(b_start) <= 0).any():
-        raise ValueError("grouped_collide: every group needs a piece")
+    for start, posed in ((a_start, a), (b_start, b)):
+        if len(start) < 2 or start[0] != 0 or start[-1] != len(posed) or (np.diff(start) <= 0).any():
+            raise ValueError("grouped_collide: the groups must cover the pieces in order, every group a piece")
     k, m = np.asarray(pairs, dtype=np.intp).reshape(-1, 2).T
     a_lo, a_hi = np.minimum.reduceat(a.lo, a_start[:-1]), np.maximum.reduceat(a.hi, a_start[:-1])
     b_lo, b_hi = np.minimum.reduceat(b.lo, b_start[:-1]), np.maximum.reduceat(b.hi, b_start[:-1])
@@ -804,12 +805,14 @@ def grouped_collide(
     k, m = k[meet], m[meet]
     if not len(k):
         return False
+    # every piece of a's group against every piece of b's, pair by pair: a's pieces of the pairs first (rows),
+    # then each row repeated once per piece of its pair's b group
     na, nb = np.diff(a_start)[k], np.diff(b_start)[m]
-    size = na * nb
-    which = np.repeat(np.arange(len(k)), size)
-    within = np.arange(int(size.sum())) - np.repeat(np.cumsum(size) - size, size)
-    i = a_start[k][which] + within // nb[which]
-    j = b_start[m][which] + within % nb[which]
+    pair = np.repeat(np.arange(len(k)), na)
+    rows = a_start[k][pair] + np.arange(len(pair)) - np.repeat(np.cumsum(na) - na, na)
+    per_row = nb[pair]
+    i = np.repeat(rows, per_row)
+    j = np.repeat(b_start[m][pair] - (np.cumsum(per_row) - per_row), per_row) + np.arange(int(per_row.sum()))
     keep = _boxes_overlap(a.lo[i], a.hi[i], b.lo[j], b.hi[j])
     return bool(_exact(a, b, i[keep], j[keep], tolerance, stop=True))
 

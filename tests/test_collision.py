@@ -665,8 +665,9 @@ def test_grouped_collide_tests_only_pieces_of_the_paired_groups() -> None:
     assert grouped_collide(a, one_each, b, one_each, np.array([[1, 0], [1, 1]]))  # a's second against both
     assert grouped_collide(a, np.array([0, 2]), b, np.array([0, 2]), np.array([[0, 0]]))  # one group each
     assert not grouped_collide(a, one_each, b, one_each, np.zeros((0, 2), dtype=int))
-    with pytest.raises(ValueError, match="every group needs a piece"):
-        grouped_collide(a, np.array([0, 0, 2]), b, one_each, np.array([[1, 1]]))
+    for bad in ([0, 0, 2], [0, 1], [1, 2], [0]):  # an empty group, pieces left out, a group before 0, none
+        with pytest.raises(ValueError, match="every group a piece"):
+            grouped_collide(a, np.array(bad), b, one_each, np.array([[0, 0]]))
 
 
 @settings(max_examples=60, deadline=None)

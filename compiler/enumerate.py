@@ -31,6 +31,7 @@ from typing import Callable, Iterable
 
 from mrgc.compiler.diagnose import prune
 from mrgc.compiler.encodings.base import Encoded, Encoding
+from mrgc.compiler.grasp_order import preferred
 from mrgc.compiler.ir import Row, Solver, SolveStatus
 from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action, TaskGraph
@@ -80,10 +81,10 @@ class SkeletonGenerator:
         # number of objects, so a larger limit changes nothing but the size of time-indexed models
         complete = max(1, len(graph.objects))
         self.limit = min(max_makespan, complete) if max_makespan is not None else complete
-        robots = max(1, len(graph.robots))
-        self.horizon = max(1, math.ceil(len(graph.must_move) / robots))  # each step moves <= |R| objects
+        self.horizon = first_horizon(self.graph)
         self.first_horizon = self.horizon
         self.found: list[frozenset[int]] = []
+        self.given: set[frozenset[int]] = set()  # the same action sets, to look up
         #: actions (indices) kept out of the skeletons until the others are used up; then ``released``
         self.deferred: set[int] = set()
         #: actions (indices) whose deferral was lifted: never deferred again
@@ -122,6 +123,19 @@ class SkeletonGenerator:
         self.horizon, self.solver, self.done = self.first_horizon, None, False
         return False
 
+    def _preferred(self, skel: Skeleton, chosen: frozenset[int]) -> tuple[Skeleton, frozenset[int]]:
+        """The solution's preferred form (its actions' grasps in declared order, compiler/grasp_order.py)
+        when that action set has not been given yet, else the solution as it is.  Only the action set given
+        is cut: the solver's own form, when it differs, comes again later and is given then, so enumeration
+        still gives every action set once, in the same (makespan, moved) order."""
+        swap = preferred(self.graph, chosen, self.deferred)
+        best = frozenset(swap.values())
+        if best == chosen or best in self.given:
+            return skel, chosen
+        actions = self.graph.actions
+        by = {actions[i]: actions[j] for i, j in swap.items()}
+        return Skeleton(tuple(tuple(by[a] for a in step) for step in skel.steps)), best
+
     def _load(self) -> None:
         t0 = time.perf_counter()
         self.encoded = self.encoding.build(self.graph, self.horizon if self.loop else self.limit)
@@ -158,7 +172,9 @@ class SkeletonGenerator:
             if sol.status == SolveStatus.OPTIMAL:
                 skel = self.encoded.decode(sol.values)
                 chosen = frozenset(i for i, v in enumerate(self.encoded.select) if sol.values[v])
+                skel, chosen = self._preferred(skel, chosen)
                 self.found.append(chosen)
+                self.given.add(chosen)
                 self.solver.add_rows([self.encoded.cut(chosen, name=f"cut{len(self.found) - 1}")])
                 out.append(skel)
             elif sol.status == SolveStatus.INFEASIBLE:
@@ -172,6 +188,20 @@ class SkeletonGenerator:
             else:
                 return Batch(out, BatchOutcome.ERROR, sol.message, stats=dict(self.stats))
         return Batch(out, BatchOutcome.ENOUGH, stats=dict(self.stats))
+
+
+def first_horizon(graph: TaskGraph) -> int:
+    """A lower bound on the makespan of every skeleton of ``graph`` (at least 1), where the horizon loop
+    starts: each step moves at most one object per robot, so at least ``|M*| / |R|`` steps; and a robot does
+    one action per step, so at least as many steps as M* has objects that only actions of that robot move
+    (on the PA presets the arm that reaches the start region takes part in every move: the bound is 3
+    instead of 2 on most PA10 instances, a model load and an infeasible solve fewer)."""
+    robots = max(1, len(graph.robots))
+    bound = math.ceil(len(graph.must_move) / robots)
+    for r in graph.robots:
+        mine = [o for o in graph.must_move if graph.actions_of(o)]
+        bound = max(bound, sum(all(r in graph.actions[i].robots for i in graph.actions_of(o)) for o in mine))
+    return max(1, bound)
 
 
 def _out(enc: Encoded, actions: Iterable[int]) -> list[Row]:

@@ -45,6 +45,11 @@ PLACEMENT_TRIES = 6  # placements sampled per place before the step gives up
 OUT_OF_REACH_TRIES = 30
 #: other regions an obstacle with no reachable place in its own may be parked in, nearest first
 PARKING_REGIONS = 2
+#: carries to a placement blocked by the step's other robots (what they sweep in the same phase) after which
+#: a place grounded clear of them gives up: the step is then split or re-timed, which costs less than more
+#: placements each failing its carry the same way (PA7-s1: 17 carries of about 85 ms each, every one
+#: blocked by the other arm, before the split that grounded at once)
+BUSY_CARRIES = 2
 #: exchanges tried per handover point when the giver's carry to one fails: another branch of the arms at the
 #: same point is often an easy carry where the first (the solution nearest home) is not (6-arm seed 0: r5's
 #: first exchange at h5 is reached by no RRTConnect path of 64,000 checks, its second in 0.03 s)
@@ -303,8 +308,10 @@ class ReverseGrounder:
         same: frozenset[str] = frozenset(),
     ) -> list[GroundedStep] | Failure:
         """Ground one skeleton step; when its robots get in each other's way (an action collides with what
-        another robot of the step sweeps in the same phase), split it: the failing action alone one step
-        later, or else one step earlier, than the others (each part split again as needed).  The skeleton's
+        another robot of the step sweeps in the same phase), ground it again with the failing action first
+        (each action keeps clear of the ones grounded before it, so the others then plan around it); then
+        re-time (below); then split it: the failing action alone one step later, or else one step earlier,
+        than the others (each part split again as needed).  The skeleton's
         action set and order constraints are kept (actions of one step constrain each other in neither
         direction); only the plan's makespan grows.
 
@@ -320,9 +327,16 @@ class ReverseGrounder:
         done = self._step(step, avoid, set(same), v_fut, key, index)
         if not isinstance(done, Failure):
             return [done]
-        if len(step) < 2 or not (done.detail == BUSY or done.check.endswith("robots of the step collide")):
+        lead = _lead(step, done)
+        if lead is not None and lead is not step[0]:
+            # the failing action grounded first: the others then plan around what it sweeps (PA7-s1)
+            first = self._step((lead,) + tuple(a for a in step if a is not lead), avoid, set(same), v_fut, key, index)
+            if not isinstance(first, Failure):
+                self._plan.noted.append(done)
+                return [first]
+        if lead is None:
             return done
-        alone = next(a for a in step if label(a) == done.action)
+        alone = lead
         rest = tuple(a for a in step if a is not alone)
         # first the same actions over the skeleton's steps: the failing action in an earlier step, else
         # (its robots busy in every earlier step) the action of the robot it met there
@@ -618,6 +632,8 @@ class ReverseGrounder:
             done = self._place(a, planned, a.region, start, lift, avoid, v_fut, key, placed, busy)
             if not isinstance(done, Failure) or a.obj in self.goal or a.obj in self._forced:
                 return done
+            if done.detail == BUSY:  # the step's other robots in the way, not a crowded region: the step
+                return done  # is split (or re-timed) instead
             # beyond the paper: an obstacle with no place in its own region that its arm reaches (a crowded
             # start region, the later steps' sweeps kept clear) is parked in another region the arm reaches
             for region in self._parking(a):
@@ -673,6 +689,7 @@ class ReverseGrounder:
             )
         )
         looked = 0
+        crossed = 0  # carries blocked by what the step's other robots sweep meanwhile (``busy``)
         static = True  # every placement tried failed on what never moves (Failure.static)
         while looked < PLACEMENT_TRIES + OUT_OF_REACH_TRIES and tried < PLACEMENT_TRIES:
             self._on_time()
@@ -717,6 +734,9 @@ class ReverseGrounder:
             )
             if not carry.ok:
                 last = _failed(f"carry to the placement by {a.place_robot}", carry)
+                crossed += carry.detail == BUSY
+                if crossed >= BUSY_CARRIES:
+                    return last
                 continue
             planned.region = region
             planned.place_pose = _matrix(pose)
@@ -1086,6 +1106,15 @@ def _telling(failures: list[tuple[Failure, GroundStatus, bool]]) -> Failure:
             if telling(f, status, exchanged):
                 return f
     return failures[-1][0]
+
+
+def _lead(step: tuple[Action, ...], failure: Failure) -> Action | None:
+    """The action of ``step`` to ground first when the step's robots got in each other's way grounded in the
+    order given (``failure``): the failing one, so that the others plan around it; None for another
+    failure."""
+    if len(step) < 2 or not (failure.detail == BUSY or failure.check.endswith("robots of the step collide")):
+        return None
+    return next((a for a in step if label(a) == failure.action), None)
 
 
 def _failed(what: str, answer: Answer) -> Failure:

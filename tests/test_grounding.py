@@ -1230,3 +1230,59 @@ def test_two_robots_of_a_step_take_a_phase_in_turn_when_no_wait_of_one_clears_it
     assert clash is not None
     left, _ = _waiting(action, mine, motions, clash, owners)
     assert left is not None and not action.waits() and not earlier.waits() and len(motions["r1"]["to-place"]) == 5
+
+
+def _pa7_s1_first_steps() -> tuple[Any, Grounder, Skeleton]:
+    """PA7-s1 (the preset, seed 1) and its first skeleton: step 1 has r1 clear o7 aside in the start region
+    while r2 clears o4 there too."""
+    from mrgc import parse_string
+    from mrgc.generate import preset
+
+    problem = parse_string(preset("pa7", 1), "pa7-s1.mrg", str(ROOT / "domains" / "packaging")).problem()
+    steps = (
+        (Action("o7", "start", "r1", "r1", "top", "top"), Action("o4", "start", "r2", "r2", "side-y+", "side-y+")),
+        (Action("o6", "bin-c", "r1", "r2", "side-x+", "top"),),
+        (Action("o5", "bin-b", "r1", "r2", "side-x-", "top"),),
+        (Action("o3", "bin-a", "r1", "r1", "side-y-", "side-y-"),),
+    )
+    return problem, Grounder(scene_from_problem(problem), seed=0), Skeleton(steps)
+
+
+def test_a_clash_settled_by_grounding_the_failing_action_first_keeps_the_step() -> None:
+    """PA7-s1's step 1: grounded in the skeleton's order, r2's carry of o4 meets r1's of o7 and no placement
+    of o4 clear of what r1 sweeps is reached; neither action can go to another step (both robots are busy in
+    step 2).  Grounded with o4 first, r1 plans around it (one waits for the other), and the plan keeps the
+    skeleton's four steps (it had five: the step split, one robot after the other)."""
+    problem, g, skeleton = _pa7_s1_first_steps()
+    grounding = ReverseGrounder(g, dict(problem.goal_regions)).ground(skeleton, [], order=lambda a: [])
+    assert grounding.outcome is Outcome.SUCCESS, grounding.reason
+    assert [sorted(a.object for a in s.actions) for s in grounding.steps] == [["o4", "o7"], ["o6"], ["o5"], ["o3"]]
+    assert [a.object for a in grounding.steps[0].actions] == ["o4", "o7"]
+    assert grounding.retimed == []
+    assert [(f.action, f.bodies) for f in grounding.resolved] == [("r2 moves o4 to start (side-y+)", ("r1", "r2"))]
+
+
+def test_a_place_kept_clear_of_the_other_robots_gives_up_after_a_few_carries_they_block(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """PA7-s1's step 1 again: while o4's place keeps clear of what r1 sweeps, at most BUSY_CARRIES carries are
+    blocked by it per try and no other region is tried (parking is for a crowded region, not for robots in
+    each other's way); it tried 17 placements in three regions before (1.5 s of carries)."""
+    from mrgc.geometry.answers import BUSY
+    from mrgc.planner.ground import BUSY_CARRIES
+
+    problem, g, skeleton = _pa7_s1_first_steps()
+    carries: list[tuple[str, bool]] = []
+    transfer = Grounder.transfer
+
+    def counted(self: Grounder, robot: str, obj: str, *args: Any, **kw: Any) -> Answer:
+        answer = transfer(self, robot, obj, *args, **kw)
+        if obj == "o4" and kw.get("busy"):
+            carries.append((kw.get("phase", ""), answer.detail == BUSY))
+        return answer
+
+    monkeypatch.setattr(Grounder, "transfer", counted)
+    grounding = ReverseGrounder(g, dict(problem.goal_regions)).ground(skeleton, [], order=lambda a: [])
+    assert grounding.outcome is Outcome.SUCCESS, grounding.reason
+    blocked = [c for c in carries if c[1]]
+    assert 0 < len(blocked) <= BUSY_CARRIES, carries

@@ -25,7 +25,7 @@ from mrgc import cli, parse_file, parse_string
 from mrgc.backends.registry import backend_class
 from mrgc.compiler.diagnose import explain_infeasible, explain_waits, orderable
 from mrgc.compiler.encodings import get_encoding
-from mrgc.compiler.enumerate import BatchOutcome, SkeletonGenerator
+from mrgc.compiler.enumerate import BatchOutcome, SkeletonGenerator, first_horizon
 from mrgc.compiler.facts import FactBase
 from mrgc.compiler.task_graph import Action, build_task_graph
 from mrgc.language.model import Problem
@@ -50,6 +50,16 @@ def problems() -> Any:
 def reference_graph(problem: Problem, must: Sequence[str] | None = None, moved: Sequence[str] = ()) -> Any:
     """Alg. 1 by the oracle, from the problem's raw facts (no mrgc.compiler code)."""
     return oracle.problem_graph(problem, must, moved)
+
+
+def _to_the_end(source: SkeletonSource | SkeletonGenerator) -> tuple[list[Any], BatchOutcome]:
+    """Every skeleton ``source`` gives, three at a time, and why the last batch stopped."""
+    got = []
+    while True:
+        batch = source.next(3)
+        got += batch.skeletons
+        if batch.outcome is not BatchOutcome.ENOUGH:
+            return got, batch.outcome
 
 
 # ---------------------------------------------------------------- the property
@@ -217,20 +227,97 @@ def test_time_of_move_one_horizon_at_a_time_enumerates_as_one_model_does(case: S
         generator = SkeletonGenerator(
             graph, get_encoding("time-of-move"), lambda: backend_class("cpsat")(), limit, grow_horizon=grow
         )
-        got = []
-        while True:
-            batch = generator.next(3)
-            got += batch.skeletons
-            if batch.outcome is not BatchOutcome.ENOUGH:
-                break
+        got, outcome = _to_the_end(generator)
         where = f"grow_horizon={grow}, limit {limit}\n{text}"
-        assert batch.outcome is BatchOutcome.EXHAUSTED, where
+        assert outcome is BatchOutcome.EXHAUSTED, where
         assert [s.key for s in got] == sorted((m, len(a)) for a, m in wanted.items()), where
         assert {s.actions: s.makespan for s in got} == wanted, where
         if grow and got and got[-1].makespan:  # a model per horizon from T0 to the last skeleton's makespan
             assert generator.stats["models"] >= got[-1].makespan - generator.first_horizon + 1, where
         if not grow:
             assert generator.stats["models"] <= 1, where
+
+
+def _preferred_form(graph: Any, actions: frozenset[Action]) -> frozenset[Action]:
+    """Each action replaced by the first of the graph's actions interchangeable with it (compiler/
+    grasp_order.py's definition, read from the graph's data here: the same object, region, robots and relay
+    region, the same pick obstacles and the same place obstacles)."""
+
+    def sig(i: int) -> tuple[Any, ...]:
+        a = graph.actions[i]
+        blocks = (set(graph.block_pick[i]), set(graph.block_place[i]))
+        return (a.obj, a.region, a.pick_robot, a.place_robot, a.via, *blocks)
+
+    index = {a: i for i, a in enumerate(graph.actions)}
+    first = [next(j for j in range(len(graph.actions)) if sig(j) == sig(index[a])) for a in actions]
+    return frozenset(graph.actions[j] for j in first)
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@given(problems(), st.sampled_from(["mip", "cpsat"]), st.sampled_from(ENCODINGS))
+def test_interchangeable_actions_come_in_declared_grasp_order_and_no_skeleton_is_lost(
+    case: SymbolicCase, backend: str, encoding: str
+) -> None:
+    """compiler/grasp_order.py: enumerated to the end, every feasible action set of the oracle comes once, at its
+    minimum makespan and in (makespan, moved) order, and a skeleton whose actions are not all the first of their
+    interchangeable ones comes only after the skeleton that has those (its preferred form)."""
+    problem, text = case.problem(), case.text
+    sets = oracle.feasible_action_sets(reference_graph(problem))
+    assume(0 < len(sets) <= 40)
+    source = SkeletonSource(FactBase.from_problem(problem), must_move(problem), (), backend, encoding)
+    got, outcome = _to_the_end(source)
+    where = f"{backend}/{encoding}\n{text}"
+    assert outcome is BatchOutcome.EXHAUSTED, where
+    assert [s.actions for s in got if s.actions in sets] == [s.actions for s in got], where
+    assert len({s.actions for s in got}) == len(got) == len(sets), where
+    assert [s.key for s in got] == sorted(s.key for s in got), where
+    assert all(sets[s.actions] == s.makespan for s in got), where
+    given_at = {s.actions: k for k, s in enumerate(got)}
+    swapped = 0
+    for k, s in enumerate(got):
+        best = _preferred_form(source.generator.graph, s.actions)
+        assert given_at[best] <= k, f"{s.describe()} before its preferred form\n{where}"
+        swapped += best != s.actions
+    event(f"{'some' if swapped else 'no'} skeleton after its preferred form")
+
+
+@pytest.mark.parametrize("backend", ["mip", "cpsat", "smt"])
+@pytest.mark.parametrize("grasps", ["a b c d e f", "f e d c b a"])
+def test_the_first_skeleton_takes_the_grasps_declared_first(backend: str, grasps: str) -> None:
+    """Four objects any grasp of either robot moves to the goal, nothing in the way: the first skeleton moves
+    each with the first grasp the domain declares, in either order of the declaration (HiGHS and CP-SAT,
+    left to themselves, take the last one)."""
+    objects = ["o1", "o2", "o3", "o4"]
+    init = " ".join(f"(in-region {o} start)" for o in objects)
+    init += " ".join(
+        f" (reachable-pick {o} {g} {r}) (reachable-place {o} goal {g} {r})"
+        for o in objects
+        for r in ("r1", "r2")
+        for g in grasps.split()
+    )
+    goal = " ".join(f"(in-region {o} goal)" for o in objects)
+    text = (
+        f"(define (domain g) (:requirements :handover :symbolic) (:grasps {grasps}))\n"
+        f"(define (problem p) (:domain g) (:robots r1 r2) (:movable {' '.join(objects)}) (:regions start goal)"
+        f" (:init {init}) (:goal (and {goal})))"
+    )
+    first = compile_problem(parse_string(text).problem(), backend=backend, encoding="time-of-move").skeletons[0]
+    assert first.key == (2, 4)
+    assert {(a.pick_grasp, a.place_grasp) for a in first.actions} == {(grasps[0], grasps[0])}
+
+
+@settings(max_examples=50, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@given(problems())
+def test_the_first_horizon_is_a_lower_bound_on_every_makespan(case: SymbolicCase) -> None:
+    """compiler/enumerate.py's ``first_horizon`` never exceeds the makespan of a feasible action set (the
+    oracle's minimum): starting the horizon loop there skips only horizons without skeletons."""
+    problem = case.problem()
+    sets = oracle.feasible_action_sets(reference_graph(problem))
+    assume(sets)
+    graph = build_task_graph(FactBase.from_problem(problem), must_move(problem))
+    bound = first_horizon(graph)
+    event(f"bound {'=' if bound == min(sets.values()) else '<'} the smallest makespan")
+    assert bound <= min(sets.values()), case.text
 
 
 # ---------------------------------------------------------------- the oracle is not vacuous

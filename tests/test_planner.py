@@ -153,6 +153,31 @@ def test_mcts_follows_a_partial_grounding_to_a_plan() -> None:
     assert search.stats["nodes"] == 2
 
 
+def test_two_skeletons_grounding_a_suffix_of_the_same_moves_share_its_node() -> None:
+    """planner/mcts.py: a partial grounding whose suffix moves the same objects to the same regions with the same
+    robots as one grounded before, with the same objects left to move, leads to that suffix's node: no second
+    node, no second skeleton source (the 6-arm set's root grounded one 4-step suffix from a dozen skeletons,
+    each a node of its own with its own solver)."""
+    side = Skeleton(((Action("o1", "goal", "r1", "r1", "side", "side"),),))
+    made: list[set[str]] = []
+
+    def ground(skel: Skeleton, suffix: list[GroundedStep]) -> Grounding:
+        if not suffix:  # either skeleton: o1 placed, o2 in the way
+            return Grounding(Outcome.PARTIAL, [step_of(A1)], {"o2"})
+        return Grounding(Outcome.FAIL)
+
+    def sources(need: set[str], moved: set[str]):  # type: ignore[no-untyped-def]
+        made.append(set(need))
+        return feeder([SKEL_DIRECT, side] if "o1" in need else _distinct("g")(10))
+
+    search = MCTS(ground, sources, {"o1"}, k=2)
+    search.run(deadline=float("inf"), max_iterations=20)
+    first, second = search.root.edges
+    assert first.child is not None and second.child is first.child
+    assert search.stats["nodes"] == 2 and search.stats["shared_nodes"] == 1
+    assert made == [{"o1"}, {"o2"}]
+
+
 def test_mcts_memoises_failures_and_reports_no_plan() -> None:
     def ground(skel: Skeleton, suffix: list[GroundedStep]) -> Grounding:
         return Grounding(Outcome.FAIL)

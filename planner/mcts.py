@@ -19,12 +19,14 @@ the first skeleton grounds to a plan (most of PA5-PA10) the other solves are nev
 CPU of a 1.1-1.6 s PA10 run); where it does not, they are made after its grounding, so the deferrals that
 grounding caused already shape them.
 
-Shared nodes (beyond the paper, session 31): a partial grounding whose suffix does what one grounded before
-does -- the same objects to the same regions by the same robots (:func:`_shape`, the failures' memo's
-notion of the same suffix), the same objects left to move -- leads to that suffix's node instead of a new
-one.  On the 6-arm, 40-object instance of seed 1 the root grounded one 4-step suffix from a dozen skeletons
-(they differed in the steps before it, which failed), each a node of its own with its own skeleton source:
-195 nodes and 1.4 GB in 300 s without a plan; with the nodes shared, a plan in 70 s at 440 MB.
+Shared nodes (beyond the paper, session 31): a partial grounding whose suffix does what ``SHAPE_NODES`` (2)
+grounded before do -- the same objects to the same regions by the same robots (:func:`_shape`, the failures'
+memo's notion of the same suffix), the same objects left to move -- leads to the last of their nodes instead
+of a new one.  On the 6-arm, 40-object instance of seed 1 the root grounded one 4-step suffix from a dozen
+skeletons (they differed in the steps before it, which failed), each a node of its own with its own skeleton
+source: 195 nodes and 1.4 GB in 300 s without a plan; with every such suffix sharing the first node, a plan
+in 70 s at 440 MB, but seed 2 lost its plan: its second 6-step suffix of one shape, another geometry of the
+same moves, is where the plan was found (a node per shape: a time limit; two: both solved).
 
 Progressive widening (beyond the paper, :meth:`MCTS._wider`): a node whose open edges are all visited asks
 for one more skeleton when the selection rule would pick it (unvisited, with its last skeleton's prior) over
@@ -42,6 +44,10 @@ from typing import Callable
 from mrgc.compiler.skeleton import Skeleton
 from mrgc.planner.ground import GroundedStep, Grounding, Outcome, moved_objects
 from mrgc.planner.outcome import DeadlineReached
+
+#: nodes made for suffixes of one shape (the same moves, the same objects left) before the next such suffix
+#: shares the last of them: a second geometry of a suffix may ground what the first did not (6-arm seed 2)
+SHAPE_NODES = 2
 
 # makes a skeleton source for (M*, moved objects): returns a callable giving the next k skeletons
 SourceFactory = Callable[[set[str], set[str]], Callable[[int], list[Skeleton]]]
@@ -122,7 +128,7 @@ class MCTS:
         first_skeletons = time.perf_counter() - t0
         self.memo: set[tuple[frozenset[tuple[str, ...]], frozenset[object]]] = set()
         #: the nodes made, by their suffix's shape (:func:`_shape`) and the objects that must move before it
-        self.nodes: dict[tuple[frozenset[tuple[str, ...]], frozenset[str]], Node] = {}
+        self.nodes: dict[tuple[frozenset[tuple[str, ...]], frozenset[str]], list[Node]] = {}
         #: the best full plan found so far (by makespan, then objects moved)
         self.best: list[GroundedStep] | None = None
         self.stats: dict[str, float] = {
@@ -239,8 +245,9 @@ class MCTS:
             return plan, 1.0 + self.alpha / max(1, len(moved_objects(plan)))
         moved = moved_objects(result.steps)
         same = (_shape(result.steps), frozenset(result.must_move))
-        child = self.nodes.get(same)
-        if child is not None:  # a suffix of the same moves grounded before: its node, not a second one
+        twins = self.nodes.setdefault(same, [])
+        child = twins[-1] if len(twins) >= SHAPE_NODES else None
+        if child is not None:  # the same moves grounded often enough: the last such node, not another one
             self.stats["shared_nodes"] += 1
         else:
             t0 = time.perf_counter()
@@ -249,7 +256,7 @@ class MCTS:
             self.stats["skeleton_seconds"] += time.perf_counter() - t0
             self.stats["skeletons"] += len(child.edges)
             self.stats["nodes"] += 1
-            self.nodes[same] = child
+            twins.append(child)
         edge.child = child
         if not child.edges:
             edge.dead = True

@@ -10,6 +10,8 @@ skeletons of makespan T once those of smaller makespans are used up (its infeasi
 keys in the same order as one model up to the limit, from a model whose bounds are tight (6-arm, 40-object
 packaging: 0.16 s per skeleton instead of 5 s with CP-SAT, docs/compiler.md).  ``next(k)`` returns the next
 k skeletons and keeps the solver, the horizon and the cuts, so asking again continues where it stopped.
+Each solution is given first in its preferred form (grasps in declared order among interchangeable actions,
+compiler/grasp_order.py) and, when that differs, in the solver's own form when the solver returns it again.
 
 Beyond the paper, actions may be *deferred* (:meth:`SkeletonGenerator.defer`; the planner defers an action
 whose grounding keeps failing): the skeletons that hold none of them come first, and when those are used
@@ -198,9 +200,9 @@ def first_horizon(graph: TaskGraph) -> int:
     instead of 2 on most PA10 instances, a model load and an infeasible solve fewer)."""
     robots = max(1, len(graph.robots))
     bound = math.ceil(len(graph.must_move) / robots)
+    movable = [graph.actions_of(o) for o in graph.must_move if graph.actions_of(o)]
     for r in graph.robots:
-        mine = [o for o in graph.must_move if graph.actions_of(o)]
-        bound = max(bound, sum(all(r in graph.actions[i].robots for i in graph.actions_of(o)) for o in mine))
+        bound = max(bound, sum(all(r in graph.actions[i].robots for i in acts) for acts in movable))
     return max(1, bound)
 
 

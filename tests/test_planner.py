@@ -153,34 +153,6 @@ def test_mcts_follows_a_partial_grounding_to_a_plan() -> None:
     assert search.stats["nodes"] == 2
 
 
-def test_skeletons_grounding_a_suffix_of_the_same_moves_share_a_node_beyond_a_few() -> None:
-    """planner/mcts.py: a partial grounding whose suffix moves the same objects to the same regions with the same
-    robots as ``SHAPE_NODES`` grounded before, with the same objects left to move, leads to the last of their
-    nodes: no further node, no further skeleton source (the 6-arm set's root grounded one 4-step suffix from a
-    dozen skeletons, each a node of its own with its own solver)."""
-    from mrgc.planner.mcts import SHAPE_NODES
-
-    root = [Skeleton(((Action("o1", "goal", "r1", "r1", f"g{k}", f"g{k}"),),)) for k in range(SHAPE_NODES + 1)]
-    made: list[set[str]] = []
-
-    def ground(skel: Skeleton, suffix: list[GroundedStep]) -> Grounding:
-        if not suffix:  # every root skeleton: o1 placed, o2 in the way
-            return Grounding(Outcome.PARTIAL, [step_of(A1)], {"o2"})
-        return Grounding(Outcome.FAIL)
-
-    def sources(need: set[str], moved: set[str]):  # type: ignore[no-untyped-def]
-        made.append(set(need))
-        return feeder(list(root) if "o1" in need else _distinct("g")(10))
-
-    search = MCTS(ground, sources, {"o1"}, k=len(root))
-    search.run(deadline=float("inf"), max_iterations=30)
-    children = [e.child for e in search.root.edges]
-    assert all(c is not None for c in children)
-    assert len({id(c) for c in children}) == SHAPE_NODES and children[-1] is children[-2]
-    assert search.stats["nodes"] == 1 + SHAPE_NODES and search.stats["shared_nodes"] == 1
-    assert made == [{"o1"}] + [{"o2"}] * SHAPE_NODES
-
-
 def test_mcts_memoises_failures_and_reports_no_plan() -> None:
     def ground(skel: Skeleton, suffix: list[GroundedStep]) -> Grounding:
         return Grounding(Outcome.FAIL)

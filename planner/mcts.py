@@ -19,6 +19,19 @@ the first skeleton grounds to a plan (most of PA5-PA10) the other solves are nev
 CPU of a 1.1-1.6 s PA10 run); where it does not, they are made after its grounding, so the deferrals that
 grounding caused already shape them.
 
+Shared nodes (beyond the paper, session 31): a partial grounding whose suffix does what ``SHAPE_NODES`` (2)
+grounded before do -- the same objects to the same regions by the same robots (:func:`_shape`, the failures'
+memo's notion of the same suffix), the same objects left to move -- leads to the last of their nodes instead
+of a new one.  On the 6-arm, 40-object instance of seed 1 the root grounded one 4-step suffix from a dozen
+skeletons (they differed in the steps before it, which failed), each a node of its own with its own skeleton
+source: 195 nodes and 1.4 GB in 300 s without a plan; with every such suffix sharing the first node, a plan
+in 70 s at 440 MB, but seed 2 lost its plan: its second 6-step suffix of one shape, another geometry of the
+same moves, is where the plan was found (a node per shape: a time limit; two: both solved).  Only a suffix
+that moves more than its node's does shares (a suffix only grows, so every node then reaches only nodes that do
+more than it): the search stays a graph without cycles.  Sharing without that rule hung the test suite in
+session 31 -- a suffix moving an object again, where and by whom its node's suffix had, shared that very node,
+and the selection descended it forever.
+
 Progressive widening (beyond the paper, :meth:`MCTS._wider`): a node whose open edges are all visited asks
 for one more skeleton when the selection rule would pick it (unvisited, with its last skeleton's prior) over
 each of them -- the search selects as if the node held all its source's skeletons -- so a node whose subtree
@@ -35,6 +48,10 @@ from typing import Callable
 from mrgc.compiler.skeleton import Skeleton
 from mrgc.planner.ground import GroundedStep, Grounding, Outcome, moved_objects
 from mrgc.planner.outcome import DeadlineReached
+
+#: nodes made for suffixes of one shape (the same moves, the same objects left) before the next such suffix
+#: shares the last of them: a second geometry of a suffix may ground what the first did not (6-arm seed 2)
+SHAPE_NODES = 2
 
 # makes a skeleton source for (M*, moved objects): returns a callable giving the next k skeletons
 SourceFactory = Callable[[set[str], set[str]], Callable[[int], list[Skeleton]]]
@@ -114,6 +131,8 @@ class MCTS:
         self.root.refill(1)  # the other k - 1 when the root is selected again (the module docstring)
         first_skeletons = time.perf_counter() - t0
         self.memo: set[tuple[frozenset[tuple[str, ...]], frozenset[object]]] = set()
+        #: the nodes made, by their suffix's shape (:func:`_shape`) and the objects that must move before it
+        self.nodes: dict[tuple[frozenset[tuple[str, ...]], frozenset[str]], list[Node]] = {}
         #: the best full plan found so far (by makespan, then objects moved)
         self.best: list[GroundedStep] | None = None
         self.stats: dict[str, float] = {
@@ -123,6 +142,7 @@ class MCTS:
             "skeletons": len(self.root.edges),
             "nodes": 1,
             "memo_hits": 0,
+            "shared_nodes": 0,
         }
 
     def q(self, node: Node, e: Edge) -> float:
@@ -179,6 +199,8 @@ class MCTS:
                         self.stats["plans"] = self.stats.get("plans", 0) + 1
                 break
             node = edge.child
+            if any(node is n for n, _ in path):  # the nodes' sharing keeps the graph acyclic (_expand)
+                raise RuntimeError("the search graph has a cycle: a node is its own descendant")
         if not path:
             return False  # the root ran out of skeletons
         self._backprop(path, reward)
@@ -205,10 +227,7 @@ class MCTS:
         return fresh > max(self.q(node, e) for e in edges)
 
     def _expand(self, node: Node, edge: Edge) -> tuple[list[GroundedStep] | None, float]:
-        memo_key = (
-            frozenset((a.object, a.region, a.pick_robot, a.place_robot) for s in node.suffix for a in s.actions),
-            edge.skeleton.actions,
-        )
+        memo_key = (_shape(node.suffix), edge.skeleton.actions)
         if memo_key in self.memo:
             self.stats["memo_hits"] += 1
             edge.dead = True
@@ -231,12 +250,24 @@ class MCTS:
             plan = result.steps
             return plan, 1.0 + self.alpha / max(1, len(moved_objects(plan)))
         moved = moved_objects(result.steps)
-        t0 = time.perf_counter()
-        child = Node(result.steps, self.sources(result.must_move, moved))
-        child.refill(1)  # the first of its k skeletons: the others when it is selected again
-        self.stats["skeleton_seconds"] += time.perf_counter() - t0
-        self.stats["skeletons"] += len(child.edges)
-        self.stats["nodes"] += 1
+        shape = _shape(result.steps)
+        same = (shape, frozenset(result.must_move))
+        twins = self.nodes.setdefault(same, [])
+        # only a suffix that adds moves to its node's shares: every node reached from a node then does more
+        # than it, so no node can be its own descendant (a suffix moving an object again, to where and by whom
+        # its node's suffix did, would have shared that node or an ancestor: a cycle the selection never left)
+        grows = not shape <= _shape(node.suffix)
+        child = twins[-1] if grows and len(twins) >= SHAPE_NODES else None
+        if child is not None:  # the same moves grounded often enough: the last such node, not another one
+            self.stats["shared_nodes"] += 1
+        else:
+            t0 = time.perf_counter()
+            child = Node(result.steps, self.sources(result.must_move, moved))
+            child.refill(1)  # the first of its k skeletons: the others when it is selected again
+            self.stats["skeleton_seconds"] += time.perf_counter() - t0
+            self.stats["skeletons"] += len(child.edges)
+            self.stats["nodes"] += 1
+            twins.append(child)
         edge.child = child
         if not child.edges:
             edge.dead = True
@@ -251,6 +282,12 @@ class MCTS:
             edge.value += reward
             edge.visits += 1
             node.visits += 1
+
+
+def _shape(suffix: list[GroundedStep]) -> frozenset[tuple[str, ...]]:
+    """What a grounded suffix does, without its geometry: each object moved, where to and by which robots
+    (the failures' memo and the nodes' sharing compare suffixes by it)."""
+    return frozenset((a.object, a.region, a.pick_robot, a.place_robot) for s in suffix for a in s.actions)
 
 
 def _cost(steps: list[GroundedStep]) -> tuple[int, int]:

@@ -19,7 +19,7 @@ from mrgc.geometry.collision import Packed
 from mrgc.planfile.format import PlannedAction, file_sha256
 from mrgc.planfile.reader import read_plan
 from mrgc.planner.ground import GroundedStep, Grounding, Outcome, swept
-from mrgc.planner.mcts import MCTS
+from mrgc.planner.mcts import MCTS, Node
 from mrgc.planner.search import plan_problem
 from mrgc.validator.validate import validate
 
@@ -151,6 +151,60 @@ def test_mcts_follows_a_partial_grounding_to_a_plan() -> None:
     assert result.steps is not None and [s.moved for s in result.steps] == [("o2",), ("o1",)]
     assert calls == [(SKEL_DIRECT, 0), (Skeleton(((A2,),)), 1)]
     assert search.stats["nodes"] == 2
+
+
+def test_skeletons_grounding_a_suffix_of_the_same_moves_share_a_node_beyond_a_few() -> None:
+    """planner/mcts.py: a partial grounding whose suffix moves the same objects to the same regions with the same
+    robots as ``SHAPE_NODES`` grounded before, with the same objects left to move, leads to the last of their
+    nodes: no further node, no further skeleton source (the 6-arm set's root grounded one 4-step suffix from a
+    dozen skeletons, each a node of its own with its own solver)."""
+    from mrgc.planner.mcts import SHAPE_NODES
+
+    root = [Skeleton(((Action("o1", "goal", "r1", "r1", f"g{k}", f"g{k}"),),)) for k in range(SHAPE_NODES + 1)]
+    made: list[set[str]] = []
+
+    def ground(skel: Skeleton, suffix: list[GroundedStep]) -> Grounding:
+        if not suffix:  # every root skeleton: o1 placed, o2 in the way
+            return Grounding(Outcome.PARTIAL, [step_of(A1)], {"o2"})
+        return Grounding(Outcome.FAIL)
+
+    def sources(need: set[str], moved: set[str]):  # type: ignore[no-untyped-def]
+        made.append(set(need))
+        return feeder(list(root) if "o1" in need else _distinct("g")(10))
+
+    search = MCTS(ground, sources, {"o1"}, k=len(root))
+    search.run(deadline=float("inf"), max_iterations=30)
+    children = [e.child for e in search.root.edges]
+    assert all(c is not None for c in children)
+    assert len({id(c) for c in children}) == SHAPE_NODES and children[-1] is children[-2]
+    assert search.stats["nodes"] == 1 + SHAPE_NODES and search.stats["shared_nodes"] == 1
+    assert made == [{"o1"}] + [{"o2"}] * SHAPE_NODES
+
+
+def test_a_suffix_that_moves_nothing_new_shares_no_node_so_the_graph_stays_acyclic() -> None:
+    """planner/mcts.py, shared nodes: a partial grounding whose new steps only move an object again, where and
+    by whom its node's suffix did, has its node's shape; sharing the last node of that shape could make a node
+    its own descendant, a cycle the selection would follow forever (the suite hung on it in session 31).  Such
+    a suffix gets a node of its own; the search ends at its iteration limit and the graph has no cycle."""
+    from mrgc.planner.mcts import SHAPE_NODES
+
+    def ground(skel: Skeleton, suffix: list[GroundedStep]) -> Grounding:
+        return Grounding(Outcome.PARTIAL, [step_of(A1), *suffix], {"o2"})  # o1 to the goal again, o2 in the way
+
+    fresh = _distinct("g")  # one endless source below the root: no skeleton twice, so none is memoised
+
+    def sources(need: set[str], moved: set[str]):  # type: ignore[no-untyped-def]
+        return feeder([SKEL_DIRECT]) if "o1" in need else fresh  # the root: one skeleton, then deeper
+
+    search = MCTS(ground, sources, {"o1"}, k=SHAPE_NODES + 1)
+    result = search.run(deadline=float("inf"), max_iterations=40)
+    assert result.ended == "iteration limit" and search.stats["groundings"] == 40
+
+    def acyclic(node: Node, above: tuple[int, ...]) -> bool:
+        below = [e.child for e in node.edges if e.child is not None]
+        return all(id(c) not in above and acyclic(c, (*above, id(c))) for c in below)
+
+    assert acyclic(search.root, (id(search.root),))
 
 
 def test_mcts_memoises_failures_and_reports_no_plan() -> None:

@@ -227,7 +227,8 @@ class MCTS:
         return fresh > max(self.q(node, e) for e in edges)
 
     def _expand(self, node: Node, edge: Edge) -> tuple[list[GroundedStep] | None, float]:
-        memo_key = (_shape(node.suffix), edge.skeleton.actions)
+        here = _shape(node.suffix)
+        memo_key = (here, edge.skeleton.actions)
         if memo_key in self.memo:
             self.stats["memo_hits"] += 1
             edge.dead = True
@@ -256,7 +257,7 @@ class MCTS:
         # only a suffix that adds moves to its node's shares: every node reached from a node then does more
         # than it, so no node can be its own descendant (a suffix moving an object again, to where and by whom
         # its node's suffix did, would have shared that node or an ancestor: a cycle the selection never left)
-        grows = not shape <= _shape(node.suffix)
+        grows = not shape <= here
         child = twins[-1] if grows and len(twins) >= SHAPE_NODES else None
         if child is not None:  # the same moves grounded often enough: the last such node, not another one
             self.stats["shared_nodes"] += 1

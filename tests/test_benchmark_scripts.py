@@ -107,3 +107,55 @@ def test_motion_state_costs_each_stage_of_a_motion_check(tmp_path: Path) -> None
     assert bad.returncode == 2 and bad.stderr.splitlines()[-1] == (
         "motion_state.py: error: --robot r9: not an arm of pa10.mrg (its arms: r1, r2)"
     )
+
+
+def test_search_log_classes_each_grounding_line_and_its_seconds(tmp_path: Path) -> None:
+    """``benchmarks/search_log.py LOG``: the grounding lines of a ``-v`` log, written here by the search's own
+    formatter (``planner/search.py``'s ``_log_line``), counted by where they were grounded and how the root's
+    ended (the action of the first failure), with the seconds since the line before; a file without one is
+    refused with exit code 2."""
+    from mrgc.compiler.skeleton import Skeleton
+    from mrgc.compiler.task_graph import Action
+    from mrgc.geometry.collision import Packed, Posed
+    from mrgc.planfile.format import PlannedAction
+    from mrgc.planner.ground import GroundedStep, Grounding, Outcome, label
+    from mrgc.planner.outcome import Failure
+    from mrgc.planner.search import _log_line
+
+    park = Action("o2", "start", "r1", "r1", "top", "top")
+    relay = Action("o1", "bin-b", "r1", "r2", "top", "top", via="start")
+    hand = Action("o1", "bin-b", "r1", "r2", "top", "side")
+    skel = Skeleton(((park,), (hand,)))
+    step = GroundedStep([PlannedAction("o1", "bin-b", "r1", "r2", "top", "side")], Packed.of(Posed.of([])), ("o1",))
+    lines = [
+        _log_line(
+            2.0, 1, skel, [], Grounding(Outcome.FAIL, failures=[Failure(1, label(park), "place by r1: collision")])
+        ),
+        _log_line(
+            5.5,
+            2,
+            Skeleton(((relay,),)),
+            [],
+            Grounding(Outcome.PARTIAL, [step], {"o3"}, failures=[Failure(1, label(relay), "relay: no spot")]),
+        ),
+        "  deferred after 3 failures: r1 places o2 in start (skeletons without it first)",
+        _log_line(6.0, 3, Skeleton(((park,),)), [step], Grounding(Outcome.FAIL, reason="no", failures=[])),
+        _log_line(9.0, 4, skel, [], Grounding(Outcome.SUCCESS, [step])),
+    ]
+    log = tmp_path / "run.log"
+    log.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    script = ROOT / "benchmarks" / "search_log.py"
+    out = subprocess.run([sys.executable, str(script), str(log)], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    rows = {r[0].strip("| "): (r[1], r[2]) for r in (line.split(" | ") for line in out.stdout.splitlines()[4:])}
+    assert out.stdout.startswith("4 groundings, the last at t=9.0 s")
+    assert rows == {
+        "root, fail, move start": ("1", "2.0"),
+        "root, partial, relay via start": ("1", "3.5"),
+        "under a partial suffix": ("1", "0.5"),
+        "plan": ("1", "3.0"),
+    }, out.stdout
+    empty = tmp_path / "quiet.log"
+    empty.write_text("plan for x: solved\n", encoding="utf-8")
+    out = subprocess.run([sys.executable, str(script), str(empty)], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 2 and "no grounding line" in out.stderr

@@ -26,7 +26,7 @@ LINE = re.compile(
     r"\[t=(?P<t>[\d.]+)s\] skeleton (?P<n>\d+) \(makespan (?P<span>\d+), moves (?P<moves>\d+)"
     r"(?P<under>, under a suffix of \d+ steps?)?\): (?P<rest>.*)"
 )
-ACTION = re.compile(r"step \d+, r\S+ (?P<kind>moves|hand|relay) \S+ (?:over )?to (?P<region>\S+)(?: via (?P<via>\S+))?")
+ACTION = re.compile(r"step \d+, \S+ (?P<kind>moves|hand|relay) \S+ (?:over )?to (?P<region>\S+)(?: via (?P<via>\S+))?")
 KINDS = {"moves": "move", "hand": "handover", "relay": "relay"}
 
 

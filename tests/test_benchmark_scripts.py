@@ -142,18 +142,22 @@ def test_search_log_classes_each_grounding_line_and_its_seconds(tmp_path: Path) 
         _log_line(6.0, 3, Skeleton(((park,),)), [step], Grounding(Outcome.FAIL, reason="no", failures=[])),
         _log_line(9.0, 4, skel, [], Grounding(Outcome.SUCCESS, [step])),
     ]
+    cart = Action("b1", "goal", "cart1", "cart1", "push", "push")  # robots of any name
+    failed = Grounding(Outcome.FAIL, failures=[Failure(1, label(cart), "drive: no path")])
+    lines.insert(4, _log_line(7.0, 4, Skeleton(((cart,),)), [], failed))
     log = tmp_path / "run.log"
     log.write_text("\n".join(lines) + "\n", encoding="utf-8")
     script = ROOT / "benchmarks" / "search_log.py"
     out = subprocess.run([sys.executable, str(script), str(log)], capture_output=True, text=True, timeout=60)
     assert out.returncode == 0, out.stderr
     rows = {r[0].strip("| "): (r[1], r[2]) for r in (line.split(" | ") for line in out.stdout.splitlines()[4:])}
-    assert out.stdout.startswith("4 groundings, the last at t=9.0 s")
+    assert out.stdout.startswith("5 groundings, the last at t=9.0 s")
     assert rows == {
         "root, fail, move start": ("1", "2.0"),
+        "root, fail, move goal": ("1", "1.0"),
         "root, partial, relay via start": ("1", "3.5"),
         "under a partial suffix": ("1", "0.5"),
-        "plan": ("1", "3.0"),
+        "plan": ("1", "2.0"),
     }, out.stdout
     empty = tmp_path / "quiet.log"
     empty.write_text("plan for x: solved\n", encoding="utf-8")

@@ -7,10 +7,10 @@ ended (partial: a suffix grounded, other objects to move first; fail), with the 
     mrgc plan big-0.mrg --seed 0 --time-limit 300 -v 2> run.log      # or benchmarks/cpu_plan.py: CPU seconds
     python benchmarks/search_log.py run.log
 
-Session 33 read the 6-arm, 40-object instance of seed 0 this way (docs/benchmarks.md, "Session 33"): half of
-its 1,200 s went to root skeletons whose strict attempt found no place to park an obstacle in the crowded
-start region.  The line format is :func:`mrgc.planner.search._log_line`'s (tests/test_benchmark_scripts.py
-reads a real log).
+Session 33 read the 6-arm, 40-object instance of seed 0 this way (docs/benchmarks.md, "Session 33"): more than
+half of its 1,200 s went to root skeletons that found no place to park an obstacle, or to set a relay's object
+down, in the crowded start region.  The line format is :func:`mrgc.planner.search._log_line`'s
+(tests/test_benchmark_scripts.py writes its lines with that function).
 """
 
 from __future__ import annotations

@@ -23,7 +23,7 @@ from collections import defaultdict
 from pathlib import Path
 
 LINE = re.compile(
-    r"\[t=(?P<t>[\d.]+)s\] skeleton (?P<n>\d+) \(makespan (?P<span>\d+), moves (?P<moves>\d+)"
+    r"\[t=(?P<t>[\d.]+)s\] skeleton \d+ \(makespan \d+, moves \d+"
     r"(?P<under>, under a suffix of \d+ steps?)?\): (?P<rest>.*)"
 )
 ACTION = re.compile(r"step \d+, \S+ (?P<kind>moves|hand|relay) \S+ (?:over )?to (?P<region>\S+)(?: via (?P<via>\S+))?")

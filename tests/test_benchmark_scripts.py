@@ -125,6 +125,7 @@ def test_search_log_classes_each_grounding_line_and_its_seconds(tmp_path: Path) 
     park = Action("o2", "start", "r1", "r1", "top", "top")
     relay = Action("o1", "bin-b", "r1", "r2", "top", "top", via="start")
     hand = Action("o1", "bin-b", "r1", "r2", "top", "side")
+    cart = Action("b1", "goal", "cart1", "cart1", "push", "push")  # a robot of any name
     skel = Skeleton(((park,), (hand,)))
     step = GroundedStep([PlannedAction("o1", "bin-b", "r1", "r2", "top", "side")], Packed.of(Posed.of([])), ("o1",))
     lines = [
@@ -140,11 +141,11 @@ def test_search_log_classes_each_grounding_line_and_its_seconds(tmp_path: Path) 
         ),
         "  deferred after 3 failures: r1 places o2 in start (skeletons without it first)",
         _log_line(6.0, 3, Skeleton(((park,),)), [step], Grounding(Outcome.FAIL, reason="no", failures=[])),
-        _log_line(9.0, 4, skel, [], Grounding(Outcome.SUCCESS, [step])),
+        _log_line(
+            7.0, 4, Skeleton(((cart,),)), [], Grounding(Outcome.FAIL, failures=[Failure(1, label(cart), "drive")])
+        ),
+        _log_line(9.0, 5, skel, [], Grounding(Outcome.SUCCESS, [step])),
     ]
-    cart = Action("b1", "goal", "cart1", "cart1", "push", "push")  # robots of any name
-    failed = Grounding(Outcome.FAIL, failures=[Failure(1, label(cart), "drive: no path")])
-    lines.insert(4, _log_line(7.0, 4, Skeleton(((cart,),)), [], failed))
     log = tmp_path / "run.log"
     log.write_text("\n".join(lines) + "\n", encoding="utf-8")
     script = ROOT / "benchmarks" / "search_log.py"

@@ -17,6 +17,7 @@ objects not moved in S' plus the M_out objects that obstruct S'; otherwise it fa
 from __future__ import annotations
 
 import enum
+import hashlib
 import math
 import time
 from contextlib import ExitStack
@@ -1343,6 +1344,25 @@ def _retimable(alone: Action, step: tuple[Action, ...], failure: Failure) -> lis
     PA5-s15's `r2 moves o3` had no earlier step with r2 free, `r1 moves o2` had)."""
     met = set(failure.bodies) - set(alone.robots)
     return [alone] + [b for b in step if b is not alone and met & set(b.robots)]
+
+
+def draw_key(skeleton: Skeleton, suffix: Iterable[GroundedStep]) -> str:
+    """The key a grounding of ``skeleton`` under ``suffix`` draws its random placements and relay spots from
+    (:meth:`ReverseGrounder.ground`'s ``key``): made of what is grounded -- the skeleton's steps and the suffix's
+    moves, step by step (objects, regions, robots, grasps, relays) -- not of when, so the same skeleton under the
+    same moves draws the same way however many groundings came before it, and a change to the search re-draws
+    only the groundings it changes (docs/planner.md, "Draws keyed by what is grounded").  16 hex digits of a
+    SHA-1, the same on every machine and in every process."""
+    lines = [" | ".join(f"{a}" for a in step) for step in skeleton.steps] + ["--"]
+    for s in suffix:
+        lines.append(
+            " | ".join(
+                f"{a.object} {a.region} {a.pick_robot} {a.place_robot} {a.pick_grasp} {a.place_grasp}"
+                + (" relay" if a.relay else "")
+                for a in s.actions
+            )
+        )
+    return hashlib.sha1("\n".join(lines).encode()).hexdigest()[:16]
 
 
 def moved_objects(steps: Iterable[GroundedStep]) -> set[str]:

@@ -99,7 +99,7 @@ def _search(context: Context, sources: _Sources, deadline: float) -> Result:
     """The MCTS over skeletons with reverse-search grounding, each complete plan judged by the referee."""
     from mrgc.geometry.grounding import Grounder
     from mrgc.geometry.scene import scene_from_problem
-    from mrgc.planner.ground import Outcome, ReverseGrounder
+    from mrgc.planner.ground import Outcome, ReverseGrounder, draw_key
     from mrgc.planner.mcts import MCTS
 
     problem, o, why, say = context.problem, context.options, context.why, context.log
@@ -107,10 +107,16 @@ def _search(context: Context, sources: _Sources, deadline: float) -> Result:
     reverse = ReverseGrounder(grounder, problem.goal_regions, full=context.full, deadline=deadline)
     count = [0]
     timing = _Timing()
+    #: each grounding's draw key -> its number in the search (the log says "as grounding N")
+    numbers: dict[str, int] = {}
 
     def ground(skel: Skeleton, suffix: list[GroundedStep]) -> Grounding:
         count[0] += 1
-        result = reverse.ground(skel, suffix, key=str(count[0]), order=sources.order_of(skel))
+        key = draw_key(skel, suffix)
+        numbers.setdefault(key, count[0])
+        result = reverse.ground(skel, suffix, key=key, order=sources.order_of(skel))
+        if result.repeats:
+            result.repeats = str(numbers.get(result.repeats, result.repeats))
         timing.grounded(skel, suffix, result)
         if result.outcome is Outcome.SUCCESS:
             result = _referee(context, result)

@@ -100,7 +100,7 @@ def _search(context: Context, sources: _Sources, deadline: float) -> Result:
     from mrgc.geometry.grounding import Grounder
     from mrgc.geometry.scene import scene_from_problem
     from mrgc.planner.ground import Outcome, ReverseGrounder, draw_key
-    from mrgc.planner.mcts import MCTS
+    from mrgc.planner.mcts import MCTS, SearchResult
 
     problem, o, why, say = context.problem, context.options, context.why, context.log
     grounder = Grounder(scene_from_problem(problem), seed=context.seed)
@@ -134,20 +134,27 @@ def _search(context: Context, sources: _Sources, deadline: float) -> Result:
 
     search = MCTS(ground, sources, set(context.goals), c=o["c"], alpha=o["alpha"], k=o["skeletons"])
     result = search.run(deadline, max_iterations=o["max_iterations"], anytime=o["anytime"])
-    out = _conclude_search(why, result, sources.root, grounder, deadline)
-    stats = out.stats
-    stats.update({k: (round(v, 4) if isinstance(v, float) else v) for k, v in result.stats.items()})
-    stats["iterations"] = result.iterations
-    stats["geometric_queries"] = grounder.queries
-    stats["deferred"] = sorted(describe(p) for p in sources.deferrals.deferred)
-    stats["doomed_skeletons"] = reverse.doomed.doomed  # failed by a probe before their later steps (doomed.py)
-    stats["repeated_failures"] = reverse.repeated  # failed as an earlier grounding did (ReverseGrounder._repeated)
-    stats.update(timing.of(result.steps))
-    if out.status is PlanStatus.TIME_LIMIT and result.ended == "iteration limit":
-        out.summary = f"the search's iteration limit ({o['max_iterations']}) was reached before a plan was found"
-    elif out.status is PlanStatus.INFEASIBLE:
-        out.summary = "infeasible by the facts: no task skeleton exists"
-    return out
+
+    def conclude(result: SearchResult) -> Result:
+        out = _conclude_search(why, result, sources.root, grounder, deadline)
+        stats = out.stats
+        stats.update({k: (round(v, 4) if isinstance(v, float) else v) for k, v in result.stats.items()})
+        stats["iterations"] = result.iterations
+        stats["geometric_queries"] = grounder.queries
+        stats["deferred"] = sorted(describe(p) for p in sources.deferrals.deferred)
+        stats["doomed_skeletons"] = reverse.doomed.doomed  # failed by a probe before their later steps (doomed.py)
+        stats["repeated_failures"] = reverse.repeated  # failed as an earlier grounding did (ReverseGrounder._repeated)
+        stats.update(timing.of(result.steps))
+        if out.status is PlanStatus.TIME_LIMIT and result.ended == "iteration limit":
+            out.summary = f"the search's iteration limit ({o['max_iterations']}) was reached before a plan was found"
+        elif out.status is PlanStatus.INFEASIBLE:
+            out.summary = "infeasible by the facts: no task skeleton exists"
+        return out
+
+    try:
+        return conclude(result)
+    except KeyboardInterrupt:  # a signal after the search's loop, while concluding: interrupted, its counts kept
+        return conclude(SearchResult(result.steps, result.iterations, result.stats, "interrupted"))
 
 
 class _Timing:

@@ -164,6 +164,11 @@ def test_a_signal_during_the_search_reports_and_writes_nothing(tmp_path: Path, s
             "-o",
             str(out),
             "-v",
+            # the search goes on after its first plan (found by the first grounding here), so the signal sent
+            # after the first log line lands in the search, not in the few milliseconds after it (a race CI met)
+            "--anytime",
+            "--time-limit",
+            "100",
         ],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
@@ -177,6 +182,27 @@ def test_a_signal_during_the_search_reports_and_writes_nothing(tmp_path: Path, s
     assert proc.returncode == code, stderr
     assert word in stderr and "no plan file written" in stderr and "skeletons" in stderr
     assert not out.exists() and "Traceback" not in stderr
+
+
+def test_a_signal_after_the_search_loop_still_reports_the_search_so_far(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A signal that lands while the search is being concluded (the plan found, its statistics being
+    gathered) ends the run as interrupted with the search's counts, not as an empty run."""
+    from mrgc.planner import search
+
+    real, calls = search._Timing.of, []
+
+    def interrupted_once(self: Any, steps: Any) -> dict[str, int]:
+        calls.append(steps)
+        if len(calls) == 1:
+            raise KeyboardInterrupt
+        return real(self, steps)
+
+    monkeypatch.setattr(search._Timing, "of", interrupted_once)
+    path = ROOT / "domains" / "packaging" / "pa3-handover.mrg"
+    problem = parse_file(path).problem()
+    plan = plan_problem(problem, str(path), file_sha256(str(path)), __version__, seed=1)
+    assert len(calls) == 2 and plan.status == "interrupted"
+    assert plan.stats["skeletons"] >= 1 and plan.stats["groundings"] >= 1 and plan.stats["makespan"] >= 1
 
 
 # ------------------------------------------------------------------ the validator inside the search

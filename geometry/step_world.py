@@ -33,7 +33,7 @@ import hashlib
 import operator
 import time
 from contextlib import contextmanager
-from typing import Callable, Iterable, Iterator, Mapping
+from typing import Any, Callable, Iterable, Iterator, Mapping
 
 import numpy as np
 
@@ -62,6 +62,9 @@ class StepWorld:
         self._paths: dict[tuple[object, ...], Answer] = {}
         #: volumes (V_fut, what the step's other robots sweep, ``after``) as the collision kernel reads them
         self._volumes = _VolumeCache()
+        #: the free placements :meth:`Placements.crowded_out <mrgc.geometry.placements.Placements.crowded_out>`
+        #: found, by object, region, what to avoid (and where), volume and key (most recent last)
+        self._rooms: dict[tuple[object, ...], Any] = {}
         #: robots that park (:attr:`Robot.parks <mrgc.geometry.robot.Robot.parks>`: planar robots) wait at home
         #: (their start pose, as the validator assumes), obstacles for the others: robot -> its world bodies
         #: there, group ``robots``

@@ -770,7 +770,7 @@ class ReverseGrounder:
         if not still:
             return None
         mine = [p for phases in self._motions(planned).values() for vols in phases.values() for v in vols for p in v]
-        crowded = self.g.crowded_out(still, planned.region, avoid, _plus(v_fut, mine), key)
+        crowded = self.g.crowded_out(still, planned.region, avoid, v_fut, key, extra=mine)
         if crowded is None:
             return None
         return Failure(0, "", f"placement: leaves no free pose of {crowded} in {planned.region}")

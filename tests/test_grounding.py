@@ -240,6 +240,30 @@ def test_crowded_out_names_an_object_left_no_free_pose(pa3: Grounder) -> None:
     assert pa3.placement("o2", "bin-b", volume=wall, packed=True).status is GroundStatus.NO_PLACEMENT
 
 
+@settings(max_examples=12, deadline=None)
+@given(st.integers(0, 2**31 - 1))
+def test_crowded_out_asks_extra_pieces_as_part_of_one_volume_and_keeps_its_rooms(seed: int) -> None:
+    """``crowded_out`` with the placement's own motions given apart (``extra``) answers as with them joined
+    to the volume, however the pieces are split between the two (part of a wall over the bin, some objects
+    left no pose, some not); asked again with a volume of the same content (a new object), it answers from
+    the free poses it kept, without a further collision query."""
+    rng = np.random.default_rng(seed)
+    problem = parse_file(ROOT / "domains" / "packaging" / "pa3-handover.mrg").problem()
+    split, joined = Grounder(scene_from_problem(problem), seed=0), Grounder(scene_from_problem(problem), seed=0)
+    wall = _wall(split, "bin-b")
+    share = rng.uniform(0.05, 0.6) if rng.random() < 0.7 else 1.0  # about half the draws leave o2 no pose
+    pieces = [p for p in wall if rng.random() < share]
+    cut = int(rng.integers(0, len(pieces) + 1))
+    for objs in (["o2", "o3"], ["o3", "o2"]):
+        expected = joined.crowded_out(objs, "bin-b", volume=pieces or None)
+        base = Posed.of(pieces[:cut]) if cut else None
+        assert split.crowded_out(objs, "bin-b", volume=base, extra=pieces[cut:]) == expected
+        before = split.queries
+        again = Posed.of(pieces[:cut]) if cut else None
+        assert split.crowded_out(objs, "bin-b", volume=again, extra=pieces[cut:]) == expected
+        assert split.queries == before
+
+
 def test_a_placement_that_leaves_no_room_for_an_earlier_object_is_passed_over(tmp_path: Path) -> None:
     """Grounding o2, o13, o10 into the bin in that order: before, the first placement of the last object swept
     the whole bin and o2 had no free pose ("placement: no free pose of o2 in bin-a" on every skeleton, the

@@ -338,7 +338,9 @@ class ScriptedGrounder:
     def comfortable(self, robot: str, obj: str, grasp: str) -> Any:
         return lambda poses: np.zeros(len(poses))
 
-    def crowded_out(self, objs: Any, region: str, avoid: Any = (), volume: Any = None, key: str = "") -> str | None:
+    def crowded_out(
+        self, objs: Any, region: str, avoid: Any = (), volume: Any = None, key: str = "", extra: Any = ()
+    ) -> str | None:
         return None
 
     def arm_volume(self, robot: str, configs: np.ndarray, holding: Any = None, grasp: Any = None) -> list[Any]:

@@ -164,11 +164,12 @@ class Placements(StepWorld):
         (:func:`_content`) and key: walked again, a kept room gives the poses it found before and then looks
         further (the last :data:`ROOMS` asked are kept)."""
         where = b"".join(self.world.transform(name).tobytes() for name in avoid if name in self.world)
-        content = _content(self._volumes.posed(volume) if volume is not None else None, self.scene.body(region))
-        index = (obj, region, avoid, where, content, key)
+        # only what of the volume the region can meet: the same answers, and a room holds no more of it
+        part = _around(self._volumes.posed(volume), self.scene.body(region)) if volume is not None else None
+        index = (obj, region, avoid, where, _content(part), key)
         room: _Room | None = self._rooms.pop(index, None)
         if room is None:
-            room = _Room(self.placements(obj, region, avoid, volume, key=f"room:{key}", packed=True), volume)
+            room = _Room(self.placements(obj, region, avoid, part, key=f"room:{key}", packed=True), part)
         self._rooms[index] = room  # the most recent last
         while len(self._rooms) > ROOMS:
             del self._rooms[next(iter(self._rooms))]
@@ -193,8 +194,9 @@ class Placements(StepWorld):
 
 class _Room:
     """The free placements of one object in one region under one volume (:meth:`Placements._room`): those
-    found so far, then the rest of the search for them (``source``, resumed where it stopped).  ``volume`` is
-    held so that the ids of its shapes, part of the room's key (:func:`_content`), are not reused meanwhile."""
+    found so far, then the rest of the search for them (``source``, resumed where it stopped).  ``volume`` (the
+    part of it the region can meet) is held so that the ids of its shapes, part of the room's key
+    (:func:`_content`), are not reused meanwhile."""
 
     def __init__(self, source: Iterator[np.ndarray], volume: object) -> None:
         self.source, self.volume = source, volume
@@ -217,14 +219,13 @@ class _Room:
             self.found.append(pose)
 
 
-def _content(volume: Posed | None, region: SceneBody) -> bytes:
-    """What of ``volume`` a placement inside ``region`` can meet (:func:`_around`), as bytes: its pieces'
-    shapes (their ids: the room that holds the volume keeps them alive), kinds and transforms, in order.  Two
-    volumes with the same content give every candidate the same answers (a step grounded again under the
-    same suffix makes its V_fut anew)."""
-    if volume is None:
+def _content(part: Posed | None) -> bytes:
+    """A volume's pieces (what of it a region can meet: :func:`_around`) as bytes: their shapes (by id: the
+    room that holds the part keeps them alive), kinds and transforms, in order.  Two volumes with the same
+    content give every candidate the same answers (a step grounded again under the same suffix makes its
+    V_fut anew)."""
+    if part is None:
         return b""
-    part = _around(volume, region)
     shapes = np.array([id(s) for s in part.shapes], dtype=np.int64)
     return hashlib.blake2b(shapes.tobytes() + part.kind.tobytes() + part.transforms.tobytes(), digest_size=16).digest()
 

@@ -63,7 +63,8 @@ class StepWorld:
         #: volumes (V_fut, what the step's other robots sweep, ``after``) as the collision kernel reads them
         self._volumes = _VolumeCache()
         #: the free placements :meth:`Placements.crowded_out <mrgc.geometry.placements.Placements.crowded_out>`
-        #: found, by object, region, what to avoid (and where), volume and key (most recent last)
+        #: found, by object, region, what to avoid (and where), the content of the volume's part the region
+        #: can meet, and key (most recent last)
         self._rooms: dict[tuple[object, ...], Any] = {}
         #: robots that park (:attr:`Robot.parks <mrgc.geometry.robot.Robot.parks>`: planar robots) wait at home
         #: (their start pose, as the validator assumes), obstacles for the others: robot -> its world bodies

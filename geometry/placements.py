@@ -147,26 +147,29 @@ class Placements(StepWorld):
         avoid, reg = tuple(avoid), self.scene.body(region)
         pad = volume.pad if isinstance(volume, Posed) else TOLERANCE
         more = _around(Posed.of(extra, pad), reg) if extra else None
+        # only what of the volume the region can meet: the same answers, and a room holds no more of it
+        part = _around(self._volumes.posed(volume), reg) if volume is not None else None
+        # what the rooms asked now depend on besides the object: where the objects to avoid are, the part
+        where = b"".join(self.world.transform(name).tobytes() for name in avoid if name in self.world)
+        context = (region, avoid, where, _content(part), key)
         for obj in objs:
             if self.late():
                 return None
             if inside(reg, self.scene.body(obj).shape, self.poses[obj]):
                 continue
             shape = self.shape(obj)
-            room = self._room(obj, region, avoid, volume, key)
+            room = self._room(obj, context, part)
             if not any(more is None or not posed_collide(Posed.of([(shape, pose)]), more) for pose in room):
                 return obj
         return None
 
-    def _room(self, obj: str, region: str, avoid: tuple[str, ...], volume: Sweep | None, key: str) -> _Room:
-        """The free packed placements of ``obj`` in ``region`` (:meth:`placements` with ``key`` ``room:<key>``),
-        kept per object, region, ``avoid`` at their current poses, what of ``volume`` the region can meet
-        (:func:`_content`) and key: walked again, a kept room gives the poses it found before and then looks
-        further (the last :data:`ROOMS` asked are kept)."""
-        where = b"".join(self.world.transform(name).tobytes() for name in avoid if name in self.world)
-        # only what of the volume the region can meet: the same answers, and a room holds no more of it
-        part = _around(self._volumes.posed(volume), self.scene.body(region)) if volume is not None else None
-        index = (obj, region, avoid, where, _content(part), key)
+    def _room(self, obj: str, context: tuple[str, tuple[str, ...], bytes, bytes, str], part: Posed | None) -> _Room:
+        """The free packed placements of ``obj`` in a region (:meth:`placements` with ``key`` ``room:<key>``),
+        kept per object and ``context`` (the region, the objects to avoid, their poses, the content of the
+        ``part`` of the volume the region can meet (:func:`_content`) and the key): walked again, a kept room
+        gives the poses it found before and then looks further (the last :data:`ROOMS` asked are kept)."""
+        region, avoid, _, _, key = context
+        index = (obj, *context)
         room: _Room | None = self._rooms.pop(index, None)
         if room is None:
             room = _Room(self.placements(obj, region, avoid, part, key=f"room:{key}", packed=True), part)

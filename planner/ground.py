@@ -51,6 +51,11 @@ PARKING_REGIONS = 2
 #: placements each failing its carry the same way (PA7-s1: 17 carries of about 85 ms each, every one
 #: blocked by the other arm, before the split that grounded at once)
 BUSY_CARRIES = 2
+#: parts of a split that may fail while one skeleton step is grounded (the strict or the relaxed attempt, every
+#: split of its parts included) before no further split is tried: each part is split again, so the attempts
+#: multiply with the step's actions (6-arm instance 2: the re-timings' and splits' parts took 59 % of the step
+#: groundings' CPU, those that failed 21 %; with this budget it is solved in 216 s, a time limit before)
+SPLIT_PART_FAILURES = 4
 #: exchanges tried per handover point when the giver's carry to one fails: another branch of the arms at the
 #: same point is often an easy carry where the first (the solution nearest home) is not (6-arm seed 0: r5's
 #: first exchange at h5 is reached by no RRTConnect path of 64,000 checks, its second in 0.03 s)
@@ -158,6 +163,10 @@ class ReverseGrounder:
         self._failed: dict[tuple[object, ...], tuple[tuple[GroundedStep, ...], Grounding, str]] = {}
         #: groundings that repeated a failure instead of grounding anything (:meth:`ground`)
         self.repeated = 0
+        #: parts of a split that failed in the skeleton step being grounded (:data:`SPLIT_PART_FAILURES`), and
+        #: the splits not tried for want of that budget
+        self._part_fails = 0
+        self.split_budgets_spent = 0
         #: the skeleton being grounded, its actions as re-timed so far (see :class:`_Retiming`)
         self._plan = _Retiming([], None)
         #: actions found doomed before the later steps are grounded (planner/doomed.py)
@@ -312,7 +321,8 @@ class ReverseGrounder:
         another robot of the step sweeps in the same phase), ground it again with the failing action first
         (each action keeps clear of the ones grounded before it, so the others then plan around it); then
         re-time (below); then split it: the failing action alone one step later, or else one step earlier,
-        than the others (each part split again as needed).  The skeleton's
+        than the others (each part split again as needed, until :data:`SPLIT_PART_FAILURES` parts have failed
+        in the skeleton step).  The skeleton's
         action set and order constraints are kept (actions of one step constrain each other in neither
         direction); only the plan's makespan grows.
 
@@ -324,6 +334,8 @@ class ReverseGrounder:
         searched the same hopeless carry 18 times, 41 of the skeleton's 59 s)."""
         if any(a.via is not None for a in step):
             return self._relay_steps(step, avoid, v_fut, key, index)
+        if not same:  # a skeleton step, not a part of a split: its budget of failed parts starts again
+            self._part_fails = 0
         same = same | {a.obj for a in step}
         done = self._step(step, avoid, set(same), v_fut, key, index)
         if not isinstance(done, Failure):
@@ -338,7 +350,6 @@ class ReverseGrounder:
         if lead is None:
             return done
         alone = lead
-        rest = tuple(a for a in step if a is not alone)
         # first the same actions over the skeleton's steps: the failing action in an earlier step, else
         # (its robots busy in every earlier step) the action of the robot it met there
         mark = self._plan.mark()
@@ -350,11 +361,36 @@ class ReverseGrounder:
                 self._plan.noted.append(done)
                 return again
             self._plan.rollback(mark)
+        split = self._split(step, alone, avoid, v_fut, key, index, same, mark)
+        if split is None:
+            return done
+        self._plan.noted.append(done)
+        return split
+
+    def _split(
+        self,
+        step: tuple[Action, ...],
+        alone: Action,
+        avoid: set[str],
+        v_fut: Posed,
+        key: str,
+        index: int,
+        same: frozenset[str],
+        mark: tuple[int, int],
+    ) -> list[GroundedStep] | None:
+        """``step`` split in two plan steps (see :meth:`_steps`): ``alone`` one step later than the others, else
+        one step earlier; None when neither grounds or the skeleton step's budget of failed parts
+        (:data:`SPLIT_PART_FAILURES`) is spent (the re-timings since ``mark`` are taken back on a failure)."""
+        rest = tuple(a for a in step if a is not alone)
         for later, earlier in (((alone,), rest), (rest, (alone,))):
+            if self._part_fails >= SPLIT_PART_FAILURES:
+                self.split_budgets_spent += 1
+                break
             # the reverse search grounds the later part first; the earlier one then avoids its objects (at
             # their initial poses) and its volume
             tail = self._steps(later, avoid, v_fut, key, index, same)
             if isinstance(tail, Failure):
+                self._part_fails += 1
                 self._plan.rollback(mark)
                 continue
             before = self.grounded
@@ -371,10 +407,10 @@ class ReverseGrounder:
             finally:
                 self.grounded = before
             if not isinstance(head, Failure):
-                self._plan.noted.append(done)
                 return head + tail
+            self._part_fails += 1
             self._plan.rollback(mark)
-        return done
+        return None
 
     def _relay_steps(
         self, step: tuple[Action, ...], avoid: set[str], v_fut: Posed, key: str, index: int

@@ -794,6 +794,39 @@ def test_a_failure_is_not_grounded_again_under_the_same_steps(pa3: Grounder) -> 
     assert not third.repeats and pa3.queries > queries
 
 
+@pytest.mark.parametrize("actions", [2, 3, 4, 5, 6])
+def test_a_step_whose_split_parts_keep_failing_stops_splitting_when_its_budget_is_spent(
+    pa3: Grounder, monkeypatch: pytest.MonkeyPatch, actions: int
+) -> None:
+    """planner/ground.py ``SPLIT_PART_FAILURES``: each part of a split is split again, so a step whose robots
+    keep meeting tries more parts the more actions it has.  Here every joint action of the step fails as two of
+    its robots colliding (each action alone too): a step of up to four actions fails as before, trying the
+    same parts; a larger one stops splitting once that many parts have failed, with the same failure."""
+    from mrgc.planner import ground
+    from mrgc.planner.outcome import Failure
+
+    step = tuple(Action(f"o{i}", "bin-a", f"r{i}", f"r{i}", "top", "top") for i in range(1, actions + 1))
+    tried: list[int] = []
+
+    def clash(self: ReverseGrounder, part: tuple[Action, ...], *args: Any, **kwargs: Any) -> Failure:
+        tried.append(len(part))
+        robots = tuple(sorted({part[0].pick_robot, part[-1].pick_robot}))
+        return Failure(1, ground.label(part[-1]), "pick: robots of the step collide", robots)
+
+    monkeypatch.setattr(ReverseGrounder, "_step", clash)
+    answers = []
+    for budget in (10**9, ground.SPLIT_PART_FAILURES):
+        monkeypatch.setattr(ground, "SPLIT_PART_FAILURES", budget)
+        reverse = ReverseGrounder(pa3, {})
+        tried.clear()
+        answers.append((reverse._steps(step, set(), ground.swept([]), "k", 1), len(tried), reverse.split_budgets_spent))
+    (unbounded, tries, spent), (bounded, budgeted_tries, budget_spent) = answers
+    assert isinstance(unbounded, Failure) and unbounded == bounded  # the step's own failure either way
+    assert spent == 0 and budgeted_tries <= tries
+    # a small step never spends the budget and tries what it tried before; a large one stops early
+    assert (budget_spent > 0) == (budgeted_tries < tries) == (actions >= 5)
+
+
 def test_a_pick_failing_on_what_never_moves_fails_every_skeleton_holding_it_at_once(pa3: Grounder) -> None:
     """planner/doomed.py: r1 reaches o2 with no side-y+ grasp (every attempt fails on its inverse kinematics:
     a static answer).  Once one grounding has failed on that pick, another skeleton holding the same pick (with

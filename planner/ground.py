@@ -334,7 +334,7 @@ class ReverseGrounder:
         searched the same hopeless carry 18 times, 41 of the skeleton's 59 s)."""
         if any(a.via is not None for a in step):
             return self._relay_steps(step, avoid, v_fut, key, index)
-        if not same:  # a skeleton step, not a part of a split: its budget of failed parts starts again
+        if not same:  # a skeleton step (or a relay's half), not a part of a split: its budget starts again
             self._part_fails = 0
         same = same | {a.obj for a in step}
         done = self._step(step, avoid, set(same), v_fut, key, index)

@@ -708,7 +708,7 @@ class ReverseGrounder:
         ``start``, into ``planned`` (its region too); the failure of the last placement tried otherwise."""
         g = self.g
         last: Failure | None = None
-        tried = 0  # placements that failed for another reason than being out of the arm's reach
+        tried = 0  # placements whose carry was planned, or whose approach the step's other robots blocked
         forced = self._forced.get(a.obj)
         # goal bins are shared by several objects: packed from the corners; elsewhere (moving an obstacle
         # aside) the middle of the region first, nearest the arms that reach it
@@ -749,7 +749,10 @@ class ReverseGrounder:
             )
             if not place.ok:
                 last = _failed(f"place by {a.place_robot}", place)
-                tried += place.status is not GroundStatus.NO_IK
+                # an approach costs a try only when the step's other robots are in its way; out of reach, or
+                # an object, fixed body or the arm itself in the way, it costs a look (a crowded start region:
+                # the free pose next to the others, fingers touching a neighbour, then one with room)
+                tried += place.detail == BUSY
                 if place.static:
                     self._dead_spots.add(spot)
                 static = static and place.static

@@ -465,10 +465,16 @@ class ReverseGrounder:
             both = _both(
                 g.comfortable(a.pick_robot, a.obj, a.pick_grasp), g.comfortable(a.place_robot, a.obj, a.place_grasp)
             )
+            beyond = _both(
+                g.comfortable(a.pick_robot, a.obj, a.pick_grasp, share=1.0),
+                g.comfortable(a.place_robot, a.obj, a.place_grasp, share=1.0),
+            )
             for pose in g.placements(
                 a.obj, where, avoid=others, volume=_plus(v_fut, taken), key=key, packed=True, prefer=both
             ):
                 self._on_time()
+                if beyond(pose[None])[0] > 0:
+                    continue  # past one arm's reach bound: neither sets it down and picks it up there
                 tried += 1
                 if tried > PLACEMENT_TRIES + OUT_OF_REACH_TRIES:
                     break
@@ -725,7 +731,8 @@ class ReverseGrounder:
                 prefer=g.comfortable(a.place_robot, a.obj, a.place_grasp),
             )
         )
-        looked = 0
+        beyond = g.comfortable(a.place_robot, a.obj, a.place_grasp, share=1.0)  # > 0: past the arm's reach bound
+        looked = far = 0
         crossed = 0  # carries blocked by what the step's other robots sweep meanwhile (``busy``)
         static = True  # every placement tried failed on what never moves (Failure.static)
         while looked < PLACEMENT_TRIES + OUT_OF_REACH_TRIES and tried < PLACEMENT_TRIES:
@@ -733,10 +740,16 @@ class ReverseGrounder:
             pose = next(spots, None)
             if pose is None:
                 none = Failure(0, "", f"placement: no free pose of {a.obj} in {region}")
+                if far and last is None:  # as when every pose tried had no IK (static, as that was)
+                    none = Failure(0, "", f"place by {a.place_robot}: {GroundStatus.NO_IK.value}", static=True)
+                    return replace(none, detail=f"the free poses in {region} are all beyond its reach")
                 return _static(last, static) if last else none
             spot = (a.place_robot, a.obj, a.place_grasp, _spot_key(pose))
             if spot in self._dead_spots:
                 continue  # failed before on what never moves: fails again, and costs no try
+            if forced is None and beyond(pose[None])[0] > 0:
+                far += 1
+                continue  # no arm configuration reaches it (the reach bound is an upper bound): costs no try
             looked += 1
             place = g.place(
                 a.place_robot,

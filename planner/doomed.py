@@ -194,6 +194,7 @@ class DoomedActions:
             packed=self.goal.get(a.obj) == region,
             prefer=g.comfortable(a.place_robot, a.obj, a.place_grasp),
         )
+        beyond = g.comfortable(a.place_robot, a.obj, a.place_grasp, share=1.0)  # > 0: past the reach bound
         looked, any_pose = 0, False
         for pose in poses:
             self.on_time()
@@ -201,7 +202,7 @@ class DoomedActions:
             if looked >= self.tries:
                 break
             spot = (a.place_robot, a.obj, a.place_grasp, self.spot_key(pose))
-            if spot in self.dead:  # as the grounding does: a spot known unreachable costs no try
+            if spot in self.dead or beyond(pose[None])[0] > 0:  # as the grounding does: costs no try
                 continue
             looked += 1
             place = g.place(a.place_robot, a.obj, a.place_grasp, pose, avoid=avoid)

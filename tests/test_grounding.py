@@ -1343,3 +1343,59 @@ def test_a_place_kept_clear_of_the_other_robots_gives_up_after_a_few_carries_the
     assert grounding.outcome is Outcome.SUCCESS, grounding.reason
     blocked = [c for c in carries if c[1]]
     assert 0 < len(blocked) <= BUSY_CARRIES, carries
+
+
+@pytest.mark.parametrize("busy", [False, True])
+def test_a_place_approach_blocked_by_an_object_costs_a_look_and_by_the_step_s_robots_a_try(
+    pa3: Grounder, busy: bool
+) -> None:
+    """A crowded start region: the first free poses lie next to other objects, and the fingers touch one.  Such
+    an approach costs a look (up to PLACEMENT_TRIES + OUT_OF_REACH_TRIES), so the place goes on to a pose with
+    room (6-arm instances: 1 in 10 obstacles with a reachable free pose was given up after 6 such touches); an
+    approach the step's other robots block still costs a try, so that step is split or re-timed soon."""
+    from mrgc.geometry.answers import BUSY
+    from mrgc.planner.ground import OUT_OF_REACH_TRIES, PLACEMENT_TRIES
+
+    blocked = 10**6 if busy else PLACEMENT_TRIES + 2
+    calls: list[int] = []
+    place = pa3.place
+
+    def crowded(robot: str, obj: str, *args: Any, **kw: Any) -> Answer:
+        calls.append(1)
+        if len(calls) <= blocked:
+            if busy:
+                return Answer(GroundStatus.COLLISION, detail=BUSY)
+            return Answer(GroundStatus.COLLISION, blockers={"o2"})
+        return place(robot, obj, *args, **kw)
+
+    pa3.place = crowded  # type: ignore[method-assign]
+    skel = Skeleton(((Action("o1", "bin-a", "r1", "r1", "top", "top"),),))
+    grounding = ReverseGrounder(pa3, {"o1": "bin-a"}).ground(skel, [], key="looks")
+    if busy:
+        # the strict attempt and the relaxed one (M_out ignored) each give up after PLACEMENT_TRIES approaches
+        assert grounding.outcome is Outcome.FAIL and len(calls) == 2 * PLACEMENT_TRIES, (len(calls), grounding.reason)
+    else:
+        assert grounding.outcome is Outcome.SUCCESS, grounding.reason
+        assert blocked < len(calls) <= PLACEMENT_TRIES + OUT_OF_REACH_TRIES
+
+
+def test_placements_past_the_arm_s_reach_bound_are_never_asked_and_fail_as_out_of_reach(pa3: Grounder) -> None:
+    """r1 cannot reach bin-b: every free pose there lies past its reach bound (an upper bound of where its
+    end effector can be), so no place query is made for them and none costs a look; the step fails as one
+    whose every placement has no inverse kinematics (static: on what never moves), naming why."""
+    asked: list[np.ndarray] = []
+    place = pa3.place
+
+    def recorded(robot: str, obj: str, grasp: str, pose: np.ndarray, *args: Any, **kw: Any) -> Answer:
+        asked.append(pose)
+        return place(robot, obj, grasp, pose, *args, **kw)
+
+    pa3.place = recorded  # type: ignore[method-assign]
+    beyond = pa3.comfortable("r1", "o1", "top", share=1.0)
+    skel = Skeleton(((Action("o1", "bin-b", "r1", "r1", "top", "top"),),))
+    grounding = ReverseGrounder(pa3, {"o1": "bin-b"}).ground(skel, [], key="far")
+    assert grounding.outcome is Outcome.FAIL, grounding.reason
+    failure = grounding.failures[0]
+    assert (failure.check, failure.static) == ("place by r1: no inverse kinematics", True)
+    assert "beyond its reach" in failure.detail
+    assert all(beyond(p[None])[0] == 0 for p in asked)

@@ -69,7 +69,8 @@ def failed_part(a: Action, check: str) -> Part | None:
 class DoomedActions:
     """The suspect parts and the cached probes of one search (see the module docstring).  ``grounder`` answers
     the geometric queries; ``regions(a)`` gives the regions a place of ``a`` is tried in, in order (its own,
-    then for an obstacle the parking regions); ``tries`` bounds the placements looked at per region; ``dead``
+    then for an obstacle the parking regions); ``tries`` bounds the placements looked at per region, ``samples``
+    the random ones drawn there (as the grounding does); ``dead``
     is the grounding's set of (robot, object, grasp, placement key) whose place has no inverse kinematics, which
     the probes read and add to; ``spot_key`` makes such a key from a pose; ``on_time`` raises when the search's
     deadline has passed; ``label`` names an action as failure lines do."""
@@ -80,12 +81,13 @@ class DoomedActions:
         goal: dict[str, str],
         regions: Callable[[Action], list[str]],
         tries: int,
+        samples: int,
         dead: set[tuple[str, str, str, tuple[float, ...]]],
         spot_key: Callable[[np.ndarray], tuple[float, ...]],
         on_time: Callable[[], None],
         label: Callable[[Action], str],
     ) -> None:
-        self.g, self.goal, self.regions, self.tries = grounder, goal, regions, tries
+        self.g, self.goal, self.regions, self.tries, self.samples = grounder, goal, regions, tries, samples
         self.dead, self.spot_key, self.on_time, self.label = dead, spot_key, on_time, label
         self.suspects: set[Part] = set()
         #: (robot, object, grasp) of picks that failed on what never moves, with their failure
@@ -193,6 +195,7 @@ class DoomedActions:
             key="doomed",
             packed=self.goal.get(a.obj) == region,
             prefer=g.comfortable(a.place_robot, a.obj, a.place_grasp),
+            samples=self.samples,
         )
         beyond = g.comfortable(a.place_robot, a.obj, a.place_grasp, share=1.0)  # > 0: past the reach bound
         looked, any_pose = 0, False

@@ -40,9 +40,13 @@ from mrgc.planfile.format import PlannedAction
 from mrgc.planner.doomed import DoomedActions
 from mrgc.planner.outcome import DeadlineReached, Failure
 
-PLACEMENT_TRIES = 6  # placements sampled per place before the step gives up
-#: more placements an arm may try when they are out of its reach (a bin at the edge of the arm's reach:
-#: the corners come first when packing, and many are unreachable)
+#: tries per place before the step gives up: a placement whose carry was planned, or whose approach the step's
+#: other robots blocked (:meth:`ReverseGrounder._place`)
+PLACEMENT_TRIES = 6
+#: more placements a place may look at whose approaches failed without costing a try: out of the arm's reach (a
+#: bin at the edge of the arm's reach: the corners come first when packing, and many are unreachable), or
+#: touching an object, a fixed body or the arm itself (a crowded start region; placements past the arm's reach
+#: bound are passed over without a look)
 OUT_OF_REACH_TRIES = 30
 #: random placements drawn per region after the fixed ones (the lattice, a packed bin's grid): a crowded start
 #: region has few free poses, most past the arm's reach (6-arm seed 0: 14 free poses of o21 among 200 draws,

@@ -331,11 +331,12 @@ class ScriptedGrounder:
         key: str = "",
         packed: bool = False,
         prefer: Any = None,
+        samples: int = 200,
     ) -> Any:
         self.asked.append(("placement", obj, key))
         yield np.eye(4)
 
-    def comfortable(self, robot: str, obj: str, grasp: str) -> Any:
+    def comfortable(self, robot: str, obj: str, grasp: str, share: float = 0.85) -> Any:
         return lambda poses: np.zeros(len(poses))
 
     def crowded_out(

@@ -18,8 +18,9 @@ avoiding only the objects still at their initial poses then (those the skeleton 
 those of its own step).  The
 probe asks what never depends on that context -- a pick's inverse kinematics, and for a place whether any free
 placement the arm's inverse kinematics reaches exists among the first :data:`~mrgc.planner.ground.PLACEMENT_TRIES`
-+ :data:`~mrgc.planner.ground.OUT_OF_REACH_TRIES` free ones (the region's, and for an obstacle the parking
-regions the grounding would try next) -- so a failing probe means the step fails in its real context too:
++ :data:`~mrgc.planner.ground.OUT_OF_REACH_TRIES` free ones within the arm's reach bound (those past it are passed
+over, as the grounding passes them; the region's, and for an obstacle the parking regions the grounding would try
+next) -- so a failing probe means the step fails in its real context too:
 the fixed lattice of placements only shrinks when more is avoided, and a placement's inverse kinematics
 answer (no solution from any start) does not depend on what is avoided.  The random placements beyond the
 lattice are drawn with the probe's own seed, so the implication holds for the lattice exactly and for the

@@ -194,6 +194,14 @@ class Placements(StepWorld):
         g_t = grasp_transform(spec, self.scene.body(obj).shape)
         return lambda poses: mover.comfort(poses @ g_t, share)
 
+    def out_of_reach(self, robot: str, obj: str, grasp: str) -> Callable[[np.ndarray], bool]:
+        """Whether a placement of ``obj`` (an object pose (4, 4)) is certainly out of ``robot``'s reach holding it
+        with ``grasp``: its end effector would lie past the reach bound (:meth:`comfortable` at share 1, above
+        0), an upper bound of where it can be, so no inverse kinematics answer exists there.  Never true for a
+        robot without a reach bound (a cart) or a grasp without geometry."""
+        rank = self.comfortable(robot, obj, grasp, share=1.0)
+        return lambda pose: bool(rank(pose[None])[0] > 0)
+
 
 class _Room:
     """The free placements of one object in one region under one volume (:meth:`Placements._room`): those

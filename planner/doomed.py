@@ -198,7 +198,7 @@ class DoomedActions:
             prefer=g.comfortable(a.place_robot, a.obj, a.place_grasp),
             samples=self.samples,
         )
-        beyond = g.comfortable(a.place_robot, a.obj, a.place_grasp, share=1.0)  # > 0: past the reach bound
+        far_off = g.out_of_reach(a.place_robot, a.obj, a.place_grasp)
         looked, any_pose = 0, False
         for pose in poses:
             self.on_time()
@@ -206,7 +206,7 @@ class DoomedActions:
             if looked >= self.tries:
                 break
             spot = (a.place_robot, a.obj, a.place_grasp, self.spot_key(pose))
-            if spot in self.dead or beyond(pose[None])[0] > 0:  # as the grounding does: costs no try
+            if spot in self.dead or far_off(pose):  # as the grounding does: costs no try
                 continue
             looked += 1
             place = g.place(a.place_robot, a.obj, a.place_grasp, pose, avoid=avoid)

@@ -474,15 +474,15 @@ class ReverseGrounder:
             both = _both(
                 g.comfortable(a.pick_robot, a.obj, a.pick_grasp), g.comfortable(a.place_robot, a.obj, a.place_grasp)
             )
-            beyond = _both(
-                g.comfortable(a.pick_robot, a.obj, a.pick_grasp, share=1.0),
-                g.comfortable(a.place_robot, a.obj, a.place_grasp, share=1.0),
+            far_off = (
+                g.out_of_reach(a.pick_robot, a.obj, a.pick_grasp),
+                g.out_of_reach(a.place_robot, a.obj, a.place_grasp),
             )
             for pose in g.placements(
                 a.obj, where, avoid=others, volume=_plus(v_fut, taken), key=key, packed=True, prefer=both
             ):
                 self._on_time()
-                if beyond(pose[None])[0] > 0:
+                if any(far(pose) for far in far_off):
                     continue  # past one arm's reach bound: neither sets it down and picks it up there
                 tried += 1
                 if tried > PLACEMENT_TRIES + OUT_OF_REACH_TRIES:
@@ -741,7 +741,7 @@ class ReverseGrounder:
                 samples=PLACEMENT_SAMPLES,
             )
         )
-        beyond = g.comfortable(a.place_robot, a.obj, a.place_grasp, share=1.0)  # > 0: past the arm's reach bound
+        far_off = g.out_of_reach(a.place_robot, a.obj, a.place_grasp)
         looked = far = 0
         crossed = 0  # carries blocked by what the step's other robots sweep meanwhile (``busy``)
         static = True  # every placement tried failed on what never moves (Failure.static)
@@ -757,7 +757,7 @@ class ReverseGrounder:
             spot = (a.place_robot, a.obj, a.place_grasp, _spot_key(pose))
             if spot in self._dead_spots:
                 continue  # failed before on what never moves: fails again, and costs no try
-            if forced is None and beyond(pose[None])[0] > 0:
+            if forced is None and far_off(pose):
                 far += 1
                 continue  # no arm configuration reaches it (the reach bound is an upper bound): costs no try
             looked += 1

@@ -1391,12 +1391,12 @@ def test_placements_past_the_arm_s_reach_bound_are_never_asked_and_fail_as_out_o
         return place(robot, obj, grasp, pose, *args, **kw)
 
     pa3.place = recorded  # type: ignore[method-assign]
-    beyond = pa3.comfortable("r1", "o1", "top", share=1.0)
+    far_off = pa3.out_of_reach("r1", "o1", "top")
     skel = Skeleton(((Action("o1", "bin-b", "r1", "r1", "top", "top"),),))
     grounding = ReverseGrounder(pa3, {"o1": "bin-b"}).ground(skel, [], key="far")
     assert grounding.outcome is Outcome.FAIL, grounding.reason
     failure = grounding.failures[0]
     assert (failure.check, failure.static) == ("place by r1: no inverse kinematics", True)
     assert "beyond its reach" in failure.detail
-    assert all(beyond(p[None])[0] > 0 for p in pa3.placements("o1", "bin-b", key="far", packed=True))
+    assert all(far_off(p) for p in pa3.placements("o1", "bin-b", key="far", packed=True))
     assert not asked  # every free pose lies past the bound: none was asked

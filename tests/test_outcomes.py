@@ -336,8 +336,11 @@ class ScriptedGrounder:
         self.asked.append(("placement", obj, key))
         yield np.eye(4)
 
-    def comfortable(self, robot: str, obj: str, grasp: str, share: float = 0.85) -> Any:
+    def comfortable(self, robot: str, obj: str, grasp: str) -> Any:
         return lambda poses: np.zeros(len(poses))
+
+    def out_of_reach(self, robot: str, obj: str, grasp: str) -> Any:
+        return lambda pose: False
 
     def crowded_out(
         self, objs: Any, region: str, avoid: Any = (), volume: Any = None, key: str = "", extra: Any = ()

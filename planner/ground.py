@@ -751,8 +751,8 @@ class ReverseGrounder:
             if pose is None:
                 none = Failure(0, "", f"placement: no free pose of {a.obj} in {region}")
                 if far and last is None:  # as when every pose tried had no IK (static, as that was)
-                    none = Failure(0, "", f"place by {a.place_robot}: {GroundStatus.NO_IK.value}", static=True)
-                    return replace(none, detail=f"the free poses in {region} not failed at before are beyond its reach")
+                    beyond = f"the free poses in {region} not failed at before are beyond its reach"
+                    return Failure(0, "", f"place by {a.place_robot}: {GroundStatus.NO_IK.value}", (), beyond, True)
                 return _static(last, static) if last else none
             spot = (a.place_robot, a.obj, a.place_grasp, _spot_key(pose))
             if spot in self._dead_spots:

@@ -236,9 +236,9 @@ def export_model(
     The model is the one the backend solves for the first skeleton, without cuts: its optimum is the first
     skeleton's (makespan, objects moved).  ``horizon`` T chooses another: for the ``paper`` and
     ``disaggregated`` encodings the model of skeletons of exactly T steps, for ``time-of-move`` of at most T
-    steps.  By default T is the makespan of the first skeleton (compiled now), or, when there is none, the
-    horizon limit (``max_makespan``, capped at the number of objects in the task graph).  docs/backends.md
-    says what each file holds and how to load it into its solver.
+    steps.  By default T is the makespan of the first skeleton (compiled now; 1 when the goals hold at the
+    start and it is 0), or, when there is none, the horizon limit (``max_makespan``, capped at the number of
+    objects in the task graph).  docs/backends.md says what each file holds and how to load it into its solver.
     """
     from mrgc.planner.skeletons import export_model as write_model
     from mrgc.planner.skeletons import needs_facts, problem_facts
@@ -252,7 +252,8 @@ def export_model(
         result = compile(
             problem, backend=backend, encoding=encoding, max_makespan=max_makespan, facts=fact_list, seed=seed
         )
-        horizon = result.skeletons[0].makespan if result.skeletons else None  # none: the limit
+        # none: the limit; goals that hold at the start (makespan 0): the model of one step
+        horizon = max(1, result.skeletons[0].makespan) if result.skeletons else None
     return write_model(
         problem,
         os.fspath(path),

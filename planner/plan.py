@@ -61,6 +61,12 @@ class Plan:
         return len(self.steps)
 
     @property
+    def has_plan(self) -> bool:
+        """Whether this holds a plan: one with steps, or a solved one without (the goals held at the start,
+        makespan 0); a run without a plan states neither makespan nor motion cost (null in its file)."""
+        return bool(self.steps) or self.status is PlanStatus.SOLVED
+
+    @property
     def motion_cost(self) -> int:
         """The number of moves (the paper's cost, objects moved; an object a relay sets down moves twice)."""
         return sum(len(step) for step in self.steps)
@@ -94,8 +100,8 @@ class Plan:
             "status": str(self.status),
             "symbolic": self.symbolic,
             **({} if self.symbolic else {"motion_model": (self.motion_model or planner_motion_model()).to_json()}),
-            "makespan": self.makespan if self.steps else None,
-            "motion_cost": self.motion_cost if self.steps else None,
+            "makespan": self.makespan if self.has_plan else None,
+            "motion_cost": self.motion_cost if self.has_plan else None,
             "steps": [
                 {"index": i, "actions": [a.to_json() for a in step], "waiting": self._waiting(step)}
                 for i, step in enumerate(self.steps, 1)
@@ -121,8 +127,8 @@ class Plan:
             seed=self.seed,
             status=str(self.status),
             symbolic=self.symbolic,
-            makespan=self.makespan if self.steps else None,
-            motion_cost=self.motion_cost if self.steps else None,
+            makespan=self.makespan if self.has_plan else None,
+            motion_cost=self.motion_cost if self.has_plan else None,
             steps=tuple(Step(i, tuple(step), tuple(self._waiting(step))) for i, step in enumerate(self.steps, 1)),
             motion_model=None if self.symbolic else (self.motion_model or planner_motion_model()),
             problem_digest=self.problem_digest,
@@ -142,7 +148,7 @@ class Plan:
             f"plan for {self.problem}: {self.status}"
             + (
                 f", makespan {self.makespan}, {moved_text([[a.object for a in step] for step in self.steps])}"
-                if self.steps
+                if self.has_plan
                 else ""
             )
         ]

@@ -17,7 +17,7 @@ from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action
 from mrgc.geometry.collision import Packed
 from mrgc.planfile.format import PlannedAction, file_sha256
-from mrgc.planfile.reader import read_plan
+from mrgc.planfile.reader import read_plan, read_plan_file
 from mrgc.planner.ground import GroundedStep, Grounding, Outcome, swept
 from mrgc.planner.mcts import MCTS, Node
 from mrgc.planner.search import plan_problem
@@ -101,6 +101,44 @@ def test_symbolic_plans_are_the_best_skeleton(capsys: pytest.CaptureFixture[str]
     assert data["symbolic"] and data["makespan"] == 3 and data["motion_cost"] == 7
     assert cli.main(["plan", str(ROOT / "domains" / "symbolic" / "infeasible.mrg")]) == 1
     assert json.loads(capsys.readouterr().out)["status"] == "infeasible"
+
+
+@pytest.mark.parametrize("planner", ["mcts", "ap1", "ap2"])
+def test_goals_that_hold_at_the_start_are_a_valid_empty_plan(
+    planner: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # the tutorial's two arms, its goal box already in its goal region: solved with no step (makespan and motion
+    # cost 0, not null), and the validator agrees (the plan used to state null and fail its own summary check)
+    text = (ROOT / "docs" / "tutorial" / "two-arms.mrg").read_text(encoding="utf-8")
+    text = text.replace("(:goal (in-region box1 bin))", "(:goal (in-region box1 start))")
+    assert "(in-region box1 start)" in text
+    (tmp_path / "domain.mrg").write_text((ROOT / "docs" / "tutorial" / "domain.mrg").read_text(encoding="utf-8"))
+    src, out = tmp_path / "held.mrg", tmp_path / "plan.json"
+    src.write_text(text, encoding="utf-8")
+    assert cli.main(["plan", str(src), "--planner", planner, "-o", str(out)]) == 0
+    assert "solved, makespan 0" in capsys.readouterr().out
+    data = json.loads(out.read_text(encoding="utf-8"))
+    assert (data["status"], data["makespan"], data["motion_cost"], data["steps"]) == ("solved", 0, 0, [])
+    assert validate(parse_file(src).problem(), read_plan_file(str(out))).ok
+
+
+def test_a_symbolic_goal_that_holds_at_the_start(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    src = tmp_path / "held.mrg"
+    src.write_text(
+        (ROOT / "domains" / "symbolic" / "domain.mrg").read_text(encoding="utf-8")
+        + "(define (problem held) (:domain abstract) (:robots r1) (:movable o1) (:regions a b)\n"
+        "  (:init (in-region o1 a) (reachable-pick o1 top r1) (reachable-place o1 b top r1))\n"
+        "  (:goal (in-region o1 a)))\n",
+        encoding="utf-8",
+    )
+    out = tmp_path / "plan.json"
+    assert cli.main(["plan", str(src), "-o", str(out)]) == 0
+    data = json.loads(out.read_text(encoding="utf-8"))
+    assert (data["status"], data["makespan"], data["motion_cost"]) == ("solved", 0, 0)
+    assert validate(parse_file(src).problem(), read_plan_file(str(out))).ok
+    # its model is written with one step (a horizon of 0 used to be refused although none was asked for)
+    assert cli.main(["compile", str(src), "--emit", str(tmp_path / "m.pbtxt")]) == 0
+    assert "(horizon 1)" in capsys.readouterr().out and (tmp_path / "m.pbtxt").stat().st_size > 0
 
 
 # ------------------------------------------------------------------ MCTS mechanics, scripted grounding

@@ -220,6 +220,17 @@ def test_spheres_touch_at_a_point() -> None:
     assert "lies on the edge of the support polygon of its contacts with ball" in on_ball.message()
 
 
+@PROPERTY
+@given(r=st.floats(0.005, 0.3), x=st.floats(-0.49, 0.49), y=st.floats(-0.49, 0.49), lift=st.floats(0, 0.009))
+@example(r=0.025, x=-0.2000000000003, y=0.0, lift=0.0)  # the contact point rounded, the centre not: -3e-13 m
+def test_a_ball_on_a_top_is_stable_wherever_it_touches(r: float, x: float, y: float, lift: float) -> None:
+    """A ball's centre is above its contact point (neutral equilibrium, required margin 0): the margin is 0
+    up to rounding, which must not make every ball placement "topple" (it did, 3e-13 m "outside")."""
+    table = {"t": (Box(1, 1, 0.1), translation(0, 0, 0.05))}
+    ball = stability("ball", Sphere(r), translation(x, y, 0.1 + lift + r), table)
+    assert ball.stable and ball.supporters == ("t",) and abs(ball.margin) < 1e-9
+
+
 def _write_obj(path: Path, vertices: list[tuple[float, float, float]], faces: list[tuple[int, ...]]) -> str:
     lines = [f"v {x} {y} {z}" for x, y, z in vertices] + ["f " + " ".join(str(i + 1) for i in f) for f in faces]
     path.write_text("\n".join(lines) + "\n", encoding="utf-8")

@@ -29,6 +29,7 @@ distance to the polygon), minus infinity without a supporter.
 **The required margin** is ``min(MARGIN, MARGIN_SHARE × the object's smaller footprint side)``: 5 mm, or 5 %
 of the smaller side of a small object (a 4 cm cube needs 2 mm), and 0 for a sphere (a ball on a flat top
 is in neutral equilibrium: its centre is always above its contact point; it must only touch a top face).
+A margin within :data:`EPS` (1 nm) of the required one passes: for a ball it is 0 up to rounding.
 Why 5 mm: a centre of mass on the polygon's edge is the tipping point itself, so some margin is needed
 for a verdict that does not flip with noise, and 5 mm covers what the validator lets a release pose be off
 by (1 mm in position; 0.01 rad of tilt moves the centre of mass of a 0.3 m box 1.5 mm sideways; the
@@ -199,7 +200,7 @@ def stability(
     required = _required(shape)
     return Stability(
         obj=obj,
-        stable=bool(flat and names and margin >= required),
+        stable=bool(flat and names and margin >= required - EPS),  # on the edge within EPS: a ball on its point
         flat=flat,
         tilt=tilt,
         margin=margin,

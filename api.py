@@ -113,7 +113,7 @@ def _resolve(source: ProblemSource, name: str | None, allow_outside: Sequence[st
 
 def _layout(problem: "Problem", robots: bool, arms: bool = True) -> list[Diagnostic]:
     """The layout diagnostics of a geometric problem (none for a symbolic one): those ``check`` reports, or
-    (``robots``) those that need the robots' models (docs/errors.md, E263-E266, W270-W272); ``arms`` False
+    (``robots``) those that need the robots' models (docs/errors.md, E263-E268, W270-W272); ``arms`` False
     leaves out the warnings W274-W276 (:mod:`mrgc.geometry.arm_diagnosis`)."""
     if problem.symbolic:
         return []

@@ -11,6 +11,9 @@ Each finding is a located :class:`~mrgc.errors.Diagnostic` (docs/errors.md).  Tw
 - ``E265`` a movable object overlaps a fixed object at its start pose;
 - ``E266`` a planar robot's footprint at its start pose overlaps a movable object, a fixed object or
   another robot's footprint;
+- ``E267`` a ``(mesh ...)`` shape's file holds no triangle, ``E268`` the mesh of a movable object or a
+  footprint is not centred on its origin, ``E403`` a mesh file cannot be used (:func:`mesh_diagnostics`:
+  every mesh file is read here; a declaration whose mesh is refused gets no other complaint);
 - ``W270`` (:func:`mrgc.geometry.grasps.grasp_warnings`) a grasp no gripper opens wide enough for;
 - ``W271`` a movable object lies in no region at its start pose (``in-region`` holds for none): unless it
   is a goal object it can never move, so an obstacle in no region makes its goals unreachable;
@@ -61,10 +64,14 @@ def layout_diagnostics(problem: Problem, arms: bool = True) -> list[Diagnostic]:
         return []
     from mrgc.geometry.grasps import grasp_warnings
 
-    out = home_diagnostics(problem)
-    out += overlap_diagnostics(problem)
-    out += grasp_warnings(problem)
-    out += region_diagnostics(problem)
+    meshes = mesh_diagnostics(problem)
+    unusable = {d.span for d in meshes}  # a declaration whose mesh is refused gets no other complaint
+    out = home_diagnostics(problem) + meshes
+    out += [
+        d
+        for d in overlap_diagnostics(problem) + grasp_warnings(problem) + region_diagnostics(problem)
+        if d.span not in unusable
+    ]
     out += tcp_diagnostics(problem)
     if arms and not any(d.severity != "warning" for d in out):  # an arm that can reach nothing, and why
         from mrgc.geometry.arm_diagnosis import arm_diagnostics
@@ -148,6 +155,70 @@ def home_diagnostics(problem: Problem) -> list[Diagnostic]:
                 kind.home_span,
             )
         )
+    return out
+
+
+# ---------------------------------------------------------------------------------------------- meshes
+#: m: how far a movable object's (or a footprint's) mesh may have its bounding box's centre off its origin
+MESH_CENTRE_TOL = 1e-3
+
+
+def mesh_diagnostics(problem: Problem) -> list[Diagnostic]:
+    """The mesh files of ``(mesh ...)`` shapes, read now (each once): E403 for a file that cannot be used
+    (located in that file), E267 for one with no triangle (nothing to collide with, grasp or set down), and
+    E268 for the mesh of a movable object or a robot's footprint whose bounding box is not centred on its
+    origin (:data:`MESH_CENTRE_TOL`): grasps, placements and a cart's load take such a shape's origin as its
+    centre, so an off-centre one would be set down in the air or gripped beside itself.  A fixed object's or
+    a region's mesh may lie anywhere about its origin."""
+    import numpy as np
+
+    from mrgc.geometry.meshes import read_mesh
+
+    uses: list[tuple[str, str, Mesh, Span, bool]] = []
+    for what, decls in (("movable object", problem.movable), ("fixed object", problem.fixed)):
+        for d in decls:
+            if isinstance(d.shape, Mesh):
+                uses.append((what, d.name, d.shape, d.span, what == "movable object"))
+    uses += [("region", r.name, r.shape, r.span, False) for r in problem.regions if isinstance(r.shape, Mesh)]
+    uses += [
+        ("the footprint of robot kind", k.name, k.footprint, k.span, True)
+        for k in problem.domain.robot_kinds
+        if isinstance(k.footprint, Mesh)
+    ]
+    out: list[Diagnostic] = []
+    unusable: set[str] = set()
+    for what, name, mesh, span, centred in uses:
+        try:
+            vertices, faces = read_mesh(mesh.path)
+        except InputError as exc:
+            if mesh.path not in unusable:  # the file's own complaint, once
+                out += exc.diagnostics
+            unusable.add(mesh.path)
+            continue
+        if not len(faces) or not len(vertices):
+            out.append(
+                Diagnostic(
+                    "E267",
+                    f"mesh file '{mesh.path}' of {what} '{name}' holds no triangle ({len(vertices)} vertices, "
+                    f"{len(faces)} faces): "
+                    + ("it holds nothing to set down in" if what == "region" else "it has no volume to collide with"),
+                    span,
+                )
+            )
+            continue
+        scaled = np.asarray(vertices, dtype=float) * mesh.scale
+        centre = (scaled.min(axis=0) + scaled.max(axis=0)) / 2
+        if centred and float(np.abs(centre).max()) > MESH_CENTRE_TOL:
+            x, y, z = (float(c) + 0.0 for c in centre)  # + 0.0: no "-0.0000"
+            out.append(
+                Diagnostic(
+                    "E268",
+                    f"the mesh of {what} '{name}' is not centred on its origin: its bounding box's centre lies at "
+                    f"({x:.4f}, {y:.4f}, {z:.4f}) m in the mesh's frame; grasps and placements take the origin "
+                    f"as the centre, so move the file's vertices by ({0.0 - x:.4f}, {0.0 - y:.4f}, {0.0 - z:.4f}) m",
+                    span,
+                )
+            )
     return out
 
 

@@ -74,6 +74,8 @@ CODES: dict[str, str] = {
     "E264": "movable objects overlap at the start",
     "E265": "movable object overlaps a fixed object at the start",
     "E266": "robot overlaps an object at the start",
+    "E267": "mesh with no triangle",
+    "E268": "mesh not centred on its origin",
     # warnings (the file is accepted)
     "W270": "grasp wider than the gripper",
     "W271": "object in no region",
@@ -235,6 +237,14 @@ HELP: dict[str, str] = {
     "E266": "A robot at its start overlaps (by more than 1 mm) a movable or fixed object: a planar robot's "
     "`:footprint` at its `:base` pose (also another planar robot's footprint), found by `mrgc check`; an arm's "
     "links at its `:home` configuration, found by `mrgc facts` (and `mrgc plan`), which read the arm's meshes.",
+    "E267": "A `(mesh ...)` shape's file holds no triangle (an empty file, or vertices without faces): the "
+    "shape has no volume, so nothing could collide with it, grasp it or set it down. Found by `mrgc check`, "
+    "which reads every mesh file of the problem (a file that cannot be read at all is E403).",
+    "E268": "The mesh of a movable object, or of a planar robot kind's `:footprint`, is not centred on its "
+    "origin: the centre of its bounding box lies more than 1 mm from the mesh file's origin. Grasps, "
+    "placements and a cart's load take such a shape's origin as its centre (an object whose origin is on its "
+    "bottom face would be set down in the air, and gripped beside its middle). Move the file's vertices by "
+    "the offset the message gives; a fixed object's or a region's mesh may lie anywhere about its origin.",
     "W271": "A warning, not an error: a movable object lies in no region at its start pose (no region holds it "
     "entirely, so `in-region` holds for none). A goal object can still be moved into its goal region; any other "
     "object can never move, so if it obstructs something, that goal cannot be reached.",

@@ -545,7 +545,10 @@ def test_urdf_meshes_resolve_beside_the_urdf_never_the_current_folder(tmp_path: 
 def test_geometry_files_are_confined_to_the_problems_tree(tmp_path: Path, mrgc) -> None:  # type: ignore[no-untyped-def]
     outside = tmp_path / "outside"
     outside.mkdir()
-    (outside / "block.obj").write_text("v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nv 0 0 0.1\n", encoding="utf-8")
+    (outside / "block.obj").write_text(  # a tetrahedron centred on its origin (E267, E268 otherwise)
+        "v -0.05 -0.05 -0.05\nv 0.05 -0.05 -0.05\nv -0.05 0.05 -0.05\nv 0 0 0.05\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n",
+        encoding="utf-8",
+    )
     folder = tmp_path / "problem"
     folder.mkdir()
     text = (

@@ -1,4 +1,4 @@
-"""The layout checks of geometric problems (geometry/layout.py, docs/errors.md E263-E266, W271, W272): each
+"""The layout checks of geometric problems (geometry/layout.py, docs/errors.md E263-E268, W271, W272): each
 fires on the layout it names, located; none fires on the shipped problems or on generated ones; the
 commands that work on a problem refuse an impossible start before any work."""
 
@@ -173,3 +173,50 @@ def test_facts_reports_the_robot_model_warnings(capsys: pytest.CaptureFixture[st
     result = mrgc.compute_facts(golden, workers=1)
     assert [d.code for d in result.warnings] == ["W272"] and result.facts
     assert mrgc.check(golden).warnings == ()  # check reads no robot model
+
+
+# ---------------------------------------------------------------------------------------------- meshes
+def _block_obj(path: Path, z0: float, faces: bool = True) -> None:
+    """A 4 x 4 x 8 cm block whose lowest face lies at z = ``z0`` in its file's frame."""
+    v = [(x, y, z) for x in (-0.02, 0.02) for y in (-0.02, 0.02) for z in (z0, z0 + 0.08)]
+    f = [(1, 3, 4, 2), (5, 6, 8, 7), (1, 2, 6, 5), (3, 7, 8, 4), (1, 5, 7, 3), (2, 4, 8, 6)] if faces else []
+    lines = [f"v {x} {y} {z}" for x, y, z in v] + ["f " + " ".join(map(str, q)) for q in f]
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+
+
+def mesh_codes(tmp_path: Path, movable: str, **kw: str) -> list[tuple[str, int]]:
+    src = tmp_path / "p.mrg"
+    src.write_text(cell(movable, **kw), encoding="utf-8")
+    found = layout_diagnostics(mrgc.parse_file(src).problem(), arms=False)
+    return [(d.code, d.span.line if d.span else 0) for d in found]
+
+
+@pytest.mark.parametrize("z0", [-0.04, -0.0405, 0.0, 0.01])
+def test_a_movable_mesh_must_be_centred_on_its_origin(tmp_path: Path, z0: float) -> None:
+    """E268 past 1 mm off centre (the planner set a bottom-origin block down 8 cm in the air, exit 5); a fixed
+    object's mesh may lie anywhere about its origin."""
+    _block_obj(tmp_path / "b.obj", z0)
+    found = mesh_codes(tmp_path, '(o1 :shape (mesh "b.obj") :pose (0 0 0.05 0))')
+    assert found == ([] if abs(z0 + 0.04) <= 1e-3 else [("E268", 10)])
+    fixed = '(table :shape (box 1.4 1.4 0.05) :pose (0 0 -0.025 0)) (post :shape (mesh "b.obj") :pose (0.5 0.5 0 0))'
+    assert mesh_codes(tmp_path, f"(o1 :shape {BOX} :pose (0 0 0.05 0))", fixed=fixed) == []
+
+
+@pytest.mark.parametrize("content", ["", "v 0 0 0\nv 1 0 0\nv 0 1 0\n", "solid x\nendsolid x\n"])
+def test_a_mesh_with_no_triangle_is_refused_where_it_is_used(tmp_path: Path, content: str) -> None:
+    """E267 at the declaration, for an object and for a region (check said "ok" and phase 1 failed without
+    a location, or gave a region made of such a file no fact at all)."""
+    name = "m.stl" if content.startswith("solid") else "m.obj"
+    (tmp_path / name).write_text(content, encoding="utf-8")
+    assert mesh_codes(tmp_path, f'(o1 :shape (mesh "{name}") :pose (0 0 0.05 0))') == [("E267", 10)]
+    region = f'(start :shape (box 0.4 0.4 0.3) :pose (0 0 0.15 0)) (bin :shape (mesh "{name}") :pose (0 0.3 0 0))'
+    assert mesh_codes(tmp_path, f"(o1 :shape {BOX} :pose (0 0 0.05 0))", regions=region) == [("E267", 9)]
+
+
+def test_a_broken_mesh_file_is_reported_by_check_in_it(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    (tmp_path / "m.obj").write_text("v 0 0 0\nv 1 0 nan\nv 0 1 0\nf 1 2 3\n", encoding="utf-8")
+    src = tmp_path / "p.mrg"
+    src.write_text(cell('(o1 :shape (mesh "m.obj") :pose (0 0 0.05 0))'), encoding="utf-8")
+    assert cli.main(["check", str(src)]) == 2
+    first = capsys.readouterr().err.splitlines()[0]
+    assert first.startswith(f"{tmp_path / 'm.obj'}:2:1: error[E403]") and "nan" in first

@@ -8,7 +8,8 @@ and any command added later) goes through :func:`write_text` / :func:`write_byte
   inputs (the problem file, its domain, its includes, meshes and URDFs; compared by device and inode, so
   hard links, symlinks and ``./x`` spellings are caught) is refused with E005; a folder, a FIFO, a device,
   a path under a missing or unwritable folder with E006.  :func:`check_output` is the check alone, for
-  commands that want to fail before a long computation.
+  commands that want to fail before a long computation; :func:`check_folder` the same for a folder a
+  command writes into (made at once).
 - **Atomic replacement.**  The text goes to a temp file created with ``O_EXCL`` in the target's own folder
   (:func:`tempfile.mkstemp`: a random name, never following a planted symlink), is flushed and fsynced,
   gets the target's permission bits (and owner, where allowed; a new file gets ``0666 & ~umask``), and is
@@ -91,6 +92,30 @@ def check_output(path: str, inputs: Iterable[str] = (), *, option: str = "-o") -
     if not os.access(folder, os.W_OK | os.X_OK):
         raise _refuse(E_UNWRITABLE, f"{option} {path}: folder {os.path.dirname(path) or '.'} is not writable")
     return real
+
+
+def check_folder(path: str, *, option: str) -> str:
+    """The folder ``path`` a command writes its files into (``--figures DIR``, ``bench run --work DIR``),
+    made now (with its parents) if it does not exist, before any work is spent; InputError E006 when it is
+    not a folder (a file, a device) or cannot be made.  Its absolute path."""
+    if not path:
+        raise _refuse(E_UNWRITABLE, f"{option}: the folder path is empty")
+    try:
+        st: os.stat_result | None = os.stat(path)
+    except FileNotFoundError:
+        st = None
+    except (OSError, ValueError) as exc:
+        raise _refuse(E_UNWRITABLE, f"{option} {path}: {getattr(exc, 'strerror', None) or exc}") from None
+    if st is not None and not stat.S_ISDIR(st.st_mode):
+        what = "a file" if stat.S_ISREG(st.st_mode) else file_kind(st.st_mode)
+        raise _refuse(E_UNWRITABLE, f"{option} {path}: is {what}, not a folder; name a folder")
+    try:
+        os.makedirs(path, exist_ok=True)
+    except OSError as exc:
+        raise _refuse(E_UNWRITABLE, f"{option} {path}: cannot be made: {exc.strerror or exc}") from None
+    if not os.access(path, os.W_OK | os.X_OK):
+        raise _refuse(E_UNWRITABLE, f"{option} {path}: is not writable")
+    return os.path.abspath(path)
 
 
 def write_text(path: str, text: str, inputs: Iterable[str] = (), *, option: str = "-o") -> None:

@@ -17,10 +17,10 @@
 from __future__ import annotations
 
 import json
-import os
 import sqlite3
-from typing import Any
+from typing import Any, Iterable
 
+from mrgc import outputs
 from mrgc.bench.db import ResultsDB
 from mrgc.bench.outcome import RunStatus
 
@@ -42,23 +42,21 @@ CREATE TABLE progress (runid INTEGER, time REAL, PRIMARY KEY (runid, time),
 STATUS_VALUES = [s.value for s in RunStatus]
 
 
-def export_planner_arena(db: ResultsDB, out: str, study: str | None = None) -> int:
+def export_planner_arena(db: ResultsDB, out: str, study: str | None = None, inputs: Iterable[str] = ()) -> int:
     """Write the runs of one study or of every study to a new OMPL benchmark database ``out`` (replaced if
-    it exists); the number of runs written."""
-    tmp = out + ".mrgc-tmp"
-    if os.path.exists(tmp):
-        os.unlink(tmp)
-    conn = sqlite3.connect(tmp)
-    try:
-        conn.executescript(_SCHEMA)
-        conn.executemany("INSERT INTO enums VALUES ('status', ?, ?)", list(enumerate(STATUS_VALUES)))
-        written = 0
-        for name in [study] if study is not None else db.studies():
-            written += _study(conn, db, name)
-        conn.commit()
-    finally:
-        conn.close()
-    os.replace(tmp, out)
+    it exists, atomically: :func:`mrgc.outputs.atomic_path`; ``inputs``, the results database's files among
+    them, are refused as ``out`` with E005); the number of runs written."""
+    with outputs.atomic_path(out, inputs, option="--planner-arena") as tmp:
+        conn = sqlite3.connect(tmp)
+        try:
+            conn.executescript(_SCHEMA)
+            conn.executemany("INSERT INTO enums VALUES ('status', ?, ?)", list(enumerate(STATUS_VALUES)))
+            written = 0
+            for name in [study] if study is not None else db.studies():
+                written += _study(conn, db, name)
+            conn.commit()
+        finally:
+            conn.close()
     return written
 
 

@@ -116,11 +116,17 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 def cmd_report(args: argparse.Namespace) -> int:
     """``mrgc bench report``: tables on standard output; figures and a Planner Arena database on request."""
+    from mrgc import outputs
     from mrgc.bench.db import ResultsDB
     from mrgc.bench.report import render
     from mrgc.bench.run import DEFAULT_DB
 
-    with ResultsDB(args.db or DEFAULT_DB, readonly=True) as db:
+    path = args.db or DEFAULT_DB
+    # the outputs are checked before the report is made: the database read is no output, a folder is made
+    figures = args.figures if args.figures and outputs.check_folder(args.figures, option="--figures") else None
+    if args.planner_arena:
+        outputs.check_output(args.planner_arena, _database_files(path), option="--planner-arena")
+    with ResultsDB(path, readonly=True) as db:
         if args.study is not None and args.study not in db.studies():
             from mrgc.errors import Diagnostic, InputError
             from mrgc.language.suggest import did_you_mean
@@ -136,14 +142,20 @@ def cmd_report(args: argparse.Namespace) -> int:
                 ]
             )
         sys.stdout.write(render(db, args.format, args.study, args.time))
-        if args.figures:
+        if figures is not None:
             from mrgc.bench.figures import write_figures
 
-            for path in write_figures(db, args.figures, args.study, args.time):
-                print(f"figure written: {path}", file=sys.stderr)
+            for written in write_figures(db, figures, args.study, args.time):
+                print(f"figure written: {written}", file=sys.stderr)
         if args.planner_arena:
             from mrgc.bench.arena import export_planner_arena
 
-            n = export_planner_arena(db, args.planner_arena, args.study)
+            n = export_planner_arena(db, args.planner_arena, args.study, inputs=_database_files(path))
             print(f"{args.planner_arena}: {n} runs as an OMPL benchmark database (Planner Arena)", file=sys.stderr)
     return 0
+
+
+def _database_files(path: str) -> list[str]:
+    """The files of the SQLite results database ``path`` (its write-ahead log and shared memory too): inputs
+    of ``bench report``, which no output may replace."""
+    return [path, path + "-wal", path + "-shm"]

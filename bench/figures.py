@@ -17,6 +17,7 @@ from __future__ import annotations
 import os
 from typing import Any
 
+from mrgc import outputs
 from mrgc.bench.db import ResultsDB
 from mrgc.bench.report import CLOCKS, aggregate
 
@@ -95,6 +96,9 @@ def _cactus(plt: Any, name: str, times: dict[str, list[float]], folder: str, lab
 def _save(plt: Any, fig: Any, folder: str, file: str) -> str:
     path = os.path.join(folder, file)
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    try:
+        with outputs.atomic_path(path, option="--figures") as tmp:  # a figure is whole or not there
+            fig.savefig(tmp, dpi=120, format="png")
+    finally:
+        plt.close(fig)
     return path

@@ -15,6 +15,7 @@ from collections import Counter
 from dataclasses import dataclass, field
 from typing import Callable, Iterable
 
+from mrgc import outputs
 from mrgc.bench.db import ResultsDB, WriterLock
 from mrgc.bench.execute import RawRun, RunTask, now
 from mrgc.bench.instances import expand_instances
@@ -113,6 +114,7 @@ def run_study(
             ]
         )
     work = work or default_work(db)
+    outputs.check_folder(work, option="--work")  # made before any run (E006 when it cannot be)
     method_index = {m.name: i for i, m in enumerate(study.methods)}
     with WriterLock(db), ResultsDB(db) as results:
         tasks, skipped = study_tasks(study, work)

@@ -15,6 +15,7 @@ from typing import Any
 
 from mrgc.bench.study import E_STUDY_READ, E_STUDY_SCHEMA, FACTS_CACHE, InstanceSpec, Limits, Method, Study
 from mrgc.errors import Diagnostic, InputError, Span
+from mrgc.language.files import FileTooLarge, read_regular
 
 _NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.+-]*$")
 _RANGE = re.compile(r"^\s*(\d+)\s*\.\.\s*(\d+)\s*$")
@@ -70,12 +71,11 @@ def load_study(path: str | os.PathLike[str]) -> Study:
     """Read and check a study file; :class:`~mrgc.errors.InputError` lists every problem found (E600/E601)."""
     path = os.fspath(path)
     try:
-        with open(path, "rb") as fh:
-            data = fh.read(_MAX_BYTES + 1)
+        data = read_regular(path, _MAX_BYTES)  # non-blocking open: a FIFO is refused, not waited on
+    except FileTooLarge:
+        raise InputError([Diagnostic(E_STUDY_READ, f"study '{path}' is larger than {_MAX_BYTES} bytes")]) from None
     except OSError as exc:
         raise InputError([Diagnostic(E_STUDY_READ, f"cannot read study '{path}': {exc.strerror or exc}")]) from None
-    if len(data) > _MAX_BYTES:
-        raise InputError([Diagnostic(E_STUDY_READ, f"study '{path}' is larger than {_MAX_BYTES} bytes")])
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError as exc:

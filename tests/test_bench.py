@@ -657,6 +657,54 @@ def test_planner_arena_export_has_ompl_s_tables(tmp_path: Path) -> None:
     assert all(v.startswith("mrgc ") for (v,) in conn.execute("SELECT version FROM experiments"))
 
 
+def test_report_outputs_are_checked_first_and_never_replace_the_database(tmp_path: Path) -> None:
+    """The database read is no output (E005: --planner-arena onto it used to overwrite it, every run lost); a
+    folder, a file given as --figures' folder, a missing folder are E006 before the report is printed (they
+    were internal errors, exit 70, after it; --planner-arena /tmp left /tmp.mrgc-tmp behind)."""
+    db = golden_db(tmp_path)
+    before = db.read_bytes()
+    (tmp_path / "notes.txt").write_text("hello", encoding="utf-8")
+    cases = [
+        (["--planner-arena", str(db)], "error[E005]: --planner-arena"),
+        (["--planner-arena", str(tmp_path)], "error[E006]: --planner-arena"),
+        (["--planner-arena", str(tmp_path / "no" / "a.db")], "error[E006]: --planner-arena"),
+        (["--figures", str(tmp_path / "notes.txt")], "error[E006]: --figures"),
+        (["--figures", "/dev/null"], "error[E006]: --figures"),
+    ]
+    for extra, first in cases:
+        out = subprocess.run(
+            [*MRGC, "bench", "report", "--db", str(db), *extra], capture_output=True, text=True, timeout=60
+        )
+        assert out.returncode == 2 and out.stderr.startswith(first) and out.stdout == "", (extra, out.stderr)
+    assert db.read_bytes() == before and len(rows(db)) > 0
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["golden.db", "notes.txt"]  # no temp file left
+    out = subprocess.run(
+        [*MRGC, "bench", "report", "--db", str(db), "--figures", str(tmp_path / "f" / "g")],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert out.returncode == 0 and sorted(p.suffix for p in (tmp_path / "f" / "g").iterdir()) == [".png"] * 3
+
+
+def test_a_study_that_is_a_fifo_or_a_work_folder_that_is_a_file_is_refused_at_once(tmp_path: Path) -> None:
+    symbolic_copy(tmp_path / "p", "chain-3")
+    study = write_study(tmp_path / "s.yaml", "study: s\ninstances: [{file: p/chain-3.mrg}]\nmethods: [{name: O}]\n")
+    fifo = tmp_path / "s.fifo"
+    os.mkfifo(fifo)
+    out = subprocess.run(
+        [*MRGC, "bench", "run", str(fifo), "--db", str(tmp_path / "r.db")], capture_output=True, text=True, timeout=60
+    )
+    assert out.returncode == 2 and out.stderr.startswith("error[E600]") and "FIFO" in out.stderr
+    out = subprocess.run(
+        [*MRGC, "bench", "run", str(study), "--db", str(tmp_path / "r.db"), "--work", str(study)],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert out.returncode == 2 and out.stderr.startswith("error[E006]: --work") and not (tmp_path / "r.db").exists()
+
+
 def test_the_python_api_names_resolve_and_importing_it_loads_no_heavy_library() -> None:
     code = (
         "import sys, mrgc.bench as b\n"

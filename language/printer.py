@@ -242,9 +242,11 @@ def _goal(out: _Out, sec: ast.Goal) -> None:
         out.emit(f"(:goal {atom(sec.atoms[0])})", ind, sec.span)
         return
     one_line = "(:goal (and" + "".join(" " + atom(a) for a in sec.atoms) + "))"
-    s = sec.span
+    s, last = sec.span, sec.atoms[-1].span if sec.atoms else sec.span
+    # a comment before the last atom keeps the goal on several lines; one inside or after the last atom does
+    # not: it is printed after that atom, outside the goal, where the next formatting finds it (idempotence)
     commented = s.file != "<generated>" and any(
-        (s.line, s.column) < (c.line, c.column) < (s.end_line, s.end_column) for c in out.pending
+        (s.line, s.column) < (c.line, c.column) < (last.line, last.column) for c in out.pending
     )
     if len(ind + one_line) <= WIDTH and not commented:
         out.emit(one_line, ind, sec.span)

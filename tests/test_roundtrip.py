@@ -149,6 +149,49 @@ def test_print_then_parse_gives_the_tree(tree: ast.SourceFile) -> None:
     assert format_source(back) == text
 
 
+TOKEN = re.compile(r'\(|\)|"(?:\\.|[^"\\])*"|;[^\n]*|[^\s()";]+|\s+')
+
+
+@SETTINGS
+@given(
+    source_files,
+    st.lists(st.tuples(st.integers(0, 10**6), st.sampled_from([" ; after\n", "\n; own line\n", "\n\n"])), max_size=8),
+)
+@example(
+    ast.SourceFile(
+        (
+            ast.ProblemDef(
+                "p", (ast.Goal((ast.Atom("in-region", ("o1", "a")), ast.Atom("in-region", ("o2", "b"))), True),)
+            ),
+        )
+    ),
+    [(31, " ; c\n")],  # a comment after the goal's conjunction, before its closing parenthesis
+)
+@example(
+    ast.SourceFile(
+        (
+            ast.ProblemDef(
+                "p", (ast.Goal((ast.Atom("in-region", ("o1", "a")), ast.Atom("in-region", ("o2", "b"))), True),)
+            ),
+        )
+    ),
+    [(26, " ; c\n"), (28, "\n; own line\n")],  # comments inside the last atom
+)
+def test_formatting_a_commented_file_is_idempotent(tree: ast.SourceFile, cuts: list[tuple[int, str]]) -> None:
+    """Comments (after code, on their own line) and blank lines put between any two tokens of a file: its
+    formatting keeps the tree, and formatting that again changes nothing (the goal's layout once changed)."""
+    tokens = TOKEN.findall(format_source(tree))
+    for at, piece in sorted(cuts, reverse=True):
+        k = at % (len(tokens) + 1)
+        if k < len(tokens) and tokens[k].startswith('"'):
+            continue
+        tokens.insert(k, piece)
+    text = "".join(tokens)
+    once = format_source(parsed(text), text)
+    assert parsed(once) == tree
+    assert format_source(parsed(once), once) == once
+
+
 @SETTINGS
 @given(source_files)
 def test_generated_names_are_names(tree: ast.SourceFile) -> None:

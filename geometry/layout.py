@@ -25,9 +25,10 @@ Each finding is a located :class:`~mrgc.errors.Diagnostic` (docs/errors.md).  Tw
 **With robot models** (``mrgc facts`` and the commands that run phase 1, ``plan``):
 
 - ``E266`` an arm at its home configuration overlaps a movable object or a fixed object (the mount, the base
-  link and the links fixed to it, bolted in place, is left out, as everywhere in the geometry layer).  Arms
-  overlapping each other at home are not checked: the grounding keeps every motion clear of the other arms
-  at home, so such arms only narrow what can be planned;
+  link and the links fixed to it, bolted in place, is left out, as everywhere in the geometry layer), or an
+  arm's mount overlaps another arm's (two arms bolted at one base).  Arms whose moving links overlap at home
+  are not checked: the grounding keeps every motion clear of the other arms at home, so such arms only
+  narrow what can be planned;
 - ``W272`` a region lies outside the workspace of every robot: farther from each arm's shoulder than its
   reach bound (:attr:`~mrgc.geometry.kinematics.RobotModel.reach`).  Planar robots drive, so a problem with
   one has no such warning.
@@ -369,38 +370,54 @@ def robot_diagnostics(problem: Problem, arms: bool = True) -> list[Diagnostic]:
 
 
 def _arms_at_home(problem: Problem, scene: SceneSpec, arms: list[Arm]) -> list[Diagnostic]:
-    """E266 for each arm at its home configuration overlapping an object (the deepest link per object)."""
+    """E266 for each arm whose mount overlaps another arm's (two arms bolted at one base: :func:`_arm_on_arm`),
+    and for each arm at its home configuration overlapping an object (the deepest link per object; the mount
+    stands on what the arm is bolted to and is left out)."""
     spans = _spans(problem)
     world = scene_world(scene)
-    links: dict[str, list[str]] = {}
+    links: dict[str, list[str]] = {}  # each arm's moving links, then its mount's
     for arm in arms:
         shapes, index = arm.probes
         transforms = arm.link_transforms(arm.home[None])[0]
+        parts = [(arm.model.links[k].name, shape, t) for shape, k, t in zip(shapes, index, transforms)]
         links[arm.name] = []
-        for shape, k, t in zip(shapes, index, transforms):
-            key = f"{arm.name}/{arm.model.links[k].name}"
-            world.add(key, shape, t, f"robot:{arm.name}")
-            links[arm.name].append(key)
-    out: list[Diagnostic] = []
+        for name, shape, t in [*parts, *arm.base_hulls]:
+            world.add(f"{arm.name}/{name}", shape, t, f"robot:{arm.name}")
+            links[arm.name].append(f"{arm.name}/{name}")
+    out = _arm_on_arm(world, arms, links, spans)
     objects = [*world.names("movable"), *world.names("fixed")]
     for arm in arms:
         found: dict[str, tuple[float, str]] = {}
-        for key in links[arm.name]:
+        for key in links[arm.name][: len(arm.probes[0])]:
             for other, depth in _overlaps(world, key, objects):
                 if depth > found.get(other, (0.0, ""))[0]:
                     found[other] = (depth, key.split("/")[1])
         for target, (depth, link) in found.items():
             what = "movable object" if target in world.names("movable") else "fixed object"
-            out.append(
-                _overlap(
-                    "E266",
-                    f"robot '{arm.name}' ({link}) at its home configuration overlaps {what} '{target}'",
-                    depth,
-                    spans,
-                    arm.name,
-                    target,
-                )
-            )
+            message = f"robot '{arm.name}' ({link}) at its home configuration overlaps {what} '{target}'"
+            out.append(_overlap("E266", message, depth, spans, arm.name, target))
+    return out
+
+
+def _arm_on_arm(
+    world: CollisionWorld, arms: list[Arm], links: dict[str, list[str]], spans: dict[str, Span]
+) -> list[Diagnostic]:
+    """E266 for each pair of arms whose mounts (the last of ``links``: world keys ``arm/link``) overlap: arms
+    bolted into each other (two at one base), named by the later arm, with the deepest pair of links.  Arms
+    whose moving links overlap at home are not reported: the paper's motion model does not check the way
+    home (docs/geometry.md, "Layout checks")."""
+    mounts = {arm.name: links[arm.name][len(arm.probes[0]) :] for arm in arms}
+    out: list[Diagnostic] = []
+    for i, arm in enumerate(arms):
+        met: dict[str, tuple[float, str, str]] = {}
+        for key in mounts[arm.name]:
+            for other in arms[:i]:
+                for hit, depth in _overlaps(world, key, mounts[other.name]):
+                    if depth > met.get(other.name, (0.0, "", ""))[0]:
+                        met[other.name] = (depth, key.split("/")[1], hit.split("/")[1])
+        for name, (depth, link, other_link) in met.items():
+            message = f"the mount of robot '{arm.name}' ({link}) overlaps the mount of robot '{name}' ({other_link})"
+            out.append(_overlap("E266", message, depth, spans, arm.name, name))
     return out
 
 

@@ -236,7 +236,8 @@ HELP: dict[str, str] = {
     "into the table or stands inside a wall. An object resting on a surface only touches it.",
     "E266": "A robot at its start overlaps (by more than 1 mm) a movable or fixed object: a planar robot's "
     "`:footprint` at its `:base` pose (also another planar robot's footprint), found by `mrgc check`; an arm's "
-    "links at its `:home` configuration, found by `mrgc facts` (and `mrgc plan`), which read the arm's meshes.",
+    "links at its `:home` configuration, and an arm's mount overlapping another arm's (two arms bolted at one "
+    "base), found by `mrgc facts` (and `mrgc plan`), which read the arms' meshes.",
     "E267": "A `(mesh ...)` shape's file holds no triangle (an empty file, or vertices without faces): the "
     "shape has no volume, so nothing could collide with it, grasp it or set it down. Found by `mrgc check`, "
     "which reads every mesh file of the problem (a file that cannot be read at all is E403).",

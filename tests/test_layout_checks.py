@@ -175,6 +175,23 @@ def test_facts_reports_the_robot_model_warnings(capsys: pytest.CaptureFixture[st
     assert mrgc.check(golden).warnings == ()  # check reads no robot model
 
 
+@pytest.mark.parametrize(
+    ("base", "hit"), [("(0 -0.6 0 90)", True), ("(0.05 -0.62 0 0)", True), ("(0.4 -0.6 0 90)", False)]
+)
+def test_two_arms_bolted_into_each_other_are_found_with_their_models(base: str, hit: bool) -> None:
+    """Arms whose mounts interpenetrate: E266 naming both (two Pandas at the same base used to pass, and
+    planning said "infeasible: no robot can pick o1"); arms whose moving links only meet at home are not
+    reported (the paper's motion model does not check the way home)."""
+    two = f"(:robots (r1 :kind panda :base (0 -0.6 0 90)) (r2 :kind panda :base {base}))"
+    text = cell(f"(o1 :shape {BOX} :pose (0 0 0.05 0))").replace("(:robots (r1 :kind panda :base (0 -0.6 0 90)))", two)
+    problem = mrgc.parse_string(text, "p.mrg").problem()
+    found = [d for d in robot_diagnostics(problem, arms=False) if d.code == "E266"]
+    assert len(found) == hit, [d.message for d in found]
+    if hit:
+        assert found[0].message.startswith("the mount of robot 'r2' (panda_link0) overlaps the mount of robot 'r1'")
+        assert found[0].span is not None and found[0].span.line == 7
+
+
 # ---------------------------------------------------------------------------------------------- meshes
 def _block_obj(path: Path, z0: float, faces: bool = True) -> None:
     """A 4 x 4 x 8 cm block whose lowest face lies at z = ``z0`` in its file's frame."""

@@ -17,8 +17,12 @@ from mrgc import cli
 TUTORIAL = ROOT / "docs" / "tutorial.md"
 
 
+def text_of() -> str:
+    return TUTORIAL.read_text(encoding="utf-8")
+
+
 def commands() -> list[list[str]]:
-    text = TUTORIAL.read_text(encoding="utf-8")
+    text = text_of()
     blocks = re.findall(r"```sh\n(.*?)```", text, re.S)
     lines = [ln.strip() for b in blocks for ln in b.splitlines() if ln.strip()]
     assert lines and all(ln.startswith("mrgc ") for ln in lines), lines
@@ -44,10 +48,19 @@ def test_every_command_of_the_tutorial_runs(
     work = tmp_path / "tutorial"
     shutil.copytree(ROOT / "docs" / "tutorial", work)
     monkeypatch.chdir(work)
+    # each shell block followed by a text block: the output shown for the block's commands
+    shown = {
+        ln.strip(): out
+        for block, out in re.findall(r"```sh\n(.*?)```\n\n```text\n(.*?)```", text_of(), re.S)
+        for ln in block.splitlines()
+    }
     for args in commands():
         code = cli.main(args)
         out = capsys.readouterr()
         assert code == 0, f"mrgc {' '.join(args)} exited {code}: {out.err}"
+        line = "mrgc " + " ".join(args)
+        if "--summary" in args:  # the output the page shows is what it prints (it said 34 facts, not 39)
+            assert shown[line] == out.out, f"{line}: the tutorial shows\n{shown[line]}\nmrgc prints\n{out.out}"
         if "-o" in args:
             written = work / args[args.index("-o") + 1]
             assert written.is_file() and written.stat().st_size > 0, written

@@ -25,7 +25,7 @@ Each finding is a located :class:`~mrgc.errors.Diagnostic` (docs/errors.md).  Tw
 **With robot models** (``mrgc facts`` and the commands that run phase 1, ``plan``):
 
 - ``E266`` an arm at its home configuration overlaps a movable object or a fixed object (the mount, the base
-  link and the links fixed to it, bolted in place, is left out, as everywhere in the geometry layer), or an
+  link and the links fixed to it, bolted in place, is checked against movable objects only), or an
   arm's mount overlaps another arm's (two arms bolted at one base).  Arms whose moving links overlap at home
   are not checked: the grounding keeps every motion clear of the other arms at home, so such arms only
   narrow what can be planned;
@@ -372,7 +372,7 @@ def robot_diagnostics(problem: Problem, arms: bool = True) -> list[Diagnostic]:
 def _arms_at_home(problem: Problem, scene: SceneSpec, arms: list[Arm]) -> list[Diagnostic]:
     """E266 for each arm whose mount overlaps another arm's (two arms bolted at one base: :func:`_arm_on_arm`),
     and for each arm at its home configuration overlapping an object (the deepest link per object; the mount
-    stands on what the arm is bolted to and is left out)."""
+    stands on what the arm is bolted to, and is checked against movable objects only)."""
     spans = _spans(problem)
     world = scene_world(scene)
     links: dict[str, list[str]] = {}  # each arm's moving links, then its mount's
@@ -385,11 +385,12 @@ def _arms_at_home(problem: Problem, scene: SceneSpec, arms: list[Arm]) -> list[D
             world.add(f"{arm.name}/{name}", shape, t, f"robot:{arm.name}")
             links[arm.name].append(f"{arm.name}/{name}")
     out = _arm_on_arm(world, arms, links, spans)
-    objects = [*world.names("movable"), *world.names("fixed")]
+    movable, objects = world.names("movable"), [*world.names("movable"), *world.names("fixed")]
     for arm in arms:
         found: dict[str, tuple[float, str]] = {}
-        for key in links[arm.name][: len(arm.probes[0])]:
-            for other, depth in _overlaps(world, key, objects):
+        moving = len(arm.probes[0])
+        for n, key in enumerate(links[arm.name]):  # the mount against movable objects only
+            for other, depth in _overlaps(world, key, objects if n < moving else movable):
                 if depth > found.get(other, (0.0, ""))[0]:
                     found[other] = (depth, key.split("/")[1])
         for target, (depth, link) in found.items():

@@ -192,6 +192,17 @@ def test_two_arms_bolted_into_each_other_are_found_with_their_models(base: str, 
         assert found[0].span is not None and found[0].span.line == 7
 
 
+def test_an_object_inside_an_arm_s_base_is_found() -> None:
+    """The mount stands on the table (no complaint about that), but a movable object in it is E266 (it was left
+    out with the mount, and every plan was then rejected at its first pick: 'exhausted')."""
+    text = cell(f"(o1 :shape {BOX} :pose (0 0 0.05 0)) (o2 :shape (box 0.05 0.05 0.05) :pose (0 -0.6 0.025 0))")
+    problem = mrgc.parse_string(text, "p.mrg").problem()
+    found = [d for d in robot_diagnostics(problem, arms=False) if d.code == "E266"]
+    assert [d.message.split(" by ")[0] for d in found] == [
+        "robot 'r1' (panda_link0) at its home configuration overlaps movable object 'o2'"
+    ]
+
+
 # ---------------------------------------------------------------------------------------------- meshes
 def _block_obj(path: Path, z0: float, faces: bool = True) -> None:
     """A 4 x 4 x 8 cm block whose lowest face lies at z = ``z0`` in its file's frame."""

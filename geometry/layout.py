@@ -11,6 +11,7 @@ Each finding is a located :class:`~mrgc.errors.Diagnostic` (docs/errors.md).  Tw
 - ``E265`` a movable object overlaps a fixed object at its start pose;
 - ``E266`` a planar robot's footprint at its start pose overlaps a movable object, a fixed object or
   another robot's footprint;
+- ``E269`` a region whose shape is not a box (:func:`region_shape_diagnostics`);
 - ``E267`` a ``(mesh ...)`` shape's file holds no triangle, ``E268`` the mesh of a movable object or a
   footprint is not centred on its origin, ``E403`` a mesh file cannot be used (:func:`mesh_diagnostics`:
   every mesh file is read here; a declaration whose mesh is refused gets no other complaint);
@@ -70,7 +71,12 @@ def layout_diagnostics(problem: Problem, arms: bool = True) -> list[Diagnostic]:
     out = home_diagnostics(problem) + meshes
     out += [
         d
-        for d in overlap_diagnostics(problem) + grasp_warnings(problem) + region_diagnostics(problem)
+        for d in (
+            overlap_diagnostics(problem)
+            + grasp_warnings(problem)
+            + region_shape_diagnostics(problem)
+            + region_diagnostics(problem)
+        )
         if d.span not in unusable
     ]
     out += tcp_diagnostics(problem)
@@ -169,8 +175,8 @@ def mesh_diagnostics(problem: Problem) -> list[Diagnostic]:
     (located in that file), E267 for one with no triangle (nothing to collide with, grasp or set down), and
     E268 for the mesh of a movable object or a robot's footprint whose bounding box is not centred on its
     origin (:data:`MESH_CENTRE_TOL`): grasps, placements and a cart's load take such a shape's origin as its
-    centre, so an off-centre one would be set down in the air or gripped beside itself.  A fixed object's or
-    a region's mesh may lie anywhere about its origin."""
+    centre, so an off-centre one would be set down in the air or gripped beside itself.  A fixed object's
+    mesh may lie anywhere about its origin (a region's shape is a box: E269)."""
     import numpy as np
 
     from mrgc.geometry.meshes import read_mesh
@@ -314,11 +320,32 @@ def _overlap(code: str, what: str, depth: float, spans: dict[str, Span], name: s
 
 
 # ---------------------------------------------------------------------------------------------- regions
+def region_shape_diagnostics(problem: Problem) -> list[Diagnostic]:
+    """E269 for each region whose shape is not a box: ``in-region``, phase 1's placements and the grounding's
+    are tests against a region's box, so nothing could ever be put in (or found in) a cylinder, a sphere or a
+    mesh; planning said "no robot can reach goal region" for one within every arm's reach."""
+    from mrgc.language.model import Box
+
+    kinds = {"Cylinder": "a cylinder", "Sphere": "a sphere", "Mesh": "a mesh"}
+    return [
+        Diagnostic(
+            "E269",
+            f"region '{r.name}' is {kinds.get(type(r.shape).__name__, 'not a box')}: a region is a box "
+            "(in-region and placements test against it); give the box objects are to stand in",
+            r.span,
+        )
+        for r in problem.regions
+        if r.shape is not None and not isinstance(r.shape, Box)
+    ]
+
+
 def region_diagnostics(problem: Problem) -> list[Diagnostic]:
     """W271 for each movable object in no region at its start pose (as ``in-region`` of phase 1 reads
     it; a mesh whose file cannot be read is left to ``mrgc facts``)."""
     from mrgc.geometry.scene import Body, inside
 
+    if region_shape_diagnostics(problem):
+        return []  # a region that is not a box is E269: "in no region" would only repeat it
     regions = [Body(r.name, r.shape, from_pose(r.pose)) for r in problem.regions if r.shape and r.pose]
     goal = problem.goal_regions
     out = []

@@ -76,6 +76,7 @@ CODES: dict[str, str] = {
     "E266": "robot overlaps an object at the start",
     "E267": "mesh with no triangle",
     "E268": "mesh not centred on its origin",
+    "E269": "region that is not a box",
     # warnings (the file is accepted)
     "W270": "grasp wider than the gripper",
     "W271": "object in no region",
@@ -245,7 +246,11 @@ HELP: dict[str, str] = {
     "origin: the centre of its bounding box lies more than 1 mm from the mesh file's origin. Grasps, "
     "placements and a cart's load take such a shape's origin as its centre (an object whose origin is on its "
     "bottom face would be set down in the air, and gripped beside its middle). Move the file's vertices by "
-    "the offset the message gives; a fixed object's or a region's mesh may lie anywhere about its origin.",
+    "the offset the message gives; a fixed object's mesh may lie anywhere about its origin.",
+    "E269": "A region of a geometric problem is a box (turned by its pose's yaw): `in-region`, phase 1's "
+    "placements and the grounding's are tests against that box, so a region drawn as a cylinder, a sphere or a "
+    "mesh could never hold an object (planning said no robot reaches it). Give the box objects are to stand in; "
+    "a fixed object (a bin's walls, a tray) may have any shape.",
     "W271": "A warning, not an error: a movable object lies in no region at its start pose (no region holds it "
     "entirely, so `in-region` holds for none). A goal object can still be moved into its goal region; any other "
     "object can never move, so if it obstructs something, that goal cannot be reached.",

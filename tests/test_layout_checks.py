@@ -248,3 +248,11 @@ def test_a_broken_mesh_file_is_reported_by_check_in_it(tmp_path: Path, capsys: p
     assert cli.main(["check", str(src)]) == 2
     first = capsys.readouterr().err.splitlines()[0]
     assert first.startswith(f"{tmp_path / 'm.obj'}:2:1: error[E403]") and "nan" in first
+
+
+@pytest.mark.parametrize("shape", ["(cylinder 0.2 0.3)", "(sphere 0.2)"])
+def test_a_region_is_a_box(shape: str) -> None:
+    """E269 (a cylinder region was accepted, and planning said no robot reaches it; an object at its centre was
+    'in no region', W271); W271 is left out while a region is not a box."""
+    text = cell(f"(o1 :shape {BOX} :pose (0 0 0.05 0))", regions=f"(start :shape {shape} :pose (0 0 0.15 0))")
+    assert codes(text) == [("E269", 9)]

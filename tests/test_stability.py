@@ -237,6 +237,52 @@ def _write_obj(path: Path, vertices: list[tuple[float, float, float]], faces: li
     return str(path)
 
 
+def _revolved(path: Path, profile: list[tuple[float, float]], n: int = 48) -> Mesh:
+    """A closed surface of revolution about z: ``profile`` (radius, z) from the bottom up, its ends on the axis
+    (radius 0), centred on its bounding box's centre."""
+    zs = [z for _, z in profile]
+    mid = (min(zs) + max(zs)) / 2
+    verts: list[tuple[float, float, float]] = []
+    rings: list[list[int]] = []
+    for r, z in profile:
+        if r == 0.0:
+            verts.append((0.0, 0.0, z - mid))
+            rings.append([len(verts) - 1] * n)
+            continue
+        rings.append(list(range(len(verts), len(verts) + n)))
+        verts += [(r * math.cos(2 * math.pi * k / n), r * math.sin(2 * math.pi * k / n), z - mid) for k in range(n)]
+    faces = []
+    for lo, hi in zip(rings, rings[1:]):
+        for k in range(n):
+            a, b, c, d = lo[k], lo[(k + 1) % n], hi[(k + 1) % n], hi[k]
+            faces += [t for t in ((a, b, c), (a, c, d)) if len(set(t)) == 3]
+    return Mesh(_write_obj(path, verts, faces))
+
+
+@pytest.mark.parametrize(("tall", "rolls"), [(0.17, True), (0.03, True), (0.002, False)])
+def test_a_mesh_on_a_rounded_bottom_rolls_over_when_its_centre_of_mass_is_high(
+    tmp_path: Path, tall: float, rolls: bool
+) -> None:
+    """A 12 mm hemispherical bottom under a 17 cm tube (a test tube on its round end) rolls over, whatever the
+    1 mm lowest face says (a 4.9 mm disc, the centre of mass 1.2 mm inside it was "stable", and pybullet's
+    tube fell flat from a 0.002 rad tilt), and so does a 3 cm one; under a 2 mm one (a bowl's shape) the centre
+    of mass is below the hemisphere's centre, and it rights itself."""
+    r = 0.012
+    bottom = [(r * math.sin(a), r - r * math.cos(a)) for a in np.linspace(0.0, math.pi / 2, 13)]
+    tube = _revolved(tmp_path / "tube.obj", [*bottom, (r, r + tall), (0.0, r + tall)])
+    half = (r + tall) / 2
+    table = {"t": (Box(1, 1, 0.1), translation(0, 0, 0.05))}
+    s = stability("tube", tube, translation(0.2, 0.1, 0.1 + half), table)
+    assert s.flat and s.supporters == ("t",) and s.stable != rolls
+    assert (s.rolls is not None) == rolls
+    if rolls:
+        assert "would roll over on t: tilted toward" in s.message()
+    # a flat-bottomed mesh of the same size stands, and tilts back onto its bottom's edge every way
+    can = _revolved(tmp_path / "can.obj", [(0.0, 0.0), (r, 0.0), (r, r + tall), (0.0, r + tall)])
+    flat = stability("can", can, translation(0.2, 0.1, 0.1 + half), table)
+    assert flat.stable and flat.rolls is None
+
+
 def test_a_mesh_stands_on_its_lowest_vertices_with_its_volume_centroid(tmp_path: Path) -> None:
     """A wedge (a right triangle 0.3 long and 0.2 high, 0.1 deep, outward faces): its centroid lies a third
     of the way along, not in the middle of its bounding box."""

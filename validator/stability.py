@@ -37,6 +37,16 @@ cylinder's polygon 0.1 mm) with room to spare, while a 0.3 m box still needs to 
 before it falls (``atan(5 / 150)``).  The share keeps the test meaningful for small objects, for which
 5 mm would be a large part of their width.
 
+**A rounded bottom** (a mesh: :func:`_rolls`).  A mesh's lowest face is what lies within 1 mm of its lowest
+point, which for a rounded bottom is a small disc that can hold the centre of mass (a test tube on its round
+end: a 4.9 mm disc, the centre of mass 1.2 mm inside it).  So a mesh that stands by the polygon is also tilted
+in 16 directions by 0.01 to 0.16 rad, about its centre of mass, and must right itself at one of those tilts
+in every direction: a contact with a horizontal floor farther along the tilt than its centre of mass.  A flat
+bottom tilts onto its edge; a rounded one of radius R rolls over when its centre of mass lies higher than R
+above its lowest point (message: ``{obj} would roll over on {supporters}: tilted toward (x, y), its centre of
+mass passes beyond its contact with them (a rounded bottom under a high centre of mass)``).  Boxes, cylinders
+and spheres need no such test (a flat face, or neutral equilibrium).
+
 **Messages** (:meth:`Stability.message`; the replay reports an unstable verdict as ``[unstable]`` with the
 object as subject).  Distances in mm with one decimal, supporters sorted and joined by ", " (a region's
 floor named ``floor of R``), the tilt in degrees with one decimal:
@@ -105,6 +115,12 @@ CIRCLE_POINTS = 64
 EPS = 1e-9
 #: m²: three points spanning less than this (twice the triangle's area) are collinear
 AREA_EPS = 1e-15
+#: directions a mesh is tilted in to see whether it rolls over (:func:`_rolls`) ...
+ROLL_DIRECTIONS = 16
+#: ... and the tilts (rad), the first :data:`FLAT_TOL`
+ROLL_TILTS = (FLAT_TOL, 0.02, 0.04, 0.08, 0.16)
+#: m: a tilted mesh touches the floor at the points this close to its lowest one
+CONTACT_EXACT = 1e-6
 
 
 @dataclass(frozen=True)
@@ -129,12 +145,21 @@ class Stability:
     polygon: tuple[tuple[float, float], ...]
     com: tuple[float, float]
     load: tuple[str, ...] = ()
+    #: a mesh whose bottom is rounded: tilted in this direction (x, y), its centre of mass passes beyond its new
+    #: contact with the floor, so the tilt grows (None: it rights itself every way; :func:`_rolls`)
+    rolls: tuple[float, float] | None = None
 
     def message(self) -> str:
         """The verdict in one line (the formats of the module docstring)."""
         on = ", ".join(self.supporters)
         if not self.supporters:
             return f"{self.obj} rests on nothing: nothing lies within {SUPPORT_TOL * 1e3:g} mm under its lowest face"
+        if self.rolls is not None:
+            dx, dy = self.rolls
+            return (
+                f"{self.obj} would roll over on {on}: tilted toward ({dx:.2f}, {dy:.2f}), its centre of mass passes "
+                f"beyond its contact with them (a rounded bottom under a high centre of mass)"
+            )
         if not self.flat:
             return (
                 f"{self.obj} is set down tilted {math.degrees(self.tilt):.1f} degrees from upright on {on}: it "
@@ -198,9 +223,15 @@ def stability(
     com = weights @ centres / weights.sum() if weights.sum() > 0 else centres[0]
     margin = _signed_distance(com, polygon)
     required = _required(shape)
+    standing = bool(flat and names and margin >= required - EPS)  # on the edge within EPS: a ball on its point
+    rolls = None
+    if standing and isinstance(shape, Mesh):
+        centres3 = np.array([(p @ np.append(_centroid(s), 1.0))[:3] for s, p in parts])
+        rolls = _rolls(shape, pose, weights @ centres3 / weights.sum() if weights.sum() > 0 else centres3[0])
     return Stability(
         obj=obj,
-        stable=bool(flat and names and margin >= required - EPS),  # on the edge within EPS: a ball on its point
+        stable=standing and rolls is None,
+        rolls=rolls,
         flat=flat,
         tilt=tilt,
         margin=margin,
@@ -286,6 +317,41 @@ def _face(shape: Shape, pose: Array, top: bool) -> tuple[Array, float]:
     chosen = world[sign * key >= float((sign * key).max()) - FACE_TOL]
     height = float(chosen[:, 2].max() if top else chosen[:, 2].min())
     return chosen[:, :2], height
+
+
+def _rolls(shape: Mesh, pose: Array, com: Array) -> tuple[float, float] | None:
+    """A direction (x, y) in which ``shape`` at ``pose``, standing with its centre of mass at ``com`` (world,
+    3D), rolls over, or None when it rights itself every way (:data:`ROLL_DIRECTIONS` directions).  Tilted by
+    an angle (about a horizontal axis through its centre of mass) it touches a horizontal floor at its lowest
+    points (within :data:`CONTACT_EXACT`); gravity turns it back iff one of them lies farther in the direction
+    of the tilt than the centre of mass.  It rolls over in a direction when that fails at every one of
+    :data:`ROLL_TILTS`: a flat bottom tilts onto its edge on that side, well ahead of the centre of mass; a
+    rounded one (radius R, centre of mass h above its lowest point) touches about R x tilt ahead of the old
+    contact while the centre of mass moves h x tilt, so it rolls over when h > R, as a test tube standing on
+    its round end does.  The larger tilts carry the contact across the facets of a tessellated curve (a mesh
+    standing on one vertex tilts about it until the next ring of vertices touches)."""
+    world = _points(shape) @ pose[:3, :3].T + pose[:3, 3] - com
+    for k in range(ROLL_DIRECTIONS):
+        a = 2 * math.pi * k / ROLL_DIRECTIONS
+        d = np.array([math.cos(a), math.sin(a), 0.0])
+        axis = np.array([-d[1], d[0], 0.0])  # z x d: the top moves toward d
+        if not any(_rights_itself(world @ _rotation(axis, tilt).T, d) for tilt in ROLL_TILTS):
+            return (float(d[0]), float(d[1]))
+    return None
+
+
+def _rights_itself(points: Array, d: Array) -> bool:
+    """Whether a body whose points (relative to its centre of mass) are ``points`` rests on a floor with a
+    contact farther along ``d`` than its centre of mass (gravity then turns it back against ``d``)."""
+    low = points[:, 2] <= float(points[:, 2].min()) + CONTACT_EXACT
+    return float((points[low] @ d).max()) > 0.0
+
+
+def _rotation(axis: Array, angle: float) -> Array:
+    """The rotation by ``angle`` about unit ``axis`` (Rodrigues)."""
+    k = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
+    out: Array = np.eye(3) + math.sin(angle) * k + (1.0 - math.cos(angle)) * (k @ k)
+    return out
 
 
 @functools.lru_cache(maxsize=256)

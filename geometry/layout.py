@@ -75,6 +75,7 @@ def layout_diagnostics(problem: Problem, arms: bool = True) -> list[Diagnostic]:
             overlap_diagnostics(problem)
             + grasp_warnings(problem)
             + region_shape_diagnostics(problem)
+            + floor_diagnostics(problem)
             + region_diagnostics(problem)
         )
         if d.span not in unusable
@@ -337,6 +338,47 @@ def region_shape_diagnostics(problem: Problem) -> list[Diagnostic]:
         for r in problem.regions
         if r.shape is not None and not isinstance(r.shape, Box)
     ]
+
+
+def floor_diagnostics(problem: Problem) -> list[Diagnostic]:
+    """W277 for each region whose floor holds nothing up: it lies neither on the ground nor under a fixed
+    box's top at its height anywhere (:func:`mrgc.geometry.scene.floor_support`, the rule the planner's
+    placements follow and the validator's ``floating``), so nothing set down in it can stand (a region drawn
+    a few cm above its table).  Left out while a region is not a box (E269)."""
+    import numpy as np
+
+    from mrgc.geometry.scene import Body, floor_support
+    from mrgc.geometry.transforms import translation
+    from mrgc.language.model import Box
+
+    if region_shape_diagnostics(problem):
+        return []
+    fixed = [Body(f.name, f.shape, from_pose(f.pose)) for f in problem.fixed if f.shape and f.pose]
+    out = []
+    for r in problem.regions:
+        if not isinstance(r.shape, Box) or r.pose is None:
+            continue
+        region = Body(r.name, r.shape, from_pose(r.pose))
+        try:
+            held = floor_support(fixed, region)
+        except InputError:  # a fixed mesh that cannot be read: E403 says so
+            continue
+        if held is None:
+            continue
+        grid = np.linspace(-0.5, 0.5, 21)  # the floor's points on a 21 x 21 grid
+        spots = [(x * r.shape.sx, y * r.shape.sy) for x in grid for y in grid]
+        if not any(held(region.pose @ translation(x, y, 0.0)) for x, y in spots):
+            z = float(region.pose[2, 3] - r.shape.sz / 2)
+            out.append(
+                Diagnostic(
+                    "W277",
+                    f"the floor of region '{r.name}' (z = {z:.3f}) holds nothing up: it lies neither on the "
+                    "ground nor on a fixed object's top, so nothing set down in it can stand",
+                    r.span,
+                    severity="warning",
+                )
+            )
+    return out
 
 
 def region_diagnostics(problem: Problem) -> list[Diagnostic]:

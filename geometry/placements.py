@@ -25,7 +25,7 @@ from mrgc.geometry.conventions import ARM_PLACE_LIFT, lattice_offsets, seed_for
 from mrgc.geometry.grasps import grasp_transform
 from mrgc.geometry.robot import Pieces, Sweep
 from mrgc.geometry.scene import Body as SceneBody
-from mrgc.geometry.scene import half_extents, inside, inside_test
+from mrgc.geometry.scene import floor_support, half_extents, inside, inside_test
 from mrgc.geometry.step_world import StepWorld
 from mrgc.geometry.transforms import rot_z, translation
 from mrgc.language.model import Box
@@ -90,6 +90,8 @@ class Placements(StepWorld):
         avoid = tuple(a for a in avoid if a != obj)
         shape = self.shape(obj)
         within = inside_test(reg, body.shape)
+        # a region's floor off the ground holds objects up only over a fixed box's top (floor_support)
+        held = floor_support(self.scene.fixed, reg) if not isinstance(region, SceneBody) else None
         # first the 3 × 3 lattice phase 1 uses (so a placement the facts relied on is tried first), then
         # random positions and the four yaws
         room = np.maximum(h_r[:2] - h_o[:2], 0) * 0.9
@@ -108,7 +110,7 @@ class Placements(StepWorld):
                 yaw = (np.pi / 2) * (k % 4)
                 x, y = rng.uniform(-1, 1, 2) * np.maximum(h_r[:2] - min(h_o[0], h_o[1]), 0)
             pose = reg.pose @ translation(x, y, -h_r[2] + h_o[2] + ARM_PLACE_LIFT) @ rot_z(yaw)
-            if not within(pose):
+            if not within(pose) or (held is not None and not held(pose)):
                 continue
             probe = [(shape, pose)]
             self.queries += 1

@@ -47,7 +47,7 @@ from mrgc.geometry.ik import solve_ik_many
 from mrgc.geometry.kinds import approaches
 from mrgc.geometry.relays import Asks, Spots, relay_facts, spot_region, stranded
 from mrgc.geometry.relays import asks as relay_asks
-from mrgc.geometry.scene import Body, SceneSpec, half_extents, inside
+from mrgc.geometry.scene import Body, SceneSpec, floor_support, half_extents, inside
 from mrgc.geometry.transforms import translation
 from mrgc.language.model import Box, Fact
 from mrgc.workers import map_in_workers, map_until, worker_count
@@ -312,10 +312,11 @@ class RobotEvaluator:
         room = h_r[:2] - h_o[:2]
         if np.any(room < 0) or h_o[2] > h_r[2]:
             return []
+        held = floor_support(self.scene.fixed, reg) if not isinstance(region, Body) else None  # off the ground
         out = []
         for a, b in lattice_offsets(PLACEMENT_GRID):
             pose = reg.pose @ translation(a * room[0] * 0.9, b * room[1] * 0.9, -h_r[2] + h_o[2] + ARM_PLACE_LIFT)
-            if inside(reg, body.shape, pose):
+            if inside(reg, body.shape, pose) and (held is None or held(pose)):
                 out.append(pose)
         return out
 

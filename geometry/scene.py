@@ -9,7 +9,7 @@ from __future__ import annotations
 import os
 import weakref
 from dataclasses import dataclass, field
-from typing import Callable
+from typing import Callable, Sequence
 
 import numpy as np
 
@@ -150,6 +150,48 @@ def surface(body: Body) -> Body:
     pose = body.pose.copy()
     pose[:3, 3] = body.pose[:3, 3] + np.array([0.0, 0.0, up])
     return Body(body.name, Box(body.shape.sx, body.shape.sy, SURFACE_HEIGHT), pose)
+
+
+#: m: a fixed object's top within this of a region's floor holds up what is set down on that floor, and a
+#: region's floor within this of the ground lies on it (the validator's support band)
+FLOOR_BAND = 0.01
+#: m: how far inside a fixed object's top an object's centre stays when the region's floor is not on the
+#: ground (the validator's largest required margin)
+SUPPORT_MARGIN = 5e-3
+
+
+def ground_height(fixed: Sequence[Body]) -> float:
+    """The ground: z = 0, or the lowest point of a ``fixed`` object if one reaches lower (a table slab whose top
+    is at z = 0 stands on a ground at its bottom)."""
+    lows = [float((outline(b.shape) @ b.pose[:3, :3].T + b.pose[:3, 3])[:, 2].min()) for b in fixed]
+    return min([0.0, *lows])
+
+
+def floor_support(fixed: Sequence[Body], region: Body) -> Callable[[np.ndarray], bool] | None:
+    """What holds up an object set down on ``region``'s floor, as a test of the object's pose (its centre
+    over a ``fixed`` box whose top lies at the floor, :data:`SUPPORT_MARGIN` inside that top), or None when
+    the floor lies on the ground (:func:`ground_height`) and holds up anything.  A region drawn over a table is
+    held up by the table, where the table is; one drawn in the air by nothing (the validator rejects such
+    placements as ``floating``, or ``unstable`` over a table's edge).  Fixed objects that are not boxes hold
+    nothing up here (conservative)."""
+    floor = float((outline(region.shape) @ region.pose[:3, :3].T + region.pose[:3, 3])[:, 2].min())
+    if abs(floor - ground_height(fixed)) <= FLOOR_BAND:
+        return None
+    tops = []
+    for b in fixed:
+        if isinstance(b.shape, Box) and abs(b.pose[2, 3] + b.shape.sz / 2 - floor) <= FLOOR_BAND:
+            half = np.array([b.shape.sx, b.shape.sy]) / 2 - SUPPORT_MARGIN
+            if np.all(half > 0):
+                tops.append((np.linalg.inv(b.pose), half))
+
+    def held(pose: np.ndarray) -> bool:
+        for inv, half in tops:
+            local = inv[:3, :3] @ pose[:3, 3] + inv[:3, 3]
+            if abs(local[0]) <= half[0] and abs(local[1]) <= half[1]:
+                return True
+        return False
+
+    return held
 
 
 def _mesh_shapes(problem: Problem) -> list[Mesh]:

@@ -85,6 +85,7 @@ CODES: dict[str, str] = {
     "W274": "every configuration of an arm collides",
     "W275": "an arm's home configuration collides",
     "W276": "IK finds no solution for an arm",
+    "W277": "region floor that holds nothing up",
 }
 
 #: codes that are warnings: reported, but the input is accepted (exit code 0)
@@ -277,6 +278,11 @@ HELP: dict[str, str] = {
     "object within its reach bound, collisions ignored: the chain from the URDF's base to the `:end-effector` "
     "link cannot put that link there. Usually `:end-effector` names the wrong link (the message says how many "
     "joints its chain has) or `:tcp` is far off. Reported by `mrgc check`, `mrgc facts` and `mrgc plan`.",
+    "W277": "A warning, not an error: a region's floor holds nothing up. It lies neither on the ground (z = 0, or "
+    "the lowest point of a fixed object if one reaches lower) nor on the top of a fixed box anywhere, so an "
+    "object set down in it would fall (the validator rejects it as `floating`) and the planner finds no "
+    "placement in it. Usually the region's pose is a few cm too high: its floor should lie on the table's top. "
+    "A floor partly over a table holds objects up only there (their centre 5 mm inside the table's top).",
     "W270": "A warning, not an error: the object is wider along the grasp's finger axis (plus the 1 cm "
     "clearance) than a robot kind's `:gripper-opening`, so robots of that kind get no facts for this "
     "(object, grasp). `mrgc check` exits 0.",

@@ -62,9 +62,11 @@ configurations (:mod:`mrgc.validator.sampling`).
   needs more than :data:`MAX_SAMPLES` checked times, is not checked and so not valid ``[too-long]``;
 - every placement lies inside its action's region ``[outside-region]``, is free of fixed objects, other
   objects and the robots at home, to :data:`CONTACT_TOL` ``[collision-...]``, and rests on something
-  ``[floating]``: its lowest point at most :data:`SUPPORT_TOL` above the floor of a region under it, or
-  lowered by :data:`SUPPORT_TOL` it would sink into a fixed or movable object (one beside it does not
-  count); an object that rested on one a step moves away must still rest on something;
+  ``[floating]``: its lowest point at most :data:`SUPPORT_TOL` above the floor of a region under it whose
+  floor lies on the ground (:func:`_grounded_regions`; a region drawn over a table is held up by the table,
+  one drawn in the air by nothing), or lowered by :data:`SUPPORT_TOL` it would sink into a fixed or movable
+  object (one beside it does not count); an object that rested on one a step moves away must still rest on
+  something;
 - at the end every goal object lies entirely inside its goal region ``[goal]``.
 """
 
@@ -358,6 +360,21 @@ def _arm_bounds(rs: ReplayScene, homes: dict[str, np.ndarray]) -> dict[str, ArmB
     return out
 
 
+def _grounded_regions(scene: SceneSpec) -> frozenset[str]:
+    """The regions whose floor lies on the ground: within :data:`SUPPORT_TOL` of the ground's height, z = 0
+    or the lowest point of a fixed object if one reaches lower (a table slab whose top is z = 0 stands on
+    a ground at its bottom).  Only their floors hold objects up; any other region's floor is drawn over
+    something (a table, a shelf) that must hold the object up itself, or over nothing."""
+    lows = [float((outline(b.shape) @ b.pose[:3, :3].T + b.pose[:3, 3])[:, 2].min()) for b in scene.fixed]
+    ground = min([0.0, *lows])
+    out = set()
+    for r in scene.regions:
+        floor = float((outline(r.shape) @ r.pose[:3, :3].T + r.pose[:3, 3])[:, 2].min())
+        if abs(floor - ground) <= SUPPORT_TOL:
+            out.add(r.name)
+    return frozenset(out)
+
+
 class _Replayer(ActionReader):
     def __init__(self, scene: SceneSpec, rs: ReplayScene, model: MotionModel) -> None:
         super().__init__(scene, rs, model)
@@ -377,6 +394,7 @@ class _Replayer(ActionReader):
             if self.planar[r.name] and r.kind.footprint
         }
         self.radius = {b.name: float(np.linalg.norm(outline(b.shape), axis=1).max()) for b in scene.movable}
+        self.grounded = _grounded_regions(scene)
         self._placements_state()
         self.support = {o: self._supports(o) for o in self.movable}  # what each object rests on
 
@@ -794,14 +812,17 @@ class _Replayer(ActionReader):
             for r in self.planar:
                 self._hit(t, "placement", o, r, rs.closest(o, r), (f"{o} placed", ""), (r, "at home"), "robot-object")
 
-    def _floor_gap(self, obj: str) -> tuple[float, str] | None:
+    def _floor_gap(self, obj: str, grounded: bool = True) -> tuple[float, str] | None:
         """How far the object's lowest point stands above the floor of the nearest region under its centre
-        (negative: below it), and that region; None when no region lies under it."""
+        (negative: below it), and that region; None when no region lies under it.  ``grounded``: only the
+        regions whose floor lies on the ground (:func:`_grounded_regions`), the floors that hold objects up."""
         pose = self.poses[obj]
         pts = outline(self.shapes[obj]) @ pose[:3, :3].T + pose[:3, 3]
         low = float(pts[:, 2].min())
         best: tuple[float, str] | None = None
         for region in self.scene.regions:
+            if grounded and region.name not in self.grounded:
+                continue
             corners = outline(region.shape) @ region.pose[:3, :3].T + region.pose[:3, 3]
             inv = np.linalg.inv(region.pose)
             local = inv[:3, :3] @ pose[:3, 3] + inv[:3, 3]
@@ -855,12 +876,15 @@ class _Replayer(ActionReader):
             o = a.obj
             self.support[o] = self._supports(o)
             if not self.support[o]:
-                floor = self._floor_gap(o)
+                floor = self._floor_gap(o, grounded=False)
                 p = self.poses[o][:3, 3]
                 above = (
-                    f"its lowest point is {floor[0] * 1e3:.1f} mm above the floor of {floor[1]}"
-                    if floor
-                    else "no region lies under it"
+                    "no region lies under it"
+                    if floor is None
+                    else f"it stands on the floor of {floor[1]}, which holds nothing up there: that floor lies "
+                    "neither on the ground nor on a fixed object"
+                    if floor[1] not in self.grounded and floor[0] <= SUPPORT_TOL
+                    else f"its lowest point is {floor[0] * 1e3:.1f} mm above the floor of {floor[1]}"
                 )
                 self._v(
                     t,
@@ -892,7 +916,7 @@ class _Replayer(ActionReader):
         stands on several supports or on something fixed: the centre of mass over the support polygon of the
         contacts, with a margin, flat on its lowest face (:mod:`mrgc.validator.stability`) ``[unstable]``;
         ``gone``: objects not in the scene now (picked up)."""
-        floors = [(r.name, r.shape, r.pose) for r in self.scene.regions]
+        floors = [(r.name, r.shape, r.pose) for r in self.scene.regions if r.name in self.grounded]
         bodies = {
             b: (s, self.poses[b] if b in self.poses else self.scene.body(b).pose)
             for b, s in self.shapes.items()

@@ -1,0 +1,91 @@
+"""A region's floor holds objects up only where something is under it (session 40): on the ground, or over a
+fixed box's top.  A goal region drawn wider than the pedestal it stands on, or a few cm above its table, or
+over a table's edge, used to pass the validator with objects released in the air (pybullet: they fall).  The
+planner places over the pedestal only (``geometry/scene.py``, ``floor_support``), the validator rejects a
+placement off it (``floating``), ``mrgc check`` warns of a floor that holds nothing up (W277)."""
+
+from __future__ import annotations
+
+import copy
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from support import ROOT
+
+from mrgc import cli, parse_file
+from mrgc.geometry.scene import Body, floor_support, ground_height
+from mrgc.geometry.transforms import translation
+from mrgc.language.model import Box
+
+PEDESTAL = """(define (problem pedestal)
+  (:domain packaging)
+  (:robots (r1 :kind panda :base (0 -0.55 0 90)))
+  (:fixed
+    (table :shape (box 1.2 1.2 0.05) :pose (0 0 -0.025 0))
+    (pedestal :shape (box 0.16 0.16 0.12) :pose (0.3 0 0.06 0)))
+  (:regions
+    (start :shape (box 0.3 0.2 0.3) :pose (-0.2 0 0.15 0))
+    (top :shape (box 0.26 0.26 0.3) :pose (0.3 0 0.27 0)))
+  (:movable
+    (o1 :shape (box 0.05 0.05 0.1) :pose (-0.2 0 0.05 0)))
+  (:goal (in-region o1 top)))
+"""
+
+
+def _problem(folder: Path, text: str) -> Path:
+    (folder / "domain.mrg").write_text((ROOT / "domains" / "packaging" / "domain.mrg").read_text(encoding="utf-8"))
+    path = folder / "p.mrg"
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def test_placements_stand_on_the_pedestal_and_one_beside_it_is_floating(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    src, out = _problem(tmp_path, PEDESTAL), tmp_path / "plan.json"
+    assert cli.main(["plan", str(src), "-o", str(out)]) == 0
+    plan = json.loads(out.read_text(encoding="utf-8"))
+    (action,) = [a for s in plan["steps"] for a in s["actions"]]
+    x, y = np.array(action["place_pose"])[:2, 3]
+    assert abs(x - 0.3) <= 0.075 and abs(y) <= 0.075  # over the pedestal's top, 5 mm inside it
+    moved = copy.deepcopy(plan)
+    moved["steps"][0]["actions"][0]["place_pose"][0][3] = 0.41  # inside the region, beside the pedestal
+    bad = tmp_path / "beside.json"
+    bad.write_text(json.dumps(moved), encoding="utf-8")
+    capsys.readouterr()
+    assert cli.main(["validate", str(src), str(bad), "--format", "json"]) == 1
+    floating = [v for v in json.loads(capsys.readouterr().out)["violations"] if v["code"] == "floating"]
+    assert floating and "floor of top, which holds nothing up there" in floating[0]["message"]
+
+
+@pytest.mark.parametrize(("z", "warned"), [(0.27, False), (0.31, True)])
+def test_a_floor_off_its_table_is_warned_of(
+    tmp_path: Path, z: float, warned: bool, capsys: pytest.CaptureFixture[str]
+) -> None:
+    text = PEDESTAL.replace(
+        "(top :shape (box 0.26 0.26 0.3) :pose (0.3 0 0.27 0))", f"(top :shape (box 0.26 0.26 0.3) :pose (0.3 0 {z} 0))"
+    )
+    assert cli.main(["check", str(_problem(tmp_path, text))]) == 0
+    assert ("warning[W277]: the floor of region 'top'" in capsys.readouterr().err) == warned
+
+
+def test_the_ground_and_what_holds_a_floor_up() -> None:
+    table = Body("table", Box(1.0, 1.0, 0.05), translation(0, 0, -0.025))
+    wall = Body("wall", Box(0.1, 2.0, 0.5), translation(1, 0, 0.25))
+    assert ground_height([table]) == pytest.approx(-0.05) and ground_height([wall]) == 0.0 and ground_height([]) == 0.0
+    on_table = Body("bin", Box(0.2, 0.2, 0.3), translation(0.45, 0, 0.15))  # half of it over the table's edge
+    held = floor_support([table], on_table)
+    assert held is not None and held(translation(0.49, 0, 0.05)) and not held(translation(0.5, 0, 0.05))
+    assert floor_support([wall], Body("room", Box(2, 2, 0.3), translation(0, 0, 0.15))) is None  # on the ground
+    assert floor_support([table], Body("air", Box(0.2, 0.2, 0.3), translation(0, 0, 0.25))) is not None
+
+
+def test_shipped_problems_have_no_floor_that_holds_nothing_up(capsys: pytest.CaptureFixture[str]) -> None:
+    files = sorted((ROOT / "domains").rglob("*.mrg"))
+    problems = [p for f in files for p in parse_file(f).problems if not p.symbolic]
+    assert len(problems) >= 10
+    for f in files:
+        cli.main(["check", str(f)])
+    assert "W277" not in capsys.readouterr().err

@@ -11,7 +11,8 @@ Each finding is a located :class:`~mrgc.errors.Diagnostic` (docs/errors.md).  Tw
 - ``E265`` a movable object overlaps a fixed object at its start pose;
 - ``E266`` a planar robot's footprint at its start pose overlaps a movable object, a fixed object or
   another robot's footprint;
-- ``E269`` a region whose shape is not a box (:func:`region_shape_diagnostics`);
+- ``E269`` a region whose shape is not a box (:func:`region_shape_diagnostics`); ``W277`` a region's floor that
+  holds nothing up (:func:`floor_diagnostics`); ``W278`` an object no cart can carry (:func:`load_diagnostics`);
 - ``E267`` a ``(mesh ...)`` shape's file holds no triangle, ``E268`` the mesh of a movable object or a
   footprint is not centred on its origin, ``E403`` a mesh file cannot be used (:func:`mesh_diagnostics`:
   every mesh file is read here; a declaration whose mesh is refused gets no other complaint);
@@ -77,6 +78,7 @@ def layout_diagnostics(problem: Problem, arms: bool = True) -> list[Diagnostic]:
             + region_shape_diagnostics(problem)
             + floor_diagnostics(problem)
             + region_diagnostics(problem)
+            + load_diagnostics(problem)
         )
         if d.span not in unusable
     ]
@@ -375,6 +377,44 @@ def floor_diagnostics(problem: Problem) -> list[Diagnostic]:
                     f"the floor of region '{r.name}' (z = {z:.3f}) holds nothing up: it lies neither on the "
                     "ground nor on a fixed object's top, so nothing set down in it can stand",
                     r.span,
+                    severity="warning",
+                )
+            )
+    return out
+
+
+def load_diagnostics(problem: Problem) -> list[Diagnostic]:
+    """W278 for each movable object that no planar robot of the problem can carry with any of its side grasps:
+    at its kind's ``:carry`` pose it would reach below the floor or into the cart's own footprint
+    (:meth:`~mrgc.geometry.planar.PlanarRobot.load_fits`; the validator's ``carry``).  None without planar
+    robots, or when an arm could move the object."""
+    from mrgc.geometry.kinds import approaches
+    from mrgc.geometry.planar import PlanarRobot
+    from mrgc.geometry.planar_grasps import PLANAR_GRASPS
+    from mrgc.geometry.scene import RobotSpec
+
+    kinds = {k.name: k for k in problem.domain.robot_kinds}
+    carts = []
+    for r in problem.robots:
+        kind = kinds.get(r.kind or "")
+        if kind is None or r.base is None:
+            continue
+        if approaches(kind):
+            return []  # an arm may move what no cart carries
+        if kind.footprint is not None and not isinstance(kind.footprint, Mesh):
+            carts.append(PlanarRobot(RobotSpec(r.name, kind, from_pose(r.base))))
+    out = []
+    for m in problem.movable:
+        if not carts or m.shape is None or isinstance(m.shape, Mesh):
+            continue
+        grasps = [g for g in problem.grasps_of(m.name) if g in PLANAR_GRASPS]
+        if grasps and not any(c.load_fits(m.shape, g) for c in carts for g in grasps):
+            out.append(
+                Diagnostic(
+                    "W278",
+                    f"no robot can carry movable object '{m.name}': at the :carry pose of its kind it would reach "
+                    "below the floor or into the robot's own footprint with every grasp, so it can never move",
+                    m.span,
                     severity="warning",
                 )
             )

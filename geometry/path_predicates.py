@@ -271,8 +271,8 @@ class PlanarEvaluator:
         carried = (shape, robot.carry_transform(m.shape, g))
         key = (m.name, g)
         others = self.movable - {m.name}
-        if self._collides(robot.probe(q_pick, carried), ()):
-            return None  # M cannot be lifted to its carry pose where it was picked
+        if not robot.load_fits(m.shape, g) or self._collides(robot.probe(q_pick, carried), ()):
+            return None  # M cannot ride at its carry pose (into the floor or the cart), or be lifted to it here
         free, blocked = self._place_candidates(m, g, region, carried, others)
         if want_free:
             for _, q in free[:PLACE_FREE_TRIES]:

@@ -22,7 +22,9 @@ The model (docs/geometry.md, "Planar robots"):
   ``carry @ Rz(face yaw of g)`` (``side-x-``: 0°, ``side-y-``: -90°, ``side-x+``: 180°, ``side-y+``: 90°).
   Without ``:carry`` the object rides on top of the footprint (centred, ``PLANAR_LIFT`` above it).  The
   change from "M on the floor in front of the robot" to "M at the carry pose" is instantaneous (not swept),
-  but M at the carry pose must be free of fixed objects at the pick base pose.
+  but M at the carry pose must be free of fixed objects at the pick base pose, and must fit: above the floor
+  and out of the robot's own footprint, 1 mm of depth allowed (:meth:`PlanarRobot.load_fits`; the
+  validator's ``carry``).
 - **Place base pose.**  Placing M at a pose P with grasp g is the pick geometry in reverse: the robot stands
   at the pick base pose it would use to pick M from P.  Candidate placements inside a region are a lattice
   (centre first) × four yaws (M's current yaw + 0°, 90°, 180°, 270°); a placement rests on the region's
@@ -42,7 +44,7 @@ from typing import Mapping
 
 import numpy as np
 
-from mrgc.geometry.collision import CollisionShape, ConvexHull, collision_shape
+from mrgc.geometry.collision import CollisionShape, CollisionWorld, ConvexHull, collision_shape
 from mrgc.geometry.conventions import PLANAR_LIFT, lattice_offsets, se2, to_se2, yaw_of
 from mrgc.geometry.lattice import box_corners
 from mrgc.geometry.planar_grasps import carry_transform, grasp_base
@@ -55,6 +57,11 @@ from mrgc.language.model import Box, Cylinder, GraspSpec, Shape
 PLACEMENT_GRID = 5
 #: placement yaws tried, relative to the object's current yaw (degrees)
 PLACEMENT_YAWS = (0.0, 90.0, 180.0, 270.0)
+
+
+#: m: how deep a carried object may reach into the floor or its cart's footprint (the validator's contact
+#: tolerance: touching is not overlapping)
+LOAD_TOL = 1e-3
 
 
 class PlanarRobot:
@@ -80,6 +87,7 @@ class PlanarRobot:
         #: the footprint's frame relative to the base frame
         self.lift = translation(0.0, 0.0, float(self.half[2]) + PLANAR_LIFT)
         self.start = to_se2(spec.base)
+        self._loads: dict[tuple[Shape, str], bool] = {}  # load_fits' answers
 
     @property
     def home(self) -> np.ndarray:
@@ -100,6 +108,23 @@ class PlanarRobot:
     def carry_transform(self, shape: Shape, grasp: str) -> np.ndarray:
         """Pose of a carried object (of ``shape``, held with ``grasp``) relative to the base frame."""
         return carry_transform(self.spec.kind, shape, grasp)
+
+    def load_fits(self, shape: Shape, grasp: str) -> bool:
+        """Whether an object of ``shape`` held with ``grasp`` can ride at its carry pose: above the floor the
+        robot drives on (its lowest point no lower than 1 mm below z = 0) and clear of the robot's own
+        footprint (:func:`~mrgc.geometry.collision.posed_collide`).  A box taller than twice the ``:carry``
+        height would drag through the floor, a deep one ride inside the cart; the validator rejects both
+        (``carry``), so such a pick is no fact.  As there, touching is not overlapping: 1 mm of depth is
+        allowed (a 0.4 m deep box at ``:carry (0.45 0 0.2 0)`` touches the front of a 0.5 m footprint)."""
+        key = (shape, grasp)
+        if key not in self._loads:
+            carried = self.carry_transform(shape, grasp)
+            low = float((outline(shape) @ carried[:3, :3].T + carried[:3, 3])[:, 2].min())
+            world = CollisionWorld()
+            world.add("footprint", self.shape, self.lift)
+            world.add("load", shape, carried)
+            self._loads[key] = low >= -LOAD_TOL and world.distance("footprint", "load") >= -LOAD_TOL
+        return self._loads[key]
 
     def probe(
         self, q: np.ndarray, carried: tuple[CollisionShape, np.ndarray] | None = None, margin: float = 0.0

@@ -86,6 +86,7 @@ CODES: dict[str, str] = {
     "W275": "an arm's home configuration collides",
     "W276": "IK finds no solution for an arm",
     "W277": "region floor that holds nothing up",
+    "W278": "object no robot can carry",
 }
 
 #: codes that are warnings: reported, but the input is accepted (exit code 0)
@@ -278,6 +279,11 @@ HELP: dict[str, str] = {
     "object within its reach bound, collisions ignored: the chain from the URDF's base to the `:end-effector` "
     "link cannot put that link there. Usually `:end-effector` names the wrong link (the message says how many "
     "joints its chain has) or `:tcp` is far off. Reported by `mrgc check`, `mrgc facts` and `mrgc plan`.",
+    "W278": "A warning, not an error: a movable object that no planar robot of the problem (and there is no "
+    "arm) can carry with any of its side grasps: at the kind's `:carry` pose (the centre's height above the "
+    "floor) it would reach more than 1 mm below the floor it drives on, or into the robot's own footprint. It "
+    "can never move (phase 1 gives it no fact, the validator rejects such a carry as `carry`). Raise `:carry`'s "
+    "z to at least half the object's height, or move its x forward by half its depth beyond the footprint.",
     "W277": "A warning, not an error: a region's floor holds nothing up. It lies neither on the ground (z = 0, or "
     "the lowest point of a fixed object if one reaches lower) nor on the top of a fixed box anywhere, so an "
     "object set down in it would fall (the validator rejects it as `floating`) and the planner finds no "

@@ -407,6 +407,9 @@ class _Replayer(ActionReader):
         self._phase(t, "pick", st, [self._pick(a, st) for a in geo])
         self._picked_from_under(t, [a.obj for a in geo])
         for a in geo:
+            if self.planar[a.action.pick_robot]:
+                self._cart_load(t, a)
+        for a in geo:
             st.hold[a.action.pick_robot] = (a.obj, a.action.pick_grasp)
         self._phase(t, "to-handover", st, [self._path(a, n) for a in geo for n in ("to-handover", "taker-to-handover")])
         self._phase(t, "handover", st, [tr for a in geo if a.handover for tr in self._exchange(a, st)])
@@ -450,6 +453,26 @@ class _Replayer(ActionReader):
         fingers = self.fingers(robot, a.obj, a.action.pick_grasp)
         exempt = None if self.planar[robot] else a.obj
         return _Track(robot, qs, "pick", fingers=fingers, exempt=exempt, exempt_from=contact)
+
+    def _cart_load(self, t: int, a: ActionGeometry) -> None:
+        """A planar robot carries its box where its kind's ``:carry`` puts it, the same all along the carry: that
+        pose must keep the box above the floor the robot drives on (z = 0) and out of the robot's own footprint,
+        to :data:`CONTACT_TOL` ``[carry]`` (a 0.6 m box at a carry height of 0.2 m was dragged 10 cm through the
+        floor, a 0.6 m deep one rode 10 cm inside its cart, and no other check saw either: the footprint is
+        not an obstacle to what it carries, and the floor is no body)."""
+        robot, obj, grasp = a.action.pick_robot, a.obj, a.action.pick_grasp
+        rs = self.rs
+        rs.set_config(robot, a.configs["pick"][-1])
+        pose = self.held_pose_now(robot, obj, grasp)
+        low = float((outline(self.shapes[obj]) @ pose[:3, :3].T + pose[:3, 3])[:, 2].min())
+        if low < -CONTACT_TOL:
+            below = f"with its lowest point {-low * 1e3:.1f} mm below the floor it drives on"
+            self._v(t, obj, "carry", f"{robot} carries {obj} {below}")
+        rs.set_pose(obj, pose)
+        hit = rs.closest(obj, robot, 0.0)
+        rs.set_pose(obj, self.poses[obj])
+        if hit is not None and -hit.distance > CONTACT_TOL:
+            self._v(t, obj, "carry", f"{robot} carries {obj} {-hit.distance * 1e3:.1f} mm into its own footprint")
 
     def _exchange(self, a: ActionGeometry, st: _StepState) -> list[_Track]:
         """A handover's giver and taker at their exchange configurations, both holding the object (where

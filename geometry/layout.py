@@ -13,6 +13,7 @@ Each finding is a located :class:`~mrgc.errors.Diagnostic` (docs/errors.md).  Tw
   another robot's footprint;
 - ``E269`` a region whose shape is not a box (:func:`region_shape_diagnostics`); ``W277`` a region's floor that
   holds nothing up (:func:`floor_diagnostics`); ``W278`` an object no cart can carry (:func:`load_diagnostics`);
+  ``W279`` a goal object too tall for its goal region (:func:`fit_diagnostics`);
 - ``E267`` a ``(mesh ...)`` shape's file holds no triangle, ``E268`` the mesh of a movable object or a
   footprint is not centred on its origin, ``E403`` a mesh file cannot be used (:func:`mesh_diagnostics`:
   every mesh file is read here; a declaration whose mesh is refused gets no other complaint);
@@ -78,6 +79,7 @@ def layout_diagnostics(problem: Problem, arms: bool = True) -> list[Diagnostic]:
             + region_shape_diagnostics(problem)
             + floor_diagnostics(problem)
             + region_diagnostics(problem)
+            + fit_diagnostics(problem)
             + load_diagnostics(problem)
         )
         if d.span not in unusable
@@ -377,6 +379,46 @@ def floor_diagnostics(problem: Problem) -> list[Diagnostic]:
                     f"the floor of region '{r.name}' (z = {z:.3f}) holds nothing up: it lies neither on the "
                     "ground nor on a fixed object's top, so nothing set down in it can stand",
                     r.span,
+                    severity="warning",
+                )
+            )
+    return out
+
+
+def fit_diagnostics(problem: Problem) -> list[Diagnostic]:
+    """W279 for each goal object taller than its goal region leaves room for: placements rest
+    :data:`~mrgc.geometry.conventions.ARM_PLACE_LIFT` above the floor (``PLANAR_LIFT`` when only carts place),
+    and the object must lie entirely inside the region (``in-region``), so a 0.100 m object in a 0.105 m bin
+    has no placement at all (planning said "no robot can reach goal region bin").  Left out while a region is
+    not a box (E269) or a mesh cannot be used."""
+    from mrgc.geometry.conventions import ARM_PLACE_LIFT, PLANAR_LIFT
+    from mrgc.geometry.kinds import approaches
+    from mrgc.geometry.scene import half_extents
+    from mrgc.language.model import Box
+
+    if region_shape_diagnostics(problem):
+        return []
+    kinds = {k.name: k for k in problem.domain.robot_kinds}
+    arms = any(approaches(kinds[r.kind]) for r in problem.robots if r.kind in kinds)
+    lift = ARM_PLACE_LIFT if arms else PLANAR_LIFT
+    regions = {r.name: r for r in problem.regions}
+    out = []
+    for m in problem.movable:
+        region = regions.get(problem.goal_regions.get(m.name, ""))
+        if m.shape is None or region is None or not isinstance(region.shape, Box):
+            continue
+        try:
+            tall = 2 * float(half_extents(m.shape)[2])
+        except InputError:
+            continue
+        if tall + lift > region.shape.sz:
+            out.append(
+                Diagnostic(
+                    "W279",
+                    f"movable object '{m.name}' ({tall:.3f} m tall) does not fit in its goal region "
+                    f"'{region.name}' ({region.shape.sz:.3f} m tall): it is set down {lift * 1e3:g} mm above the "
+                    f"floor and must lie entirely inside, so the region needs {tall + lift:.3f} m",
+                    m.span,
                     severity="warning",
                 )
             )

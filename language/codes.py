@@ -87,6 +87,7 @@ CODES: dict[str, str] = {
     "W276": "IK finds no solution for an arm",
     "W277": "region floor that holds nothing up",
     "W278": "object no robot can carry",
+    "W279": "goal object too tall for its goal region",
 }
 
 #: codes that are warnings: reported, but the input is accepted (exit code 0)
@@ -284,6 +285,11 @@ HELP: dict[str, str] = {
     "floor) it would reach more than 1 mm below the floor it drives on, or into the robot's own footprint. It "
     "can never move (phase 1 gives it no fact, the validator rejects such a carry as `carry`). Raise `:carry`'s "
     "z to at least half the object's height, or move its x forward by half its depth beyond the footprint.",
+    "W279": "A warning, not an error: a goal object is taller than its goal region leaves room for. Placements "
+    "rest 6 mm above the region's floor (1 mm when only carts place: touching counts as colliding, and an object "
+    "in hand dips a few mm while the arm moves), and the object must lie entirely inside the region, so a 0.100 m "
+    "object in a 0.105 m bin has no placement at all. Make the region taller (its height is only where objects "
+    "may be, not a wall).",
     "W277": "A warning, not an error: a region's floor holds nothing up. It lies neither on the ground (z = 0, or "
     "the lowest point of a fixed object if one reaches lower) nor on the top of a fixed box anywhere, so an "
     "object set down in it would fall (the validator rejects it as `floating`) and the planner finds no "

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Callable, Iterable, Mapping, Sequence, Union
 
 from mrgc.errors import Diagnostic, InputError
+from mrgc.limits import checked
 from mrgc.planner.defaults import DEFAULT_BACKEND, DEFAULT_ENCODING, DEFAULT_PLANNER, DEFAULT_TIME_LIMIT
 
 if TYPE_CHECKING:
@@ -107,6 +108,9 @@ def _resolve(source: ProblemSource, name: str | None, allow_outside: Sequence[st
         return source, source.source if source.source and os.path.isfile(source.source) else None
     from mrgc.language.loader import parse_file
 
+    if not isinstance(source, (str, os.PathLike)):
+        what = type(source).__name__
+        raise InputError([Diagnostic("E000", f"a problem is a file's path or a Problem, not a {what}")])
     path = os.fspath(source)
     return parse_file(path, allow_outside=tuple(allow_outside)).problem(name), path
 
@@ -147,6 +151,8 @@ def compute_facts(
     (``.stats``); ``workers`` processes (default one per robot).  InputError E402 for a symbolic problem."""
     from mrgc.planner.phase1 import compute_problem_facts
 
+    checked("seed", seed, "count")
+    checked("workers", workers, "count", none=True)
     problem = load_problem(source, name=name, allow_outside=allow_outside)
     warnings = _checked_layout(problem, robots=True)
     result = compute_problem_facts(problem, seed=seed, workers=workers)
@@ -170,6 +176,7 @@ def facts_summary(
     from mrgc.planner.skeletons import needs_facts, problem_facts
     from mrgc.planner.summary import summarize
 
+    checked("seed", seed, "count")
     problem = load_problem(source, name=name, allow_outside=allow_outside)
     warnings = _checked_layout(problem, robots=facts is None and needs_facts(problem))
     fact_list, _ = problem_facts(problem, facts, seed=seed)
@@ -200,12 +207,16 @@ def compile(  # noqa: A001
     (through the facts cache, docs/geometry.md)."""
     from mrgc.planner.skeletons import compile_problem, needs_facts, problem_facts
 
+    checked("seed", seed, "count")
+    checked("skeletons", skeletons, "count")
+    checked("max_makespan", max_makespan, "count", none=True)
+    checked("time_limit", time_limit, "number", none=True, positive=True)
     problem = load_problem(source, name=name, allow_outside=allow_outside)
     _checked_layout(problem, robots=facts is None and needs_facts(problem))
     fact_list, facts_seconds = problem_facts(problem, facts, seed=seed)
     result = compile_problem(
         problem,
-        backend=backend,
+        backend=DEFAULT_BACKEND if backend is None else backend,
         encoding=encoding,
         skeletons=skeletons,
         max_makespan=max_makespan,
@@ -243,9 +254,11 @@ def export_model(
     from mrgc.planner.skeletons import export_model as write_model
     from mrgc.planner.skeletons import needs_facts, problem_facts
 
+    checked("seed", seed, "count")
+    checked("horizon", horizon, "count", none=True)
+    checked("max_makespan", max_makespan, "count", none=True)
+    backend = DEFAULT_BACKEND if backend is None else backend
     problem = load_problem(source, name=name, allow_outside=allow_outside)
-    if horizon is not None and horizon < 1:
-        raise InputError([Diagnostic("E000", f"the horizon is at least 1, not {horizon}")])
     _checked_layout(problem, robots=facts is None and needs_facts(problem))
     fact_list, _ = problem_facts(problem, facts, seed=seed)
     if horizon is None:
@@ -307,6 +320,8 @@ def plan(
     from mrgc.planner.outcome import PlanStatus
 
     started = time.perf_counter()  # the time limit covers the layout checks, which load the robots' models
+    checked("seed", seed, "count")
+    checked("time_limit", time_limit, "number", positive=True)
     problem, path = _resolve(source, name, allow_outside)
     _checked_layout(problem, arms=False)  # W274-W276 (warnings) only explain a plan not found: asked for then
     digest = problem_digest(problem)

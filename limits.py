@@ -11,7 +11,8 @@ from __future__ import annotations
 
 import argparse
 import math
-from typing import Callable
+import numbers
+from typing import Any, Callable
 
 #: option -> (lowest, highest) accepted value; the reason for each bound is in docs/cli.md
 BOUNDS: dict[str, tuple[float, float]] = {
@@ -76,3 +77,39 @@ def number(
 
 def _shown(text: str) -> str:
     return repr(text if len(text) <= 40 else text[:37] + "...")
+
+
+def checked(
+    name: str,
+    value: object,
+    kind: str,
+    *,
+    option: str | None = None,
+    bounds: tuple[float, float] | None = None,
+    none: bool = False,
+    positive: bool = False,
+) -> Any:
+    """A Python API argument checked as the command line checks its option (``option``, default ``--`` +
+    ``name`` with dashes; ``bounds``, default its row of :data:`BOUNDS`): ``kind`` ``"count"`` (a whole
+    number, ``bool`` excluded) or ``"number"`` (finite; ``positive`` excludes the lowest bound); ``none`` lets
+    None through.  The value,
+    else InputError E000 ``name=...: must be ...`` (the API's misuse is an exception of the one root, never a
+    solver's own error or a wrong verdict: a seed past CP-SAT's 32 bits was a false "time limit")."""
+    from mrgc.errors import Diagnostic, InputError
+
+    if value is None and none:
+        return None
+    flag = option or "--" + name.replace("_", "-")
+    lo, hi = bounds if bounds is not None else BOUNDS[flag]
+    whole = isinstance(value, numbers.Integral) and not isinstance(value, bool)
+    if kind == "count":
+        ok = whole and lo <= value <= hi  # type: ignore[operator]
+        what = f"must be a whole number from {int(lo)} to {int(hi):,}"
+    else:
+        real = whole or isinstance(value, numbers.Real) and not isinstance(value, bool)
+        ok = real and math.isfinite(value) and lo <= value <= hi and not (positive and value <= lo)  # type: ignore[arg-type,operator]
+        span = f"more than {lo:g} and at most {hi:g}" if positive else f"from {lo:g} to {hi:g}"
+        what = f"must be a finite number {span}"
+    if not ok:
+        raise InputError([Diagnostic("E000", f"{name}={value!r}: {what}{' or None' if none else ''}")])
+    return value

@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Any
 
 from mrgc.errors import Diagnostic, InputError
 from mrgc.planner.defaults import DEFAULT_TIME_LIMIT
-from mrgc.planner.method import Context, Log, Planner, Result
+from mrgc.planner.method import Context, Log, Option, Planner, Result
 from mrgc.planner.outcome import PlanStatus, Why
 
 if TYPE_CHECKING:
@@ -34,11 +34,30 @@ def options_for(method: Planner, given: dict[str, Any]) -> dict[str, Any]:
     """Every option ``method`` declares, ``given`` ones over the defaults; an option it does not declare is a
     usage error (InputError E000, exit code 2)."""
     declared = {o.name: o for o in method.options}
-    for key in given:
+    for key, value in given.items():
         if key not in declared:
             flag = f"-{key}" if len(key) == 1 else "--" + key.replace("_", "-")
             raise InputError([Diagnostic("E000", f"{flag} is not an option of the {method.name} planner")])
+        _check_value(declared[key], value)
     return {name: given.get(name, o.default) for name, o in declared.items()}
+
+
+def _check_value(option: Option, value: Any) -> None:
+    """A value given to ``option`` through the Python API, checked as the command line checks it (its kind,
+    the bounds of ``limits.BOUNDS`` or its own, its choices): InputError E000 otherwise (a max_makespan of 0
+    made a feasible problem 'infeasible')."""
+    from mrgc import limits
+
+    if value is None and option.default is None:
+        return
+    if option.kind in ("count", "number"):
+        bounds = limits.BOUNDS.get(option.flag, option.bounds)
+        limits.checked(option.name, value, option.kind, option=option.flag, bounds=bounds)
+    elif option.kind == "flag" and not isinstance(value, bool):
+        raise InputError([Diagnostic("E000", f"{option.name}={value!r}: must be True or False")])
+    elif option.kind == "text" and (not isinstance(value, str) or (option.choices and value not in option.choices)):
+        choices = f"one of {', '.join(option.choices)}" if option.choices else "a string"
+        raise InputError([Diagnostic("E000", f"{option.name}={value!r}: must be {choices}")])
 
 
 def run(
@@ -65,7 +84,7 @@ def run(
     from mrgc.planner.skeletons import facts_until, must_move
 
     if motions not in MOTIONS or motions not in method.motions:
-        raise ValueError(f"motions is one of {', '.join(method.motions)}, not {motions!r}")
+        raise InputError([Diagnostic("E000", f"motions={motions!r}: must be one of {', '.join(method.motions)}")])
     options = options_for(method, given)
     method.check(problem)
     t0 = time.perf_counter() if started is None else started

@@ -388,3 +388,41 @@ def test_missing_file(tmp_path: Path) -> None:
     with pytest.raises(InputError) as info:
         mrgc.parse_file(tmp_path / "absent.mrg")
     assert codes(info) == ["E001"]
+
+
+CHAIN = str(Path(__file__).resolve().parent.parent / "domains" / "symbolic" / "chain-3.mrg")
+
+
+@pytest.mark.parametrize(
+    ("call", "kwargs", "said"),
+    [
+        ("plan", {"seed": 2**31}, "seed=2147483648: must be a whole number from 0 to 2,147,483,647"),
+        ("compile", {"seed": 2**64}, "seed="),
+        ("plan", {"max_makespan": 0}, "max_makespan=0: must be a whole number from 1"),
+        ("plan", {"max_makespan": -1, "planner": "ap2"}, "max_makespan=-1"),
+        ("plan", {"time_limit": 0}, "time_limit=0: must be a finite number more than 0"),
+        ("plan", {"time_limit": None}, "time_limit=None"),
+        ("plan", {"motions": "bogus"}, "motions='bogus': must be one of configurations, full"),
+        ("plan", {"c": -1}, "c=-1"),
+        ("plan", {"anytime": "yes"}, "anytime='yes': must be True or False"),
+        ("compile", {"max_makespan": 0}, "max_makespan=0"),
+        ("compile", {"skeletons": 0}, "skeletons=0"),
+        ("compile", {"time_limit": -1}, "time_limit=-1"),
+        ("compile", {"time_limit": "5"}, "time_limit='5'"),
+        ("compile", {"time_limit": 1e10}, "time_limit=10000000000.0"),
+        ("facts_summary", {"seed": 1.5}, "seed=1.5"),
+    ],
+)
+def test_api_arguments_are_checked_as_the_command_line_checks_them(call: str, kwargs: dict, said: str) -> None:
+    """A bad number is InputError E000 naming the argument (a seed past 32 bits was a false 'time limit', a
+    max_makespan of 0 a false 'infeasible', time_limit=None a TypeError from deep inside)."""
+    with pytest.raises(mrgc.MrgcError) as err:
+        getattr(mrgc, call)(CHAIN, **kwargs)
+    assert err.value.diagnostics[0].code == "E000" and said in err.value.diagnostics[0].message
+
+
+def test_api_defaults_and_bounds_pass() -> None:
+    assert mrgc.compile(CHAIN, backend=None, seed=2**31 - 1, time_limit=1e6).status == "optimal"
+    assert mrgc.plan(CHAIN, max_makespan=10_000, seed=0).status == "solved"
+    with pytest.raises(mrgc.MrgcError, match="a problem is a file's path or a Problem, not a NoneType"):
+        mrgc.compile(None)  # type: ignore[arg-type]

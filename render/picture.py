@@ -98,13 +98,16 @@ def layout(
     legend: Sequence[LegendEntry] = (),
     labels: tuple[str, ...] = (),
 ) -> Layout:
-    """The layout of frames ``width`` × ``height`` with these captions (none: no caption band), legend
-    (dropped when it would take more than :data:`LEGEND_SHARE` of the height) and kinds of label."""
+    """The layout of frames ``width`` × ``height`` with these captions (none: no caption band; dropped when it
+    would take more than half the height), legend (dropped when it would take more than
+    :data:`LEGEND_SHARE` of the height) and kinds of label."""
     size = text_size(height)
     pad = _pad(size)
     texts = set(captions)
     lines = max((len(wrap(t, size, width - 2 * pad, CAPTION_LINES)) for t in texts), default=0)
     bottom = lines * (size + 2) + 2 * pad if lines else 0
+    if height - bottom < height / 2:  # a tiny picture: the caption would leave too little scene (none at 16 px)
+        lines, bottom = 0, 0
     top = legend_band(width, legend, size).shape[0] if legend else 0
     if top > LEGEND_SHARE * height or height - top - bottom < height / 2:
         top, legend = 0, ()

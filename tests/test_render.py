@@ -560,3 +560,27 @@ def test_sheets_and_html_replays_of_pa10_and_bo8_name_their_robots_and_regions(
     picture, ok = screenshot_when(page_path.as_uri(), lambda p: non_blank(p) and not unnamed(p), timeout=150)
     Image.fromarray(picture).save(tmp_path / "chromium.png")
     assert ok, f"region names missing in the replay: {unnamed(picture)} ({tmp_path / 'chromium.png'})"
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    w=st.integers(16, 4096),
+    h=st.integers(16, 4096),
+    caption=st.text(alphabet="abc ,.", min_size=0, max_size=300),
+)
+@example(w=400, h=16, caption="pa3-handover: step 1 of 1, to-place: r1 hands o1 over to r2")
+def test_every_allowed_size_leaves_half_the_picture_to_the_scene(w: int, h: int, caption: str) -> None:
+    """At the documented 16 px the caption band used to take the whole height: pybullet was asked for a
+    picture of no rows (std::bad_alloc, exit 134) or 1 row (ZeroDivisionError, exit 70)."""
+    from mrgc.render.picture import layout
+
+    lay = layout(w, h, [caption] if caption else [])
+    assert lay.scene_height >= h / 2 and lay.scene_height > 0
+
+
+def test_the_smallest_pictures_are_drawn(tmp_path: Path) -> None:
+    src = ROOT / "domains" / "packaging" / "pa3-handover.mrg"
+    for size in ("16x16", "400x17"):
+        out = tmp_path / f"{size}.png"
+        assert cli.main(["render", str(src), "--size", size, "-o", str(out)]) == 0
+        assert Image.open(out).size == tuple(int(v) for v in size.split("x"))

@@ -86,25 +86,38 @@ def expand_instances(study: Study, work: str) -> list[Instance]:
 
 def _files(study: Study, spec: InstanceSpec, work: str) -> list[tuple[str, str]]:
     """(instance name, path) of the entry's files."""
+    if spec.kind != "generate":
+        return instance_files(spec, study.folder)
+    return _generated(spec, os.path.join(work, "instances", spec.name))
+
+
+def instance_files(spec: InstanceSpec, folder: str) -> list[tuple[str, str]]:
+    """(instance name, path) of a ``file:`` or ``glob:`` entry, relative to the study's ``folder``; InputError
+    E602 located at the entry when the file does not exist or the glob matches no problem file (the study
+    checker asks it too, so that every error of a study is reported at once)."""
 
     def missing(message: str) -> InputError:
         return InputError([Diagnostic(E_INSTANCE, message, spec.span)])
 
     if spec.kind == "file":
-        path = os.path.join(study.folder, spec.source)
+        path = os.path.join(folder, spec.source)
         if not os.path.isfile(path):
             raise missing(f"instance file '{spec.source}' not found (looked for {path})")
         return [(spec.name, path)]
     if spec.kind == "glob":
         paths = sorted(
             p
-            for p in globbing.glob(os.path.join(study.folder, spec.source), recursive=True)
+            for p in globbing.glob(os.path.join(folder, spec.source), recursive=True)
             if os.path.isfile(p) and p.endswith(".mrg") and os.path.basename(p) != "domain.mrg"
         )
         if not paths:
-            raise missing(f"glob '{spec.source}' matches no problem file (.mrg, domain.mrg excluded) in {study.folder}")
+            raise missing(f"glob '{spec.source}' matches no problem file (.mrg, domain.mrg excluded) in {folder}")
         return [(re.sub(r"[^A-Za-z0-9_.+-]", "-", os.path.splitext(os.path.basename(p))[0]), p) for p in paths]
-    folder = os.path.join(work, "instances", spec.name)
+    raise ValueError(f"not a file or glob entry: {spec.kind}")
+
+
+def _generated(spec: InstanceSpec, folder: str) -> list[tuple[str, str]]:
+    """(instance name, path) of a ``generate:`` entry's files, written into ``folder``."""
     os.makedirs(folder, exist_ok=True)
     out = []
     for seed in spec.seeds:

@@ -146,7 +146,9 @@ def _bad_value(action: argparse.Action, value: Any) -> str:
         return "takes a value, not true/false"
     try:
         converted = action.type(str(value)) if callable(action.type) else str(value)
-    except (TypeError, ValueError, argparse.ArgumentTypeError):
+    except argparse.ArgumentTypeError as exc:  # the command line's own words: the bounds (limits.py)
+        return str(exc)
+    except (TypeError, ValueError):
         kind = getattr(action.type, "__name__", "value")
         return f"'{value}' is not {'an' if kind[0] in 'aeiou' else 'a'} {kind}"
     if action.choices is not None and converted not in action.choices:

@@ -31,15 +31,19 @@ GLOB_KEYS = ("glob", "name", "problem")
 GENERATE_KEYS = ("generate", "name", "seeds")  # plus the generator's own options
 
 
+#: the largest seed: mrgc plan's and compile's (``mrgc.limits.BOUNDS``: CP-SAT's seed is a 32-bit integer)
+MAX_SEED = 2**31 - 1
+
+
 def parse_seeds(value: Any) -> tuple[int, ...] | None:
     """``3`` → (3,); ``"0..19"`` → (0, ..., 19); a list of those → their concatenation; None if malformed."""
     if isinstance(value, bool):
         return None
     if isinstance(value, int):
-        return (value,) if value >= 0 else None
+        return (value,) if 0 <= value <= MAX_SEED else None
     if isinstance(value, str):
         m = _RANGE.match(value)
-        if not m or int(m.group(1)) > int(m.group(2)):
+        if not m or int(m.group(1)) > int(m.group(2)) or int(m.group(2)) > MAX_SEED:
             return None
         return tuple(range(int(m.group(1)), int(m.group(2)) + 1))
     if isinstance(value, list) and value:
@@ -80,11 +84,13 @@ def load_study(path: str | os.PathLike[str]) -> Study:
         text = data.decode("utf-8")
     except UnicodeDecodeError as exc:
         raise InputError([Diagnostic(E_STUDY_READ, f"study '{path}' is not UTF-8 text (byte {exc.start})")]) from None
-    return parse_study(text, path)
+    return parse_study(text, path, files=True)
 
 
-def parse_study(text: str, path: str = "<study>") -> Study:
-    """Check the text of a study file named ``path`` (relative paths in it resolve against its folder)."""
+def parse_study(text: str, path: str = "<study>", files: bool = False) -> Study:
+    """Check the text of a study file named ``path`` (relative paths in it resolve against its folder);
+    ``files``: also that every ``file:`` exists and every ``glob:`` matches a problem file (E602), as
+    :func:`load_study` asks, so that a study's every error is reported at once."""
     import yaml
 
     try:
@@ -97,7 +103,7 @@ def parse_study(text: str, path: str = "<study>") -> Study:
         ) from None
     except yaml.YAMLError as exc:
         raise InputError([Diagnostic(E_STUDY_READ, f"study is not YAML: {exc}")], {path: text}) from None
-    reader = Reader(path)
+    reader = Reader(path, files)
     study = reader.study(root)
     if reader.diags or study is None:
         diags = reader.diags or [Diagnostic(E_STUDY_SCHEMA, "the study is empty", Span(path, 1, 1, 1, 2))]
@@ -108,8 +114,9 @@ def parse_study(text: str, path: str = "<study>") -> Study:
 class Reader:
     """Walks the composed YAML tree, collecting a located diagnostic per problem."""
 
-    def __init__(self, path: str) -> None:
+    def __init__(self, path: str, files: bool = False) -> None:
         self.path = path
+        self.files = files  # also look for the instance files and globs (a study read from its file)
         self.diags: list[Diagnostic] = []
         self.set_names: list[str] = []
 
@@ -188,7 +195,7 @@ class Reader:
         """A list of distinct seeds (:func:`parse_seeds`), or None with an error."""
         seeds = parse_seeds(self.value(node))
         if seeds is None:
-            self.error(node, f"{what} must be a seed (integer >= 0), a range 'a..b' (a <= b) or a list of those")
+            self.error(node, f"{what} must be a seed (0 to {MAX_SEED:,}), a range 'a..b' (a <= b) or a list of those")
         elif len(set(seeds)) != len(seeds):
             self.error(node, f"{what} repeat a seed")
             return None
@@ -212,11 +219,29 @@ class Reader:
         instances = self.instances(top["instances"][1]) if "instances" in top else []
         self.set_names = [i.name for i in instances]
         methods = self.methods(top["methods"][1], limits or Limits()) if "methods" in top else []
+        self.later(instances, methods)  # with the rest: every error of a study at once
         if name is None or seeds is None or limits is None or self.diags:
             return None
         return Study(
             name, self.path, "", tuple(instances), tuple(methods), seeds, limits, description or "", facts_cache
         )
+
+    def later(self, instances: list[InstanceSpec], methods: list[Method]) -> None:
+        """The errors of what parsed that the run would find before its first run: an instance file that
+        does not exist or a glob that matches none (E602), a method's unknown backend, encoding or option
+        and a bad option value (E601): found here, they come with the rest, not in later rounds."""
+        from mrgc.bench.instances import instance_files
+        from mrgc.bench.methods import check_methods
+
+        folder = os.path.dirname(os.path.abspath(self.path))
+        for spec in instances if self.files else ():
+            if spec.kind != "generate":
+                try:
+                    instance_files(spec, folder)
+                except InputError as exc:
+                    self.diags += exc.diagnostics
+        partial = Study("study", self.path, "", tuple(instances), tuple(methods), (0,), Limits())
+        self.diags += check_methods(partial)[0]
 
     def facts_cache(self, node: Any) -> str:
         """The study's ``facts_cache`` (a key of :data:`~mrgc.bench.study.FACTS_CACHE`), "own" with an error

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import shutil
 import signal
 import sqlite3
@@ -152,13 +153,16 @@ def test_a_valid_study_and_its_methods_as_mrgc_command_lines() -> None:
         args = build_parser().parse_args([*method_args(m)[:1], "x.mrg", *method_args(m)[1:]])
         # mrgc plan passes a planner only the options given (its own defaults apply); compile's default is cpsat
         assert getattr(args, "backend", "cpsat") == (m.backend or "cpsat")
-    bad = parse_study(
-        "study: d\ninstances: [{file: a.mrg}]\nmethods:\n  - {name: A, options: {skeleton: 3}}\n"
-        "  - {name: B, backend: cplex, options: {anytime: 3}}\n  - {name: C, options: {seed: 1}}\n",
-        "s.yaml",
-    )
-    diags, _ = check_methods(bad)
+    with pytest.raises(InputError) as err:  # the methods' errors come with the study's (once, all of them)
+        parse_study(
+            "study: d\ninstances: [{file: a.mrg}]\nmethods:\n  - {name: A, options: {skeleton: 3}}\n"
+            "  - {name: B, backend: cplex, options: {anytime: 3}}\n  - {name: C, options: {seed: 1}}\n"
+            "  - {name: D, options: {skeletons: 0}}\n",
+            "s.yaml",
+        )
+    diags = err.value.diagnostics
     text = "\n".join(d.message for d in diags)
+    assert "option 'skeletons': must be a whole number from 1 to 10,000 (got 0)" in text  # was "'0' is not an integer"
     assert "no option --skeleton (did you mean 'skeletons'?)" in text and "unknown backend 'cplex'" in text
     assert "is a flag" in text and "set by the study itself" in text
 
@@ -713,3 +717,24 @@ def test_the_python_api_names_resolve_and_importing_it_loads_no_heavy_library() 
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60, check=True)
     assert out.stdout.strip() == "[]"
+
+
+def test_a_study_s_errors_come_at_once(tmp_path: Path) -> None:
+    """Schema, instance files and methods checked together (they came in three rounds: fix five errors, get
+    seven more, then a glob that matches nothing); a seed past 32 bits is an error at once (every run was
+    recorded as 'error' and never retried)."""
+    study = write_study(
+        tmp_path / "s.yaml",
+        "study: s\nseeds: 2147483648\ninstances: [{glob: none-*.mrg}]\n"
+        "methods: [{name: A, backend: gurobi, options: {c: -1}}]\n",
+    )
+    out = subprocess.run(
+        [*MRGC, "bench", "run", str(study), "--db", str(tmp_path / "r.db")], capture_output=True, text=True, timeout=60
+    )
+    assert out.returncode == 2 and not (tmp_path / "r.db").exists()
+    codes = re.findall(r"error\[(E60\d)\]", out.stderr)
+    assert sorted(codes) == ["E601", "E601", "E601", "E602"], out.stderr
+    assert "seeds must be a seed (0 to 2,147,483,647)" in out.stderr and "unknown backend 'gurobi'" in out.stderr
+    assert (
+        "option 'c': must be a finite number from 0 to 1e+06" in out.stderr and "matches no problem file" in out.stderr
+    )

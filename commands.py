@@ -202,6 +202,8 @@ def cmd_compile(args: argparse.Namespace) -> int:
 
     mf = _load(args)
     problem = mf.problem(args.problem)
+    if args.horizon is not None and not args.emit:
+        raise InputError([Diagnostic("E000", "--horizon is the horizon of the model --emit writes: give --emit")])
     if args.emit:  # before any solving: a path the solver cannot write, or a format it does not write
         check_output(args.emit, inputs_of(mf), option="--emit")
         check_export(args.backend, args.emit)

@@ -15,6 +15,7 @@ from typing import Any, Iterator
 
 from mrgc.errors import Diagnostic, InputError
 from mrgc.exits import ExitCode
+from mrgc.limits import count
 from mrgc.planner.defaults import DEFAULT_BACKEND, DEFAULT_ENCODING
 
 MAX_SIDE = 4096  # pixels
@@ -85,7 +86,7 @@ def add_commands(sub: Any) -> None:
         help=f"backend generating skeletons for --skeleton (default {DEFAULT_BACKEND})",
     )
     p.add_argument("--encoding", default=DEFAULT_ENCODING)
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=count("--seed"), default=0)
     add_no_cache(p)
     p.set_defaults(func=cmd_graph)
 
@@ -222,6 +223,8 @@ def cmd_graph(args: argparse.Namespace) -> int:
         raise _usage(f"cannot write {args.output!r}: mrgc graph writes {', '.join(graph.FORMATS)}")
     if args.skeleton is not None and args.skeleton < 1:
         raise _usage("--skeleton must be at least 1")
+    if args.skeleton is None and (args.backend, args.encoding) != (DEFAULT_BACKEND, DEFAULT_ENCODING):
+        raise _usage("--backend and --encoding choose how the skeleton of --skeleton K is made: give --skeleton")
     mf = parse_file(args.file)
     files.check_output(args.output, list(mf.files))
     if ext != ".dot":

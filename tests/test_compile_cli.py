@@ -289,3 +289,12 @@ def test_backends_json(capsys: pytest.CaptureFixture[str]) -> None:
         assert r["encodings"] == ["paper", "disaggregated", "time-of-move"]
     assert rows["mip"]["exports"] == ["lp", "mps"] and rows["smt"]["exports"] == ["smt2"]
     assert rows["cpsat"]["exports"] == ["pbtxt"] and rows["pysmt"]["exports"] == []
+
+
+def test_options_that_would_be_ignored_are_refused(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    """--horizon without --emit, graph --backend without --skeleton: they did nothing, silently."""
+    src = str(Path(__file__).resolve().parent.parent / "domains" / "symbolic" / "medium.mrg")
+    assert cli.main(["compile", src, "--horizon", "3"]) == 2
+    assert "--horizon is the horizon of the model --emit writes" in capsys.readouterr().err
+    assert cli.main(["graph", src, "-o", str(tmp_path / "g.dot"), "--backend", "smt"]) == 2
+    assert "give --skeleton" in capsys.readouterr().err and not (tmp_path / "g.dot").exists()

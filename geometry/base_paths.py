@@ -80,7 +80,8 @@ class BasePaths(Volumes):
         busy: Sequence[tuple[CollisionShape, np.ndarray]],
     ) -> Answer:
         others = [name for r, names in self.parked.items() if r != robot for name in names]
-        against = ("fixed", *others, *movers)
+        arms = (*self._homes(), *self._bases)  # the arms at home and their mounts (an arm that moves is in busy)
+        against = ("fixed", *others, *arms, *movers)
         ignore = (holding[0],) if holding else ()
         if robot not in self._grids:
             self._grids[robot] = DiscGrid(self.planar(robot), self.scene, scene_bounds(self.scene, 0.5))
@@ -114,14 +115,8 @@ class BasePaths(Volumes):
         if holding is not None:
             body = self.scene.body(holding[0])
             parts.append((body.shape, pr.carry_transform(body.shape, holding[1])))
-        bodies: list[tuple[Hashable, Body, np.ndarray]] = [(b.name, b.shape, b.pose) for b in self.scene.fixed]
-        bodies += [((a, self.poses[a].tobytes()), self.scene.body(a).shape, self.poses[a]) for a in movers]
-        for r, names in self.parked.items():  # the other parked robots where they wait
-            if r != robot:
-                bodies += [(name, _body(shape), t) for name, (shape, t) in zip(names, self.robot(r).rest().home)]
-        bodies += [(("busy", pts.tobytes()), pts, np.eye(4)) for pts in _swept_hulls(busy)]
         lattice = self._lattices[robot]
-        occupied = lattice.occupancy(parts, bodies)
+        occupied = lattice.occupancy(parts, self._lattice_bodies(robot, movers, busy))
         res = lattice.plan(
             occupied,
             np.asarray(start, dtype=float),
@@ -137,6 +132,25 @@ class BasePaths(Volumes):
             self.cut = True
             return Answer(GroundStatus.TIME_LIMIT)
         return Answer(GroundStatus.OK if res.solved else GroundStatus.NO_PATH, path=list(res.path))
+
+    def _lattice_bodies(
+        self, robot: str, movers: list[str], busy: Sequence[tuple[CollisionShape, np.ndarray]]
+    ) -> list[tuple[Hashable, Body, np.ndarray]]:
+        """What the lattice's occupancy keeps ``robot`` clear of: the fixed objects, ``movers`` where they are,
+        the other parked robots where they wait, the arms at home and their mounts (a cart drove through a
+        Panda on the floor, and every plan was refused), and what ``busy`` sweeps."""
+        bodies: list[tuple[Hashable, Body, np.ndarray]] = [(b.name, b.shape, b.pose) for b in self.scene.fixed]
+        bodies += [((a, self.poses[a].tobytes()), self.scene.body(a).shape, self.poses[a]) for a in movers]
+        for r, names in self.parked.items():  # the other parked robots where they wait
+            if r != robot:
+                bodies += [(name, _body(shape), t) for name, (shape, t) in zip(names, self.robot(r).rest().home)]
+        for spec in self.scene.robots:  # the arms at home, and their mounts
+            if not self.robot(spec.name).parks:
+                rest = self.robot(spec.name).rest()
+                bodies += [((spec.name, i), _body(shape), t) for i, (shape, t) in enumerate(rest.home)]
+                bodies += [((spec.name, "base", j), _body(shape), t) for j, (_, shape, t) in enumerate(rest.mount)]
+        bodies += [(("busy", pts.tobytes()), pts, np.eye(4)) for pts in _swept_hulls(busy)]
+        return bodies
 
 
 def _swept_hulls(volume: Sequence[tuple[CollisionShape, np.ndarray]], chunk: int = 8) -> list[np.ndarray]:

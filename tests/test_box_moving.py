@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from support import ROOT
 
-from mrgc import parse_file, parse_string
+from mrgc import cli, parse_file, parse_string
 from mrgc.geometry.path_predicates import PlanarEvaluator
 from mrgc.geometry.planar import DiscGrid, PlanarRobot, placements, scene_bounds
 from mrgc.geometry.planar_grasps import CLEARANCE
@@ -225,3 +225,28 @@ def test_shipped_problem_compiles_to_its_expected_optimum(path: Path) -> None:
     assert result.status == "optimal", result.reasons
     best = result.skeletons[0]
     assert (best.makespan, len(best.moved)) == (int(expect.group(1)), int(expect.group(2)))
+
+
+def test_a_cart_drives_around_an_arm_standing_on_the_floor(tmp_path: Path) -> None:
+    """A Panda bolted in the middle of a 3 m wide room: the cart's base paths ignored the arms (at home and
+    their mounts), drove straight through it, and every plan was refused by the referee ('exhausted')."""
+    src, out = ROOT / "tests" / "data" / "mixed" / "arm-in-the-way.mrg", tmp_path / "plan.json"
+    assert cli.main(["plan", str(src), "--time-limit", "120", "-o", str(out)]) == 0
+    assert cli.main(["validate", str(src), str(out)]) == 0
+
+
+def test_a_box_is_set_down_aligned_with_a_turned_region() -> None:
+    """A 0.3 m box at yaw 0 into a 0.34 m region turned 45°: its own four yaws never fit, so the region's are
+    tried too (it was "infeasible: no robot can reach goal region"); an aligned box gets no extra candidate."""
+    from mrgc.geometry.scene import Body
+    from mrgc.geometry.transforms import rot_z, translation
+    from mrgc.language.model import Box
+
+    box = Body("b", Box(0.3, 0.3, 0.3), translation(0, 0, 0.15))
+    turned = Body("goal", Box(0.34, 0.34, 0.5), translation(2, 0, 0.25) @ rot_z(math.radians(45)))
+    found = placements(box, turned)
+    assert found and all(
+        abs(math.remainder(math.atan2(p[1, 0], p[0, 0]) - math.radians(45), math.pi / 2)) < 1e-9 for p in found
+    )
+    square = Body("goal", Box(0.34, 0.34, 0.5), translation(2, 0, 0.25))
+    assert len(placements(box, square)) == len(placements(Body("b", box.shape, box.pose @ rot_z(math.pi / 2)), square))

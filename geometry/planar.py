@@ -215,8 +215,11 @@ def scene_bounds(scene: SceneSpec, margin: float) -> tuple[float, float, float, 
 def placements(obj: Body, region: Body, grid: int = PLACEMENT_GRID) -> list[np.ndarray]:
     """Candidate poses of ``obj`` resting inside box ``region``: a lattice (centre first) × four yaws.
 
-    The object's yaw is its current yaw plus each of :data:`PLACEMENT_YAWS`; the lattice spans the room the
-    object's (rotated) bounding box leaves in the region; every returned pose passes :func:`inside`.
+    The object's yaw is its current yaw plus each of :data:`PLACEMENT_YAWS`, then, when that is not a
+    multiple of 90° in the region's frame, the region's own yaw plus each of them (a box turned 45° to a
+    tight region fits it only aligned with it: "no robot can reach goal region" before); the lattice spans
+    the room the object's (rotated) bounding box leaves in the region; every returned pose passes
+    :func:`inside`.
     """
     if not isinstance(region.shape, Box):
         return []
@@ -224,10 +227,13 @@ def placements(obj: Body, region: Body, grid: int = PLACEMENT_GRID) -> list[np.n
     if h_o[2] * 2 + PLANAR_LIFT > h_r[2] * 2:
         return []
     obj_yaw, reg_yaw = yaw_of(obj.pose), yaw_of(region.pose)
+    turns = [obj_yaw - reg_yaw + math.radians(d) for d in PLACEMENT_YAWS]  # the object's yaws in the region frame
+    off = math.remainder(obj_yaw - reg_yaw, math.pi / 2)
+    if abs(off) > 1e-6:
+        turns += [math.radians(d) for d in PLACEMENT_YAWS]  # aligned with the region
     out = []
     for a, b in lattice_offsets(grid):
-        for dyaw in PLACEMENT_YAWS:
-            rel = obj_yaw - reg_yaw + math.radians(dyaw)  # the object's yaw in the region frame
+        for rel in turns:
             c, s = abs(math.cos(rel)), abs(math.sin(rel))
             ex, ey = c * h_o[0] + s * h_o[1], s * h_o[0] + c * h_o[1]  # its bounding box in the region frame
             room = (h_r[0] - ex, h_r[1] - ey)

@@ -55,6 +55,7 @@ from mrgc.language.model import FixedObject, Mesh, MovableObject, Problem, Robot
 if TYPE_CHECKING:
     from mrgc.geometry.arm import Arm
     from mrgc.geometry.scene import SceneSpec
+    from mrgc.geometry.urdf import UrdfJoint
 
 #: penetration depth (m) above which two shapes overlap
 TOLERANCE = 1e-3
@@ -123,6 +124,12 @@ def tcp_diagnostics(problem: Problem) -> list[Diagnostic]:
 def arm_joints(kind: RobotKind) -> tuple[str, ...] | None:
     """The joints of ``kind``'s arm from its base to its end-effector link, read from the URDF; None when
     the kind has no URDF or it cannot be found or read (``mrgc facts`` reports that)."""
+    chain = _arm_chain(kind)
+    return None if chain is None else tuple(j.name for j in chain)
+
+
+def _arm_chain(kind: RobotKind) -> "tuple[UrdfJoint, ...] | None":
+    """:func:`arm_joints` as the URDF's joints (with their limits)."""
     if kind.urdf is None or kind.end_effector is None:
         return None
     from mrgc.geometry.kinematics import resolve_urdf
@@ -140,13 +147,15 @@ def arm_joints(kind: RobotKind) -> tuple[str, ...] | None:
     while link in urdf.joint_of:
         joint = urdf.joint_of[link]
         if joint.kind in ("revolute", "continuous", "prismatic"):
-            chain.append(joint.name)
+            chain.append(joint)
         link = joint.parent
     return tuple(reversed(chain))
 
 
 def home_diagnostics(problem: Problem) -> list[Diagnostic]:
-    """E263 for each robot kind used by the problem whose ``:home`` length differs from its arm's joints."""
+    """E263 for each robot kind used by the problem whose ``:home`` does not fit its arm: a length that
+    differs from its arm's joints, or a value outside its joint's limits (the planner and the validator
+    clamp it, so every motion started and ended elsewhere than declared, silently)."""
     from mrgc.geometry.kinds import approaches
 
     used = {r.kind for r in problem.robots}
@@ -154,8 +163,27 @@ def home_diagnostics(problem: Problem) -> list[Diagnostic]:
     for kind in problem.domain.robot_kinds:
         if kind.name not in used or not approaches(kind) or not kind.home:
             continue
-        joints = arm_joints(kind)
-        if joints is None or len(joints) == len(kind.home):
+        chain = _arm_chain(kind)
+        if chain is None:
+            continue
+        joints = tuple(j.name for j in chain)
+        if len(joints) == len(kind.home):
+            outside = [
+                (j, v)
+                for j, v in zip(chain, kind.home)
+                if j.kind != "continuous" and not j.lower - 1e-9 <= v <= j.upper + 1e-9
+            ]
+            if outside:
+                j, v = outside[0]
+                out.append(
+                    Diagnostic(
+                        "E263",
+                        f"robot kind '{kind.name}': :home gives joint '{j.name}' {v:g}, outside its limits "
+                        f"[{j.lower:g}, {j.upper:g}] in '{kind.urdf}' (the arm would be homed at the nearest limit)"
+                        + (f"; {len(outside) - 1} more joint(s) outside theirs" if len(outside) > 1 else ""),
+                        kind.home_span,
+                    )
+                )
             continue
         shown = ", ".join(joints) if len(joints) <= 4 else f"{joints[0]}, ..., {joints[-1]}"
         out.append(

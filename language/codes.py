@@ -70,7 +70,7 @@ CODES: dict[str, str] = {
     "E261": "symbolic problem mixes in geometry",
     "E262": "geometric declaration lacks its shape or pose",
     # the start layout of a geometric problem (geometry/layout.py)
-    "E263": "home configuration of the wrong length",
+    "E263": "home configuration that does not fit the arm",
     "E264": "movable objects overlap at the start",
     "E265": "movable object overlaps a fixed object at the start",
     "E266": "robot overlaps an object at the start",
@@ -230,7 +230,9 @@ HELP: dict[str, str] = {
     "E243": "In a domain with robot kinds every grasp needs geometry: a bare name must be a built-in grasp "
     "(top, top-x, side-x+, side-x-, side-y+, side-y-), any other grasp is declared as "
     "`(NAME :approach AXIS :fingers AXIS)`. Domains without robot kinds (symbolic) accept any name.",
-    "E263": "A robot kind's `:home` needs one value (radians, metres for a prismatic joint) per joint of its arm: the "
+    "E263": "A robot kind's `:home` needs one value (radians, metres for a prismatic joint) per joint of its arm, "
+    "each within its joint's limits in the URDF (a value outside them was clamped, silently, by the planner and "
+    "the validator alike, so every motion started and ended elsewhere than declared): the "
     "URDF's revolute, continuous and prismatic joints from the base link to the `:end-effector` link (7 for "
     "the Franka Panda; finger joints are not part of it). Checked by `mrgc check` when the URDF can be read "
     "(otherwise `mrgc facts` reports E400/E401).",

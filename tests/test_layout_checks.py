@@ -257,3 +257,14 @@ def test_a_region_is_a_box(shape: str) -> None:
     'in no region', W271); W271 is left out while a region is not a box."""
     text = cell(f"(o1 :shape {BOX} :pose (0 0 0.05 0))", regions=f"(start :shape {shape} :pose (0 0 0.15 0))")
     assert codes(text) == [("E269", 9)]
+
+
+def test_a_home_outside_the_joint_limits_is_refused() -> None:
+    """The planner and the validator clamped it, so every motion started and ended elsewhere than declared (an
+    xArm6's joint5 at -1.9 was homed at -1.693, silently)."""
+    text = cell(f"(o1 :shape {BOX} :pose (0 0 0.05 0))").replace(
+        ":home (0 -0.785 0 -2.356 0 1.571 0.785)", ":home (0 -0.785 0 0.5 0 1.571 0.785)"
+    )
+    found = [d for d in layout_diagnostics(mrgc.parse_string(text, "p.mrg").problem(), arms=False) if d.code == "E263"]
+    assert len(found) == 1 and "joint 'panda_joint4' 0.5, outside its limits [-3.1416, 0]" in found[0].message
+    assert found[0].span is not None and found[0].span.line == 3

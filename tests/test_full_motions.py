@@ -7,6 +7,7 @@ import pytest
 from support import ROOT
 
 from mrgc import __version__, parse_file
+from mrgc.errors import InputError
 from mrgc.planfile.format import file_sha256
 from mrgc.planner.search import plan_problem
 from mrgc.validator.validate import validate
@@ -38,5 +39,5 @@ def test_full_motions_plan_every_path_and_validate() -> None:
 
 def test_unknown_motion_model_is_misuse() -> None:
     problem = parse_file(HANDOVER).problem()
-    with pytest.raises(ValueError, match="motions"):
+    with pytest.raises(InputError, match="motions='teleport': must be one of configurations, full"):
         plan_problem(problem, str(HANDOVER), "0" * 64, __version__, motions="teleport")

@@ -215,8 +215,9 @@ def scene_bounds(scene: SceneSpec, margin: float) -> tuple[float, float, float, 
 def placements(obj: Body, region: Body, grid: int = PLACEMENT_GRID) -> list[np.ndarray]:
     """Candidate poses of ``obj`` resting inside box ``region``: a lattice (centre first) × four yaws.
 
-    The object's yaw is its current yaw plus each of :data:`PLACEMENT_YAWS`, then, when that is not a
-    multiple of 90° in the region's frame, the region's own yaw plus each of them (a box turned 45° to a
+    The object's yaw is its current yaw plus each of :data:`PLACEMENT_YAWS`, then (after every one of those,
+    so they come first as before), when that is not a multiple of 90° in the region's frame, the region's own
+    yaw plus each of them (a box turned 45° to a
     tight region fits it only aligned with it: "no robot can reach goal region" before); the lattice spans
     the room the object's (rotated) bounding box leaves in the region; every returned pose passes
     :func:`inside`.
@@ -227,12 +228,11 @@ def placements(obj: Body, region: Body, grid: int = PLACEMENT_GRID) -> list[np.n
     if h_o[2] * 2 + PLANAR_LIFT > h_r[2] * 2:
         return []
     obj_yaw, reg_yaw = yaw_of(obj.pose), yaw_of(region.pose)
-    turns = [obj_yaw - reg_yaw + math.radians(d) for d in PLACEMENT_YAWS]  # the object's yaws in the region frame
-    off = math.remainder(obj_yaw - reg_yaw, math.pi / 2)
-    if abs(off) > 1e-6:
-        turns += [math.radians(d) for d in PLACEMENT_YAWS]  # aligned with the region
+    groups = [[obj_yaw - reg_yaw + math.radians(d) for d in PLACEMENT_YAWS]]  # the object's yaws, region frame
+    if abs(math.remainder(obj_yaw - reg_yaw, math.pi / 2)) > 1e-6:
+        groups.append([math.radians(d) for d in PLACEMENT_YAWS])  # aligned with the region, after all of those
     out = []
-    for a, b in lattice_offsets(grid):
+    for turns, (a, b) in ((t, ab) for t in groups for ab in lattice_offsets(grid)):
         for rel in turns:
             c, s = abs(math.cos(rel)), abs(math.sin(rel))
             ex, ey = c * h_o[0] + s * h_o[1], s * h_o[0] + c * h_o[1]  # its bounding box in the region frame

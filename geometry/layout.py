@@ -171,7 +171,7 @@ def home_diagnostics(problem: Problem) -> list[Diagnostic]:
             outside = [
                 (j, v)
                 for j, v in zip(chain, kind.home)
-                if j.kind != "continuous" and not j.lower - 1e-9 <= v <= j.upper + 1e-9
+                if not j.lower - 1e-9 <= v <= j.upper + 1e-9  # a continuous joint's: [-pi, pi], clamped alike
             ]
             if outside:
                 j, v = outside[0]
@@ -405,7 +405,7 @@ def floor_diagnostics(problem: Problem) -> list[Diagnostic]:
                 Diagnostic(
                     "W277",
                     f"the floor of region '{r.name}' (z = {z:.3f}) holds nothing up: it lies neither on the "
-                    "ground nor on a fixed object's top, so nothing set down in it can stand",
+                    "ground nor on a fixed object's top (at most 3 mm above it), so nothing set down in it can stand",
                     r.span,
                     severity="warning",
                 )
@@ -414,21 +414,18 @@ def floor_diagnostics(problem: Problem) -> list[Diagnostic]:
 
 
 def fit_diagnostics(problem: Problem) -> list[Diagnostic]:
-    """W279 for each goal object taller than its goal region leaves room for: placements rest
-    :data:`~mrgc.geometry.conventions.ARM_PLACE_LIFT` above the floor (``PLANAR_LIFT`` when only carts place),
+    """W279 for each goal object taller than its goal region leaves room for: the grounding's placements rest
+    :data:`~mrgc.geometry.conventions.ARM_PLACE_LIFT` above the floor (a cart's too),
     and the object must lie entirely inside the region (``in-region``), so a 0.100 m object in a 0.105 m bin
     has no placement at all (planning said "no robot can reach goal region bin").  Left out while a region is
     not a box (E269) or a mesh cannot be used."""
-    from mrgc.geometry.conventions import ARM_PLACE_LIFT, PLANAR_LIFT
-    from mrgc.geometry.kinds import approaches
+    from mrgc.geometry.conventions import ARM_PLACE_LIFT
     from mrgc.geometry.scene import half_extents
     from mrgc.language.model import Box
 
     if region_shape_diagnostics(problem):
         return []
-    kinds = {k.name: k for k in problem.domain.robot_kinds}
-    arms = any(approaches(kinds[r.kind]) for r in problem.robots if r.kind in kinds)
-    lift = ARM_PLACE_LIFT if arms else PLANAR_LIFT
+    lift = ARM_PLACE_LIFT  # the grounding sets every object down this high, a cart's too (phase 1: PLANAR_LIFT)
     regions = {r.name: r for r in problem.regions}
     out = []
     for m in problem.movable:

@@ -152,46 +152,100 @@ def surface(body: Body) -> Body:
     return Body(body.name, Box(body.shape.sx, body.shape.sy, SURFACE_HEIGHT), pose)
 
 
-#: m: a fixed object's top within this of a region's floor holds up what is set down on that floor, and a
-#: region's floor within this of the ground lies on it (the validator's support band)
-FLOOR_BAND = 0.01
+#: m: how far a region's floor may lie above what holds it up (the ground, a fixed object's top) and below
+#: it (then the object, set down 6 mm above the floor, would hit that top: its collision check refuses it):
+#: an object set down ``ARM_PLACE_LIFT`` above the floor must stand within the validator's 10 mm support band
+FLOOR_ABOVE = 3e-3
+FLOOR_BELOW = 1e-2
 #: m: how far inside a fixed object's top an object's centre stays when the region's floor is not on the
 #: ground (the validator's largest required margin)
 SUPPORT_MARGIN = 5e-3
+#: m: a fixed object's top this close to z = 0 is a table's top, not the ground
+GROUND_TOL = 1e-3
 
 
 def ground_height(fixed: Sequence[Body]) -> float:
-    """The ground: z = 0, or the lowest point of a ``fixed`` object if one reaches lower (a table slab whose top
-    is at z = 0 stands on a ground at its bottom)."""
-    lows = [float((outline(b.shape) @ b.pose[:3, :3].T + b.pose[:3, 3])[:, 2].min()) for b in fixed]
-    return min([0.0, *lows])
+    """The ground: z = 0, unless a ``fixed`` object's top lies there (a table slab whose top is z = 0: then
+    the ground is the lowest bottom of such slabs).  A wall or post reaching below z = 0 does not move it."""
+    slabs = []
+    for b in fixed:
+        z = (outline(b.shape) @ b.pose[:3, :3].T + b.pose[:3, 3])[:, 2]
+        if abs(float(z.max())) <= GROUND_TOL:
+            slabs.append(float(z.min()))
+    return min(slabs) if slabs else 0.0
 
 
 def floor_support(fixed: Sequence[Body], region: Body) -> Callable[[np.ndarray], bool] | None:
     """What holds up an object set down on ``region``'s floor, as a test of the object's pose (its centre
-    over a ``fixed`` box whose top lies at the floor, :data:`SUPPORT_MARGIN` inside that top), or None when
-    the floor lies on the ground (:func:`ground_height`) and holds up anything.  A region drawn over a table is
-    held up by the table, where the table is; one drawn in the air by nothing (the validator rejects such
-    placements as ``floating``, or ``unstable`` over a table's edge).  Fixed objects that are not boxes hold
-    nothing up here (conservative)."""
+    over the top of a ``fixed`` object that lies at the floor, :data:`FLOOR_ABOVE` below it to
+    :data:`FLOOR_BELOW` above it, :data:`SUPPORT_MARGIN` inside that top), or None when the floor lies on the
+    ground (:func:`ground_height`, within :data:`GROUND_TOL`) and holds up anything.  A region drawn over a
+    table is held up by the table, where the table is; one drawn in the air by nothing (the validator rejects
+    such placements as ``floating``, or ``unstable`` over a table's edge).  A box's top is its rectangle, a
+    vertical cylinder's its disc, a mesh's the convex hull of its vertices within 1 mm of its highest one; a
+    sphere or a lying cylinder holds nothing up."""
     floor = float((outline(region.shape) @ region.pose[:3, :3].T + region.pose[:3, 3])[:, 2].min())
-    if abs(floor - ground_height(fixed)) <= FLOOR_BAND:
+    if abs(floor - ground_height(fixed)) <= GROUND_TOL:
         return None
-    tops = []
-    for b in fixed:
-        if isinstance(b.shape, Box) and abs(b.pose[2, 3] + b.shape.sz / 2 - floor) <= FLOOR_BAND:
-            half = np.array([b.shape.sx, b.shape.sy]) / 2 - SUPPORT_MARGIN
-            if np.all(half > 0):
-                tops.append((np.linalg.inv(b.pose), half))
+    tests = [t for t in (_top_test(b, floor) for b in fixed) if t is not None]
 
     def held(pose: np.ndarray) -> bool:
-        for inv, half in tops:
-            local = inv[:3, :3] @ pose[:3, 3] + inv[:3, 3]
-            if abs(local[0]) <= half[0] and abs(local[1]) <= half[1]:
-                return True
-        return False
+        return any(test(pose[:3, 3]) for test in tests)
 
     return held
+
+
+def _top_test(body: Body, floor: float) -> Callable[[np.ndarray], bool] | None:
+    """Whether a point (x, y) lies :data:`SUPPORT_MARGIN` inside ``body``'s top, when that top lies at
+    ``floor`` (:func:`floor_support`); None when it does not (or the top is too small)."""
+    pts = outline(body.shape) @ body.pose[:3, :3].T + body.pose[:3, 3]
+    top = float(pts[:, 2].max())
+    if not -FLOOR_BELOW <= floor - top <= FLOOR_ABOVE:
+        return None
+    inv = np.linalg.inv(body.pose)
+    if isinstance(body.shape, Box):
+        half = np.array([body.shape.sx, body.shape.sy]) / 2 - SUPPORT_MARGIN
+        if np.any(half <= 0):
+            return None
+        return lambda p: bool(np.all(np.abs((inv[:3, :3] @ p + inv[:3, 3])[:2]) <= half))
+    if isinstance(body.shape, Cylinder) and abs(float(body.pose[2, 2])) > 1 - 1e-9:  # standing on a disc
+        r = body.shape.radius - SUPPORT_MARGIN
+        return None if r <= 0 else lambda p: bool(np.hypot(*(inv[:3, :3] @ p + inv[:3, 3])[:2]) <= r)
+    if not isinstance(body.shape, Mesh):
+        return None  # a sphere's top is a point, a lying cylinder's a line: nothing stands on them
+    ring = pts[pts[:, 2] >= top - 1e-3][:, :2]  # a mesh's top, as the validator builds a face
+    if len(ring) < 3:
+        return None
+    hull = _hull_2d(ring)
+    if len(hull) < 3:
+        return None
+    edges = np.roll(hull, -1, axis=0) - hull
+    normals = np.stack([edges[:, 1], -edges[:, 0]], axis=1)  # outward for a counter-clockwise hull
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    offsets = np.einsum("ij,ij->i", normals, hull)
+    return lambda p: bool(np.all(normals @ p[:2] - offsets <= -SUPPORT_MARGIN))
+
+
+def _hull_2d(points: np.ndarray) -> np.ndarray:
+    """The convex hull of (x, y) points, counter-clockwise (Andrew's monotone chain)."""
+    pts = sorted(set(map(tuple, np.round(points, 9).tolist())))
+    if len(pts) < 3:
+        return np.array(pts)
+
+    def half(seq: list[tuple[float, float]]) -> list[tuple[float, float]]:
+        out: list[tuple[float, float]] = []
+        for p in seq:
+            while (
+                len(out) >= 2
+                and (out[-1][0] - out[-2][0]) * (p[1] - out[-2][1]) - (out[-1][1] - out[-2][1]) * (p[0] - out[-2][0])
+                <= 0
+            ):
+                out.pop()
+            out.append(p)
+        return out
+
+    lower, upper = half(pts), half(pts[::-1])
+    return np.array(lower[:-1] + upper[:-1])
 
 
 def _mesh_shapes(problem: Problem) -> list[Mesh]:

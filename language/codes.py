@@ -288,12 +288,13 @@ HELP: dict[str, str] = {
     "can never move (phase 1 gives it no fact, the validator rejects such a carry as `carry`). Raise `:carry`'s "
     "z to at least half the object's height, or move its x forward by half its depth beyond the footprint.",
     "W279": "A warning, not an error: a goal object is taller than its goal region leaves room for. Placements "
-    "rest 6 mm above the region's floor (1 mm when only carts place: touching counts as colliding, and an object "
-    "in hand dips a few mm while the arm moves), and the object must lie entirely inside the region, so a 0.100 m "
+    "rest 6 mm above the region's floor (a cart's too: touching counts as colliding, and an object in hand dips a "
+    "few mm while the arm moves), and the object must lie entirely inside the region, so a 0.100 m "
     "object in a 0.105 m bin has no placement at all. Make the region taller (its height is only where objects "
     "may be, not a wall).",
     "W277": "A warning, not an error: a region's floor holds nothing up. It lies neither on the ground (z = 0, or "
-    "the lowest point of a fixed object if one reaches lower) nor on the top of a fixed box anywhere, so an "
+    "the bottom of a table slab whose top is z = 0) nor on the top of a fixed object anywhere (at most 3 mm above "
+    "it: an object is set down 6 mm above the floor and may fall at most 10 mm), so an "
     "object set down in it would fall (the validator rejects it as `floating`) and the planner finds no "
     "placement in it. Usually the region's pose is a few cm too high: its floor should lie on the table's top. "
     "A floor partly over a table holds objects up only there (their centre 5 mm inside the table's top).",

@@ -71,10 +71,41 @@ def test_a_floor_off_its_table_is_warned_of(
     assert ("warning[W277]: the floor of region 'top'" in capsys.readouterr().err) == warned
 
 
+def test_a_round_pedestal_holds_its_region_up(tmp_path: Path) -> None:
+    """A cylinder's top holds up too (only boxes did: 'infeasible', and a false W277)."""
+    text = PEDESTAL.replace(
+        "(pedestal :shape (box 0.16 0.16 0.12) :pose (0.3 0 0.06 0))",
+        "(pedestal :shape (cylinder 0.09 0.12) :pose (0.3 0 0.06 0))",
+    )
+    src, out = _problem(tmp_path, text), tmp_path / "plan.json"
+    assert cli.main(["plan", str(src), "-o", str(out)]) == 0
+    assert cli.main(["validate", str(src), str(out)]) == 0
+
+
+@pytest.mark.parametrize(("z", "holds"), [(0.272, True), (0.278, False)])
+def test_a_floor_a_few_mm_above_its_top(
+    tmp_path: Path, z: float, holds: bool, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Set down 6 mm above a floor 8 mm above the pedestal, the object would be released 14 mm up: floating
+    for the validator (10 mm), so the planner takes a top at most 3 mm below the floor (it took 10 mm, and the
+    plans it made were refused: 'exhausted')."""
+    text = PEDESTAL.replace(
+        "(top :shape (box 0.26 0.26 0.3) :pose (0.3 0 0.27 0))", f"(top :shape (box 0.26 0.26 0.3) :pose (0.3 0 {z} 0))"
+    )
+    src, out = _problem(tmp_path, text), tmp_path / "plan.json"
+    assert cli.main(["check", str(src)]) == 0
+    assert ("W277" in capsys.readouterr().err) != holds
+    assert (cli.main(["plan", str(src), "-o", str(out)]) == 0) == holds
+    if holds:
+        assert cli.main(["validate", str(src), str(out)]) == 0
+
+
 def test_the_ground_and_what_holds_a_floor_up() -> None:
     table = Body("table", Box(1.0, 1.0, 0.05), translation(0, 0, -0.025))
     wall = Body("wall", Box(0.1, 2.0, 0.5), translation(1, 0, 0.25))
+    sunk = Body("wall", Box(0.1, 2.0, 0.54), translation(1, 0, 0.23))  # 4 cm below z = 0: not the ground's
     assert ground_height([table]) == pytest.approx(-0.05) and ground_height([wall]) == 0.0 and ground_height([]) == 0.0
+    assert ground_height([sunk]) == 0.0 and ground_height([sunk, table]) == pytest.approx(-0.05)
     on_table = Body("bin", Box(0.2, 0.2, 0.3), translation(0.45, 0, 0.15))  # half of it over the table's edge
     held = floor_support([table], on_table)
     assert held is not None and held(translation(0.49, 0, 0.05)) and not held(translation(0.5, 0, 0.05))

@@ -361,16 +361,21 @@ def _arm_bounds(rs: ReplayScene, homes: dict[str, np.ndarray]) -> dict[str, ArmB
 
 
 def _grounded_regions(scene: SceneSpec) -> frozenset[str]:
-    """The regions whose floor lies on the ground: within :data:`SUPPORT_TOL` of the ground's height, z = 0
-    or the lowest point of a fixed object if one reaches lower (a table slab whose top is z = 0 stands on
-    a ground at its bottom).  Only their floors hold objects up; any other region's floor is drawn over
-    something (a table, a shelf) that must hold the object up itself, or over nothing."""
-    lows = [float((outline(b.shape) @ b.pose[:3, :3].T + b.pose[:3, 3])[:, 2].min()) for b in scene.fixed]
-    ground = min([0.0, *lows])
+    """The regions whose floor lies on the ground, within :data:`CONTACT_TOL`: z = 0, unless a fixed object's
+    top lies there (a table slab whose top is z = 0 stands on a ground at its bottom: then the lowest bottom of
+    such slabs; a wall reaching below z = 0 does not move the ground).  Only their floors hold objects up;
+    any other region's floor is drawn over something (a table, a shelf) that must hold the object up itself,
+    or over nothing."""
+    slabs = []
+    for b in scene.fixed:
+        z = (outline(b.shape) @ b.pose[:3, :3].T + b.pose[:3, 3])[:, 2]
+        if abs(float(z.max())) <= CONTACT_TOL:
+            slabs.append(float(z.min()))
+    ground = min(slabs) if slabs else 0.0
     out = set()
     for r in scene.regions:
         floor = float((outline(r.shape) @ r.pose[:3, :3].T + r.pose[:3, 3])[:, 2].min())
-        if abs(floor - ground) <= SUPPORT_TOL:
+        if abs(floor - ground) <= CONTACT_TOL:
             out.add(r.name)
     return frozenset(out)
 

@@ -107,9 +107,11 @@ def checked(
         what = f"must be a whole number from {int(lo)} to {int(hi):,}"
     else:
         real = whole or isinstance(value, numbers.Real) and not isinstance(value, bool)
-        ok = real and math.isfinite(value) and lo <= value <= hi and not (positive and value <= lo)  # type: ignore[arg-type,operator]
+        # bounds first: math.isfinite of an int past a float's range raises OverflowError
+        ok = real and lo <= value <= hi and math.isfinite(value) and not (positive and value <= lo)  # type: ignore[arg-type,operator]
         span = f"more than {lo:g} and at most {hi:g}" if positive else f"from {lo:g} to {hi:g}"
         what = f"must be a finite number {span}"
     if not ok:
-        raise InputError([Diagnostic("E000", f"{name}={value!r}: {what}{' or None' if none else ''}")])
+        shown = repr(value) if len(repr(value)) <= 40 else repr(value)[:37] + "..."
+        raise InputError([Diagnostic("E000", f"{name}={shown}: {what}{' or None' if none else ''}")])
     return value

@@ -53,7 +53,7 @@ def _check_value(option: Option, value: Any) -> None:
     if option.kind in ("count", "number"):
         bounds = limits.BOUNDS.get(option.flag, option.bounds)
         limits.checked(option.name, value, option.kind, option=option.flag, bounds=bounds)
-    elif option.kind == "flag" and not isinstance(value, bool):
+    elif option.kind == "flag" and not (isinstance(value, bool) or type(value).__name__ in ("bool", "bool_")):
         raise InputError([Diagnostic("E000", f"{option.name}={value!r}: must be True or False")])
     elif option.kind == "text" and (not isinstance(value, str) or (option.choices and value not in option.choices)):
         choices = f"one of {', '.join(option.choices)}" if option.choices else "a string"

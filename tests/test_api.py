@@ -411,6 +411,7 @@ CHAIN = str(Path(__file__).resolve().parent.parent / "domains" / "symbolic" / "c
         ("compile", {"time_limit": "5"}, "time_limit='5'"),
         ("compile", {"time_limit": 1e10}, "time_limit=10000000000.0"),
         ("facts_summary", {"seed": 1.5}, "seed=1.5"),
+        ("plan", {"time_limit": 10**400}, "time_limit=1000000000000000000000000000000000000..."),
     ],
 )
 def test_api_arguments_are_checked_as_the_command_line_checks_them(call: str, kwargs: dict, said: str) -> None:
@@ -422,7 +423,10 @@ def test_api_arguments_are_checked_as_the_command_line_checks_them(call: str, kw
 
 
 def test_api_defaults_and_bounds_pass() -> None:
+    import numpy as np
+
     assert mrgc.compile(CHAIN, backend=None, seed=2**31 - 1, time_limit=1e6).status == "optimal"
+    assert mrgc.plan(CHAIN, seed=np.int64(3), anytime=np.False_, c=np.float64(0.5)).status == "solved"
     assert mrgc.plan(CHAIN, max_makespan=10_000, seed=0).status == "solved"
     with pytest.raises(mrgc.MrgcError, match="a problem is a file's path or a Problem, not a NoneType"):
         mrgc.compile(None)  # type: ignore[arg-type]

@@ -402,14 +402,11 @@ def graph_signature(
 
 def problem_graph(problem: "Problem", must_move: Sequence[str] | None = None, moved: Iterable[str] = ()) -> TaskGraph:
     """:func:`reference_task_graph` of a checked problem's facts (its ``:init``): M* defaults to the goal
-    objects not already in their goal region; ``moved`` are the objects of a grounded suffix.  A geometric
-    problem whose ``:init`` holds no geometric facts is a ValueError: its graph would be empty, read as
-    "infeasible" (run ``mrgc facts -o`` first, or give the facts file)."""
-    if not problem.symbolic and all(f.predicate == "in-region" for f in problem.init):
-        raise ValueError(
-            f"problem '{problem.name}' is geometric and its :init holds no geometric facts: the oracle reads "
-            "facts, it does not compute them (mrgc facts FILE -o FACTS.mrg, then the oracle on FACTS.mrg)"
-        )
+    objects not already in their goal region; ``moved`` are the objects of a grounded suffix.  It reads the
+    facts, it does not compute them: a geometric problem's own file (no facts in its ``:init``) gives an
+    empty graph, which reads as "infeasible"; give it the file ``mrgc facts -o`` writes (a facts file with
+    only ``in-region`` facts is a problem whose robots reach nothing, and is infeasible indeed).
+    """
     facts = [(f.predicate, *f.args) for f in problem.init]
     region = {f.args[0]: f.args[1] for f in problem.init if f.predicate == "in-region"}
     if must_move is None:

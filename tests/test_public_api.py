@@ -325,11 +325,3 @@ def test_the_cli_wraps_the_api(tmp_path: Path, capsys: pytest.CaptureFixture[str
     assert written["problem_digest"] == mrgc.plan(CHAIN3).problem_digest
     assert cli.main(["backends", "--format", "json"]) == 0
     assert [r["name"] for r in json.loads(capsys.readouterr().out)] == [r.name for r in mrgc.backends()]
-
-
-def test_the_oracle_refuses_a_geometric_problem_without_facts() -> None:
-    """Its graph would be empty, and read as 'infeasible' where compile finds (2, 2)."""
-    from mrgc.testing import oracle
-
-    with pytest.raises(ValueError, match="the oracle reads facts, it does not compute them"):
-        oracle.problem_graph(mrgc.load_problem(str(ROOT / "domains" / "packaging" / "pa5.mrg")))

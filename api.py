@@ -115,6 +115,10 @@ def _resolve(source: ProblemSource, name: str | None, allow_outside: Sequence[st
     return parse_file(path, allow_outside=tuple(allow_outside)).problem(name), path
 
 
+#: the layout warnings that can explain why a plan was not found (named first among its reasons)
+NO_PLAN_WARNINGS = ("W277", "W278", "W279")
+
+
 def _layout(problem: "Problem", robots: bool, arms: bool = True) -> list[Diagnostic]:
     """The layout diagnostics of a geometric problem (none for a symbolic one): those ``check`` reports, or
     (``robots``) those that need the robots' models (docs/errors.md, E263-E268, W270-W272); ``arms`` False
@@ -345,7 +349,14 @@ def plan(
     if result.why is not None and result.status is not PlanStatus.SOLVED:  # an arm that reaches nothing, and why
         from mrgc.geometry.arm_diagnosis import arm_diagnostics, reasons
 
-        result.why.facts[:0] = reasons(arm_diagnostics(problem))
+        # the layout's warnings that explain a plan not found (a floor that holds nothing up, a load no cart
+        # carries, a goal too tall for its region): their reasons come first, not only "no robot can reach"
+        explained = [
+            f"{d.span}: {d.code} {d.message}" if d.span is not None else f"{d.code} {d.message}"
+            for d in _layout(problem, False, False)
+            if d.code in NO_PLAN_WARNINGS
+        ]
+        result.why.facts[:0] = explained + reasons(arm_diagnostics(problem))
     return result
 
 

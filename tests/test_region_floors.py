@@ -120,3 +120,14 @@ def test_shipped_problems_have_no_floor_that_holds_nothing_up(capsys: pytest.Cap
     for f in files:
         cli.main(["check", str(f)])
     assert "W277" not in capsys.readouterr().err
+
+
+def test_a_plan_not_found_names_the_floor_first(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The layout's W277 leads the reasons (the plan said only "no robot can reach goal region top")."""
+    text = PEDESTAL.replace(
+        "(top :shape (box 0.26 0.26 0.3) :pose (0.3 0 0.27 0))", "(top :shape (box 0.26 0.26 0.3) :pose (0.3 0 0.31 0))"
+    )
+    src = _problem(tmp_path, text)
+    assert cli.main(["plan", str(src), "-o", str(tmp_path / "plan.json")]) == 1
+    why = capsys.readouterr().out.splitlines()
+    assert why[1].startswith("why: infeasible") and "W277 the floor of region 'top'" in why[2]

@@ -294,7 +294,9 @@ def test_a_run_past_its_wall_clock_limit_is_killed_as_a_group(tmp_path: Path) ->
     summary = run_study(str(study), str(tmp_path / "r.db"), jobs=2)
     hang, short = rows(tmp_path / "r.db")
     assert summary.outcomes == {"timeout": 1, "time limit": 1}
-    assert hang["status"] == "timeout" and not hang["success"] and 2 <= hang["wall_seconds"] < 6  # type: ignore[operator]
+    # killed by the 2 s wall limit, long before its own 600 s (the bound is loose: a loaded 2-core machine with
+    # two test workers and two runs once took 6 s to start, run and kill it)
+    assert hang["status"] == "timeout" and not hang["success"] and 2 <= hang["wall_seconds"] < 60  # type: ignore[operator]
     assert hang["signal"] == signal.SIGKILL and hang["planning_seconds"] is None
     assert short["status"] == "time limit" and short["exit_code"] == 3 and short["plan_status"] == "time limit"
     assert short["planning_seconds"] >= 1 and not short["success"]  # type: ignore[operator]

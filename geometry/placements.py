@@ -91,7 +91,7 @@ class Placements(StepWorld):
         shape = self.shape(obj)
         within = inside_test(reg, body.shape)
         # a region's floor off the ground holds objects up only over a fixed box's top (floor_support)
-        held = floor_support(self.scene.fixed, reg) if not isinstance(region, SceneBody) else None
+        held = None if isinstance(region, SceneBody) else self._held_by(reg)  # a relay's spot: on its fixed top
         # first the 3 × 3 lattice phase 1 uses (so a placement the facts relied on is tried first), then
         # random positions and the four yaws
         room = np.maximum(h_r[:2] - h_o[:2], 0) * 0.9
@@ -123,6 +123,14 @@ class Placements(StepWorld):
             if vol is not None and posed_collide(Posed.of(probe), vol):
                 continue
             yield pose
+
+    def _held_by(self, region: SceneBody) -> Callable[[np.ndarray], bool] | None:
+        """What holds up an object set down on a scene region's floor (:func:`floor_support`), made once per
+        region: the placements of every grounding ask it."""
+        if region.name not in self._floor_held:
+            self._floor_held[region.name] = floor_support(self.scene.fixed, region)
+        held: Callable[[np.ndarray], bool] | None = self._floor_held[region.name]
+        return held
 
     def crowded_out(
         self,

@@ -216,7 +216,9 @@ def _top_test(body: Body, floor: float) -> Callable[[np.ndarray], bool] | None:
     ring = pts[pts[:, 2] >= top - 1e-3][:, :2]  # a mesh's top, as the validator builds a face
     if len(ring) < 3:
         return None
-    hull = _hull_2d(ring)
+    from mrgc.geometry.lattice import hull2d  # (lattice imports this module)
+
+    hull = hull2d(ring)
     if len(hull) < 3:
         return None
     edges = np.roll(hull, -1, axis=0) - hull
@@ -224,28 +226,6 @@ def _top_test(body: Body, floor: float) -> Callable[[np.ndarray], bool] | None:
     normals /= np.linalg.norm(normals, axis=1, keepdims=True)
     offsets = np.einsum("ij,ij->i", normals, hull)
     return lambda p: bool(np.all(normals @ p[:2] - offsets <= -SUPPORT_MARGIN))
-
-
-def _hull_2d(points: np.ndarray) -> np.ndarray:
-    """The convex hull of (x, y) points, counter-clockwise (Andrew's monotone chain)."""
-    pts = sorted(set(map(tuple, np.round(points, 9).tolist())))
-    if len(pts) < 3:
-        return np.array(pts)
-
-    def half(seq: list[tuple[float, float]]) -> list[tuple[float, float]]:
-        out: list[tuple[float, float]] = []
-        for p in seq:
-            while (
-                len(out) >= 2
-                and (out[-1][0] - out[-2][0]) * (p[1] - out[-2][1]) - (out[-1][1] - out[-2][1]) * (p[0] - out[-2][0])
-                <= 0
-            ):
-                out.pop()
-            out.append(p)
-        return out
-
-    lower, upper = half(pts), half(pts[::-1])
-    return np.array(lower[:-1] + upper[:-1])
 
 
 def _mesh_shapes(problem: Problem) -> list[Mesh]:

@@ -66,6 +66,8 @@ class StepWorld:
         #: found, by object, region, what to avoid (and where), the content of the volume's part the region
         #: can meet, and key (most recent last)
         self._rooms: dict[tuple[object, ...], Any] = {}
+        #: each region's floor support test (:func:`~mrgc.geometry.scene.floor_support`), made once per region
+        self._floor_held: dict[str, Any] = {}
         #: robots that park (:attr:`Robot.parks <mrgc.geometry.robot.Robot.parks>`: planar robots) wait at home
         #: (their start pose, as the validator assumes), obstacles for the others: robot -> its world bodies
         #: there, group ``robots``

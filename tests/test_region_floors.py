@@ -106,11 +106,26 @@ def test_the_ground_and_what_holds_a_floor_up() -> None:
     sunk = Body("wall", Box(0.1, 2.0, 0.54), translation(1, 0, 0.23))  # 4 cm below z = 0: not the ground's
     assert ground_height([table]) == pytest.approx(-0.05) and ground_height([wall]) == 0.0 and ground_height([]) == 0.0
     assert ground_height([sunk]) == 0.0 and ground_height([sunk, table]) == pytest.approx(-0.05)
+
     on_table = Body("bin", Box(0.2, 0.2, 0.3), translation(0.45, 0, 0.15))  # half of it over the table's edge
     held = floor_support([table], on_table)
     assert held is not None and held(translation(0.49, 0, 0.05)) and not held(translation(0.5, 0, 0.05))
     assert floor_support([wall], Body("room", Box(2, 2, 0.3), translation(0, 0, 0.15))) is None  # on the ground
     assert floor_support([table], Body("air", Box(0.2, 0.2, 0.3), translation(0, 0, 0.25))) is not None
+
+
+def test_a_mesh_pedestal_holds_its_top_up(tmp_path: Path) -> None:
+    """A mesh's top is the hull of its highest vertices, 5 mm inside it (only boxes held up before)."""
+    from mrgc.language.model import Mesh
+
+    v = [(x, y, z) for x in (-0.1, 0.1) for y in (-0.1, 0.1) for z in (-0.06, 0.06)]
+    faces = [(1, 3, 4, 2), (5, 6, 8, 7), (1, 2, 6, 5), (3, 7, 8, 4), (1, 5, 7, 3), (2, 4, 8, 6)]
+    lines = [f"v {a} {b} {c}" for a, b, c in v] + ["f " + " ".join(map(str, q)) for q in faces]
+    (tmp_path / "p.obj").write_text("\n".join(lines) + "\n", encoding="utf-8")
+    pedestal = Body("p", Mesh(str(tmp_path / "p.obj")), translation(0.3, 0, 0.06))
+    held = floor_support([pedestal], Body("top", Box(0.3, 0.3, 0.3), translation(0.3, 0, 0.27)))
+    assert held is not None
+    assert held(translation(0.3, 0, 0.2)) and held(translation(0.394, 0, 0.2)) and not held(translation(0.396, 0, 0.2))
 
 
 def test_shipped_problems_have_no_floor_that_holds_nothing_up(capsys: pytest.CaptureFixture[str]) -> None:

@@ -54,7 +54,7 @@ import numpy as np
 from mrgc.geometry.collision import CollisionShape
 from mrgc.geometry.conventions import wrap_angle
 from mrgc.geometry.motion import MotionResult, MotionStatus
-from mrgc.geometry.scene import outline
+from mrgc.geometry.scene import hull2d, outline
 from mrgc.language.model import Shape
 
 #: lattice cell side (m) and number of headings (at most :data:`MAX_YAWS`)
@@ -79,28 +79,6 @@ Body = Union[Shape, CollisionShape, np.ndarray]
 Placed = tuple[Body, np.ndarray]
 # 8 moves in the plane and the two turns, as (dk, di, dj)
 _MOVES = [(0, di, dj) for di in (-1, 0, 1) for dj in (-1, 0, 1) if (di, dj) != (0, 0)] + [(1, 0, 0), (-1, 0, 0)]
-
-
-def hull2d(points: np.ndarray) -> np.ndarray:
-    """The convex hull of 2-D points, counter-clockwise, no repeated or collinear vertices."""
-    pts = sorted({(round(float(x), 12), round(float(y), 12)) for x, y in points})
-    if len(pts) <= 2:
-        return np.array(pts, dtype=float)
-
-    def cross(o: tuple[float, float], a: tuple[float, float], b: tuple[float, float]) -> float:
-        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-
-    lower: list[tuple[float, float]] = []
-    upper: list[tuple[float, float]] = []
-    for p in pts:
-        while len(lower) >= 2 and cross(lower[-2], lower[-1], p) <= 0:
-            lower.pop()
-        lower.append(p)
-    for p in reversed(pts):
-        while len(upper) >= 2 and cross(upper[-2], upper[-1], p) <= 0:
-            upper.pop()
-        upper.append(p)
-    return np.array(lower[:-1] + upper[:-1], dtype=float)
 
 
 _SIGNS = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=float)

@@ -216,8 +216,6 @@ def _top_test(body: Body, floor: float) -> Callable[[np.ndarray], bool] | None:
     ring = pts[pts[:, 2] >= top - 1e-3][:, :2]  # a mesh's top, as the validator builds a face
     if len(ring) < 3:
         return None
-    from mrgc.geometry.lattice import hull2d  # (lattice imports this module)
-
     hull = hull2d(ring)
     if len(hull) < 3:
         return None
@@ -226,6 +224,28 @@ def _top_test(body: Body, floor: float) -> Callable[[np.ndarray], bool] | None:
     normals /= np.linalg.norm(normals, axis=1, keepdims=True)
     offsets = np.einsum("ij,ij->i", normals, hull)
     return lambda p: bool(np.all(normals @ p[:2] - offsets <= -SUPPORT_MARGIN))
+
+
+def hull2d(points: np.ndarray) -> np.ndarray:
+    """The convex hull of 2-D points, counter-clockwise, no repeated or collinear vertices."""
+    pts = sorted({(round(float(x), 12), round(float(y), 12)) for x, y in points})
+    if len(pts) <= 2:
+        return np.array(pts, dtype=float)
+
+    def cross(o: tuple[float, float], a: tuple[float, float], b: tuple[float, float]) -> float:
+        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+
+    lower: list[tuple[float, float]] = []
+    upper: list[tuple[float, float]] = []
+    for p in pts:
+        while len(lower) >= 2 and cross(lower[-2], lower[-1], p) <= 0:
+            lower.pop()
+        lower.append(p)
+    for p in reversed(pts):
+        while len(upper) >= 2 and cross(upper[-2], upper[-1], p) <= 0:
+            upper.pop()
+        upper.append(p)
+    return np.array(lower[:-1] + upper[:-1], dtype=float)
 
 
 def _mesh_shapes(problem: Problem) -> list[Mesh]:

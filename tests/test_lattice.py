@@ -12,9 +12,10 @@ from hypothesis import strategies as st
 
 from mrgc.geometry.collision import CollisionWorld, collision_shape
 from mrgc.geometry.conventions import se2, wrap_angle
-from mrgc.geometry.lattice import SLACK, LatticePlanner, hull2d, interpolate, segment_clear
+from mrgc.geometry.lattice import SLACK, LatticePlanner, interpolate, segment_clear
 from mrgc.geometry.motion import MotionStatus
 from mrgc.geometry.planar import grown
+from mrgc.geometry.scene import hull2d
 from mrgc.geometry.transforms import rot_z, translation
 from mrgc.language.model import Box
 

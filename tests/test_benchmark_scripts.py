@@ -109,6 +109,14 @@ def test_motion_state_costs_each_stage_of_a_motion_check(tmp_path: Path) -> None
     )
 
 
+def _table(cmd: list[str]) -> tuple[str, dict[str, tuple[str, str]]]:
+    """A table script's first line and its rows (first column -> the next two), the script exiting 0."""
+    out = subprocess.run(cmd, capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    lines = out.stdout.splitlines()
+    return lines[0], {r[0].strip("| "): (r[1], r[2]) for r in (line.split(" | ") for line in lines[4:])}
+
+
 def test_search_log_classes_each_grounding_line_and_its_seconds(tmp_path: Path) -> None:
     """``benchmarks/search_log.py LOG``: the grounding lines of a ``-v`` log, written here by the search's own
     formatter (``planner/search.py``'s ``_log_line``), counted by where they were grounded and how the root's
@@ -149,17 +157,29 @@ def test_search_log_classes_each_grounding_line_and_its_seconds(tmp_path: Path) 
     log = tmp_path / "run.log"
     log.write_text("\n".join(lines) + "\n", encoding="utf-8")
     script = ROOT / "benchmarks" / "search_log.py"
-    out = subprocess.run([sys.executable, str(script), str(log)], capture_output=True, text=True, timeout=60)
-    assert out.returncode == 0, out.stderr
-    rows = {r[0].strip("| "): (r[1], r[2]) for r in (line.split(" | ") for line in out.stdout.splitlines()[4:])}
-    assert out.stdout.startswith("5 groundings, the last at t=9.0 s")
+    head, rows = _table([sys.executable, str(script), str(log)])
+    assert head == "5 groundings, the last at t=9.0 s"
     assert rows == {
         "root, fail, move start": ("1", "2.0"),
         "root, fail, move goal": ("1", "1.0"),
         "root, partial, relay via start": ("1", "3.5"),
         "under a partial suffix": ("1", "0.5"),
         "plan": ("1", "2.0"),
-    }, out.stdout
+    }, rows
+    # by the check that failed, over two logs: robots and the object of the failing action written R and O
+    more = tmp_path / "more.log"
+    clash = Failure(2, label(hand), "pick: robots of the step collide", ("r1", "r2"))
+    more.write_text(_log_line(4.0, 1, skel, [], Grounding(Outcome.FAIL, failures=[clash])) + "\n", encoding="utf-8")
+    head, rows = _table([sys.executable, str(script), "--by", "check", str(log), str(more)])
+    assert head == "6 groundings, 13.0 s in 2 logs"
+    assert rows == {
+        "fail: place by R: collision": ("1", "2.0"),
+        "fail: drive": ("1", "1.0"),
+        "fail: pick: robots of the step collide": ("1", "4.0"),
+        "partial": ("1", "3.5"),
+        "fail: no": ("1", "0.5"),
+        "plan": ("1", "2.0"),
+    }, rows
     empty = tmp_path / "quiet.log"
     empty.write_text("plan for x: solved\n", encoding="utf-8")
     out = subprocess.run([sys.executable, str(script), str(empty)], capture_output=True, text=True, timeout=60)

@@ -78,12 +78,46 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def main(argv: Sequence[str] | None = None) -> int:
+def run() -> None:
+    """The ``mrgc`` console script: :func:`main`, then exit with its code.  The signal policy stays installed
+    until the process exits, signals only recorded from the end of the command on (a second Ctrl-C after
+    the first one's report would otherwise meet Python's default handler: a traceback, or death by the
+    second signal instead of the first one's exit code).  Ignored while the interpreter shuts down: its
+    finalisation gives the signals their default actions back, and a SIGTERM then would end the process as
+    killed by it, after the command's own exit code was settled."""
+    import signal
+
+    code = main(keep_handlers=True)
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(sig, signal.SIG_IGN)
+    sys.exit(code)
+
+
+def main(argv: Sequence[str] | None = None, *, keep_handlers: bool = False) -> int:
     """Run the CLI; returns the exit code (the console script exits with it).
 
     SIGINT and SIGTERM follow the one policy of :mod:`mrgc.signals` while a command runs (exit 130 / 143,
-    workers killed, nothing written); Python's defaults are restored when ``main`` returns.
+    workers killed, nothing written); Python's defaults are restored when ``main`` returns, unless
+    ``keep_handlers`` (:func:`run`: the process exits next), which leaves signals recorded and ignored.
+    A signal that comes while the command ends on an earlier one (its report, the exit) is only recorded:
+    one line and the first signal's exit code, never a traceback.
     """
+    from mrgc import signals
+
+    try:
+        return _main(argv)
+    except KeyboardInterrupt as exc:  # a signal while an error was reported, or a second one while the first
+        signals.ending()  # one's exception was caught (before the line): the line, then the first one's code
+        print(f"mrgc: {signals.describe(exc)}; nothing written", file=sys.stderr)
+        return signals.exit_code(signal_of(exc))
+    finally:
+        signals.ending()
+        if not keep_handlers:
+            signals.uninstall()
+
+
+def _main(argv: Sequence[str] | None) -> int:
+    """:func:`main`'s command, its errors reported in one line each."""
     from mrgc import signals
 
     parser = build_parser()
@@ -110,6 +144,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except SystemExit as exc:  # argparse --help / --version / usage errors
         return exc.code if isinstance(exc.code, int) else ExitCode.INPUT
     except KeyboardInterrupt as exc:  # SIGINT, or SIGTERM (signals.Terminated)
+        signals.ending()
         print(f"mrgc: {signals.describe(exc)}; nothing written", file=sys.stderr)
         return signals.exit_code(signal_of(exc))
     except InputError as exc:
@@ -132,8 +167,6 @@ def main(argv: Sequence[str] | None = None) -> int:
             file=sys.stderr,
         )
         return ExitCode.INTERNAL
-    finally:
-        signals.uninstall()
 
 
 def signal_of(exc: BaseException) -> int:
@@ -149,4 +182,4 @@ def signal_of(exc: BaseException) -> int:
 
 
 if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())
+    run()

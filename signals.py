@@ -36,6 +36,9 @@ from mrgc.exits import ExitCode
 
 #: exit code of each handled signal (128 + the signal number, the shell's convention)
 EXIT_CODES: dict[int, ExitCode] = {signal.SIGINT: ExitCode.INTERRUPTED, signal.SIGTERM: ExitCode.TERMINATED}
+#: signals whose exception is raised in a run: the first, and a second in case Python swallowed the first
+#: (raised in a ``__del__``); later ones are only recorded (the run is stopping; see :func:`ending`)
+RAISED = 2
 NAMES: dict[int, str] = {signal.SIGINT: "interrupted (SIGINT)", signal.SIGTERM: "terminated (SIGTERM)"}
 
 
@@ -56,6 +59,7 @@ class _State:
         self.previous: tuple[object, object, int] | None = None  # handlers and wakeup fd before install()
         self.unraisable: Callable[..., object] | None = None  # sys.unraisablehook before install()
         self.shield = 0  # > 0: inside cleanup that a second signal must not cut short
+        self.ending = False  # the command is ending: signals are recorded, never raised (ending())
 
 
 _S = _State()
@@ -98,6 +102,7 @@ def uninstall() -> None:
     if _S.unraisable is not None:
         sys.unraisablehook = _S.unraisable
     _S.installed = False
+    _S.ending = False
 
 
 def _unraisable(info: "sys.UnraisableHookArgs") -> None:
@@ -116,6 +121,7 @@ def reset() -> None:
     _S.received.clear()
     _S.doing.clear()
     _S.what = ""
+    _S.ending = False
 
 
 def _handler(signum: int, frame: object) -> None:
@@ -123,9 +129,19 @@ def _handler(signum: int, frame: object) -> None:
     _S.received.append(signum)
     if first:
         _S.what = _S.doing[-1] if _S.doing else ""
-    if _S.shield:
-        return  # let the cleanup (killing workers, removing temp files) finish; shielded() raises after
+    if _S.shield or _S.ending or len(_S.received) > RAISED:
+        # let the cleanup (killing workers, removing temp files) finish, shielded() raising after it; or the
+        # command is ending on a signal already; or two were raised (the second only for a first that Python
+        # swallowed): the run is stopping, and a further exception would only cut its report short
+        return
     raise Terminated() if signum == signal.SIGTERM else KeyboardInterrupt()
+
+
+def ending() -> None:
+    """The command is ending (``cli.main`` reports the signal's exception, or has returned and the process is
+    about to exit): further signals are recorded, never raised, so that no second Ctrl-C or SIGTERM turns
+    the one line and exit code of the first into a traceback.  :func:`uninstall` ends this."""
+    _S.ending = True
 
 
 def _watch(fd: int) -> None:
@@ -171,7 +187,7 @@ def raise_if_received() -> None:
     """Raise the signal's exception again if one was received while the policy is installed (for code
     about to commit a result, or to start more work, after something swallowed the first exception)."""
     sig = received()
-    if sig is not None and _S.installed:
+    if sig is not None and _S.installed and not _S.ending:
         raise Terminated() if sig == signal.SIGTERM else KeyboardInterrupt()
 
 

@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Any, Callable, Iterator, Sequence
 from mrgc import __version__
 from mrgc.errors import Diagnostic, InputError
 from mrgc.exits import ExitCode
+from mrgc.language.files import add_allow_outside
 from mrgc.limits import BOUNDS, count, number
 from mrgc.planner.defaults import DEFAULT_BACKEND, DEFAULT_ENCODING, DEFAULT_PLANNER, DEFAULT_TIME_LIMIT
 
@@ -498,17 +499,6 @@ def add_no_cache(p: argparse.ArgumentParser) -> None:
         "--no-cache",
         action="store_true",
         help="compute phase 1 even when the facts cache holds its facts, and do not store them",
-    )
-
-
-def add_allow_outside(p: argparse.ArgumentParser) -> None:
-    """``--allow-outside PATH``: a folder tree meshes and URDFs may come from besides the problem's own."""
-    p.add_argument(
-        "--allow-outside",
-        action="append",
-        metavar="PATH",
-        help="also read mesh and URDF files under this folder (default: only the problem file's "
-        "folder tree and pybullet_data; repeatable)",
     )
 
 

@@ -152,8 +152,9 @@ HELP: dict[str, str] = {
     "E503": "The plan's `schema` names another plan format version than the one this mrgc reads "
     "(`mrgc-plan/1`); plan again, or validate with the mrgc that wrote it.",
     "E510": "`mrgc render FILE PLAN`: the plan names an object, robot, region or grasp the problem does not have, "
-    "a planar robot with a grasp it cannot use, or configurations of the wrong size: it was made for another "
-    "problem (or edited by hand). `mrgc validate FILE PLAN` lists every difference.",
+    "a planar robot with a grasp it cannot use, configurations of the wrong size, or a configuration or "
+    "placement number that is not finite or beyond 10,000 (the bound on any number of a problem, E259): it was "
+    "made for another problem (or edited by hand). `mrgc validate FILE PLAN` lists every difference.",
     "E504": "The plan file is larger than 32 MiB, nests arrays and objects more than 32 deep, holds an integer "
     "of more than 20 digits or a number beyond double precision (such as `1e999`). Checked before or while the "
     "JSON is parsed, so no plan can exhaust memory or recursion; a plan written by `mrgc plan` stays far "

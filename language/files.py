@@ -2,15 +2,21 @@
 
 Every reader of a file the user names (.mrg files and their includes, URDFs, meshes) goes through
 :func:`read_regular`, so a FIFO, a device or a socket given as input is refused at once instead of
-blocking the command or streaming forever, and a huge file is refused before it is read.
+blocking the command or streaming forever, and a huge file is refused before it is read.  Which geometry files
+may be read at all is the loader's rule (:mod:`mrgc.language.loader`: the problem's own folder tree, else
+E236); :func:`add_allow_outside` is its command-line option, for every command that reads a problem file.
 """
 
 from __future__ import annotations
 
 import os
 import stat
+from typing import TYPE_CHECKING
 
 from mrgc.errors import file_kind
+
+if TYPE_CHECKING:
+    import argparse
 
 
 class FileTooLarge(OSError):
@@ -50,3 +56,15 @@ def read_regular(path: str, limit: int) -> bytes:
         return b"".join(chunks)
     finally:
         os.close(fd)
+
+
+def add_allow_outside(p: "argparse.ArgumentParser") -> None:
+    """``--allow-outside PATH``, the command-line form of :func:`~mrgc.language.loader.parse_file`'s
+    ``allow_outside``: a folder tree meshes and URDFs may come from besides the problem's own."""
+    p.add_argument(
+        "--allow-outside",
+        action="append",
+        metavar="PATH",
+        help="also read mesh and URDF files under this folder (default: only the problem file's "
+        "folder tree and pybullet_data; repeatable)",
+    )

@@ -15,6 +15,7 @@ from typing import Any, Iterator
 
 from mrgc.errors import Diagnostic, InputError
 from mrgc.exits import ExitCode
+from mrgc.language.files import add_allow_outside
 from mrgc.limits import count
 from mrgc.planner.defaults import DEFAULT_BACKEND, DEFAULT_ENCODING
 
@@ -68,6 +69,7 @@ def add_commands(sub: Any) -> None:
         "objects' pick height, to place arms by looking",
     )
     add_no_cache(p)
+    add_allow_outside(p)
     p.set_defaults(func=cmd_render)
 
     p = sub.add_parser("graph", help="draw the collaborative manipulation task graph (CMTG): .dot, .svg or .png")
@@ -88,6 +90,7 @@ def add_commands(sub: Any) -> None:
     p.add_argument("--encoding", default=DEFAULT_ENCODING)
     p.add_argument("--seed", type=count("--seed"), default=0)
     add_no_cache(p)
+    add_allow_outside(p)
     p.set_defaults(func=cmd_graph)
 
 
@@ -150,7 +153,7 @@ def cmd_render(args: argparse.Namespace) -> int:
     if not 0 < args.fps <= MAX_FPS:
         raise _usage(f"--fps must be above 0 and at most {MAX_FPS:g}")
     kind = outputs.kind_of(args.output, args.gantt, args.plan is not None, args.reach)
-    mf = parse_file(args.file)
+    mf = parse_file(args.file, allow_outside=tuple(args.allow_outside or ()))
     inputs = list(mf.files) + ([args.plan] if args.plan else [])
     files.check_output(args.output, inputs)
     plan = None
@@ -225,7 +228,7 @@ def cmd_graph(args: argparse.Namespace) -> int:
         raise _usage("--skeleton must be at least 1")
     if args.skeleton is None and (args.backend, args.encoding) != (DEFAULT_BACKEND, DEFAULT_ENCODING):
         raise _usage("--backend and --encoding choose how the skeleton of --skeleton K is made: give --skeleton")
-    mf = parse_file(args.file)
+    mf = parse_file(args.file, allow_outside=tuple(args.allow_outside or ()))
     files.check_output(args.output, list(mf.files))
     if ext != ".dot":
         graph.require_dot()

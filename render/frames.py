@@ -18,9 +18,12 @@ validator does not check it).  Within a phase every motion runs over the same ti
 equally spaced, as the validator pairs them.  A robot without a motion in a phase stays where it is.
 
 Timing is for watching, not a robot's real speed: a phase lasts :data:`MIN_PHASE` plus its largest motion
-at :data:`ARM_SPEED` (joints, rad/s) or :data:`BASE_SPEED` (planar bases, m/s); a handover pauses
-:data:`HANDOVER_PAUSE`.  At ``fps`` frames per second a phase gets ``ceil(duration · fps)`` frames (at
-least one, the last at its end), so every phase of every step is seen.
+at :data:`ARM_SPEED` (joints, rad/s) or :data:`BASE_SPEED` (planar bases, m/s), at most :data:`MAX_PHASE`
+(a hand-edited joint of 10,000 rad is shown at that pace, not over hours of frames); a handover pauses
+:data:`HANDOVER_PAUSE`.  A plan's numbers must be finite and within the language's bound on any number
+(:data:`~mrgc.language.props.MAX_MAGNITUDE`: 10 km, 10^4 rad), or it does not fit (E510).  At ``fps``
+frames per second a phase gets ``ceil(duration · fps)`` frames (at least one, the last at its end), so every
+phase of every step is seen.
 """
 
 from __future__ import annotations
@@ -32,6 +35,7 @@ from typing import Any, Iterable, Mapping
 import numpy as np
 
 from mrgc.errors import Diagnostic, InputError
+from mrgc.language.props import MAX_MAGNITUDE
 from mrgc.planner.plan import moved_text
 from mrgc.render.world import World
 
@@ -43,6 +47,7 @@ ARM_SPEED = 4.0  # rad/s of the fastest joint
 BASE_SPEED = 1.5  # m/s of a planar base
 MIN_PHASE = 0.1  # s
 HANDOVER_PAUSE = 0.3  # s
+MAX_PHASE = 5.0  # s: the longest a phase lasts, its motions however long
 #: the code of a plan that does not fit its problem (names it lacks, configurations of the wrong size)
 E_PLAN_FIT = "E510"
 
@@ -232,7 +237,7 @@ def _step_phases(world: World, t: int, n: int, acts: list[_Act], home: Mapping[s
             view = world.robots[m.robot]
             speed = BASE_SPEED if view.planar else ARM_SPEED
             length = sum(view.distance(m.configs[i], m.configs[i + 1]) for i in range(len(m.configs) - 1))
-            move = max(move, length / speed)
+            move = max(move, min(length / speed, MAX_PHASE - MIN_PHASE))
         out.append(Phase(t, name, ms, MIN_PHASE + move + pause, f"{head} | {name} | {what}", take or {}, release or {}))
 
     hands = [a for a in acts if a.handover]
@@ -333,9 +338,9 @@ def _parse(world: World, a: Mapping[str, Any], t: int, source: str) -> _Act:
     problem = _names_misfit(world, a)
     if problem:
         raise fail(problem)
-    pose = a.get("place_pose")
-    if pose is None or np.asarray(pose, dtype=float).shape != (4, 4):
-        raise fail(f"moving {obj} has no 4x4 place_pose")
+    pose = _numbers(a.get("place_pose"))
+    if pose is None or pose.shape != (4, 4):
+        raise fail(f"moving {obj} has no 4x4 place_pose of numbers within {MAX_MAGNITUDE:g}")
     configs: dict[str, np.ndarray] = {}
     need = {"pick": (giver, 1), "place": (taker, 1)}
     if giver != taker:
@@ -345,7 +350,7 @@ def _parse(world: World, a: Mapping[str, Any], t: int, source: str) -> _Act:
         if arr is None or len(arr) < count:
             raise fail(
                 f"moving {obj}: configs.{name} must hold at least {count} configuration(s) of "
-                f"{world.robots[robot].home.size} values ({robot})"
+                f"{world.robots[robot].home.size} values within {MAX_MAGNITUDE:g} ({robot})"
             )
         configs[name] = arr
     from mrgc.validator.actions import PATH_PHASES
@@ -359,7 +364,7 @@ def _parse(world: World, a: Mapping[str, Any], t: int, source: str) -> _Act:
         if arr is None or len(arr) < 1:
             raise fail(
                 f"moving {obj}: path {name!r} must be configurations of {world.robots[robot].home.size} "
-                f"values ({robot})"
+                f"values within {MAX_MAGNITUDE:g} ({robot})"
             )
         paths[name] = arr
     return _Act(
@@ -369,7 +374,7 @@ def _parse(world: World, a: Mapping[str, Any], t: int, source: str) -> _Act:
         taker,
         a["pick_grasp"],
         a["place_grasp"],
-        np.asarray(pose, dtype=float),
+        pose,
         configs,
         paths,
         a.get("handover_point"),
@@ -398,11 +403,19 @@ def _names_misfit(world: World, a: Mapping[str, Any]) -> str | None:
     return None
 
 
-def _configs(qs: Any, dof: int) -> np.ndarray | None:
+def _numbers(values: Any) -> np.ndarray | None:
+    """``values`` as a float array when they are numbers within the language's bound (None: they are not)."""
     try:
-        arr = np.asarray(qs, dtype=float)
+        arr = np.asarray(values, dtype=float)
     except (TypeError, ValueError):
         return None
-    if arr.ndim != 2 or arr.shape[1] != dof or not np.all(np.isfinite(arr)):
+    if not np.all(np.isfinite(arr)) or (arr.size and float(np.abs(arr).max()) > MAX_MAGNITUDE):
+        return None
+    return arr
+
+
+def _configs(qs: Any, dof: int) -> np.ndarray | None:
+    arr = _numbers(qs)
+    if arr is None or arr.ndim != 2 or arr.shape[1] != dof:
         return None
     return arr

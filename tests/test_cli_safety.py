@@ -614,6 +614,12 @@ def test_geometry_files_are_confined_to_the_problems_tree(tmp_path: Path, mrgc) 
     proc = mrgc("check", "p.mrg", cwd=folder)
     assert proc.returncode == 2 and "error[E236]" in proc.stderr and "block.obj" in proc.stderr
     assert mrgc("check", "p.mrg", "--allow-outside", outside, cwd=folder).returncode == 0
+    # render and graph too (their E236 told the user to pass --allow-outside, which they did not take)
+    for command, out in (("render", "scene.png"), ("graph", "g.dot")):
+        proc = mrgc(command, "p.mrg", "-o", out, cwd=folder)
+        assert proc.returncode == 2 and "error[E236]" in proc.stderr, proc.stderr
+        proc = mrgc(command, "p.mrg", "-o", out, "--allow-outside", outside, cwd=folder)
+        assert proc.returncode == 0 and (folder / out).stat().st_size > 0, proc.stderr
     (folder / "domain.mrg").write_text(
         (PACKAGING / "domain.mrg").read_text(encoding="utf-8").replace('"franka_panda/panda.urdf"', '"/etc/passwd"'),
         encoding="utf-8",

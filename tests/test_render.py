@@ -278,6 +278,42 @@ def test_bad_requests_are_one_line_errors(plan_file: Path, tmp_path: Path, capsy
     assert not list(tmp_path.glob("x.*"))
 
 
+@pytest.mark.parametrize("value", [1e308, 1e5, -2e4])
+def test_a_number_beyond_the_bound_in_a_plan_is_e510(
+    plan_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], value: float
+) -> None:
+    """A hand-edited joint or placement number beyond 10,000 (the bound on any number of a problem) does not
+    fit (E510), in every output: 1e308 was an internal error (an overflow), 1e5 and 1e6 rad drew for minutes
+    and took gigabytes."""
+    for field in ("configs", "place_pose"):
+        bad = json.loads(plan_file.read_text())
+        action = bad["steps"][0]["actions"][0]
+        if field == "configs":
+            action["configs"]["pick"][0][0] = value
+        else:
+            action["place_pose"][0][3] = value
+        path = tmp_path / f"{field}.json"
+        path.write_text(json.dumps(bad))
+        for out in ("x.png", "x.html"):
+            code, _, err = run(["render", HANDOVER, path, "-o", tmp_path / out, *SMALL], capsys)
+            assert code == 2 and "error[E510]" in err and "within 10000" in err, err
+            assert "Traceback" not in err and "Warning" not in err
+    assert not list(tmp_path.glob("x.*"))
+
+
+def test_a_joint_turned_far_in_a_plan_is_drawn_in_phases_of_at_most_max_phase(plan_file: Path) -> None:
+    """Within the bound, a joint turned 10,000 rad away (outside its limits: drawn where it is) makes a phase
+    of at most MAX_PHASE seconds, not 2,500 s of frames."""
+    from mrgc.render.frames import MAX_PHASE, build_timeline
+    from mrgc.render.world import World
+
+    plan = json.loads(plan_file.read_text())
+    plan["steps"][0]["actions"][0]["configs"]["pick"][0][0] = 1e4
+    timeline = build_timeline(World(parse_file(str(HANDOVER)).problem(None), plan), plan)
+    assert max(ph.duration for ph in timeline.phases) == pytest.approx(MAX_PHASE)
+    assert len(timeline.frames(10)) < 10 * MAX_PHASE * len(timeline.phases)
+
+
 # ------------------------------------------------------------------------------------------- graph
 GOLDEN_GRAPH = ROOT / "tests" / "golden" / "graph"
 

@@ -279,6 +279,7 @@ def export_model(
         horizon=horizon,
         facts=fact_list,
         max_makespan=max_makespan,
+        seed=seed,
     )
 
 

@@ -196,10 +196,12 @@ def export_model(
     horizon: int | None = None,
     facts: Iterable[Fact] | None = None,
     max_makespan: int | None = None,
+    seed: int = 0,
 ) -> int:
     """Write the skeleton model of horizon ``horizon`` to ``path`` and return the horizon written (default:
     the horizon limit, ``max_makespan`` capped at the number of objects of the task graph).  The model holds
-    no cuts: its optimum is the first skeleton of that horizon."""
+    no cuts: its optimum is the first skeleton of that horizon.  ``seed``: the backend's seed, which formats
+    that carry one write (SMT-LIB's ``:random-seed``)."""
     fact_list, _ = problem_facts(problem, facts)
     base = FactBase.from_problem(problem, fact_list)
     source = SkeletonSource(base, must_move(problem, fact_list), (), backend, encoding, max_makespan)
@@ -207,7 +209,7 @@ def export_model(
     chosen = horizon or gen.limit
     enc = gen.encoding.build(gen.graph, chosen)
     check_export(backend, path)
-    solver = (backend if isinstance(backend, type) else backend_class(backend))()
+    solver = (backend if isinstance(backend, type) else backend_class(backend))(seed=seed)
     solver.load(enc.model)
     solver.export(path)
     return chosen

@@ -143,3 +143,6 @@ def test_the_smt2_script_has_no_option_z3_rejects(tmp_path: Path) -> None:
     lines = path.read_text(encoding="utf-8").splitlines()
     assert not any("opt.random_seed" in line for line in lines)
     assert "(set-option :random-seed 0)" in lines and lines[-2:] == ["(check-sat)", "(get-objectives)"]
+    # the seed given is the seed written (it was always 0: the export made its backend without it)
+    mrgc.export_model(SYMBOLIC / "chain-3.mrg", path, backend="smt", seed=7)
+    assert "(set-option :random-seed 7)" in path.read_text(encoding="utf-8").splitlines()

@@ -207,11 +207,19 @@ class ResultsDB:
         return [r[0] for r in self.conn.execute("SELECT study FROM runs GROUP BY study ORDER BY MIN(id)")]
 
     def runs(self, study: str | None = None) -> Iterator[dict[str, Any]]:
-        """The recorded runs (all studies, or one) in a stable order."""
-        where, args = ("WHERE study = ?", (study,)) if study is not None else ("", ())
+        """The recorded runs (all studies, or one) in a stable order, of each instance's newest content only:
+        the runs of an instance edited since (another content hash under the same name, recorded before the
+        newest one's last run) stay in the database but are not the study's any more, and a report mixing
+        them would average two problems."""
+        where, args = ("AND study = ?", (study,)) if study is not None else ("", ())
         columns = ", ".join(c if c in self.present else f"NULL AS {c}" for c in COLUMNS)
+        newest = (
+            "instance_sha256 = (SELECT r2.instance_sha256 FROM runs r2 WHERE r2.study = runs.study "
+            "AND r2.instance = runs.instance ORDER BY r2.id DESC LIMIT 1)"
+        )
         for r in self.conn.execute(
-            f"SELECT {columns} FROM runs {where} ORDER BY study, set_index, instance, method_index, method, seed",
+            f"SELECT {columns} FROM runs WHERE {newest} {where} "
+            "ORDER BY study, set_index, instance, method_index, method, seed",
             args,
         ):
             yield dict(r)

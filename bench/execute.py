@@ -64,8 +64,9 @@ class RunTask:
 
     @property
     def stem(self) -> str:
-        """The base name of the run's files: instance and seed."""
-        return f"{self.instance.name}-s{self.seed}"
+        """The base name of the run's files: instance, seed and the first 8 hex digits of the instance's
+        content hash (an edited instance is a new instance: its runs' files do not replace the old ones')."""
+        return f"{self.instance.name}-s{self.seed}-{self.instance.sha256[:8]}"
 
 
 @dataclass
@@ -121,18 +122,18 @@ def execute_run(task: RunTask, cancel: threading.Event | None = None, remote: bo
     out_dir = scratch or task.out_dir
     os.makedirs(out_dir, exist_ok=True)
     env = dict(os.environ, MRGC_BENCH_PARENT=str(os.getpid()))
+    final = os.path.join(out_dir, task.stem)
+    stem = final + ATTEMPT  # the attempt's files, put in place of the run's only when it ends (_settle)
+    done = False
     try:
         problem = _problem_path(task.instance, scratch) if scratch else task.instance.path
-        stem = os.path.join(out_dir, task.stem)
         plan_path = stem + (".compile.json" if task.compile_only else ".plan.json")
         extra = ["--problem", task.instance.problem] if task.instance.problem else []
         args = [task.args[0], problem, *extra, "--seed", str(task.seed), "--time-limit", f"{task.limits.time:g}"]
         if not task.compile_only:
             args += ["-o", plan_path]
         args += list(task.args[1:])
-        for stale in (plan_path, stem + ".validate.json"):
-            if os.path.exists(stale):
-                os.unlink(stale)
+        _remove(stem)  # an attempt cut short by SIGKILL
         started = now()
 
         def limited(argv: list[str], out: str, err: str) -> ProcessResult:
@@ -155,10 +156,38 @@ def execute_run(task: RunTask, cancel: threading.Event | None = None, remote: bo
             raw.validate_text = _read(stem + ".validate.json")
             raw.validate_stderr = raw.validate.stderr_tail()
         raw.finished = now()
+        done = not raw.cancelled
         return raw
     finally:
+        if done:
+            _settle(stem, final)
+        else:  # interrupted: a recorded earlier run of the same key (--retry) keeps its files
+            _remove(stem)
         if scratch:
             shutil.rmtree(scratch, ignore_errors=True)
+
+
+#: the suffix of a running attempt's files (``INSTANCE-sSEED-HASH.attempt.plan.json``, ...)
+ATTEMPT = ".attempt"
+#: the files of a run, by suffix
+SUFFIXES = (".plan.json", ".compile.json", ".out", ".err", ".validate.json", ".validate.err")
+
+
+def _settle(attempt: str, final: str) -> None:
+    """A finished attempt's files put in place of the run's (an earlier run's that the attempt did not write
+    removed: a validation that did not happen this time)."""
+    for suffix in SUFFIXES:
+        if os.path.exists(attempt + suffix):
+            os.replace(attempt + suffix, final + suffix)
+        elif os.path.exists(final + suffix):
+            os.unlink(final + suffix)
+
+
+def _remove(attempt: str) -> None:
+    """An attempt's files, gone."""
+    for suffix in SUFFIXES:
+        if os.path.exists(attempt + suffix):
+            os.unlink(attempt + suffix)
 
 
 def _status(plan_text: str) -> str | None:

@@ -281,6 +281,62 @@ def test_a_study_killed_mid_way_and_resumed_loses_no_finished_run_and_repeats_no
     assert sum(line.startswith("[") for line in again.stdout.splitlines()) == 6 - len(first)
 
 
+def test_an_edited_instance_keeps_the_old_runs_files_and_reports_only_its_new_content(tmp_path: Path) -> None:
+    """A study run, its instance edited, run again: two rows (an edited instance is a new instance), each with
+    its own plan file (the file names carry the content hash: the second run overwrote the first's, whose
+    row then pointed at the new problem's plan), and the reports read the new content's runs alone (they
+    averaged the two problems)."""
+    folder = symbolic_copy(tmp_path / "p", "chain-3")
+    study = write_study(
+        tmp_path / "s.yaml",
+        "study: edit\nseeds: 0..0\nlimits: {time: 30}\ninstances: [{glob: p/chain-3.mrg, name: sym}]\n"
+        "methods: [{name: Ours}]\n",
+    )
+    db = tmp_path / "r.db"
+    run_study(str(study), str(db))
+    shutil.copy(SYMBOLIC / "parallel.mrg", folder / "chain-3.mrg")  # another problem under the same name
+    run_study(str(study), str(db))
+    with ResultsDB(str(db), readonly=True) as results:
+        every = list(results.conn.execute("SELECT instance_sha256, plan_file, objects_moved FROM runs ORDER BY id"))
+        shown = list(results.runs())
+    assert len(every) == 2 and every[0][0] != every[1][0] and every[0][1] != every[1][1]
+    for _, plan_file, moved in every:
+        assert json.loads(Path(plan_file).read_text(encoding="utf-8"))["motion_cost"] == moved
+    assert [r["instance_sha256"] for r in shown] == [every[1][0]]
+
+
+def test_an_interrupted_retry_keeps_the_recorded_run_and_its_files(tmp_path: Path) -> None:
+    """``bench run --retry`` of a recorded run, interrupted: the run's row and files stay as they were (the
+    retry deleted the plan file up front, and its cancelled attempt was never recorded: a row pointing at
+    nothing)."""
+    packaging_copy(tmp_path / "p", "pa18-4arms")
+    study = write_study(
+        tmp_path / "s.yaml",
+        "study: retry\nseeds: 0..0\nlimits: {time: 0.5, wall: 120}\n"
+        "instances: [{glob: p/pa18-4arms.mrg, name: big}]\nmethods: [{name: Ours}]\n",
+    )
+    db = tmp_path / "r.db"
+    run_study(str(study), str(db))
+    (before,) = rows(db)
+    assert before["plan_file"] and Path(str(before["plan_file"])).is_file()
+    files = sorted(Path(str(before["plan_file"])).parent.iterdir())
+    texts = {f.name: f.read_bytes() for f in files}
+    proc = subprocess.Popen(
+        [*MRGC, "bench", "run", str(study), "--db", str(db), "--retry", str(before["status"])],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    deadline = time.monotonic() + 60
+    while not list(files[0].parent.glob("*.attempt.*")) and time.monotonic() < deadline:
+        time.sleep(0.01)  # until the retry's attempt has started (its files made)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    assert rows(db) == [before]
+    assert {f.name: f.read_bytes() for f in sorted(files[0].parent.iterdir())} == texts
+
+
 def test_a_run_past_its_wall_clock_limit_is_killed_as_a_group(tmp_path: Path) -> None:
     """The runner's wall-clock limit (shorter than the planner's own) kills a run as a group: timeout; the
     planner's own time limit ends a run by itself: time limit.  The instance is one no run solves in seconds

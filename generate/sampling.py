@@ -30,9 +30,13 @@ def check_count(name: str, value: int, low: int, high: int) -> None:
 
 
 def check_seed(seed: int) -> None:
-    """A usage error unless ``seed`` is a non-negative integer."""
-    if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
-        raise usage_error(f"--seed must be a non-negative integer (got {seed!r})")
+    """A usage error unless ``seed`` is a whole number within the command line's bound of ``--seed``
+    (:data:`mrgc.limits.BOUNDS`: a generated file's header names the command that makes it again)."""
+    from mrgc.limits import BOUNDS
+
+    lo, hi = BOUNDS["--seed"]
+    if not isinstance(seed, int) or isinstance(seed, bool) or not lo <= seed <= hi:
+        raise usage_error(f"--seed must be a whole number from {int(lo)} to {int(hi):,} (got {seed!r})")
 
 
 def uniform(rng: np.random.Generator, lo: float, hi: float, digits: int = 3) -> float:

@@ -113,7 +113,7 @@ SHOULDER, REACH, GOAL_REACH = 0.333, 0.8, 0.85
 
 
 @SETTINGS
-@given(st.integers(2, 6), st.integers(1, 12), st.integers(0, 30), st.integers(0, 2**32))
+@given(st.integers(2, 6), st.integers(1, 12), st.integers(0, 30), st.integers(0, 2**31 - 1))
 def test_packaging_instances_are_valid(robots: int, goals: int, others: int, seed: int) -> None:
     text = packaging(robots=robots, goals=goals, others=others, seed=seed)
     problem = parse(text)
@@ -154,7 +154,7 @@ def test_packaging_bins_are_sized_for_their_goals() -> None:
     bins = 0
     for _ in range(300):
         r, g, o = int(rng.integers(2, 7)), int(rng.integers(1, 13)), int(rng.integers(0, 31))
-        problem = parse(packaging(r, g, o, int(rng.integers(0, 2**32))))
+        problem = parse(packaging(r, g, o, int(rng.integers(0, 2**31))))
         movable, _, regions = geometry(problem)
         for name, (shape, _) in regions.items():
             cells = [_cell(movable[m][0]) for m, region in problem.goal_regions.items() if region == name]
@@ -207,7 +207,7 @@ def test_packaging_varies_pitch_sizes_and_shapes() -> None:
 
 # ---------------------------------------------------------------- box moving
 @SETTINGS
-@given(st.integers(1, 4), st.integers(1, 6), st.integers(0, 12), st.integers(0, 2**32))
+@given(st.integers(1, 4), st.integers(1, 6), st.integers(0, 12), st.integers(0, 2**31 - 1))
 @example(1, 1, 0, 55380)  # the goal region rounded up past its room (found by hypothesis, 2026-12-02)
 def test_box_moving_instances_are_valid(robots: int, goals: int, others: int, seed: int) -> None:
     text = box_moving(robots=robots, goals=goals, others=others, seed=seed)
@@ -330,6 +330,18 @@ def test_bad_arguments_are_usage_errors(argv: list[str], capsys: pytest.CaptureF
     err = capsys.readouterr().err
     assert "error[E000]" in err and "Traceback" not in err
     assert len([line for line in err.splitlines() if "error[" in line]) == 1
+
+
+@pytest.mark.parametrize("seed", [-1, 2**31, 2**40, True, 1.5])
+def test_the_python_api_takes_the_seeds_the_command_line_takes(seed: object) -> None:
+    """A seed past ``--seed``'s bound (2**31 - 1) is refused by the generators too: they wrote a header naming
+    a command (``mrgc generate ... --seed 1099511627776``) that the command line refuses."""
+    from mrgc.errors import InputError
+
+    for make in (lambda: packaging(seed=seed), lambda: box_moving(seed=seed), lambda: preset("pa5", seed=seed)):
+        with pytest.raises(InputError, match="--seed must be a whole number from 0 to 2,147,483,647"):
+            make()
+    assert "--seed 2147483647" in packaging(seed=2**31 - 1)
 
 
 def test_output_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

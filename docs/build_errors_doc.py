@@ -63,7 +63,7 @@ One policy for every command (`signals.py`; details in docs/cli.md):
 SPECIAL = {
     "E000": (
         "mrgc check --frobnicate x.mrg",
-        "usage: mrgc check [-h] [-q] FILE [FILE ...]\nmrgc: error[E000]: unrecognized arguments: --frobnicate",
+        "usage: mrgc [-h] [--version] COMMAND ...\nmrgc: error[E000]: unrecognized arguments: --frobnicate",
     ),
     "E005": (
         "mrgc facts domains/packaging/pa5.mrg -o domains/packaging/domain.mrg",

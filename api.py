@@ -251,9 +251,10 @@ def export_model(
     The model is the one the backend solves for the first skeleton, without cuts: its optimum is the first
     skeleton's (makespan, objects moved).  ``horizon`` T chooses another: for the ``paper`` and
     ``disaggregated`` encodings the model of skeletons of exactly T steps, for ``time-of-move`` of at most T
-    steps.  By default T is the makespan of the first skeleton (compiled now; 1 when the goals hold at the
-    start and it is 0), or, when there is none, the horizon limit (``max_makespan``, capped at the number of
-    objects in the task graph).  docs/backends.md says what each file holds and how to load it into its solver.
+    steps.  By default T is the makespan of the first skeleton (compiled now; InputError E304 when the goals
+    hold at the start and it is 0: no model of a step or more has the empty skeleton as its optimum), or, when
+    there is none, the horizon limit (``max_makespan``, capped at the number of objects in the task graph).
+    docs/backends.md says what each file holds and how to load it into its solver.
     """
     from mrgc.planner.skeletons import export_model as write_model
     from mrgc.planner.skeletons import needs_facts, problem_facts
@@ -269,8 +270,7 @@ def export_model(
         result = compile(
             problem, backend=backend, encoding=encoding, max_makespan=max_makespan, facts=fact_list, seed=seed
         )
-        # none: the limit; goals that hold at the start (makespan 0): the model of one step
-        horizon = max(1, result.skeletons[0].makespan) if result.skeletons else None
+        horizon = emit_horizon(problem.name, result)
     return write_model(
         problem,
         os.fspath(path),
@@ -281,6 +281,24 @@ def export_model(
         max_makespan=max_makespan,
         seed=seed,
     )
+
+
+def emit_horizon(name: str, result: "CompileResult") -> int | None:
+    """The horizon of the model ``compile --emit`` writes by default: the first skeleton's makespan (None
+    when there is no skeleton: the horizon limit).  InputError E304 when it is 0 (the goals of problem
+    ``name`` hold at the start): no model of a step or more has the empty skeleton as its optimum."""
+    horizon = result.skeletons[0].makespan if result.skeletons else None
+    if horizon == 0:
+        raise InputError(
+            [
+                Diagnostic(
+                    "E304",
+                    f"{name}: the goals hold at the start (makespan 0): no skeleton model has that as its "
+                    "optimum, nothing to export (give --horizon H for the model of H steps)",
+                )
+            ]
+        )
+    return horizon
 
 
 # ---------------------------------------------------------------- planning

@@ -228,11 +228,7 @@ def cmd_compile(args: argparse.Namespace) -> int:
     if facts is not None:
         result.stats["facts_seconds"] = round(facts_seconds, 6)
     if args.emit:
-        horizon = (
-            args.horizon
-            if args.horizon is not None
-            else (max(1, result.skeletons[0].makespan) if result.skeletons else None)
-        )  # goals that hold at the start (makespan 0): the model of one step
+        horizon = args.horizon if args.horizon is not None else api.emit_horizon(problem.name, result)
         with (
             signals.activity(f"writing the model to {args.emit}"),
             outputs.atomic_path(args.emit, inputs_of(mf), option="--emit") as tmp,

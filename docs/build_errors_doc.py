@@ -94,6 +94,11 @@ SPECIAL = {
         "mrgc compile domains/symbolic/chain-3.mrg --encoding bigm",
         "error[E303]: unknown encoding 'bigm' (choose from paper, disaggregated, time-of-move)",
     ),
+    "E304": (
+        "mrgc compile done.mrg --emit model.lp --backend mip",
+        "error[E304]: done: the goals hold at the start (makespan 0): no skeleton model has that as its optimum, "
+        "nothing to export (give --horizon H for the model of H steps)",
+    ),
     "E400": (
         "mrgc facts bad-urdf.mrg",
         "bad-urdf.mrg:5:3: error[E400]: robot URDF 'robots/arm.urdf' not found (looked for "

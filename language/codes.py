@@ -103,6 +103,7 @@ CLI_CODES: dict[str, str] = {
     "E301": "unknown backend",
     "E302": "backend does not support the encoding",
     "E303": "unknown encoding",
+    "E304": "nothing to export: the goals hold at the start",
     "E400": "robot URDF not found or unreadable",
     "E401": "end-effector link not in the URDF",
     "E402": "geometry asked of a symbolic problem",
@@ -134,6 +135,10 @@ HELP: dict[str, str] = {
     "E301": "`--backend` names no registered backend; `mrgc backends` lists them.",
     "E302": "The backend cannot run the chosen encoding.",
     "E303": "`--encoding` is one of `paper`, `disaggregated`, `time-of-move`.",
+    "E304": "`compile --emit` without `--horizon` writes the model whose optimum is the first skeleton; when the "
+    "goals already hold, the first skeleton is empty (makespan 0), and no model of one step or more has it as "
+    "its optimum (the paper's encodings never leave a step empty: their model of one step has no solution). "
+    "Nothing is written; give `--horizon H` for the model of H steps.",
     "E400": "A robot kind's `:urdf` names no readable URDF (looked up beside the .mrg file, then in "
     "pybullet_data), or pybullet refuses the file (a URDF of one's own is loaded into pybullet to be checked "
     "once per version of the file; pybullet_data's own files are not, as pybullet ships them and the "

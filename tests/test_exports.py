@@ -6,6 +6,8 @@ by default it is the first skeleton's makespan, whose optimum is that skeleton.
 
 from __future__ import annotations
 
+import runpy
+import shutil
 from pathlib import Path
 from typing import Any
 
@@ -135,6 +137,35 @@ def test_a_horizon_below_one_is_refused(tmp_path: Path, capsys: pytest.CaptureFi
     assert "error[E000]" in capsys.readouterr().err and not (tmp_path / "m.pbtxt").exists()
     with pytest.raises(mrgc.InputError):
         mrgc.export_model(SYMBOLIC / "chain-3.mrg", tmp_path / "m.pbtxt", horizon=0)
+
+
+def test_goals_that_hold_at_the_start_have_no_model_to_export(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The first skeleton is empty: no model of a step or more has it as its optimum (the paper encoding's
+    model of one step, written before, had no solution while compile said "optimal, makespan 0").  E304,
+    nothing written; ``--horizon`` still writes the model of that many steps."""
+    shutil.copy(SYMBOLIC / "domain.mrg", tmp_path / "domain.mrg")
+    problem = tmp_path / "done.mrg"
+    problem.write_text(
+        "(define (problem done) (:domain abstract) (:robots r1) (:movable o1 o2) (:regions start goal)\n"
+        "  (:init (in-region o1 goal) (in-region o2 start) (reachable-pick o1 top r1)\n"
+        "    (reachable-place o1 goal top r1) (reachable-pick o2 top r1) (reachable-place o2 goal top r1))\n"
+        "  (:goal (in-region o1 goal)))\n",
+        encoding="utf-8",
+    )
+    doc = runpy.run_path(str(SYMBOLIC.parent.parent / "docs" / "build_errors_doc.py"), run_name="not_main")
+    shown = doc["SPECIAL"]["E304"][1]
+    for encoding in ("paper", "disaggregated", "time-of-move"):
+        target = tmp_path / f"{encoding}.lp"
+        argv = ["compile", str(problem), "--backend", "mip", "--encoding", encoding, "--emit", str(target)]
+        assert cli.main(argv) == 2
+        err = capsys.readouterr().err
+        assert err.strip() == shown and not target.exists()  # exactly docs/errors.md's example
+        with pytest.raises(mrgc.InputError, match="E304"):
+            mrgc.export_model(problem, target, backend="mip", encoding=encoding)
+    assert cli.main(["compile", str(problem), "--backend", "mip", "--emit", str(target), "--horizon", "1"]) == 0
+    assert target.exists()
 
 
 def test_the_smt2_script_has_no_option_z3_rejects(tmp_path: Path) -> None:

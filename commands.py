@@ -306,7 +306,7 @@ def cmd_facts(args: argparse.Namespace) -> int:
         write_text(args.output, doc.text, inputs_of(mf))
         print(
             f"{args.output}: {len(result.facts)} facts ({int(result.stats['ik_solves'])} IK solves, "
-            f"{int(result.stats['workers'])} workers"
+            f"{int(result.stats['workers'])} worker{'s' * (int(result.stats['workers']) != 1)}"
             + (f"; {len(doc.assets)} mesh/URDF files copied beside it" if doc.assets else "")
             + ")"
         )

@@ -200,16 +200,17 @@ def _written(kind: str, path: str, stats: dict[str, Any]) -> str:
     if kind == "reach":
         reached = ", ".join(f"{r} reaches {n}" for r, n in stats["reached"].items()) or "no arms"
         return f"{path}: reach map ({reached} of {stats['points']} points)\n  written to {where}"
+    steps = f"{stats.get('steps', 0)} step{'s' * (stats.get('steps', 0) != 1)}"
     what = {
-        "animation": f"replay of {stats['steps']} steps, {stats['frames']} frames",
+        "animation": f"replay of {steps}, {stats['frames']} frames",
         "sheet": f"contact sheet of {stats['frames']} key frames",
         "scene": "the scene",
         "html": (
-            f"3D replay of {stats['steps']} steps, {stats['frames']} frames; open it in a web browser"
+            f"3D replay of {steps}, {stats['frames']} frames; open it in a web browser"
             if stats["steps"]
             else "the scene in 3D; open it in a web browser"
         ),
-        "gantt": f"Gantt chart of {stats['steps']} steps",
+        "gantt": f"Gantt chart of {steps}",
     }[kind]
     timing = f", {stats['draw_seconds']:.1f} s" if "draw_seconds" in stats else ""
     return f"{path}: {what}{timing}\n  written to {where}"

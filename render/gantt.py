@@ -74,7 +74,7 @@ def write(problem: Problem, plan: Mapping[str, Any], path: str) -> None:
         ax.grid(which="minor", axis="x", color="0.85")
         ax.tick_params(which="minor", length=0)
         ax.set_title(
-            f"{problem.name}: {len(steps)} steps, "
+            f"{problem.name}: {len(steps)} step{'s' * (len(steps) != 1)}, "
             + moved_text([[a["object"] for a in s.get("actions", [])] for s in steps])
         )
         ax.legend(

@@ -754,7 +754,7 @@ def test_symbolic_cli(tmp_path: Path, chain3: Any, capsys: pytest.CaptureFixture
     path = tmp_path / "plan.json"
     path.write_text(json.dumps(_plan(chain3, CHAIN3, [[_act(*A2)]], symbolic=True)), encoding="utf-8")
     assert cli.main(["validate", CHAIN3, str(path)]) == 0
-    assert capsys.readouterr().out == "valid: plan for chain-3: 1 steps, 1 objects moved (symbolic checks)\n"
+    assert capsys.readouterr().out == "valid: plan for chain-3: 1 step, 1 object moved (symbolic checks)\n"
     # a geometric plan's file given for the wrong problem file: every mismatch is reported, nothing crashes
     assert cli.main(["validate", PA3, str(path)]) == 1
     out = capsys.readouterr().out
@@ -897,7 +897,7 @@ def test_a_geometric_relay_plan_is_valid(pa3: Any, relay_plan: dict[str, Any]) -
     assert _action(relay_plan, 1)["relay"] is True and "relay" not in _action(relay_plan, 2)
     report = validate(pa3, relay_plan, PA3)
     assert report.ok, report.lines()
-    assert report.lines()[0].startswith("valid: plan for pa3-handover: 2 steps, 1 objects moved (geometric")
+    assert report.lines()[0].startswith("valid: plan for pa3-handover: 2 steps, 1 object moved (geometric")
 
 
 def test_the_onward_pick_is_checked_where_the_relay_move_put_the_object(

@@ -74,9 +74,10 @@ class ValidationReport:
                 if "configurations" in s
                 else ""
             )
+            steps, moved = s.get("steps", 0), s.get("moved", 0)
             return [
-                f"valid: plan for {s.get('problem')}: {s.get('steps', 0)} steps, {s.get('moved', 0)} objects "
-                f"moved ({s.get('mode')} checks{geo})"
+                f"valid: plan for {s.get('problem')}: {steps} step{'s' * (steps != 1)}, {moved} "
+                f"object{'s' * (moved != 1)} moved ({s.get('mode')} checks{geo})"
             ]
         n = len(self.violations)
         return [str(v) for v in self.violations] + [f"invalid: {n} violation{'s' * (n != 1)}"]

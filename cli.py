@@ -108,7 +108,7 @@ def main(argv: Sequence[str] | None = None, *, keep_handlers: bool = False) -> i
         return _main(argv)
     except KeyboardInterrupt as exc:  # a signal while an error was reported, or a second one while the first
         signals.ending()  # one's exception was caught (before the line): the line, then the first one's code
-        print(f"mrgc: {signals.describe(exc)}; nothing written", file=sys.stderr)
+        print(f"mrgc: {signals.describe(exc)}; {signals.left()}", file=sys.stderr)
         return signals.exit_code(signal_of(exc))
     finally:
         signals.ending()
@@ -145,7 +145,7 @@ def _main(argv: Sequence[str] | None) -> int:
         return exc.code if isinstance(exc.code, int) else ExitCode.INPUT
     except KeyboardInterrupt as exc:  # SIGINT, or SIGTERM (signals.Terminated)
         signals.ending()
-        print(f"mrgc: {signals.describe(exc)}; nothing written", file=sys.stderr)
+        print(f"mrgc: {signals.describe(exc)}; {signals.left()}", file=sys.stderr)
         return signals.exit_code(signal_of(exc))
     except InputError as exc:
         commands.report_input_error(exc)
@@ -159,7 +159,7 @@ def _main(argv: Sequence[str] | None) -> int:
         if signals.received() is not None:  # the signal's exception came back as another one (ctypes wraps a
             # KeyboardInterrupt raised while it converts a call's arguments, as in z3's model building, in an
             # ArgumentError): the signal still ends the run
-            print(f"mrgc: {signals.describe()}; nothing written", file=sys.stderr)
+            print(f"mrgc: {signals.describe()}; {signals.left()}", file=sys.stderr)
             return signals.exit_code()
         print(
             f"mrgc: internal error[E070]: {type(exc).__name__}: {exc} "

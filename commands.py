@@ -680,7 +680,13 @@ def build_parser() -> argparse.ArgumentParser:
     )
     add_seed(p)
     add_no_cache(p)
-    p.add_argument("--time-limit", type=number("--time-limit", positive=True), default=DEFAULT_TIME_LIMIT, metavar="S")
+    p.add_argument(
+        "--time-limit",
+        type=number("--time-limit", positive=True),
+        default=DEFAULT_TIME_LIMIT,
+        metavar="S",
+        help=f"seconds for the whole run, phase 1 included (default {DEFAULT_TIME_LIMIT:g})",
+    )
     p.add_argument(
         "--motions",
         choices=["configurations", "full"],

@@ -52,6 +52,8 @@ class _State:
         self.received: list[int] = []  # signals received, in order
         self.doing: list[str] = []  # activity stack of the main thread
         self.what: str = ""  # the activity when the first signal came
+        self.left: list[str] = []  # what the activities running leave done when interrupted (activity(left=))
+        self.kept: str = ""  # what was left done when the first signal came
         self.stops: dict[int, Callable[[], None]] = {}  # stop functions of running native solves
         self.lock = threading.Lock()
         self.next_id = 0
@@ -120,7 +122,9 @@ def reset() -> None:
         return
     _S.received.clear()
     _S.doing.clear()
+    _S.left.clear()
     _S.what = ""
+    _S.kept = ""
     _S.ending = False
 
 
@@ -129,6 +133,7 @@ def _handler(signum: int, frame: object) -> None:
     _S.received.append(signum)
     if first:
         _S.what = _S.doing[-1] if _S.doing else ""
+        _S.kept = _S.left[-1] if _S.left else ""
     if _S.shield or _S.ending or len(_S.received) > RAISED:
         # let the cleanup (killing workers, removing temp files) finish, shielded() raising after it; or the
         # command is ending on a signal already; or two were raised (the second only for a first that Python
@@ -192,14 +197,25 @@ def raise_if_received() -> None:
 
 
 @contextlib.contextmanager
-def activity(what: str) -> Iterator[None]:
-    """Name what the main thread is doing (``computing the facts of pa10``), for the interrupt message."""
+def activity(what: str, left: str = "") -> Iterator[None]:
+    """Name what the main thread is doing (``computing the facts of pa10``), for the interrupt message;
+    ``left``: what an interrupt leaves done when it is not "nothing written" (a study's recorded runs)."""
     _S.doing.append(what)
+    if left:
+        _S.left.append(left)
     try:
         yield
     finally:
         if _S.doing and _S.doing[-1] == what:
             _S.doing.pop()
+        if left and _S.left and _S.left[-1] == left:
+            _S.left.pop()
+
+
+def left() -> str:
+    """What the interrupted command leaves done, for its one line: "nothing written", or what the activity
+    running when the first signal came said (:func:`activity`)."""
+    return _S.kept or "nothing written"
 
 
 @contextlib.contextmanager

@@ -91,21 +91,27 @@ def cmd_run(args: argparse.Namespace) -> int:
     progress: list[Progress] = []
 
     def started(total: int, todo: int) -> None:
-        print(f"{args.study}: {total} runs, {total - todo} already recorded, {todo} to run", flush=True)
+        again = f" (--retry {' '.join(args.retry)}: those run again)" if args.retry else ""
+        print(f"{args.study}: {total} runs, {total - todo} recorded and kept{again}, {todo} to run", flush=True)
         progress.append(Progress(args.study, todo, args.jobs))
 
+    from mrgc import signals
+
     try:
-        summary = run_study(
-            args.study,
-            args.db or DEFAULT_DB,
-            jobs=args.jobs,
-            executor=args.executor,
-            address=args.address,
-            work=args.work,
-            retry=args.retry,
-            on_start=started,
-            on_result=lambda r: progress[0].update(r),
-        )
+        with signals.activity(
+            f"running the study {args.study}", left="every run recorded so far is kept (bench run again goes on)"
+        ):
+            summary = run_study(
+                args.study,
+                args.db or DEFAULT_DB,
+                jobs=args.jobs,
+                executor=args.executor,
+                address=args.address,
+                work=args.work,
+                retry=args.retry,
+                on_start=started,
+                on_result=lambda r: progress[0].update(r),
+            )
     finally:
         for p in progress:
             p.close()

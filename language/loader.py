@@ -51,7 +51,12 @@ class MrgFile:
             if len(self.problems) != 1:
                 found = ", ".join(p.name for p in self.problems) or "none"
                 raise InputError(
-                    [Diagnostic("E230", f"{self.path} holds {len(self.problems)} problems ({found}); name one")]
+                    [
+                        Diagnostic(
+                            "E230",
+                            f"{self.path} holds {len(self.problems)} problems ({found}); name one (--problem NAME)",
+                        )
+                    ]
                 )
             return self.problems[0]
         for p in self.problems:

@@ -198,8 +198,11 @@ def cmd_render(args: argparse.Namespace) -> int:
 def _written(kind: str, path: str, stats: dict[str, Any]) -> str:
     where = os.path.abspath(path)
     if kind == "reach":
-        reached = ", ".join(f"{r} reaches {n}" for r, n in stats["reached"].items()) or "no arms"
-        return f"{path}: reach map ({reached} of {stats['points']} points)\n  written to {where}"
+        reached = ", ".join(f"{r} reaches {n}" for r, n in stats["reached"].items())
+        what = (
+            f"{reached} of {stats['points']} points" if reached else f"no arm in the problem; {stats['points']} points"
+        )
+        return f"{path}: reach map ({what})\n  written to {where}"
     steps = f"{stats.get('steps', 0)} step{'s' * (stats.get('steps', 0) != 1)}"
     what = {
         "animation": f"replay of {steps}, {stats['frames']} frames",

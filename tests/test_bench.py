@@ -273,7 +273,7 @@ def test_a_study_killed_mid_way_and_resumed_loses_no_finished_run_and_repeats_no
         [*MRGC, "bench", "run", str(study), "--db", str(db)], capture_output=True, text=True, timeout=300
     )
     assert again.returncode == 0, again.stderr
-    assert f"6 runs, {len(first)} already recorded, {6 - len(first)} to run" in again.stdout
+    assert f"6 runs, {len(first)} recorded and kept, {6 - len(first)} to run" in again.stdout
     final = rows(db)
     keys = [(r["instance"], r["seed"]) for r in final]
     assert len(final) == 6 and len(set(keys)) == 6
@@ -333,6 +333,10 @@ def test_an_interrupted_retry_keeps_the_recorded_run_and_its_files(tmp_path: Pat
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 130, err
+    assert err.strip() == (  # not "nothing written": the recorded runs are
+        "mrgc: interrupted (SIGINT) while running the study s.yaml; every run recorded so far is kept "
+        "(bench run again goes on)"
+    ).replace("s.yaml", str(study))
     assert rows(db) == [before]
     assert {f.name: f.read_bytes() for f in sorted(files[0].parent.iterdir())} == texts
 

@@ -75,15 +75,21 @@ def cmd_check(args: argparse.Namespace) -> int:
         mf = report.file
         _warn(mf.path, mf.text, report.warnings)
         parts = [f"{len(mf.domains)} domain{'s' * (len(mf.domains) != 1)}"] if mf.domains or not mf.problems else []
-        own = {id(d) for d in mf.domains}
-        for d in {id(p.domain): p.domain for p in mf.problems if id(p.domain) not in own}.values():
-            parts.append(f"domain {d.name} from {_shown_path(d.source)}")  # the domain it used, from another file
+        own = {(d.name, d.source) for d in mf.domains}
+        # the domains its problems used from another file, each once (each problem loads its own copy)
+        used = {(p.domain.name, p.domain.source): p.domain for p in mf.problems}
+        for d in (d for key, d in used.items() if key not in own):
+            parts.append(f"domain {d.name} from {_shown_path(d.source)}")
         for p in mf.problems:
             kind = "symbolic" if p.symbolic else "geometric"
-            parts.append(
-                f"problem {p.name} ({kind}: {len(p.robots)} robots, {len(p.movable)} movable, "
-                f"{len(p.regions)} regions, {len(p.goal)} goals, {len(p.init)} facts)"
+            counts = (
+                (len(p.robots), "robot"),
+                (len(p.regions), "region"),
+                (len(p.goal), "goal"),
+                (len(p.init), "fact"),
             )
+            robots, regions, goals, facts = (f"{n} {word}{'s' * (n != 1)}" for n, word in counts)
+            parts.append(f"problem {p.name} ({kind}: {robots}, {len(p.movable)} movable, {regions}, {goals}, {facts})")
         if not args.quiet:
             for note in report.notes:
                 print(note)

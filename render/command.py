@@ -140,6 +140,16 @@ def _progress(label: str) -> Iterator[Any]:
         yield update
 
 
+def _check_view(args: argparse.Namespace, cameras: Any) -> None:
+    """E000 for a camera, frame rate or pair of label options ``render`` cannot honour."""
+    if args.camera not in cameras:
+        raise _usage(f"--camera {args.camera!r}: choose {CAMERA_HELP}")
+    if not 0 < args.fps <= MAX_FPS:
+        raise _usage(f"--fps must be above 0 and at most {MAX_FPS:g}")
+    if args.object_labels and args.no_labels:  # not one of them silently ignored
+        raise _usage("--object-labels and --no-labels ask for opposite pictures: give one of them")
+
+
 def cmd_render(args: argparse.Namespace) -> int:
     """``mrgc render``: a replay, key frames, the scene, an HTML replay or a Gantt chart, by the output's extension."""
     from mrgc import outputs as files
@@ -148,10 +158,7 @@ def cmd_render(args: argparse.Namespace) -> int:
     from mrgc.render.camera import PRESETS
 
     width, height = parse_size(args.size)
-    if args.camera not in PRESETS:
-        raise _usage(f"--camera {args.camera!r}: choose {CAMERA_HELP}")
-    if not 0 < args.fps <= MAX_FPS:
-        raise _usage(f"--fps must be above 0 and at most {MAX_FPS:g}")
+    _check_view(args, PRESETS)
     kind = outputs.kind_of(args.output, args.gantt, args.plan is not None, args.reach)
     mf = parse_file(args.file, allow_outside=tuple(args.allow_outside or ()))
     inputs = list(mf.files) + ([args.plan] if args.plan else [])

@@ -77,11 +77,10 @@ def write(problem: Problem, plan: Mapping[str, Any], path: str) -> None:
             f"{problem.name}: {len(steps)} step{'s' * (len(steps) != 1)}, "
             + moved_text([[a["object"] for a in s.get("actions", [])] for s in steps])
         )
-        ax.legend(
-            handles=[
-                Patch(facecolor=ROLE_COLOURS[Role.GOAL], label="goal object"),
-                Patch(facecolor=ROLE_COLOURS[Role.MOVED], label="moved obstacle"),
-            ],
+        shown = {role.get(a["object"], Role.MOVED) for s in steps for a in s.get("actions", [])}
+        keys = [(Role.GOAL, "goal object"), (Role.MOVED, "moved obstacle")]
+        ax.legend(  # the colours the chart has (a plan moving no obstacle has no "moved obstacle" key)
+            handles=[Patch(facecolor=ROLE_COLOURS[r], label=text) for r, text in keys if r in shown or not steps],
             loc="upper center",
             bbox_to_anchor=(0.5, -0.12 - 0.05 / max(1, len(robots))),
             ncol=2,

@@ -29,7 +29,18 @@ def good(tmp_path: Path) -> Path:
 def test_check_ok(good: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert cli.main(["check", str(good)]) == 0
     out = capsys.readouterr().out
-    assert "ok" in out and "problem tiny (symbolic: 1 robots, 1 movable" in out
+    assert "ok" in out and "problem tiny (symbolic: 1 robot, 1 movable, 2 regions, 1 goal, 3 facts)" in out
+
+
+def test_check_names_a_domain_two_problems_share_once(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Two problems of one file using the domain.mrg beside it: the domain is named once (each problem loads
+    its own copy of it, and the line named it once per copy)."""
+    (tmp_path / "domain.mrg").write_text(GOOD.split("\n", 1)[0] + "\n", encoding="utf-8")
+    problems = GOOD.split("\n", 1)[1]
+    (tmp_path / "two.mrg").write_text(problems + problems.replace("tiny", "tiny-b"), encoding="utf-8")
+    assert cli.main(["check", str(tmp_path / "two.mrg")]) == 0
+    out = capsys.readouterr().out
+    assert out.count("domain abstract from") == 1 and "problem tiny (" in out and "problem tiny-b (" in out
 
 
 def test_check_reports_every_file(good: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

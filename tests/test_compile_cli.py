@@ -164,7 +164,7 @@ def test_geometric_problem_without_facts_gets_them_from_phase_1(
     path = tmp_path / "geo.mrg"
     path.write_text(GEOMETRIC, encoding="utf-8")
     assert cli.main(["check", str(path)]) == 0
-    assert "(geometric: 1 robots, 1 movable, 2 regions, 1 goals, 0 facts)" in capsys.readouterr().out
+    assert "(geometric: 1 robot, 1 movable, 2 regions, 1 goal, 0 facts)" in capsys.readouterr().out
     code, doc = compile_json(capsys, str(path))
     assert code == 0, doc
     assert doc["status"] == "optimal" and doc["stats"]["actions"] >= 1

@@ -172,6 +172,10 @@ def test_gantt_svg_and_png(plan_file: Path, tmp_path: Path, capsys: pytest.Captu
             assert f"{a['object']} \u2192 {a['region']}" in text
             if a["kind"] == "handover":
                 assert a["handover_point"] in text and f"{a['object']} \u2192 {a['place_robot']}" in text
+    # the legend keys the colours the chart has: "moved obstacle" only when the plan moves one
+    goals = parse_file(str(HANDOVER)).problem().goal_regions
+    obstacles = {a["object"] for s in plan["steps"] for a in s["actions"]} - set(goals)
+    assert ("moved obstacle" in text) == bool(obstacles) and "goal object" in text
     again = tmp_path / "again-gantt.svg"
     assert run(["render", HANDOVER, plan_file, "-o", again], capsys)[0] == 0
     assert again.read_text() == text  # deterministic
@@ -262,6 +266,7 @@ def test_bad_requests_are_one_line_errors(plan_file: Path, tmp_path: Path, capsy
         (["render", HANDOVER, plan_file, "-o", tmp_path / "x.gif", "--size", "10x10"], 2, "--size"),
         (["render", HANDOVER, plan_file, "-o", tmp_path / "x.gif", "--camera", "fisheye"], 2, "--camera"),
         (["render", HANDOVER, plan_file, "-o", tmp_path / "x.gif", "--fps", "0"], 2, "--fps"),
+        (["render", HANDOVER, plan_file, "-o", tmp_path / "x.png", "--object-labels", "--no-labels"], 2, "opposite"),
         (["render", ROOT / "domains/symbolic/handover.mrg", "-o", tmp_path / "x.png"], 2, "E402"),
         (["render", HANDOVER, tmp_path / "none.json", "-o", tmp_path / "x.gif"], 2, "E500"),
         (["render", HANDOVER, plan_file, "-o", tmp_path / "missing" / "x.gif"], 2, "error[E"),

@@ -251,9 +251,10 @@ def export_model(
     The model is the one the backend solves for the first skeleton, without cuts: its optimum is the first
     skeleton's (makespan, objects moved).  ``horizon`` T chooses another: for the ``paper`` and
     ``disaggregated`` encodings the model of skeletons of exactly T steps, for ``time-of-move`` of at most T
-    steps.  By default T is the makespan of the first skeleton (compiled now; InputError E304 when the goals
-    hold at the start and it is 0: no model of a step or more has the empty skeleton as its optimum), or, when
-    there is none, the horizon limit (``max_makespan``, capped at the number of objects in the task graph).
+    steps.  By default T is the makespan of the first skeleton (compiled now; when the goals hold at the start
+    and it is 0, 1 for ``time-of-move`` and InputError E304 for the encodings of exactly T non-empty steps,
+    :func:`emit_horizon`), or, when there is none, the horizon limit (``max_makespan``, capped at the number
+    of objects in the task graph).
     docs/backends.md says what each file holds and how to load it into its solver.
     """
     from mrgc.planner.skeletons import export_model as write_model
@@ -270,7 +271,7 @@ def export_model(
         result = compile(
             problem, backend=backend, encoding=encoding, max_makespan=max_makespan, facts=fact_list, seed=seed
         )
-        horizon = emit_horizon(problem.name, result)
+        horizon = emit_horizon(problem.name, result, encoding)
     return write_model(
         problem,
         os.fspath(path),
@@ -283,18 +284,25 @@ def export_model(
     )
 
 
-def emit_horizon(name: str, result: "CompileResult") -> int | None:
+def emit_horizon(name: str, result: "CompileResult", encoding: str) -> int | None:
     """The horizon of the model ``compile --emit`` writes by default: the first skeleton's makespan (None
-    when there is no skeleton: the horizon limit).  InputError E304 when it is 0 (the goals of problem
-    ``name`` hold at the start): no model of a step or more has the empty skeleton as its optimum."""
+    when there is no skeleton: the horizon limit).  When it is 0 (the goals of problem ``name`` hold at the
+    start): 1 for an encoding whose model of T steps covers every makespan up to T (``time-of-move``: its
+    model of one step has the empty skeleton as its optimum), else InputError E304 (an encoding of exactly
+    T non-empty steps, ``horizon_loop``: no model of it has that optimum)."""
+    from mrgc.compiler.encodings import get_encoding
+
     horizon = result.skeletons[0].makespan if result.skeletons else None
+    if horizon == 0 and not get_encoding(encoding).horizon_loop:
+        return 1
     if horizon == 0:
         raise InputError(
             [
                 Diagnostic(
                     "E304",
-                    f"{name}: the goals hold at the start (makespan 0): no skeleton model has that as its "
-                    "optimum, nothing to export (give --horizon H for the model of H steps)",
+                    f"{name}: the goals hold at the start (makespan 0): the {encoding} encoding has no model with "
+                    "that optimum (its steps are never empty), nothing to export (give a horizon H for the "
+                    "model of H steps)",
                 )
             ]
         )

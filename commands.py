@@ -234,7 +234,7 @@ def cmd_compile(args: argparse.Namespace) -> int:
     if facts is not None:
         result.stats["facts_seconds"] = round(facts_seconds, 6)
     if args.emit:
-        horizon = args.horizon if args.horizon is not None else api.emit_horizon(problem.name, result)
+        horizon = args.horizon if args.horizon is not None else api.emit_horizon(problem.name, result, args.encoding)
         with (
             signals.activity(f"writing the model to {args.emit}"),
             outputs.atomic_path(args.emit, inputs_of(mf), option="--emit") as tmp,

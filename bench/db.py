@@ -81,6 +81,7 @@ CREATE TABLE IF NOT EXISTS runs (
 CREATE TABLE IF NOT EXISTS studies (name TEXT PRIMARY KEY, path TEXT, text TEXT, updated TEXT);
 CREATE TABLE IF NOT EXISTS methods (study TEXT, method TEXT, spec TEXT, PRIMARY KEY (study, method));
 CREATE TABLE IF NOT EXISTS skips (study TEXT, method TEXT, reason TEXT, runs INTEGER, PRIMARY KEY (study, method));
+CREATE TABLE IF NOT EXISTS contents (study TEXT, instance TEXT, sha256 TEXT, PRIMARY KEY (study, instance));
 """
 
 RunKey = tuple[str, str, str, int]
@@ -149,8 +150,10 @@ class ResultsDB:
         specs: dict[str, dict[str, Any]],
         skips: dict[str, tuple[str, int]],
         updated: str,
+        contents: dict[str, str] | None = None,
     ) -> None:
-        """Record the study and its method specs; E603 if a method changed under the same name."""
+        """Record the study and its method specs; E603 if a method changed under the same name.  ``contents``:
+        each instance's content hash now (by name), which the reports read (:meth:`runs`)."""
         known = {
             r["method"]: r["spec"]
             for r in self.conn.execute("SELECT method, spec FROM methods WHERE study = ?", (name,))
@@ -182,6 +185,11 @@ class ResultsDB:
             self.conn.execute("DELETE FROM skips WHERE study = ?", (name,))
             for method, (reason, runs) in skips.items():
                 self.conn.execute("INSERT INTO skips VALUES (?, ?, ?, ?)", (name, method, reason, runs))
+            if contents is not None:
+                self.conn.execute("DELETE FROM contents WHERE study = ?", (name,))
+                self.conn.executemany(
+                    "INSERT INTO contents VALUES (?, ?, ?)", [(name, i, sha) for i, sha in sorted(contents.items())]
+                )
 
     def add(self, result: RunResult) -> None:
         """Write one finished run (replacing an earlier row of the same key: a retried run) and commit."""
@@ -207,22 +215,38 @@ class ResultsDB:
         return [r[0] for r in self.conn.execute("SELECT study FROM runs GROUP BY study ORDER BY MIN(id)")]
 
     def runs(self, study: str | None = None) -> Iterator[dict[str, Any]]:
-        """The recorded runs (all studies, or one) in a stable order, of each instance's newest content only:
-        the runs of an instance edited since (another content hash under the same name, recorded before the
-        newest one's last run) stay in the database but are not the study's any more, and a report mixing
-        them would average two problems."""
-        where, args = ("AND study = ?", (study,)) if study is not None else ("", ())
+        """The recorded runs (all studies, or one) in a stable order, of each instance's current content only:
+        the content the study had when it was last run (its ``contents``; for a database without them, the
+        content of the instance's latest recorded run).  The runs of an instance's other contents (edited
+        since) stay in the database but are not the study's, and a report mixing them would average two
+        problems under one name."""
+        where, args = ("WHERE study = ?", (study,)) if study is not None else ("", ())
+        current = {
+            (r[0], r[1]): r[2]
+            for r in self.conn.execute(
+                "SELECT study, instance, instance_sha256 FROM runs WHERE id IN "
+                f"(SELECT MAX(id) FROM runs {where} GROUP BY study, instance)",
+                args,
+            )
+        }
+        if self._has("contents"):
+            current.update(
+                ((r[0], r[1]), r[2])
+                for r in self.conn.execute(f"SELECT study, instance, sha256 FROM contents {where}", args)
+            )
         columns = ", ".join(c if c in self.present else f"NULL AS {c}" for c in COLUMNS)
-        newest = (
-            "instance_sha256 = (SELECT r2.instance_sha256 FROM runs r2 WHERE r2.study = runs.study "
-            "AND r2.instance = runs.instance ORDER BY r2.id DESC LIMIT 1)"
-        )
-        for r in self.conn.execute(
-            f"SELECT {columns} FROM runs WHERE {newest} {where} "
-            "ORDER BY study, set_index, instance, method_index, method, seed",
+        for row in self.conn.execute(
+            f"SELECT {columns} FROM runs {where} ORDER BY study, set_index, instance, method_index, method, seed",
             args,
         ):
-            yield dict(r)
+            if current.get((row["study"], row["instance"])) == row["instance_sha256"]:
+                yield dict(row)
+
+    def _has(self, table: str) -> bool:
+        """Whether the database has ``table`` (a database written by an older mrgc may not)."""
+        return bool(
+            self.conn.execute("SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = ?", (table,)).fetchone()
+        )
 
     def skips(self, study: str) -> list[tuple[str, str, int]]:
         """The methods skipped in ``study``: (method, reason, runs), by method."""

@@ -125,6 +125,7 @@ def run_study(
             {m.name: m.spec() for m in study.methods if m.name not in skipped},
             skipped,
             now(),
+            {t.instance.name: t.instance.sha256 for t in tasks},
         )
         finished = results.finished(study.name)
         todo = [t for t in tasks if finished.get((t.study, t.instance.sha256, t.method, t.seed)) in (None, *retry)]

@@ -95,9 +95,9 @@ SPECIAL = {
         "error[E303]: unknown encoding 'bigm' (choose from paper, disaggregated, time-of-move)",
     ),
     "E304": (
-        "mrgc compile done.mrg --emit model.lp --backend mip",
-        "error[E304]: done: the goals hold at the start (makespan 0): no skeleton model has that as its optimum, "
-        "nothing to export (give --horizon H for the model of H steps)",
+        "mrgc compile done.mrg --emit model.lp --backend mip --encoding paper",
+        "error[E304]: done: the goals hold at the start (makespan 0): the paper encoding has no model with that "
+        "optimum (its steps are never empty), nothing to export (give a horizon H for the model of H steps)",
     ),
     "E400": (
         "mrgc facts bad-urdf.mrg",

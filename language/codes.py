@@ -136,9 +136,10 @@ HELP: dict[str, str] = {
     "E302": "The backend cannot run the chosen encoding.",
     "E303": "`--encoding` is one of `paper`, `disaggregated`, `time-of-move`.",
     "E304": "`compile --emit` without `--horizon` writes the model whose optimum is the first skeleton; when the "
-    "goals already hold, the first skeleton is empty (makespan 0), and no model of one step or more has it as "
-    "its optimum (the paper's encodings never leave a step empty: their model of one step has no solution). "
-    "Nothing is written; give `--horizon H` for the model of H steps.",
+    "goals already hold, the first skeleton is empty (makespan 0), and the `paper` and `disaggregated` encodings "
+    "have no model with that optimum (their models of T steps never leave a step empty: the model of one step "
+    "has no solution). Nothing is written; give `--horizon H` (the API's `horizon=H`) for the model of H steps, "
+    "or use `--encoding time-of-move`, whose model of one step has the empty skeleton as its optimum.",
     "E400": "A robot kind's `:urdf` names no readable URDF (looked up beside the .mrg file, then in "
     "pybullet_data), or pybullet refuses the file (a URDF of one's own is loaded into pybullet to be checked "
     "once per version of the file; pybullet_data's own files are not, as pybullet ships them and the "

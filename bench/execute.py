@@ -122,8 +122,7 @@ def execute_run(task: RunTask, cancel: threading.Event | None = None, remote: bo
     out_dir = scratch or task.out_dir
     os.makedirs(out_dir, exist_ok=True)
     env = dict(os.environ, MRGC_BENCH_PARENT=str(os.getpid()))
-    final = os.path.join(out_dir, task.stem)
-    stem = final + ATTEMPT  # the attempt's files, put in place of the run's only when it ends (_settle)
+    stem = os.path.join(out_dir, task.stem) + ATTEMPT  # put in place of the run's once it is recorded (settle)
     done = False
     try:
         problem = _problem_path(task.instance, scratch) if scratch else task.instance.path
@@ -133,7 +132,7 @@ def execute_run(task: RunTask, cancel: threading.Event | None = None, remote: bo
         if not task.compile_only:
             args += ["-o", plan_path]
         args += list(task.args[1:])
-        _remove(stem)  # an attempt cut short by SIGKILL
+        remove_attempt(stem)  # an attempt cut short by SIGKILL
         started = now()
 
         def limited(argv: list[str], out: str, err: str) -> ProcessResult:
@@ -156,38 +155,38 @@ def execute_run(task: RunTask, cancel: threading.Event | None = None, remote: bo
             raw.validate_text = _read(stem + ".validate.json")
             raw.validate_stderr = raw.validate.stderr_tail()
         raw.finished = now()
-        done = not raw.cancelled
+        done = not raw.cancelled and not (cancel is not None and cancel.is_set())
         return raw
     finally:
-        if done:
-            _settle(stem, final)
-        else:  # interrupted: a recorded earlier run of the same key (--retry) keeps its files
-            _remove(stem)
+        if not done:  # interrupted: never recorded, so a recorded earlier run of the same key keeps its files
+            remove_attempt(stem)
         if scratch:
             shutil.rmtree(scratch, ignore_errors=True)
 
 
-#: the suffix of a running attempt's files (``INSTANCE-sSEED-HASH.attempt.plan.json``, ...)
+#: the suffix of a run's files until the run is recorded (``INSTANCE-sSEED-HASH.attempt.plan.json``, ...)
 ATTEMPT = ".attempt"
 #: the files of a run, by suffix
 SUFFIXES = (".plan.json", ".compile.json", ".out", ".err", ".validate.json", ".validate.err")
 
 
-def _settle(attempt: str, final: str) -> None:
-    """A finished attempt's files put in place of the run's (an earlier run's that the attempt did not write
-    removed: a validation that did not happen this time)."""
+def settle(task: RunTask) -> None:
+    """A recorded run's attempt files put in place of the run's files (those of an earlier run of its key that
+    the attempt did not write removed: a validation that did not happen this time).  Called once the run's
+    row is committed, so that an interrupt before leaves the recorded run and its files as they were."""
+    final = os.path.join(task.out_dir, task.stem)
     for suffix in SUFFIXES:
-        if os.path.exists(attempt + suffix):
-            os.replace(attempt + suffix, final + suffix)
+        if os.path.exists(final + ATTEMPT + suffix):
+            os.replace(final + ATTEMPT + suffix, final + suffix)
         elif os.path.exists(final + suffix):
             os.unlink(final + suffix)
 
 
-def _remove(attempt: str) -> None:
-    """An attempt's files, gone."""
+def remove_attempt(stem: str) -> None:
+    """The files of the attempt ``stem`` (ending in :data:`ATTEMPT`), gone."""
     for suffix in SUFFIXES:
-        if os.path.exists(attempt + suffix):
-            os.unlink(attempt + suffix)
+        if os.path.exists(stem + suffix):
+            os.unlink(stem + suffix)
 
 
 def _status(plan_text: str) -> str | None:

@@ -43,7 +43,7 @@ import math
 from dataclasses import asdict, dataclass
 from typing import Any
 
-from mrgc.bench.execute import RawRun
+from mrgc.bench.execute import ATTEMPT, RawRun
 
 
 class RunStatus(str, enum.Enum):
@@ -177,7 +177,9 @@ def classify(raw: RawRun, method_index: int = 0, plan_file: str | None = None) -
         valid=valid,
         plan_status=(data or {}).get("status") if not task.compile_only else (data or {}).get("status"),
         stderr_tail=tail,
-        command=" ".join(["mrgc", *proc.argv[3:]]),
+        command=" ".join(["mrgc", *proc.argv[3:]]).replace(
+            task.stem + ATTEMPT, task.stem
+        ),  # the files' names once recorded
         time_limit=task.limits.time,
         wall_limit=task.limits.wall_seconds,
         memory_limit_mb=task.limits.memory_mb,

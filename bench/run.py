@@ -15,9 +15,9 @@ from collections import Counter
 from dataclasses import dataclass, field
 from typing import Callable, Iterable
 
-from mrgc import outputs
+from mrgc import outputs, signals
 from mrgc.bench.db import ResultsDB, WriterLock
-from mrgc.bench.execute import RawRun, RunTask, now
+from mrgc.bench.execute import ATTEMPT, RawRun, RunTask, now, remove_attempt, settle
 from mrgc.bench.instances import expand_instances
 from mrgc.bench.methods import check_methods, method_args
 from mrgc.bench.outcome import RunResult, RunStatus, classify
@@ -127,6 +127,7 @@ def run_study(
             now(),
             {t.instance.name: t.instance.sha256 for t in tasks},
         )
+        _sweep_attempts(tasks)
         finished = results.finished(study.name)
         todo = [t for t in tasks if finished.get((t.study, t.instance.sha256, t.method, t.seed)) in (None, *retry)]
         summary = StudySummary(study.name, len(tasks), len(tasks) - len(todo), skipped=skipped)
@@ -138,7 +139,9 @@ def run_study(
             for raw in exe.results(todo):
                 plan_file = _keep_files(raw) if exe.remote else _plan_file(raw)
                 result = classify(raw, method_index[raw.task.method], plan_file)
-                results.add(result)
+                with signals.shielded():  # recorded, then its files put in place: an interrupt waits for both
+                    results.add(result)
+                    settle(raw.task)
                 summary.ran += 1
                 summary.outcomes[result.status] += 1
                 if on_result is not None:
@@ -146,17 +149,31 @@ def run_study(
     return summary
 
 
+def _sweep_attempts(tasks: list[RunTask]) -> None:
+    """Attempt files a run left when its ``bench run`` was killed (SIGKILL: no cleanup ran), removed while
+    this ``bench run`` holds the database's writer lock (no other one writes the study's folders)."""
+    for folder in sorted({t.out_dir for t in tasks}):
+        if os.path.isdir(folder):
+            for name in sorted(os.listdir(folder)):
+                if ATTEMPT + "." in name:
+                    os.unlink(os.path.join(folder, name))
+
+
 def _plan_file(raw: RawRun) -> str | None:
+    """Where the run's plan file will be once the run is recorded (:func:`settle`), None when it wrote none."""
     t = raw.task
     path = os.path.join(t.out_dir, t.stem + (".compile.json" if t.compile_only else ".plan.json"))
-    return path if os.path.isfile(path) else None
+    attempt = os.path.join(t.out_dir, t.stem + ATTEMPT + (".compile.json" if t.compile_only else ".plan.json"))
+    return path if os.path.isfile(attempt) else None
 
 
 def _keep_files(raw: RawRun) -> str | None:
-    """Write what a remote run sent back into its local folder; the plan file's path."""
+    """Write what a remote run sent back into its local folder, as attempt files (:func:`settle` puts them
+    in place once the run is recorded); the plan file's path."""
     t = raw.task
     os.makedirs(t.out_dir, exist_ok=True)
-    stem = os.path.join(t.out_dir, t.stem)
+    stem = os.path.join(t.out_dir, t.stem + ATTEMPT)
+    remove_attempt(stem)
     texts = {
         (".compile.json" if t.compile_only else ".plan.json"): raw.plan_text,
         ".err": raw.plan_stderr,

@@ -303,6 +303,10 @@ def test_an_edited_instance_keeps_the_old_runs_files_and_reports_only_its_new_co
     for _, plan_file, moved in every:
         assert json.loads(Path(plan_file).read_text(encoding="utf-8"))["motion_cost"] == moved
     assert [r["instance_sha256"] for r in shown] == [every[1][0]]
+    # the edit taken back: nothing runs (that content's run is recorded), and the reports read it again
+    shutil.copy(SYMBOLIC / "chain-3.mrg", folder / "chain-3.mrg")
+    assert run_study(str(study), str(db)).ran == 0
+    assert [r["instance_sha256"] for r in rows(db)] == [every[0][0]]
 
 
 def test_an_interrupted_retry_keeps_the_recorded_run_and_its_files(tmp_path: Path) -> None:
@@ -339,6 +343,38 @@ def test_an_interrupted_retry_keeps_the_recorded_run_and_its_files(tmp_path: Pat
     ).replace("s.yaml", str(study))
     assert rows(db) == [before]
     assert {f.name: f.read_bytes() for f in sorted(files[0].parent.iterdir())} == texts
+
+
+def test_a_retry_that_fails_to_be_recorded_leaves_the_recorded_run_s_files(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The attempt's files are put in place only once its row is committed: a retry whose recording fails
+    (here the database write raises) leaves the recorded run's row and files as they were, and the next
+    ``bench run`` sweeps the attempt's leftovers."""
+    symbolic_copy(tmp_path / "p", "chain-3")
+    study = write_study(
+        tmp_path / "s.yaml",
+        "study: settle\nseeds: 0..0\nlimits: {time: 30}\ninstances: [{glob: p/chain-3.mrg, name: sym}]\n"
+        "methods: [{name: Ours}]\n",
+    )
+    db = tmp_path / "r.db"
+    run_study(str(study), str(db))
+    (before,) = rows(db)
+    folder = Path(str(before["plan_file"])).parent
+    texts = {f.name: f.read_bytes() for f in sorted(folder.iterdir())}
+
+    def refuse(self: ResultsDB, result: object) -> None:
+        raise KeyboardInterrupt
+
+    with monkeypatch.context() as m:
+        m.setattr(ResultsDB, "add", refuse)
+        with pytest.raises(KeyboardInterrupt):
+            run_study(str(study), str(db), retry=[str(before["status"])])
+    assert rows(db) == [before]
+    assert {f.name: f.read_bytes() for f in sorted(folder.iterdir()) if ".attempt." not in f.name} == texts
+    assert [f.name for f in folder.iterdir() if ".attempt." in f.name]  # the attempt, not put in place
+    run_study(str(study), str(db))  # nothing to run; the leftovers swept
+    assert {f.name: f.read_bytes() for f in sorted(folder.iterdir())} == texts
 
 
 def test_a_run_past_its_wall_clock_limit_is_killed_as_a_group(tmp_path: Path) -> None:

@@ -87,7 +87,12 @@ def run() -> None:
     killed by it, after the command's own exit code was settled."""
     import signal
 
-    code = main(keep_handlers=True)
+    from mrgc import signals
+
+    try:
+        code = main(keep_handlers=True)
+    except KeyboardInterrupt:  # a signal in the few bytecodes before main() stopped raising them
+        code = signals.exit_code()
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, signal.SIG_IGN)
     sys.exit(code)
@@ -138,7 +143,8 @@ def _main(argv: Sequence[str] | None) -> int:
             code = func(args)
         if signals.received() is not None and code not in signals.EXIT_CODES.values():
             # something swallowed the signal's exception: the signal still ends the run
-            print(f"mrgc: {signals.describe()}", file=sys.stderr)
+            signals.ending()
+            print(f"mrgc: {signals.describe()}; {signals.left()}", file=sys.stderr)
             return signals.exit_code()
         return code
     except SystemExit as exc:  # argparse --help / --version / usage errors
@@ -159,6 +165,7 @@ def _main(argv: Sequence[str] | None) -> int:
         if signals.received() is not None:  # the signal's exception came back as another one (ctypes wraps a
             # KeyboardInterrupt raised while it converts a call's arguments, as in z3's model building, in an
             # ArgumentError): the signal still ends the run
+            signals.ending()
             print(f"mrgc: {signals.describe()}; {signals.left()}", file=sys.stderr)
             return signals.exit_code()
         print(

@@ -145,8 +145,11 @@ def _handler(signum: int, frame: object) -> None:
 def ending() -> None:
     """The command is ending (``cli.main`` reports the signal's exception, or has returned and the process is
     about to exit): further signals are recorded, never raised, so that no second Ctrl-C or SIGTERM turns
-    the one line and exit code of the first into a traceback.  :func:`uninstall` ends this."""
-    _S.ending = True
+    the one line and exit code of the first into a traceback.  :func:`uninstall` ends this.  Only the main
+    thread's command, while the policy is installed, says so (a ``cli.main`` run in another thread does not
+    silence the main thread's signals)."""
+    if _S.installed and threading.current_thread() is threading.main_thread():
+        _S.ending = True
 
 
 def _watch(fd: int) -> None:

@@ -48,11 +48,15 @@ class StudySummary:
 
     def lines(self) -> list[str]:
         """The summary printed at the end of ``bench run``."""
+
+        def runs(n: int) -> str:
+            return f"{n} run{'s' * (n != 1)}"
+
         out = [
-            f"study {self.study}: {self.total} runs, {self.already} already recorded, {self.ran} run now"
+            f"study {self.study}: {runs(self.total)}, {self.already} recorded and kept, {self.ran} run now"
             + (": " + ", ".join(f"{n} {s}" for s, n in self.outcomes.most_common()) if self.ran else "")
         ]
-        out += [f"skipped method {m} ({n} runs): {why}" for m, (why, n) in self.skipped.items()]
+        out += [f"skipped method {m} ({runs(n)}): {why}" for m, (why, n) in self.skipped.items()]
         return out
 
 

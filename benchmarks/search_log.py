@@ -62,8 +62,9 @@ def check(rest: str) -> str:
     said = re.sub(r" \(as grounding \d+[^)]*\)$", "", m["check"])
     said = re.sub(r" ?\[[^]]*\]", "", said)
     words = m["label"].split()  # "R moves O to ...", "R->R hand O over ...", "R->R relay O ..."
-    robots = words[0].split("->")
-    names = dict.fromkeys(robots, "R") | ({words[2]: "O"} if words[1] in ("moves", "hand", "relay") else {})
+    robots = words[0].split("->") if words else []
+    acts = len(words) >= 3 and words[1] in ("moves", "hand", "relay")
+    names = dict.fromkeys(robots, "R") | ({words[2]: "O"} if acts else {})
     for name, mark in names.items():
         said = re.sub(rf"(?<![\w.-]){re.escape(name)}(?![\w.-])", mark, said)
     return "fail: " + said

@@ -30,13 +30,11 @@ def check_count(name: str, value: int, low: int, high: int) -> None:
 
 
 def check_seed(seed: int) -> None:
-    """A usage error unless ``seed`` is a whole number within the command line's bound of ``--seed``
-    (:data:`mrgc.limits.BOUNDS`: a generated file's header names the command that makes it again)."""
-    from mrgc.limits import BOUNDS
+    """E000 unless ``seed`` is a seed the command line takes (:func:`mrgc.limits.checked`, the API's one
+    check of ``--seed``'s bound: a generated file's header names the command that makes it again)."""
+    from mrgc.limits import checked
 
-    lo, hi = BOUNDS["--seed"]
-    if not isinstance(seed, int) or isinstance(seed, bool) or not lo <= seed <= hi:
-        raise usage_error(f"--seed must be a whole number from {int(lo)} to {int(hi):,} (got {seed!r})")
+    checked("seed", seed, "count")
 
 
 def uniform(rng: np.random.Generator, lo: float, hi: float, digits: int = 3) -> float:

@@ -169,13 +169,21 @@ def test_search_log_classes_each_grounding_line_and_its_seconds(tmp_path: Path) 
     # by the check that failed, over two logs: robots and the object of the failing action written R and O
     more = tmp_path / "more.log"
     clash = Failure(2, label(hand), "pick: robots of the step collide", ("r1", "r2"))
-    more.write_text(_log_line(4.0, 1, skel, [], Grounding(Outcome.FAIL, failures=[clash])) + "\n", encoding="utf-8")
+    unnamed = Failure(0, "", "placement: no free pose")  # a failure no action was named for yet
+    more.write_text(
+        _log_line(4.0, 1, skel, [], Grounding(Outcome.FAIL, failures=[clash]))
+        + "\n"
+        + _log_line(4.5, 2, skel, [], Grounding(Outcome.FAIL, failures=[unnamed]))
+        + "\n",
+        encoding="utf-8",
+    )
     head, rows = _table([sys.executable, str(script), "--by", "check", str(log), str(more)])
-    assert head == "6 groundings, 13.0 s in 2 logs"
+    assert head == "7 groundings, 13.5 s in 2 logs"
     assert rows == {
         "fail: place by R: collision": ("1", "2.0"),
         "fail: drive": ("1", "1.0"),
         "fail: pick: robots of the step collide": ("1", "4.0"),
+        "fail: placement: no free pose": ("1", "0.5"),
         "partial": ("1", "3.5"),
         "fail: no": ("1", "0.5"),
         "plan": ("1", "2.0"),

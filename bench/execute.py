@@ -132,8 +132,7 @@ def execute_run(task: RunTask, cancel: threading.Event | None = None, remote: bo
         if not task.compile_only:
             args += ["-o", plan_path]
         args += list(task.args[1:])
-        remove_attempt(stem)  # an attempt cut short by SIGKILL
-        started = now()
+        started = now()  # (attempts a SIGKILLed bench run left were swept when this one started)
 
         def limited(argv: list[str], out: str, err: str) -> ProcessResult:
             return run_limited(

@@ -17,7 +17,7 @@ from typing import Callable, Iterable
 
 from mrgc import outputs, signals
 from mrgc.bench.db import ResultsDB, WriterLock
-from mrgc.bench.execute import ATTEMPT, RawRun, RunTask, now, remove_attempt, settle
+from mrgc.bench.execute import ATTEMPT, RawRun, RunTask, now, settle
 from mrgc.bench.instances import expand_instances
 from mrgc.bench.methods import check_methods, method_args
 from mrgc.bench.outcome import RunResult, RunStatus, classify
@@ -177,7 +177,6 @@ def _keep_files(raw: RawRun) -> str | None:
     t = raw.task
     os.makedirs(t.out_dir, exist_ok=True)
     stem = os.path.join(t.out_dir, t.stem + ATTEMPT)
-    remove_attempt(stem)
     texts = {
         (".compile.json" if t.compile_only else ".plan.json"): raw.plan_text,
         ".err": raw.plan_stderr,

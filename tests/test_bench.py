@@ -281,19 +281,32 @@ def test_a_study_killed_mid_way_and_resumed_loses_no_finished_run_and_repeats_no
     assert sum(line.startswith("[") for line in again.stdout.splitlines()) == 6 - len(first)
 
 
+def one_run_study(tmp_path: Path, name: str, limits: str, problem: str) -> tuple[Path, Path, dict[str, object]]:
+    """A study of one instance (``p/PROBLEM.mrg``, already copied there), one seed and method Ours, run once:
+    the study file, its database and the run's row."""
+    study = write_study(
+        tmp_path / "s.yaml",
+        f"study: {name}\nseeds: 0..0\nlimits: {limits}\ninstances: [{{glob: p/{problem}.mrg, name: one}}]\n"
+        "methods: [{name: Ours}]\n",
+    )
+    db = tmp_path / "r.db"
+    run_study(str(study), str(db))
+    (row,) = rows(db)
+    return study, db, row
+
+
+def file_texts(folder: Path) -> dict[str, bytes]:
+    """The bytes of every file in ``folder``, by name."""
+    return {f.name: f.read_bytes() for f in sorted(folder.iterdir())}
+
+
 def test_an_edited_instance_keeps_the_old_runs_files_and_reports_only_its_new_content(tmp_path: Path) -> None:
     """A study run, its instance edited, run again: two rows (an edited instance is a new instance), each with
     its own plan file (the file names carry the content hash: the second run overwrote the first's, whose
     row then pointed at the new problem's plan), and the reports read the new content's runs alone (they
     averaged the two problems)."""
     folder = symbolic_copy(tmp_path / "p", "chain-3")
-    study = write_study(
-        tmp_path / "s.yaml",
-        "study: edit\nseeds: 0..0\nlimits: {time: 30}\ninstances: [{glob: p/chain-3.mrg, name: sym}]\n"
-        "methods: [{name: Ours}]\n",
-    )
-    db = tmp_path / "r.db"
-    run_study(str(study), str(db))
+    study, db, _ = one_run_study(tmp_path, "edit", "{time: 30}", "chain-3")
     shutil.copy(SYMBOLIC / "parallel.mrg", folder / "chain-3.mrg")  # another problem under the same name
     run_study(str(study), str(db))
     with ResultsDB(str(db), readonly=True) as results:
@@ -314,17 +327,10 @@ def test_an_interrupted_retry_keeps_the_recorded_run_and_its_files(tmp_path: Pat
     retry deleted the plan file up front, and its cancelled attempt was never recorded: a row pointing at
     nothing)."""
     packaging_copy(tmp_path / "p", "pa18-4arms")
-    study = write_study(
-        tmp_path / "s.yaml",
-        "study: retry\nseeds: 0..0\nlimits: {time: 0.5, wall: 120}\n"
-        "instances: [{glob: p/pa18-4arms.mrg, name: big}]\nmethods: [{name: Ours}]\n",
-    )
-    db = tmp_path / "r.db"
-    run_study(str(study), str(db))
-    (before,) = rows(db)
+    study, db, before = one_run_study(tmp_path, "retry", "{time: 0.5, wall: 120}", "pa18-4arms")
     assert before["plan_file"] and Path(str(before["plan_file"])).is_file()
-    files = sorted(Path(str(before["plan_file"])).parent.iterdir())
-    texts = {f.name: f.read_bytes() for f in files}
+    folder = Path(str(before["plan_file"])).parent
+    texts = file_texts(folder)
     proc = subprocess.Popen(
         [*MRGC, "bench", "run", str(study), "--db", str(db), "--retry", str(before["status"])],
         stdout=subprocess.DEVNULL,
@@ -332,7 +338,7 @@ def test_an_interrupted_retry_keeps_the_recorded_run_and_its_files(tmp_path: Pat
         text=True,
     )
     deadline = time.monotonic() + 60
-    while not list(files[0].parent.glob("*.attempt.*")) and time.monotonic() < deadline:
+    while not list(folder.glob("*.attempt.*")) and time.monotonic() < deadline:
         time.sleep(0.01)  # until the retry's attempt has started (its files made)
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=60)
@@ -342,7 +348,7 @@ def test_an_interrupted_retry_keeps_the_recorded_run_and_its_files(tmp_path: Pat
         "(bench run again goes on)"
     ).replace("s.yaml", str(study))
     assert rows(db) == [before]
-    assert {f.name: f.read_bytes() for f in sorted(files[0].parent.iterdir())} == texts
+    assert file_texts(folder) == texts
 
 
 def test_a_retry_that_fails_to_be_recorded_leaves_the_recorded_run_s_files(
@@ -352,16 +358,9 @@ def test_a_retry_that_fails_to_be_recorded_leaves_the_recorded_run_s_files(
     (here the database write raises) leaves the recorded run's row and files as they were, and the next
     ``bench run`` sweeps the attempt's leftovers."""
     symbolic_copy(tmp_path / "p", "chain-3")
-    study = write_study(
-        tmp_path / "s.yaml",
-        "study: settle\nseeds: 0..0\nlimits: {time: 30}\ninstances: [{glob: p/chain-3.mrg, name: sym}]\n"
-        "methods: [{name: Ours}]\n",
-    )
-    db = tmp_path / "r.db"
-    run_study(str(study), str(db))
-    (before,) = rows(db)
+    study, db, before = one_run_study(tmp_path, "settle", "{time: 30}", "chain-3")
     folder = Path(str(before["plan_file"])).parent
-    texts = {f.name: f.read_bytes() for f in sorted(folder.iterdir())}
+    texts = file_texts(folder)
 
     def refuse(self: ResultsDB, result: object) -> None:
         raise KeyboardInterrupt
@@ -371,10 +370,10 @@ def test_a_retry_that_fails_to_be_recorded_leaves_the_recorded_run_s_files(
         with pytest.raises(KeyboardInterrupt):
             run_study(str(study), str(db), retry=[str(before["status"])])
     assert rows(db) == [before]
-    assert {f.name: f.read_bytes() for f in sorted(folder.iterdir()) if ".attempt." not in f.name} == texts
+    assert {n: t for n, t in file_texts(folder).items() if ".attempt." not in n} == texts
     assert [f.name for f in folder.iterdir() if ".attempt." in f.name]  # the attempt, not put in place
     run_study(str(study), str(db))  # nothing to run; the leftovers swept
-    assert {f.name: f.read_bytes() for f in sorted(folder.iterdir())} == texts
+    assert file_texts(folder) == texts
 
 
 def test_a_run_past_its_wall_clock_limit_is_killed_as_a_group(tmp_path: Path) -> None:

@@ -40,6 +40,18 @@ def lp_names(names: Sequence[str]) -> list[str]:
     return out
 
 
+def name_table(cols: Sequence[str], rows: Sequence[str], comment: str) -> str:
+    """Comment lines (each starting with ``comment``: ``\\ `` in an LP file, ``* `` in an MPS file) that map
+    each column's and row's name in the file back to the model's, for the names :func:`lp_names` changed ('' when
+    it changed none): the file's names are legal and unique, but ``X_o1_bin_a_r1_r1_top_top_1`` does not say
+    which of ``X(o1,bin-a,r1,r1,top,top)@1`` and a name differing only in a replaced character it stands for."""
+    pairs = [(safe, name) for names in (cols, rows) for safe, name in zip(lp_names(names), names) if safe != name]
+    if not pairs:
+        return ""
+    head = f"{comment}mrgc: the model's names of the columns and rows named otherwise below (file name = model name)\n"
+    return head + "".join(f"{comment}  {safe} = {name}\n" for safe, name in pairs)
+
+
 class HighsBackend(Backend):
     """The ``mip`` backend: the model as a mixed-integer program for HiGHS (conditional rows as big-M rows)."""
 
@@ -141,9 +153,19 @@ class HighsBackend(Backend):
         return Solution(SolveStatus.ERROR, message=f"HiGHS: {self.h.modelStatusToString(status)}")
 
     def _export(self, path: str) -> None:
-        """``writeModel``; rows without terms (0 >= 1 says "infeasible") and models without variables are
-        written with a column ``zero`` fixed at 0 that those rows hold, since HiGHS writes neither (the file
-        would reload as an empty, feasible model)."""
+        """``writeModel``, then the names the file uses that are not the model's (:func:`lp_names`) mapped
+        back in comment lines at its top (:func:`name_table`); rows without terms (0 >= 1 says "infeasible")
+        and models without variables are written with a column ``zero`` fixed at 0 that those rows hold, since
+        HiGHS writes neither (the file would reload as an empty, feasible model)."""
+        self._write(path)
+        table = name_table(*self.names, comment="* " if path.lower().endswith(".mps") else "\\ ")
+        if table:
+            with open(path, encoding="utf-8") as f:
+                text = f.read()
+            with open(path, "w", encoding="utf-8") as f:
+                f.write(table + text)
+
+    def _write(self, path: str) -> None:
         assert self.model is not None
         self._pass_names()
         empty = [i for i, r in enumerate(self.model.rows) if not r.terms]

@@ -181,3 +181,26 @@ def test_the_smt2_script_has_no_option_z3_rejects(tmp_path: Path) -> None:
     # the seed given is the seed written (it was always 0: the export made its backend without it)
     mrgc.export_model(SYMBOLIC / "chain-3.mrg", path, backend="smt", seed=7)
     assert "(set-option :random-seed 7)" in path.read_text(encoding="utf-8").splitlines()
+
+
+@pytest.mark.parametrize("ext", ["lp", "mps"])
+def test_an_lp_or_mps_export_maps_the_names_it_changed_back_to_the_model_s(tmp_path: Path, ext: str) -> None:
+    """Two model names that differ only in a character the file format does not allow (``o+1``, ``op1``) get
+    unique legal names in the file, and comment lines at its top say which is which; HiGHS still reads the
+    file and finds the same optimum."""
+    from mrgc.compiler.ir import SkeletonModel
+
+    m = SkeletonModel(name="names")
+    a, b = m.bool_var("o+1"), m.bool_var("op1")
+    m.add([(a, 1), (b, 1)], lo=1, name="one of(o+1,op1)")
+    m.objectives.append(((a, 2), (b, 1)))
+    solver = backend_class("mip")()
+    solver.load(m)
+    path = tmp_path / f"names.{ext}"
+    solver.export(str(path))
+    comment = "*" if ext == "mps" else "\\"
+    lines = [line for line in path.read_text(encoding="utf-8").splitlines() if line.startswith(comment + "   ")]
+    table = dict(line[len(comment) + 3 :].split(" = ", 1) for line in lines)
+    # o+1 became op1, so the model's own op1 is op1_2 in the file: the table says which is which
+    assert table == {"op1": "o+1", "op1_2": "op1", "one_of_op1_op1__0": "one of(o+1,op1)#0"}, lines
+    assert reload(path) == (SolveStatus.OPTIMAL, (1,))

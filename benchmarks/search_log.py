@@ -7,6 +7,7 @@ ended (partial: a suffix grounded, other objects to move first; fail), with the 
     mrgc plan big-0.mrg --seed 0 --time-limit 300 -v 2> run.log      # or benchmarks/cpu_plan.py: CPU seconds
     python benchmarks/search_log.py run.log
     python benchmarks/search_log.py --by check run-*.log     # by the check that failed, over many logs
+    python benchmarks/search_log.py --by partial run-*.log   # partial groundings by their strict failure
 
 Session 33 read the 6-arm, 40-object instance of seed 0 this way (docs/benchmarks.md, "Session 33"): more than
 half of its 1,200 s went to root skeletons that found no place to park an obstacle, or to set a relay's object
@@ -70,9 +71,26 @@ def check(rest: str) -> str:
     return "fail: " + said
 
 
+STRICT = re.compile(r"must move \[[^]]*\] \((?P<why>step \d+, .*)\)$")
+
+
+def partial(rest: str) -> str:
+    """The class of one grounding line by the strict failure a partial grounding's relaxed attempt got past
+    (``--by partial``: the failure in brackets after its M*, written as :func:`check` writes failures), or
+    "not partial"."""
+    m = STRICT.search(rest) if rest.startswith("grounded") else None
+    if m is None:
+        return "not partial" if not rest.startswith("grounded") else "partial: other"
+    return "partial after: " + check("fails at " + m["why"]).removeprefix("fail: ")
+
+
+CLASSES = {"where": lambda under, rest: category(under, rest), "check": lambda _, rest: check(rest)}
+CLASSES["partial"] = lambda _, rest: partial(rest)
+
+
 def breakdown(lines: list[str], by: str = "where") -> tuple[dict[str, list[float]], int, float]:
     """Per category [groundings, seconds]; the number of grounding lines and the time of the last one.
-    ``by``: "where" (:func:`category`) or "check" (:func:`check`)."""
+    ``by``: "where" (:func:`category`), "check" (:func:`check`) or "partial" (:func:`partial`)."""
     table: dict[str, list[float]] = defaultdict(lambda: [0, 0.0])
     before, count = 0.0, 0
     for line in lines:
@@ -80,7 +98,7 @@ def breakdown(lines: list[str], by: str = "where") -> tuple[dict[str, list[float
         if m is None:
             continue
         t = float(m["t"])
-        row = table[category(m["under"] is not None, m["rest"]) if by == "where" else check(m["rest"])]
+        row = table[CLASSES[by](m["under"] is not None, m["rest"])]
         row[0] += 1
         row[1] += t - before
         before, count = t, count + 1
@@ -90,7 +108,7 @@ def breakdown(lines: list[str], by: str = "where") -> tuple[dict[str, list[float
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("log", type=Path, nargs="+", help="the stderr of `mrgc plan -v` (or benchmarks/cpu_plan.py -v)")
-    ap.add_argument("--by", choices=("where", "check"), default="where", help="class groundings by (default: where)")
+    ap.add_argument("--by", choices=tuple(CLASSES), default="where", help="class groundings by (default: where)")
     args = ap.parse_args(argv)
     table: dict[str, list[float]] = defaultdict(lambda: [0, 0.0])
     count, last = 0, 0.0
@@ -108,7 +126,7 @@ def main(argv: list[str] | None = None) -> int:
         count, last = count + n, last + end
     logs = f"the last at t={last:.1f} s" if len(args.log) == 1 else f"{last:.1f} s in {len(args.log)} logs"
     out = [f"{count} groundings, {logs}", ""]
-    head = "where, how, first failure" if args.by == "where" else "first failure"
+    head = {"where": "where, how, first failure", "check": "first failure", "partial": "strict failure"}[args.by]
     out += [f"| {head} | groundings | seconds | share |", "| --- | ---: | ---: | ---: |"]
     for name, (k, secs) in sorted(table.items(), key=lambda kv: (-kv[1][1], kv[0])):
         out.append(f"| {name} | {int(k)} | {secs:.1f} | {100 * secs / last if last else 0:.0f} % |")

@@ -25,7 +25,7 @@ from mrgc.geometry.conventions import ARM_PLACE_LIFT, lattice_offsets, seed_for
 from mrgc.geometry.grasps import grasp_transform
 from mrgc.geometry.robot import Pieces, Sweep
 from mrgc.geometry.scene import Body as SceneBody
-from mrgc.geometry.scene import floor_support, half_extents, inside, inside_test
+from mrgc.geometry.scene import SceneSpec, floor_support, half_extents, inside, inside_test, outline, surface
 from mrgc.geometry.step_world import StepWorld
 from mrgc.geometry.transforms import rot_z, translation
 from mrgc.language.model import Box
@@ -34,6 +34,42 @@ from mrgc.language.model import Box
 COMFORT = 0.85
 #: the rooms :meth:`Placements.crowded_out` keeps (the last asked)
 ROOMS = 32
+#: m: the shorter side a fixed box's top needs for obstacles to be set aside on it (:func:`aside_tops`): a
+#: table's, not a wall's or a post's
+ASIDE_SIDE = 0.3
+#: m: how far an obstacle set aside on a fixed top keeps from every region's footprint (:func:`off_regions`)
+ASIDE_GAP = 0.02
+
+
+def aside_tops(scene: SceneSpec) -> list[SceneBody]:
+    """The tops of the fixed boxes an obstacle may be set aside on beyond the regions (each the
+    :func:`~mrgc.geometry.scene.surface` of a fixed box whose footprint is at least :data:`ASIDE_SIDE` on both
+    sides, in the order the problem lists them): where an arm puts an object out of the way on a table when no
+    region has room for it.  The validator accepts an object set down on a fixed top that holds it up."""
+    return [
+        surface(b)
+        for b in scene.fixed
+        if isinstance(b.shape, Box) and min(b.shape.sx, b.shape.sy) >= ASIDE_SIDE and abs(b.pose[2, 2] - 1) < 1e-9
+    ]
+
+
+def off_regions(scene: SceneSpec, obj: str, gap: float = ASIDE_GAP) -> Callable[[np.ndarray], bool]:
+    """Whether ``obj`` at a pose (4, 4) keeps ``gap`` clear of every region's footprint (the regions'
+    boxes seen from above, grown by ``gap``, against the corners of the object's bounding box in each region's
+    frame: conservative, a pose that only nears a turned region's corner may be refused): an obstacle set aside
+    on a fixed top takes no room of a region, a goal bin's least of all."""
+    corners = outline(scene.body(obj).shape)
+    frames = [(np.linalg.inv(r.pose), half_extents(r.shape)[:2] + gap) for r in scene.regions]
+
+    def test(pose: np.ndarray) -> bool:
+        world = corners @ pose[:3, :3].T + pose[:3, 3]
+        for inv, half in frames:
+            local = (world @ inv[:3, :3].T + inv[:3, 3])[:, :2]
+            if np.all(local.min(axis=0) <= half) and np.all(local.max(axis=0) >= -half):
+                return False
+        return True
+
+    return test
 
 
 class Placements(StepWorld):

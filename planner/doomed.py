@@ -49,6 +49,7 @@ from mrgc.planner.outcome import Failure
 if TYPE_CHECKING:
     from mrgc.geometry.grounding import Grounder
     from mrgc.geometry.robot import Sweep
+    from mrgc.geometry.scene import Body as SceneBody
 
 #: a part of an action that can be doomed: ("pick", object, robot) or ("place", object, region, robot)
 Part = tuple[str, ...]
@@ -70,7 +71,8 @@ def failed_part(a: Action, check: str) -> Part | None:
 class DoomedActions:
     """The suspect parts and the cached probes of one search (see the module docstring).  ``grounder`` answers
     the geometric queries; ``regions(a)`` gives the regions a place of ``a`` is tried in, in order (its own,
-    then for an obstacle the parking regions); ``tries`` bounds the placements looked at per region, ``samples``
+    then for an obstacle the parking regions and the fixed tops it may be set aside on), each with the body to
+    look in (None: the region itself); ``tries`` bounds the placements looked at per region, ``samples``
     the random ones drawn there (as the grounding does); ``dead``
     is the grounding's set of (robot, object, grasp, placement key) whose place has no inverse kinematics, which
     the probes read and add to; ``spot_key`` makes such a key from a pose; ``on_time`` raises when the search's
@@ -80,7 +82,7 @@ class DoomedActions:
         self,
         grounder: Grounder,
         goal: dict[str, str],
-        regions: Callable[[Action], list[str]],
+        regions: Callable[[Action], list[tuple[str, SceneBody | None]]],
         tries: int,
         samples: int,
         dead: set[tuple[str, str, str, tuple[float, ...]]],
@@ -173,8 +175,8 @@ class DoomedActions:
             if pick.status is GroundStatus.NO_IK:
                 return Failure(0, "", f"pick by {a.pick_robot}: {NO_IK}", detail="probed before the later steps")
             last = None
-            for region in self.regions(a):
-                why = self._placeable(a, region, avoid)
+            for region, top in self.regions(a):
+                why = self._placeable(a, region, avoid, top)
                 if why is None:
                     return None
                 last = last or why
@@ -182,15 +184,17 @@ class DoomedActions:
         finally:
             g.step({})
 
-    def _placeable(self, a: Action, region: str, avoid: list[str]) -> Failure | None:
-        """None when a free placement of ``a``'s object in ``region`` has an inverse kinematics answer for the
-        place, else the failure saying why not."""
+    def _placeable(self, a: Action, region: str, avoid: list[str], top: SceneBody | None = None) -> Failure | None:
+        """None when a free placement of ``a``'s object in ``region`` (on the fixed top ``top`` clear of the
+        regions, as the grounding sets obstacles aside) has an inverse kinematics answer for the place, else the
+        failure saying why not."""
         from mrgc.geometry.answers import GroundStatus
+        from mrgc.geometry.placements import off_regions
 
         g = self.g
         poses = g.placements(
             a.obj,
-            region,
+            region if top is None else top,
             avoid=avoid,
             volume=self._volume,
             key="doomed",
@@ -198,6 +202,8 @@ class DoomedActions:
             prefer=g.comfortable(a.place_robot, a.obj, a.place_grasp),
             samples=self.samples,
         )
+        if top is not None:
+            poses = filter(off_regions(g.scene, a.obj), poses)
         far_off = g.out_of_reach(a.place_robot, a.obj, a.place_grasp)
         looked, any_pose = 0, False
         for pose in poses:

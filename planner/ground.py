@@ -32,8 +32,10 @@ from mrgc.geometry.answers import BUSY, SELF, Answer, GroundStatus
 from mrgc.geometry.collision import Packed, Posed, grouped_collide, pieces_collide
 from mrgc.geometry.conventions import refine
 from mrgc.geometry.grounding import Grounder
+from mrgc.geometry.placements import aside_tops, off_regions
 from mrgc.geometry.relays import spot_region
 from mrgc.geometry.robot import Volume
+from mrgc.geometry.scene import Body as SceneBody
 from mrgc.geometry.stances import PHASES, Stance, roles
 from mrgc.language.model import Box
 from mrgc.planfile.format import PlannedAction
@@ -150,6 +152,8 @@ class ReverseGrounder:
         #: -> home, and for a handover the taker's way to the exchange and the giver's way home
         self.full = full
         self.movable = [b.name for b in grounder.scene.movable]
+        #: the fixed tops obstacles may be set aside on (:attr:`_tops`), found when first asked
+        self._aside: list[SceneBody] | None = None
         #: the search's time limit (``time.perf_counter()``): the grounder's queries read it in their long
         #: loops and stop at once past it (:attr:`Grounder.cut <mrgc.geometry.grounding.Grounder.cut>`); a
         #: grounding that the deadline cut short anywhere ends with :class:`DeadlineReached` and is discarded,
@@ -181,7 +185,7 @@ class ReverseGrounder:
         self.doomed = DoomedActions(
             grounder,
             goal,
-            lambda a: [a.region] + ([] if a.obj in goal else self._parking(a)),
+            lambda a: [(a.region, None)] + ([] if a.obj in goal else self._parking(a)),
             PLACEMENT_TRIES + OUT_OF_REACH_TRIES,
             PLACEMENT_SAMPLES,
             self._dead_spots,
@@ -422,6 +426,27 @@ class ReverseGrounder:
         return None
 
     def _relay_steps(
+        self, step: tuple[Action, ...], avoid: set[str], v_fut: Posed, key: str, index: int
+    ) -> list[GroundedStep] | Failure:
+        """:meth:`_relayed`; when a relay finds no spot in its region, the step again with every relay's spot on
+        a fixed top instead (:func:`~mrgc.geometry.placements.aside_tops`: the table, in the staging square
+        between the relay's two robots, :func:`~mrgc.geometry.relays.spot_region`), as a relay that phase 1
+        found only there does (session 42: on the 6-arm, 40-object instances "relay: no spot in start where
+        both robots reach o37" was the strict failure behind half of the partial groundings).  The first
+        attempt's failure is the step's when that fails too (its actions are the skeleton's)."""
+        done = self._relayed(step, avoid, v_fut, key, index)
+        if not isinstance(done, Failure) or not done.check.startswith("relay: no spot"):
+            return done
+        for top in self._tops:
+            moved = tuple(a if a.via in (None, top.name) else replace(a, via=top.name) for a in step)
+            if moved == step:
+                continue
+            again = self._relayed(moved, avoid, v_fut, f"{key}:{top.name}", index)
+            if not isinstance(again, Failure):
+                return again
+        return done
+
+    def _relayed(
         self, step: tuple[Action, ...], avoid: set[str], v_fut: Posed, key: str, index: int
     ) -> list[GroundedStep] | Failure:
         """A skeleton step holding relays (beyond the paper) as two plan steps: the step's other actions with
@@ -688,15 +713,27 @@ class ReverseGrounder:
                 return done  # is split (or re-timed) instead
             # beyond the paper: an obstacle with no place in its own region that its arm reaches (a crowded
             # start region, the later steps' sweeps kept clear) is parked in another region the arm reaches
-            for region in self._parking(a):
-                parked = self._place(a, planned, region, start, lift, avoid, v_fut, f"{key}:park", placed, busy)
+            for region, top in self._parking(a):
+                parked = self._place(a, planned, region, start, lift, avoid, v_fut, f"{key}:park", placed, busy, top)
                 if not isinstance(parked, Failure):
                     return parked
         return done
 
-    def _parking(self, a: Action) -> list[str]:
-        """The regions an obstacle ``a`` moves may be parked in when its own has no place for it: the other
-        box regions whose centre the placing arm reaches, regions nobody's goal first, then nearest the arm."""
+    @property
+    def _tops(self) -> list[SceneBody]:
+        """The tops of fixed boxes obstacles may be set aside on, and relays set down on when their region has no
+        spot (:func:`~mrgc.geometry.placements.aside_tops`)."""
+        if self._aside is None:
+            self._aside = aside_tops(self.g.scene)
+        return self._aside
+
+    def _parking(self, a: Action) -> list[tuple[str, SceneBody | None]]:
+        """Where an obstacle ``a`` moves may be parked when its own region has no place for it: the other box
+        regions whose centre the placing arm reaches, regions nobody's goal first, then nearest the arm (at most
+        :data:`PARKING_REGIONS`); then, set aside beyond every region, the tops of the fixed boxes
+        (:func:`~mrgc.geometry.placements.aside_tops`: a table) the arm reaches (session 42: the 6-arm,
+        40-object instances park in their crowded start region or in the goal bins otherwise).  Each with the
+        body to look in (None: the region itself)."""
         g = self.g
         arm = g.arm(a.place_robot)
         goals = set(self.goal.values())
@@ -704,7 +741,8 @@ class ReverseGrounder:
         for r in g.scene.regions:
             if r.name != a.region and isinstance(r.shape, Box) and arm.in_reach(r.pose[:3, 3], margin=0.1):
                 out.append((r.name in goals, float(np.linalg.norm(r.pose[:2, 3] - arm.base[:2, 3])), r.name))
-        return [name for _, _, name in sorted(out)][:PARKING_REGIONS]
+        where: list[tuple[str, SceneBody | None]] = [(name, None) for _, _, name in sorted(out)[:PARKING_REGIONS]]
+        return where + [(top.name, top) for top in self._tops if top.name != a.region]
 
     def _place(
         self,
@@ -718,9 +756,12 @@ class ReverseGrounder:
         key: str,
         placed: dict[str, np.ndarray] | None,
         busy: dict[str, Volume],
+        top: SceneBody | None = None,
     ) -> PlannedAction | Failure:
         """Put ``a``'s object into ``region``: a placement, the place approach and the carry there from
-        ``start``, into ``planned`` (its region too); the failure of the last placement tried otherwise."""
+        ``start``, into ``planned`` (its region too); the failure of the last placement tried otherwise.  With
+        ``top`` (a fixed object's top, named ``region``) the object is set aside on it, clear of every region's
+        footprint (:func:`~mrgc.geometry.placements.off_regions`)."""
         g = self.g
         last: Failure | None = None
         tried = 0  # placements whose carry was planned, or whose approach the step's other robots blocked
@@ -732,7 +773,7 @@ class ReverseGrounder:
             if forced is not None  # a relay sets its object down where its onward move picks it up
             else g.placements(
                 a.obj,
-                region,
+                region if top is None else top,
                 avoid=avoid,
                 volume=v_fut,
                 key=key,
@@ -741,6 +782,8 @@ class ReverseGrounder:
                 samples=PLACEMENT_SAMPLES,
             )
         )
+        if top is not None:
+            spots = filter(off_regions(g.scene, a.obj), spots)
         far_off = g.out_of_reach(a.place_robot, a.obj, a.place_grasp)
         looked = far = 0
         crossed = 0  # carries blocked by what the step's other robots sweep meanwhile (``busy``)

@@ -387,8 +387,9 @@ def _names_misfit(world: World, a: Mapping[str, Any]) -> str | None:
     obj, region, giver, taker = a["object"], a["region"], a["pick_robot"], a["place_robot"]
     if obj not in world.objects:
         return f"object {obj!r} is not a movable object of the problem"
-    if region not in {b.name for b, _ in world.regions}:
-        return f"region {region!r} is not a region of the problem"
+    if region not in {b.name for b, _ in world.regions} and region not in {b.name for b in world.scene.fixed}:
+        # a fixed object's name: set down on its top (a relay's spot, an obstacle set aside on a table)
+        return f"region {region!r} is neither a region nor a fixed object of the problem"
     for r in (giver, taker):
         if r not in world.robots:
             return f"robot {r!r} is not a robot of the problem"

@@ -188,6 +188,10 @@ def test_search_log_classes_each_grounding_line_and_its_seconds(tmp_path: Path) 
         "fail: no": ("1", "0.5"),
         "plan": ("1", "2.0"),
     }, rows
+    # partial groundings by the strict failure their relaxed attempt got past (the one partial line: a relay)
+    head, rows = _table([sys.executable, str(script), "--by", "partial", str(log)])
+    assert head == "5 groundings, the last at t=9.0 s"
+    assert rows == {"not partial": ("4", "5.5"), "partial after: relay: no spot": ("1", "3.5")}, rows
     empty = tmp_path / "quiet.log"
     empty.write_text("plan for x: solved\n", encoding="utf-8")
     out = subprocess.run([sys.executable, str(script), str(empty)], capture_output=True, text=True, timeout=60)

@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 from support import ROOT
 
 import mrgc
-from mrgc import parse_file
+from mrgc import parse_file, parse_string
 from mrgc.compiler.skeleton import Skeleton
 from mrgc.compiler.task_graph import Action
 from mrgc.geometry.answers import Answer, GroundStatus
@@ -406,6 +406,80 @@ def test_an_obstacle_with_no_reachable_place_in_its_region_is_parked_in_another(
     parked = {a.region for step in plan.steps for a in step if a.object not in problem.goal_regions} - {"start"}
     assert "bin-b" in parked  # nobody's goal, tried first; goal bins after it, keeping room for their goals
     assert validate(problem, plan, str(path)).ok
+
+
+def test_an_obstacle_with_no_room_in_any_region_is_set_aside_on_the_table() -> None:
+    """tests/data/aside-table.mrg: o2 stands against o1, the goal object, in a start region that holds the two
+    and no more, and the bin holds o1 only.  Before session 42 no skeleton could be grounded (``exhausted``:
+    "placement: no free pose of o2 in start"); now r1 sets o2 aside on the table, clear of both regions'
+    footprints and resting on the table's top, and the validator accepts the plan."""
+    from mrgc.geometry.placements import ASIDE_GAP, off_regions
+    from mrgc.planfile.format import file_sha256
+    from mrgc.planner.search import plan_problem
+    from mrgc.validator.validate import validate
+
+    path = ROOT / "tests" / "data" / "aside-table.mrg"
+    problem = parse_file(path).problem()
+    plan = plan_problem(problem, str(path), file_sha256(str(path)), mrgc.__version__, seed=0, time_limit=600)
+    assert plan.status == "solved", plan.summary()
+    moves = {a.object: a for step in plan.steps for a in step}
+    assert moves["o2"].region == "table" and moves["o1"].region == "bin"
+    scene = scene_from_problem(problem)
+    pose = np.array(moves["o2"].place_pose)
+    assert off_regions(scene, "o2")(pose) and inside(scene.region("table"), scene.body("o2").shape, pose)
+    for region in scene.regions:  # its centre well outside each region's footprint
+        local = np.linalg.inv(region.pose) @ pose[:, 3]
+        assert np.any(np.abs(local[:2]) > np.array([region.shape.sx, region.shape.sy]) / 2 + ASIDE_GAP)
+    assert validate(problem, plan, str(path)).ok
+
+
+@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(
+    x=st.floats(-0.6, 0.6),
+    y=st.floats(-0.5, 0.5),
+    yaw=st.floats(-np.pi, np.pi),
+)
+def test_a_pose_off_the_regions_leaves_every_corner_of_the_object_outside_them(x: float, y: float, yaw: float) -> None:
+    """:func:`off_regions` is conservative: a pose it passes has every corner of the object's bounding box at
+    least the gap outside each region's footprint on some axis of that region (no corner inside a footprint);
+    and a pose whose centre lies inside a footprint never passes."""
+    from mrgc.geometry.placements import ASIDE_GAP, off_regions
+    from mrgc.geometry.scene import outline
+    from mrgc.geometry.transforms import rot_z
+
+    scene = _aside_scene()
+    pose = translation(x, y, 0.1) @ rot_z(yaw)
+    corners = outline(scene.body("o2").shape) @ pose[:3, :3].T + pose[:3, 3]
+    for region in scene.regions:
+        inv = np.linalg.inv(region.pose)
+        local = corners @ inv[:3, :3].T + inv[:3, 3]
+        half = np.array([region.shape.sx, region.shape.sy]) / 2
+        centre_in = bool(np.all(np.abs((inv @ pose[:, 3])[:2]) <= half))
+        if off_regions(scene, "o2")(pose):
+            assert not centre_in
+            assert not np.any(np.all(np.abs(local[:, :2]) <= half + ASIDE_GAP - 1e-9, axis=1))
+
+
+def test_only_a_fixed_box_top_of_a_table_s_size_takes_obstacles_set_aside() -> None:
+    """:func:`aside_tops`: the table's top, not a wall's (thinner than :data:`ASIDE_SIDE`) nor a cylinder's."""
+    from mrgc.geometry.placements import ASIDE_SIDE, aside_tops
+
+    text = (ROOT / "tests" / "data" / "aside-table.mrg").read_text()
+    text = text.replace(
+        "(table :shape (box 1.2 1.0 0.05) :pose (0 0 -0.025 0)))",
+        "(table :shape (box 1.2 1.0 0.05) :pose (0 0 -0.025 0))"
+        f" (wall :shape (box 1.2 {ASIDE_SIDE - 0.01} 0.3) :pose (0 0.9 0.15 0))"
+        " (post :shape (cylinder 0.3 0.5) :pose (0.9 0.9 0.25 0)))",
+    )
+    scene = scene_from_problem(parse_string(text, "aside").problems[0])
+    tops = aside_tops(scene)
+    assert [t.name for t in tops] == ["table"]
+    assert tops[0].pose[2, 3] > 0  # standing on the table's top face (z = 0), not at its centre
+
+
+@functools.lru_cache(maxsize=1)
+def _aside_scene() -> Any:
+    return scene_from_problem(parse_file(ROOT / "tests" / "data" / "aside-table.mrg").problem())
 
 
 def test_failures_say_whether_only_what_never_moves_explains_them(pa3: Grounder) -> None:

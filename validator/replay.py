@@ -886,13 +886,13 @@ class _Replayer(ActionReader):
         return out
 
     def _on_tops(self, t: int, acts: list[ActionGeometry]) -> None:
-        """A relay move onto a fixed object's top sets its object down resting on that object
-        ``[outside-region]`` (inside its :func:`~mrgc.geometry.scene.surface` box is not enough: a slab under
-        the table has one too)."""
+        """A move onto a fixed object's top (a relay's spot, an obstacle set aside on a table) sets its object
+        down resting on that object ``[outside-region]`` (inside its :func:`~mrgc.geometry.scene.surface` box
+        is not enough: a slab under the table has one too)."""
         fixed = set(self.fixed)
         for a in acts:
             top = a.action.region
-            if a.action.relay and top in fixed and top not in self._supports(a.obj):
+            if top in fixed and top not in self._supports(a.obj):
                 self._v(t, a.obj, "outside-region", f"{a.obj} is set down on {top} but does not rest on it")
 
     def _rests(self, t: int, acts: list[ActionGeometry]) -> None:

@@ -247,8 +247,8 @@ def _unknown_names(problem: Problem, names: _Names, a: PlannedAction) -> list[st
         bad.append(
             f"{obj!r} is a fixed object, which never moves" if obj in names.fixed else f"no movable object {obj!r}"
         )
-    if a.region not in names.regions and not (a.relay and a.region in names.fixed):
-        bad.append(f"no region {a.region!r}" + (" or fixed object" if a.relay else ""))
+    if a.region not in names.regions and a.region not in names.fixed:
+        bad.append(f"no region or fixed object {a.region!r}")
     for role, robot in (("pick robot", a.pick_robot), ("place robot", a.place_robot)):
         if robot not in names.robots:
             bad.append(f"no robot {robot!r} ({role})")

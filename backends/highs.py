@@ -8,6 +8,7 @@ deterministic; they are given to HiGHS when a model is exported (a solve needs n
 
 from __future__ import annotations
 
+import os
 import re
 from typing import Any, Sequence
 
@@ -44,12 +45,17 @@ def name_table(cols: Sequence[str], rows: Sequence[str], comment: str) -> str:
     """Comment lines (each starting with ``comment``: ``\\ `` in an LP file, ``* `` in an MPS file) that map
     each column's and row's name in the file back to the model's, for the names :func:`lp_names` changed ('' when
     it changed none): the file's names are legal and unique, but ``X_o1_bin_a_r1_r1_top_top_1`` does not say
-    which of ``X(o1,bin-a,r1,r1,top,top)@1`` and a name differing only in a replaced character it stands for."""
-    pairs = [(safe, name) for names in (cols, rows) for safe, name in zip(lp_names(names), names) if safe != name]
-    if not pairs:
+    which of ``X(o1,bin-a,r1,r1,top,top)@1`` and a name differing only in a replaced character it stands for.
+    ``rows`` are the backend's row names, the model's row name and ``#`` and the row's index (unique): a row's
+    line gives the model's name and the index apart (``row c11_3_o2__12 = c11[3,o2] (row 12)``)."""
+    lines = [f"{comment}  col {safe} = {name}\n" for safe, name in zip(lp_names(cols), cols) if safe != name]
+    for safe, name in zip(lp_names(rows), rows):
+        own, _, index = name.rpartition("#")
+        if safe != name:
+            lines.append(f"{comment}  row {safe} = {own} (row {index})\n")
+    if not lines:
         return ""
-    head = f"{comment}mrgc: the model's names of the columns and rows named otherwise below (file name = model name)\n"
-    return head + "".join(f"{comment}  {safe} = {name}\n" for safe, name in pairs)
+    return f"{comment}mrgc: the model's names of the columns and rows the file names otherwise\n" + "".join(lines)
 
 
 class HighsBackend(Backend):
@@ -158,6 +164,8 @@ class HighsBackend(Backend):
         and models without variables are written with a column ``zero`` fixed at 0 that those rows hold, since
         HiGHS writes neither (the file would reload as an empty, feasible model)."""
         self._write(path)
+        if not os.path.isfile(path) or os.path.getsize(path) == 0:
+            return  # HiGHS wrote nothing: Backend.export says so (no table on top of nothing)
         table = name_table(*self.names, comment="* " if path.lower().endswith(".mps") else "\\ ")
         if table:
             with open(path, encoding="utf-8") as f:

@@ -53,6 +53,17 @@ def aside_tops(scene: SceneSpec) -> list[SceneBody]:
     ]
 
 
+def nearest_on_top(top: SceneBody, point: np.ndarray) -> np.ndarray:
+    """The point of ``top``'s footprint (a top of :func:`aside_tops`, seen from above) nearest to ``point``, at the
+    height of the top face: whether an arm reaches any of the top is whether it reaches that point."""
+    inv = np.linalg.inv(top.pose)
+    local = inv[:3, :3] @ point + inv[:3, 3]
+    half = half_extents(top.shape)
+    near = np.array([*np.clip(local[:2], -half[:2], half[:2]), -half[2]])
+    out: np.ndarray = top.pose[:3, :3] @ near + top.pose[:3, 3]
+    return out
+
+
 def off_regions(scene: SceneSpec, obj: str, gap: float = ASIDE_GAP) -> Callable[[np.ndarray], bool]:
     """Whether ``obj`` at a pose (4, 4) keeps ``gap`` clear of every region's footprint (the regions'
     boxes seen from above, grown by ``gap``, against the corners of the object's bounding box in each region's

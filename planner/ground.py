@@ -32,7 +32,7 @@ from mrgc.geometry.answers import BUSY, SELF, Answer, GroundStatus
 from mrgc.geometry.collision import Packed, Posed, grouped_collide, pieces_collide
 from mrgc.geometry.conventions import refine
 from mrgc.geometry.grounding import Grounder
-from mrgc.geometry.placements import aside_tops, off_regions
+from mrgc.geometry.placements import aside_tops, nearest_on_top, off_regions
 from mrgc.geometry.relays import spot_region
 from mrgc.geometry.robot import Volume
 from mrgc.geometry.scene import Body as SceneBody
@@ -441,13 +441,13 @@ class ReverseGrounder:
             moved = tuple(a if a.via in (None, top.name) else replace(a, via=top.name) for a in step)
             if moved == step:
                 continue
-            again = self._relayed(moved, avoid, v_fut, f"{key}:{top.name}", index)
+            again = self._relayed(moved, avoid, v_fut, f"{key}:{top.name}", index, aside=True)
             if not isinstance(again, Failure):
                 return again
         return done
 
     def _relayed(
-        self, step: tuple[Action, ...], avoid: set[str], v_fut: Posed, key: str, index: int
+        self, step: tuple[Action, ...], avoid: set[str], v_fut: Posed, key: str, index: int, aside: bool = False
     ) -> list[GroundedStep] | Failure:
         """A skeleton step holding relays (beyond the paper) as two plan steps: the step's other actions with
         each relay setting its object down at a spot of its ``via`` region, then the relays' onward moves
@@ -459,7 +459,7 @@ class ReverseGrounder:
         first = tuple(a.halves[0] if a.via is not None else a for a in step)
         last: Failure = Failure(index, label(relays[0]), f"relay: no spot in {relays[0].via} both robots reach")
         for k in range(RELAY_TRIES):
-            spots = self._spots(relays, avoid | {a.obj for a in step}, v_fut, f"{key}:relay", k)
+            spots = self._spots(relays, avoid | {a.obj for a in step}, v_fut, f"{key}:relay", k, aside)
             if isinstance(spots, Failure):
                 return last if k else replace(spots, step=index)
             with self.g.moved(spots):
@@ -483,12 +483,13 @@ class ReverseGrounder:
         return last
 
     def _spots(
-        self, relays: list[Action], avoid: set[str], v_fut: Posed, key: str, k: int
+        self, relays: list[Action], avoid: set[str], v_fut: Posed, key: str, k: int, aside: bool = False
     ) -> dict[str, np.ndarray] | Failure:
         """For each relay, its k-th free spot in its ``via`` region (clear of ``avoid`` at their poses, of
         ``v_fut`` and of the spots chosen before) where its first robot sets the object down with its grasp
         and its second one picks it up with its own (both approaches free; the robots' paths are grounded
-        afterwards)."""
+        afterwards).  ``aside`` (a relay moved onto a fixed top because its region had no spot): only spots
+        clear of every region's footprint, as an obstacle set aside there (no goal bin's room taken)."""
         g, out = self.g, {}
         taken: Volume = []
         for a in relays:
@@ -503,9 +504,10 @@ class ReverseGrounder:
                 g.out_of_reach(a.pick_robot, a.obj, a.pick_grasp),
                 g.out_of_reach(a.place_robot, a.obj, a.place_grasp),
             )
-            for pose in g.placements(
+            poses = g.placements(
                 a.obj, where, avoid=others, volume=_plus(v_fut, taken), key=key, packed=True, prefer=both
-            ):
+            )
+            for pose in filter(off_regions(g.scene, a.obj), poses) if aside else poses:
                 self._on_time()
                 if any(far(pose) for far in far_off):
                     continue  # past one arm's reach bound: neither sets it down and picks it up there
@@ -742,7 +744,9 @@ class ReverseGrounder:
             if r.name != a.region and isinstance(r.shape, Box) and arm.in_reach(r.pose[:3, 3], margin=0.1):
                 out.append((r.name in goals, float(np.linalg.norm(r.pose[:2, 3] - arm.base[:2, 3])), r.name))
         where: list[tuple[str, SceneBody | None]] = [(name, None) for _, _, name in sorted(out)[:PARKING_REGIONS]]
-        return where + [(top.name, top) for top in self._tops if top.name != a.region]
+        shoulder = arm.base[:3, 3]
+        tops = [t for t in self._tops if t.name != a.region and arm.in_reach(nearest_on_top(t, shoulder), margin=0.1)]
+        return where + [(top.name, top) for top in tops]
 
     def _place(
         self,

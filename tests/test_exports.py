@@ -202,5 +202,27 @@ def test_an_lp_or_mps_export_maps_the_names_it_changed_back_to_the_model_s(tmp_p
     lines = [line for line in path.read_text(encoding="utf-8").splitlines() if line.startswith(comment + "   ")]
     table = dict(line[len(comment) + 3 :].split(" = ", 1) for line in lines)
     # o+1 became op1, so the model's own op1 is op1_2 in the file: the table says which is which
-    assert table == {"op1": "o+1", "op1_2": "op1", "one_of_op1_op1__0": "one of(o+1,op1)#0"}, lines
+    assert table == {"col op1": "o+1", "col op1_2": "op1", "row one_of_op1_op1__0": "one of(o+1,op1) (row 0)"}, lines
     assert reload(path) == (SolveStatus.OPTIMAL, (1,))
+
+
+def test_an_export_highs_wrote_nothing_of_is_reported_as_such(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """When HiGHS leaves no file (or an empty one), the name table is not written on top of nothing: the export
+    fails with its own error, not a FileNotFoundError or a file of comments alone."""
+    from mrgc.backends.highs import HighsBackend
+    from mrgc.compiler.ir import SkeletonModel
+    from mrgc.errors import MrgcError
+
+    m = SkeletonModel(name="names")
+    a = m.bool_var("o+1")
+    m.objectives.append(((a, 1),))
+    for leaves in ("nothing", "empty"):
+        solver = backend_class("mip")()
+        solver.load(m)
+        path = tmp_path / f"{leaves}.lp"
+        empty = leaves == "empty"
+        monkeypatch.setattr(
+            HighsBackend, "_write", lambda self, p, empty=empty: Path(p).write_text("") if empty else None
+        )
+        with pytest.raises(MrgcError, match="wrote nothing"):
+            solver.export(str(path))

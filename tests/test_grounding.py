@@ -458,6 +458,30 @@ def test_a_pose_off_the_regions_leaves_every_corner_of_the_object_outside_them(x
         if off_regions(scene, "o2")(pose):
             assert not centre_in
             assert not np.any(np.all(np.abs(local[:, :2]) <= half + ASIDE_GAP - 1e-9, axis=1))
+    # and a pose whose object stays farther than both half diagonals and the gap from every region passes
+    reach = float(np.linalg.norm(outline(scene.body("o2").shape)[0, :2]))
+    if all(
+        np.linalg.norm(pose[:2, 3] - r.pose[:2, 3]) > reach + np.hypot(r.shape.sx, r.shape.sy) / 2 + ASIDE_GAP
+        for r in scene.regions
+    ):
+        assert off_regions(scene, "o2")(pose)
+
+
+def test_the_doomed_probe_asks_the_table_an_obstacle_may_be_set_aside_on() -> None:
+    """The doomed probe (planner/doomed.py) tries the places the grounding would: in aside-table, with o2's own
+    spot in the suffix's volume (as o1's pick sweeps it), o2 has no free pose in start once o1 is avoided, but
+    one on the table, so moving it is not doomed; asked about start alone, the probe says why it fails there."""
+    from mrgc.planner.ground import ReverseGrounder
+
+    scene = _aside_scene()
+    g = Grounder(scene, seed=0)
+    rg = ReverseGrounder(g, dict(scene.goal))
+    rg.doomed._volume = [(g.shape("o2"), scene.body("o2").pose)]
+    move = Action("o2", "start", "r1", "r1", "top", "top")
+    assert [name for name, _ in rg._parking(move)][-1] == "table"
+    assert rg.doomed._ask(move, ["o1"]) is None
+    alone = rg.doomed._placeable(move, "start", ["o1"])
+    assert alone is not None and "o2" in alone.check and "start" in alone.check
 
 
 def test_only_a_fixed_box_top_of_a_table_s_size_takes_obstacles_set_aside() -> None:

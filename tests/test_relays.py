@@ -211,3 +211,18 @@ def test_the_validator_accepts_a_relay_on_the_table_and_rejects_edits_of_it() ->
     )
     said = [(v.code, v.message) for v in validate(slab, onward).violations]
     assert ("outside-region", "o9 is set down on floor but does not rest on it") in said, said
+    # a fixed object that is not a box has no top: nothing lies on it
+    post = parse_string(
+        TABLE.read_text().replace(
+            "(table :shape (box 1.41 1.34 0.05) :pose (0 0 -0.025 0))",
+            "(table :shape (box 1.41 1.34 0.05) :pose (0 0 -0.025 0))"
+            " (post :shape (cylinder 0.1 0.4) :pose (0.6 0.6 0.2 0))",
+        ),
+        str(TABLE),
+    ).problems[0]
+    on_post = copy.deepcopy(plan)
+    next(a for s in on_post["steps"] for a in s["actions"] if a["object"] == "o9" and not a.get("relay"))["region"] = (
+        "post"
+    )
+    codes_post = {v.code for v in validate(post, on_post).violations}
+    assert "outside-region" in codes_post, codes_post

@@ -60,7 +60,8 @@ configurations (:mod:`mrgc.validator.sampling`).
 - a motion longer than :data:`MAX_SAMPLES` samples at the resolution (:data:`RESOLUTION`), or a plan whose
   motions need more than :data:`MAX_PLAN_SAMPLES` robot samples at the resolution in all, or a phase that
   needs more than :data:`MAX_SAMPLES` checked times, is not checked and so not valid ``[too-long]``;
-- every placement lies inside its action's region ``[outside-region]``, is free of fixed objects, other
+- every placement lies inside its action's region, or on the top of the fixed object its action names and resting
+  on it ``[outside-region]``, is free of fixed objects, other
   objects and the robots at home, to :data:`CONTACT_TOL` ``[collision-...]``, and rests on something
   ``[floating]``: its lowest point at most :data:`SUPPORT_TOL` above the floor of a region under it whose
   floor lies on the ground (:func:`_grounded_regions`; a region drawn over a table is held up by the table,
@@ -517,7 +518,11 @@ class _Replayer(ActionReader):
                     a.obj,
                     "outside-region",
                     f"the placement of {a.obj} at ({p[0]:.3f}, {p[1]:.3f}, {p[2]:.3f}) "
-                    f"is not entirely inside region {a.action.region}",
+                    + (
+                        f"is not entirely on the top of {a.action.region}"
+                        if a.action.region in self.fixed
+                        else f"is not entirely inside region {a.action.region}"
+                    ),
                 )
 
     def _phase(self, t: int, phase: str, st: _StepState, tracks: list[_Track | None]) -> None:

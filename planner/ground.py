@@ -430,10 +430,11 @@ class ReverseGrounder:
     ) -> list[GroundedStep] | Failure:
         """:meth:`_relayed`; when a relay finds no spot in its region, the step again with every relay's spot on
         a fixed top instead (:func:`~mrgc.geometry.placements.aside_tops`: the table, in the staging square
-        between the relay's two robots, :func:`~mrgc.geometry.relays.spot_region`), as a relay that phase 1
-        found only there does (session 42: on the 6-arm, 40-object instances "relay: no spot in start where
-        both robots reach o37" was the strict failure behind half of the partial groundings).  The first
-        attempt's failure is the step's when that fails too (its actions are the skeleton's)."""
+        between the relay's two robots, :func:`~mrgc.geometry.relays.spot_region`, clear of every region's
+        footprint), as a relay that phase 1 found only there does (session 42: on the 6-arm, 40-object
+        instances "relay: no spot in start where both robots reach o37" was the strict failure behind half of
+        the partial groundings).  The first attempt's failure is the step's when that fails too (its actions
+        are the skeleton's)."""
         done = self._relayed(step, avoid, v_fut, key, index)
         if not isinstance(done, Failure) or not done.check.startswith("relay: no spot"):
             return done
@@ -744,8 +745,8 @@ class ReverseGrounder:
             if r.name != a.region and isinstance(r.shape, Box) and arm.in_reach(r.pose[:3, 3], margin=0.1):
                 out.append((r.name in goals, float(np.linalg.norm(r.pose[:2, 3] - arm.base[:2, 3])), r.name))
         where: list[tuple[str, SceneBody | None]] = [(name, None) for _, _, name in sorted(out)[:PARKING_REGIONS]]
-        shoulder = arm.base[:3, 3]
-        tops = [t for t in self._tops if t.name != a.region and arm.in_reach(nearest_on_top(t, shoulder), margin=0.1)]
+        base = arm.base[:3, 3]
+        tops = [t for t in self._tops if t.name != a.region and arm.in_reach(nearest_on_top(t, base), margin=0.1)]
         return where + [(top.name, top) for top in tops]
 
     def _place(

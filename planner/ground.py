@@ -61,11 +61,6 @@ PARKING_REGIONS = 2
 #: placements each failing its carry the same way (PA7-s1: 17 carries of about 85 ms each, every one
 #: blocked by the other arm, before the split that grounded at once)
 BUSY_CARRIES = 2
-#: parts of a split that may fail while one skeleton step is grounded (the strict or the relaxed attempt, every
-#: split of its parts included) before no further split is tried: each part is split again, so the attempts
-#: multiply with the step's actions (6-arm instance 2: the re-timings' and splits' parts took 59 % of the step
-#: groundings' CPU, those that failed 21 %; with this budget it is solved in 216 s, a time limit before)
-SPLIT_PART_FAILURES = 4
 #: exchanges tried per handover point when the giver's carry to one fails: another branch of the arms at the
 #: same point is often an easy carry where the first (the solution nearest home) is not (6-arm seed 0: r5's
 #: first exchange at h5 is reached by no RRTConnect path of 64,000 checks, its second in 0.03 s)
@@ -175,10 +170,8 @@ class ReverseGrounder:
         self._failed: dict[tuple[object, ...], tuple[tuple[GroundedStep, ...], Grounding, str]] = {}
         #: groundings that repeated a failure instead of grounding anything (:meth:`ground`)
         self.repeated = 0
-        #: parts of a split that failed in the skeleton step being grounded (:data:`SPLIT_PART_FAILURES`), and
-        #: the splits not tried for want of that budget
-        self._part_fails = 0
-        self.split_budgets_spent = 0
+        #: steps packed a second time, the action that failed alone in an earlier plan step first (:meth:`_packed`)
+        self.repacked = 0
         #: the skeleton being grounded, its actions as re-timed so far (see :class:`_Retiming`)
         self._plan = _Retiming([], None)
         #: actions found doomed before the later steps are grounded (planner/doomed.py)
@@ -333,40 +326,40 @@ class ReverseGrounder:
         """Ground one skeleton step; when its robots get in each other's way (an action collides with what
         another robot of the step sweeps in the same phase), ground it again with the failing action first
         (each action keeps clear of the ones grounded before it, so the others then plan around it); then
-        re-time (below); then split it: the failing action alone one step later, or else one step earlier,
-        than the others (each part split again as needed, until :data:`SPLIT_PART_FAILURES` parts have failed
-        in the skeleton step).  The skeleton's
-        action set and order constraints are kept (actions of one step constrain each other in neither
-        direction); only the plan's makespan grows.
+        re-time (below); then pack it into as few plan steps as it takes (:meth:`_packed`: the failing
+        action in the latest, every other one there that grounds with the ones before it, the rest in earlier
+        ones).  The skeleton's action set and order constraints are kept (actions of one step constrain each
+        other in neither direction); only the plan's makespan grows.
 
-        Every part of a split keeps clear of the whole skeleton step's objects at their initial poses
+        Every part of a packed step keeps clear of the whole skeleton step's objects at their initial poses
         (``same``: the step's, handed down) and draws with the step's own ``key``, as the unsplit step did:
         an action grounded in the same place of a part as in the step (the same objects and volume to keep
         clear of, what the step's earlier actions sweep) asks the same questions, and the grounder's
         remembered answers give them back instead of a second search (a 6-arm step split again and again
-        searched the same hopeless carry 18 times, 41 of the skeleton's 59 s)."""
+        searched the same hopeless carry 18 times, 41 of the skeleton's 59 s, before the parts drew with the
+        step's key)."""
         if any(a.via is not None for a in step):
             return self._relay_steps(step, avoid, v_fut, key, index)
-        if not same:  # a skeleton step (or a relay's half), not a part of a split: its budget starts again
-            self._part_fails = 0
         same = same | {a.obj for a in step}
         done = self._step(step, avoid, set(same), v_fut, key, index)
         if not isinstance(done, Failure):
             return [done]
         lead = _lead(step, done)
-        if lead is not None and lead is not step[0]:
+        if lead is None:
+            return done
+        known = {step: done}  # the step's orders grounded with these avoid and v_fut, and their failures
+        if lead is not step[0]:
             # the failing action grounded first: the others then plan around what it sweeps (PA7-s1)
-            first = self._step((lead,) + tuple(a for a in step if a is not lead), avoid, set(same), v_fut, key, index)
+            order = (lead,) + tuple(a for a in step if a is not lead)
+            first = self._step(order, avoid, set(same), v_fut, key, index)
             if not isinstance(first, Failure):
                 self._plan.noted.append(done)
                 return [first]
-        if lead is None:
-            return done
-        alone = lead
+            known[order] = first
         # first the same actions over the skeleton's steps: the failing action in an earlier step, else
         # (its robots busy in every earlier step) the action of the robot it met there
         mark = self._plan.mark()
-        for moved in _retimable(alone, step, done):
+        for moved in _retimable(lead, step, done):
             if not self._plan.retime(moved, index):
                 continue
             again = self._steps(tuple(a for a in step if a is not moved), avoid, v_fut, key, index, same)
@@ -374,56 +367,92 @@ class ReverseGrounder:
                 self._plan.noted.append(done)
                 return again
             self._plan.rollback(mark)
-        split = self._split(step, alone, avoid, v_fut, key, index, same, mark)
-        if split is None:
+        packed = self._packed(step, lead, known, avoid, v_fut, key, index, same)
+        if isinstance(packed, Failure):
             return done
         self._plan.noted.append(done)
-        return split
+        return packed
 
-    def _split(
+    def _packed(
         self,
         step: tuple[Action, ...],
-        alone: Action,
+        lead: Action,
+        known: dict[tuple[Action, ...], Failure],
         avoid: set[str],
         v_fut: Posed,
         key: str,
         index: int,
         same: frozenset[str],
-        mark: tuple[int, int],
-    ) -> list[GroundedStep] | None:
-        """``step`` split in two plan steps (see :meth:`_steps`): ``alone`` one step later than the others, else
-        one step earlier; None when neither grounds or the skeleton step's budget of failed parts
-        (:data:`SPLIT_PART_FAILURES`) is spent (the re-timings since ``mark`` are taken back on a failure)."""
-        rest = tuple(a for a in step if a is not alone)
-        for later, earlier in (((alone,), rest), (rest, (alone,))):
-            if self._part_fails >= SPLIT_PART_FAILURES:
-                self.split_budgets_spent += 1
-                break
-            # the reverse search grounds the later part first; the earlier one then avoids its objects (at
-            # their initial poses) and its volume
-            tail = self._steps(later, avoid, v_fut, key, index, same)
-            if isinstance(tail, Failure):
-                self._part_fails += 1
-                self._plan.rollback(mark)
-                continue
-            before = self.grounded
-            self.grounded = before | {a.obj for a in later}
-            try:
-                head = self._steps(
-                    earlier,
-                    avoid | {a.obj for a in later},
-                    swept(tail, v_fut),
-                    key,
-                    index,
-                    same,
-                )
-            finally:
-                self.grounded = before
-            if not isinstance(head, Failure):
-                return head + tail
-            self._part_fails += 1
-            self._plan.rollback(mark)
-        return None
+    ) -> list[GroundedStep] | Failure:
+        """``step`` over as few plan steps as it takes (see :meth:`_pack`), ``lead`` in the latest.  When an action
+        then fails on its own in an earlier one (clear of the later ones' objects and sweeps), it is packed again
+        with that action first, in the latest; and so on, each action that fails so put after those put first
+        before it, until the step is packed, one of those fails again, or an order comes round again (at most
+        one packing per action; a two-action step: the failing action alone one step later than the other, else
+        one step earlier).  The failure of the last packing otherwise.  ``known``: the step's joint actions
+        already grounded with these ``avoid`` and ``v_fut`` (their order -> what they gave)."""
+        first: list[Action] = []
+        order = (lead,) + tuple(a for a in step if a is not lead)
+        orders = {order}
+        while True:
+            packed = self._pack(order, dict(known), avoid, v_fut, key, index, same)
+            if not isinstance(packed, Failure):
+                return packed
+            failing = next((a for a in step if label(a) == packed.action), None)
+            if failing is None or failing in first:
+                return packed
+            first.append(failing)
+            order = tuple(first) + tuple(a for a in order if a not in first)
+            if order in orders:
+                return packed
+            orders.add(order)
+            self.repacked += 1
+
+    def _pack(
+        self,
+        order: tuple[Action, ...],
+        known: dict[tuple[Action, ...], Failure],
+        avoid: set[str],
+        v_fut: Posed,
+        key: str,
+        index: int,
+        same: frozenset[str],
+    ) -> list[GroundedStep] | Failure:
+        """The actions of ``order`` packed greedily into plan steps, grounded latest first (the reverse search):
+        the latest is every action, in ``order``, that grounds with the ones kept before it; an action that
+        fails (robots of the step in each other's way, or what the ones before it sweep or put down) is dropped
+        to the next earlier plan step, which keeps clear of the later steps' objects (at their initial poses)
+        and of what they sweep; each drop costs one grounding of the part (the actions before the dropped one
+        ask their remembered questions again).  The failure of an action that fails first in its plan step
+        (nothing of its step before it) when it does.  Each plan step costs one joint grounding and one more per
+        action dropped from it (k(k + 1)/2 at most for k actions, one per action when their robots keep out of
+        each other's way), where splitting the step in two again and again, each part split again, multiplied
+        them: a 6-arm step's splits failed in cascades of 30-130 s (session 42)."""
+        parts: list[GroundedStep] = []
+        left = list(order)
+        before = self.grounded
+        try:
+            while left:
+                part, dropped = list(left), []
+                while True:
+                    tried = known.pop(tuple(part), None) if not parts else None  # the latest: as the step was
+                    done = tried or self._step(tuple(part), avoid, set(same), v_fut, key, index)
+                    if not isinstance(done, Failure):
+                        break
+                    failing = next((a for a in part if label(a) == done.action), None)
+                    if failing is None or failing is part[0]:
+                        return done
+                    part.remove(failing)
+                    dropped.append(failing)
+                parts[:0] = [done]
+                objects = {a.obj for a in part}
+                avoid = avoid | objects
+                v_fut = swept([done], v_fut)
+                self.grounded = self.grounded | objects
+                left = dropped
+        finally:
+            self.grounded = before
+        return parts
 
     def _relay_steps(
         self, step: tuple[Action, ...], avoid: set[str], v_fut: Posed, key: str, index: int

@@ -144,7 +144,7 @@ def _search(context: Context, sources: _Sources, deadline: float) -> Result:
         stats["deferred"] = sorted(describe(p) for p in sources.deferrals.deferred)
         stats["doomed_skeletons"] = reverse.doomed.doomed  # failed by a probe before their later steps (doomed.py)
         stats["repeated_failures"] = reverse.repeated  # failed as an earlier grounding did (ReverseGrounder._repeated)
-        stats["split_budgets_spent"] = reverse.split_budgets_spent  # splits not tried (ground.SPLIT_PART_FAILURES)
+        stats["repacked_steps"] = reverse.repacked  # steps packed again, another action first (ReverseGrounder._packed)
         stats.update(timing.of(result.steps))
         if out.status is PlanStatus.TIME_LIMIT and result.ended == "iteration limit":
             out.summary = f"the search's iteration limit ({o['max_iterations']}) was reached before a plan was found"

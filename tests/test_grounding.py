@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 from support import ROOT
 
@@ -892,37 +892,71 @@ def test_a_failure_is_not_grounded_again_under_the_same_steps(pa3: Grounder) -> 
     assert not third.repeats and pa3.queries > queries
 
 
-@pytest.mark.parametrize("actions", [2, 3, 4, 5, 6])
-def test_a_step_whose_split_parts_keep_failing_stops_splitting_when_its_budget_is_spent(
-    pa3: Grounder, monkeypatch: pytest.MonkeyPatch, actions: int
+@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(
+    actions=st.integers(2, 7),
+    pairs=st.sets(st.tuples(st.integers(0, 6), st.integers(0, 6)), max_size=12),
+    alone=st.sets(st.integers(0, 6), max_size=2),
+)
+@example(actions=3, pairs={(0, 2)}, alone={0, 2})  # packed twice, failing both times
+@example(actions=4, pairs={(0, 1), (0, 3), (1, 3)}, alone={0, 1})  # packed three times, then the failure
+@example(actions=2, pairs={(0, 1)}, alone={0})  # packed twice: the other action in the latest plan step
+@example(actions=6, pairs={(i, j) for i in range(6) for j in range(i)}, alone=set())  # one action per plan step
+def test_a_step_whose_robots_meet_is_packed_into_plan_steps_whose_robots_do_not(
+    pa3: Grounder, actions: int, pairs: set[tuple[int, int]], alone: set[int]
 ) -> None:
-    """planner/ground.py ``SPLIT_PART_FAILURES``: each part of a split is split again, so a step whose robots
-    keep meeting tries more parts the more actions it has.  Here every joint action of the step fails as two of
-    its robots colliding (each action alone too): a step of up to four actions fails as before, trying the
-    same parts; a larger one stops splitting once that many parts have failed, with the same failure."""
+    """planner/ground.py ``ReverseGrounder._packed``: a joint action here fails at its first action that meets one
+    grounded before it (robots of the step colliding: any pair of ``pairs``), as the real one grounds its actions
+    one after another; an action of ``alone`` fails first in a plan step with a later one (what the later steps
+    sweep in its way), grounds on its own first in the latest.  The step is then packed: every action in exactly
+    one plan step, none meeting another of its plan step, the failing action in the latest, each action of an
+    earlier plan step meeting one of the next (it was dropped from there), at most k * k(k + 1)/2 + 2 joint
+    groundings for k actions (the step, the failing action first, a packing per action); or, when an action
+    fails on its own, the step's own failure."""
+    from mrgc.geometry.collision import Packed, Posed
     from mrgc.planner import ground
     from mrgc.planner.outcome import Failure
 
-    step = tuple(Action(f"o{i}", "bin-a", f"r{i}", f"r{i}", "top", "top") for i in range(1, actions + 1))
-    tried: list[int] = []
+    step = tuple(Action(f"o{i}", "bin-a", f"r{i}", f"r{i}", "top", "top") for i in range(actions))
+    meets = {frozenset((i, j)) for i, j in pairs if i != j and max(i, j) < actions}
+    number = {a: i for i, a in enumerate(step)}
+    tried: list[tuple[Action, ...]] = []
 
-    def clash(self: ReverseGrounder, part: tuple[Action, ...], *args: Any, **kwargs: Any) -> Failure:
-        tried.append(len(part))
-        robots = tuple(sorted({part[0].pick_robot, part[-1].pick_robot}))
-        return Failure(1, ground.label(part[-1]), "pick: robots of the step collide", robots)
+    def joint(self: ReverseGrounder, part: tuple[Action, ...], avoid: set[str], *args: Any, **kwargs: Any) -> Any:
+        tried.append(part)
+        later = any(a.obj in avoid for a in step)  # an earlier plan step keeps clear of the later ones' objects
+        for k, a in enumerate(part):
+            if later and k == 0 and number[a] in alone:
+                return Failure(1, ground.label(a), "carry to the placement by r0: no path")
+            met = [b for b in part[:k] if frozenset((number[a], number[b])) in meets]
+            if met:
+                robots = tuple(sorted({a.pick_robot, met[0].pick_robot}))
+                return Failure(1, ground.label(a), "pick: robots of the step collide", robots)
+        return ground.GroundedStep([], Packed.of(Posed.of([])), tuple(a.obj for a in part))
 
-    monkeypatch.setattr(ReverseGrounder, "_step", clash)
-    answers = []
-    for budget in (10**9, ground.SPLIT_PART_FAILURES):
-        monkeypatch.setattr(ground, "SPLIT_PART_FAILURES", budget)
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(ReverseGrounder, "_step", joint)
         reverse = ReverseGrounder(pa3, {})
-        tried.clear()
-        answers.append((reverse._steps(step, set(), ground.swept([]), "k", 1), len(tried), reverse.split_budgets_spent))
-    (unbounded, tries, spent), (bounded, budgeted_tries, budget_spent) = answers
-    assert isinstance(unbounded, Failure) and unbounded == bounded  # the step's own failure either way
-    assert spent == 0 and budgeted_tries <= tries
-    # a small step never spends the budget and tries what it tried before; a large one stops early
-    assert (budget_spent > 0) == (budgeted_tries < tries) == (actions >= 5)
+        out = reverse._steps(step, set(), ground.swept([]), "k", 1)
+    first = tried[0]  # the step in the skeleton's order; its failing action is the one packed in the latest
+    lead = next(
+        (a for k, a in enumerate(first) if any(frozenset((number[a], number[b])) in meets for b in first[:k])), None
+    )
+    if isinstance(out, Failure):  # the step's own failure, after an action failed first in an earlier plan step
+        assert lead is not None and out.action == ground.label(lead)
+        assert out.check.endswith("robots of the step collide")
+        assert any(number[part[0]] in alone for part in tried[2:])
+        return
+    parts = [[int(o[1:]) for o in s.moved] for s in out]
+    assert sorted(i for part in parts for i in part) == list(range(actions))
+    for part in parts:
+        assert not any(frozenset((i, j)) in meets for i in part for j in part if i < j)
+    assert (len(parts) > 1) == (lead is not None)
+    if lead is not None:
+        assert number[lead] in parts[-1] or reverse.repacked >= 1
+        for earlier, later in zip(parts, parts[1:]):
+            assert all(any(frozenset((i, j)) in meets for j in later) for i in earlier)
+    assert len(tried) <= 2 + actions * actions * (actions + 1) // 2
 
 
 def test_a_pick_failing_on_what_never_moves_fails_every_skeleton_holding_it_at_once(pa3: Grounder) -> None:

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 #: the detail of a failed query whose motion collided with what another robot of the step sweeps in the same
-#: phase (the skeleton step may be split: planner/ground.py)
+#: phase (the skeleton step may be packed into several: planner/ground.py)
 BUSY = "another robot of the step moves there in the same phase"
 #: the detail of a failed query whose every answer put the arm in collision with itself (two links that
 #: :attr:`~mrgc.geometry.kinematics.RobotModel.self_collision_pairs` keeps apart closer than

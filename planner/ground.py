@@ -57,10 +57,15 @@ PLACEMENT_SAMPLES = 1000
 #: other regions an obstacle with no reachable place in its own may be parked in, nearest first
 PARKING_REGIONS = 2
 #: carries to a placement blocked by the step's other robots (what they sweep in the same phase) after which
-#: a place grounded clear of them gives up: the step is then split or re-timed, which costs less than more
+#: a place grounded clear of them gives up: the step is then re-timed or packed, which costs less than more
 #: placements each failing its carry the same way (PA7-s1: 17 carries of about 85 ms each, every one
 #: blocked by the other arm, before the split that grounded at once)
 BUSY_CARRIES = 2
+#: packings of a skeleton step whose robots meet (:meth:`ReverseGrounder._packed`), per action of the step: each
+#: action may be put first once and last once; the re-timings' nested packings of the step's remaining actions
+#: count too (without the bound, a step of 7 actions whose re-timings each packed the rest made up to 19
+#: packings, 252 joint groundings, on a reviewer's drawn cases)
+PACKINGS_PER_ACTION = 2
 #: exchanges tried per handover point when the giver's carry to one fails: another branch of the arms at the
 #: same point is often an easy carry where the first (the solution nearest home) is not (6-arm seed 0: r5's
 #: first exchange at h5 is reached by no RRTConnect path of 64,000 checks, its second in 0.03 s)
@@ -112,7 +117,7 @@ class Grounding:
     reason: str = ""
     #: why steps failed (the strict attempt of a PARTIAL step, or the failing step of a FAIL)
     failures: list[Failure] = field(default_factory=list)
-    #: the step failures of robots in each other's way that a re-timing or a split got around, in grounding
+    #: the step failures of robots in each other's way that a re-timing or a packing got around, in grounding
     #: order (the log and the plan's statistics report them)
     resolved: list[Failure] = field(default_factory=list)
     #: actions re-timed into an earlier skeleton step: (action label, from step, to step)
@@ -170,8 +175,12 @@ class ReverseGrounder:
         self._failed: dict[tuple[object, ...], tuple[tuple[GroundedStep, ...], Grounding, str]] = {}
         #: groundings that repeated a failure instead of grounding anything (:meth:`ground`)
         self.repeated = 0
-        #: steps packed a second time, the action that failed alone in an earlier plan step first (:meth:`_packed`)
+        #: steps packed again, an action that failed on its own put first or last (:meth:`_packed`); the packings
+        #: the skeleton step being grounded may still make (:data:`PACKINGS_PER_ACTION`), and the steps whose
+        #: packings ran out
         self.repacked = 0
+        self._packings = 0
+        self.packings_spent = 0
         #: the skeleton being grounded, its actions as re-timed so far (see :class:`_Retiming`)
         self._plan = _Retiming([], None)
         #: actions found doomed before the later steps are grounded (planner/doomed.py)
@@ -195,7 +204,7 @@ class ReverseGrounder:
         constraints (each action's obstacles, :meth:`TaskGraph.obstacles
         <mrgc.compiler.task_graph.TaskGraph.obstacles>`); with them, an action in the way of another robot
         of its step is first *re-timed* into an earlier step where its robots are free and its obstacles
-        already moved (:meth:`_retime_to`), and only then is the step split; when a grounding with
+        already moved (:meth:`_Retiming.retime`), and only then is the step packed; when a grounding with
         re-timings does not succeed, the skeleton is grounded again without them.  Raises
         :class:`DeadlineReached` when the search's deadline cut a query of it short (its answer may then be
         wrong)."""
@@ -340,6 +349,8 @@ class ReverseGrounder:
         step's key)."""
         if any(a.via is not None for a in step):
             return self._relay_steps(step, avoid, v_fut, key, index)
+        if not same:  # a skeleton step (or a relay's half), not the rest of a re-timed one: its packings start again
+            self._packings = PACKINGS_PER_ACTION * len(step)
         same = same | {a.obj for a in step}
         done = self._step(step, avoid, set(same), v_fut, key, index)
         if not isinstance(done, Failure):
@@ -386,27 +397,36 @@ class ReverseGrounder:
     ) -> list[GroundedStep] | Failure:
         """``step`` over as few plan steps as it takes (see :meth:`_pack`), ``lead`` in the latest.  When an action
         then fails on its own in an earlier one (clear of the later ones' objects and sweeps), it is packed again
-        with that action first, in the latest; and so on, each action that fails so put after those put first
-        before it, until the step is packed, one of those fails again, or an order comes round again (at most
-        one packing per action; a two-action step: the failing action alone one step later than the other, else
-        one step earlier).  The failure of the last packing otherwise.  ``known``: the step's joint actions
-        already grounded with these ``avoid`` and ``v_fut`` (their order -> what they gave)."""
-        first: list[Action] = []
+        with that action first, in the latest, each action that fails so put after those put first before it;
+        an action that fails on its own in the latest (first there: nothing of its step before it) is put last
+        instead, once, so that it goes to an earlier plan step (a two-action step so tries what the split of
+        sessions 31-42 tried: the failing action alone one step later than the other, else one step earlier).
+        That goes on until the step is packed, an action fails again where it was put, an order comes round
+        again (at most two packings per action), or the skeleton step's packings are spent
+        (:data:`PACKINGS_PER_ACTION` per action of it, the packings of its re-timings' remaining actions
+        included).  The failure of the last packing otherwise.  ``known``: the step's joint actions already
+        grounded with these ``avoid`` and ``v_fut`` (their order -> what they gave)."""
+        first: list[Action] = []  # put first: failed on their own in an earlier plan step
+        last: list[Action] = []  # put last: failed on their own in the latest
         order = (lead,) + tuple(a for a in step if a is not lead)
         orders = {order}
-        while True:
+        packed: list[GroundedStep] | Failure = known[step]
+        while self._packings > 0:
+            self._packings -= 1
             packed = self._pack(order, dict(known), avoid, v_fut, key, index, same)
             if not isinstance(packed, Failure):
                 return packed
             failing = next((a for a in step if label(a) == packed.action), None)
-            if failing is None or failing in first:
+            if failing is None or failing in first + last:
                 return packed
-            first.append(failing)
-            order = tuple(first) + tuple(a for a in order if a not in first)
+            (last if failing is order[0] else first).append(failing)
+            order = tuple(first) + tuple(a for a in step if a not in first + last) + tuple(last)
             if order in orders:
                 return packed
             orders.add(order)
             self.repacked += 1
+        self.packings_spent += 1
+        return packed
 
     def _pack(
         self,
@@ -436,7 +456,7 @@ class ReverseGrounder:
                 part, dropped = list(left), []
                 while True:
                     tried = known.pop(tuple(part), None) if not parts else None  # the latest: as the step was
-                    done = tried or self._step(tuple(part), avoid, set(same), v_fut, key, index)
+                    done = tried if tried is not None else self._step(tuple(part), avoid, set(same), v_fut, key, index)
                     if not isinstance(done, Failure):
                         break
                     failing = next((a for a in part if label(a) == done.action), None)
@@ -742,7 +762,7 @@ class ReverseGrounder:
             if not isinstance(done, Failure) or a.obj in self.goal or a.obj in self._forced:
                 return done
             if done.detail == BUSY:  # the step's other robots in the way, not a crowded region: the step
-                return done  # is split (or re-timed) instead
+                return done  # is re-timed (or packed) instead
             # beyond the paper: an obstacle with no place in its own region that its arm reaches (a crowded
             # start region, the later steps' sweeps kept clear) is parked in another region the arm reaches
             for region, top in self._parking(a):
@@ -1128,7 +1148,7 @@ class _Retiming:
     takes no second one (a single handover point: the skeleton model's rule, kept for any number).  Geometry
     agrees: the objects of earlier steps are at their initial poses for the later ones, which ignore them,
     and their placements avoid what the later steps sweep, whatever step they are in.  Moves (and the
-    failures they or a split got around) are pending until the step that made them is grounded
+    failures they or a packing got around) are pending until the step that made them is grounded
     (:meth:`commit`); :meth:`rollback` takes back those made since a :meth:`mark`."""
 
     def __init__(self, steps: list[list[Action]], order: Order | None) -> None:
@@ -1227,7 +1247,7 @@ def _telling(failures: list[tuple[Failure, GroundStatus, bool]]) -> Failure:
     """Of an action's failures at each of its handover points (the exchange's there, or the giver's carry to
     it; each with its query's status and whether the exchange there was found), the one that says most about
     what would let it through: another robot of the step in the way (the step's robots' passes are then
-    compared sample by sample, or the step is split), else bodies in the way (objects to move first, or the
+    compared sample by sample, or the step is packed), else bodies in the way (objects to move first, or the
     two arms), else the carry to a point whose exchange was found (the only point that got that far), else
     anything but a point out of the arms' reach, else the last.  The last point's failure alone hid the
     others': on the 6-arm, 40-object instance one handover failed 42 times as "handover at h5: no inverse

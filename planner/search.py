@@ -144,7 +144,12 @@ def _search(context: Context, sources: _Sources, deadline: float) -> Result:
         stats["deferred"] = sorted(describe(p) for p in sources.deferrals.deferred)
         stats["doomed_skeletons"] = reverse.doomed.doomed  # failed by a probe before their later steps (doomed.py)
         stats["repeated_failures"] = reverse.repeated  # failed as an earlier grounding did (ReverseGrounder._repeated)
-        stats["repacked_steps"] = reverse.repacked  # steps packed again, another action first (ReverseGrounder._packed)
+        stats["repacked_steps"] = (
+            reverse.repacked
+        )  # steps packed again, an action first or last (ReverseGrounder._packed)
+        stats["packings_spent"] = (
+            reverse.packings_spent
+        )  # skeleton steps whose packings ran out (ground.PACKINGS_PER_ACTION)
         stats.update(timing.of(result.steps))
         if out.status is PlanStatus.TIME_LIMIT and result.ended == "iteration limit":
             out.summary = f"the search's iteration limit ({o['max_iterations']}) was reached before a plan was found"

@@ -892,41 +892,48 @@ def test_a_failure_is_not_grounded_again_under_the_same_steps(pa3: Grounder) -> 
     assert not third.repeats and pa3.queries > queries
 
 
-@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(
     actions=st.integers(2, 7),
     pairs=st.sets(st.tuples(st.integers(0, 6), st.integers(0, 6)), max_size=12),
-    alone=st.sets(st.integers(0, 6), max_size=2),
+    alone=st.sets(st.integers(0, 6), max_size=3),
+    latest=st.sets(st.integers(0, 6), max_size=2),
 )
-@example(actions=3, pairs={(0, 2)}, alone={0, 2})  # packed twice, failing both times
-@example(actions=4, pairs={(0, 1), (0, 3), (1, 3)}, alone={0, 1})  # packed three times, then the failure
-@example(actions=2, pairs={(0, 1)}, alone={0})  # packed twice: the other action in the latest plan step
-@example(actions=6, pairs={(i, j) for i in range(6) for j in range(i)}, alone=set())  # one action per plan step
+@example(actions=2, pairs={(0, 1)}, alone={0}, latest=set())  # packed twice: the other action in the latest
+@example(actions=2, pairs={(0, 1)}, alone=set(), latest={1})  # the failing action fails first in the latest: last
+@example(actions=3, pairs={(0, 2)}, alone={0, 2}, latest=set())  # the two that must be in the latest meet: fails
+@example(actions=4, pairs={(0, 3), (1, 3)}, alone={0, 1}, latest=set())  # 0 then 1 put first
+@example(actions=6, pairs={(i, j) for i in range(6) for j in range(i)}, alone=set(), latest=set())  # one per step
 def test_a_step_whose_robots_meet_is_packed_into_plan_steps_whose_robots_do_not(
-    pa3: Grounder, actions: int, pairs: set[tuple[int, int]], alone: set[int]
+    pa3: Grounder, actions: int, pairs: set[tuple[int, int]], alone: set[int], latest: set[int]
 ) -> None:
-    """planner/ground.py ``ReverseGrounder._packed``: a joint action here fails at its first action that meets one
-    grounded before it (robots of the step colliding: any pair of ``pairs``), as the real one grounds its actions
-    one after another; an action of ``alone`` fails first in a plan step with a later one (what the later steps
-    sweep in its way), grounds on its own first in the latest.  The step is then packed: every action in exactly
-    one plan step, none meeting another of its plan step, the failing action in the latest, each action of an
-    earlier plan step meeting one of the next (it was dropped from there), at most k * k(k + 1)/2 + 2 joint
-    groundings for k actions (the step, the failing action first, a packing per action); or, when an action
-    fails on its own, the step's own failure."""
+    """planner/ground.py ``ReverseGrounder._packed``: a joint action here fails at its first action that fails given
+    the ones grounded before it, as the real one grounds them one after another: one that meets one of them
+    (robots of the step colliding: any pair of ``pairs``), an action of ``alone`` in an earlier plan step (what
+    the later ones sweep in its way: it grounds in the latest only), an action of ``latest`` first in the latest
+    (grounded before the others there, it fails on its own).  Unless the step's first failure is not robots
+    colliding (then nothing is packed, as before), the step is packed exactly when the actions of ``alone`` meet
+    none of each other: every action in exactly one plan step, none meeting another of its plan step, ``alone``
+    in the latest and no action of ``latest`` first there, each action of an earlier plan step meeting one of
+    the next (it was dropped from there); the earlier plan steps keep clear of the later ones' objects, which
+    the grounding counts as grounded meanwhile; no skeleton step's packings run out.  Otherwise the step's own
+    failure."""
     from mrgc.geometry.collision import Packed, Posed
     from mrgc.planner import ground
     from mrgc.planner.outcome import Failure
 
     step = tuple(Action(f"o{i}", "bin-a", f"r{i}", f"r{i}", "top", "top") for i in range(actions))
     meets = {frozenset((i, j)) for i, j in pairs if i != j and max(i, j) < actions}
+    alone, latest = {i for i in alone if i < actions}, {i for i in latest if i < actions} - alone
     number = {a: i for i, a in enumerate(step)}
     tried: list[tuple[Action, ...]] = []
 
     def joint(self: ReverseGrounder, part: tuple[Action, ...], avoid: set[str], *args: Any, **kwargs: Any) -> Any:
         tried.append(part)
-        later = any(a.obj in avoid for a in step)  # an earlier plan step keeps clear of the later ones' objects
+        earlier = bool(self.grounded)  # a later plan step of the step grounded: this one is earlier
+        assert self.grounded <= avoid and not self.grounded & {a.obj for a in part}
         for k, a in enumerate(part):
-            if later and k == 0 and number[a] in alone:
+            if number[a] in alone and earlier or number[a] in latest and not earlier and k == 0:
                 return Failure(1, ground.label(a), "carry to the placement by r0: no path")
             met = [b for b in part[:k] if frozenset((number[a], number[b])) in meets]
             if met:
@@ -938,25 +945,31 @@ def test_a_step_whose_robots_meet_is_packed_into_plan_steps_whose_robots_do_not(
         patch.setattr(ReverseGrounder, "_step", joint)
         reverse = ReverseGrounder(pa3, {})
         out = reverse._steps(step, set(), ground.swept([]), "k", 1)
-    first = tried[0]  # the step in the skeleton's order; its failing action is the one packed in the latest
-    lead = next(
-        (a for k, a in enumerate(first) if any(frozenset((number[a], number[b])) in meets for b in first[:k])), None
+    assert not reverse.grounded
+    first = tried[0]  # the step in the skeleton's order, in the latest plan step
+    failed = next(
+        (
+            a
+            for k, a in enumerate(first)
+            if number[a] in latest and k == 0 or any(frozenset((number[a], number[b])) in meets for b in first[:k])
+        ),
+        None,
     )
-    if isinstance(out, Failure):  # the step's own failure, after an action failed first in an earlier plan step
-        assert lead is not None and out.action == ground.label(lead)
-        assert out.check.endswith("robots of the step collide")
-        assert any(number[part[0]] in alone for part in tried[2:])
+    clash = failed is not None and failed is not first[0]
+    packable = not any(frozenset((i, j)) in meets for i in alone for j in alone)
+    assert isinstance(out, Failure) == (failed is not None and not (clash and packable)), (out, failed, clash)
+    assert reverse.packings_spent == 0 and reverse.repacked <= 2 * actions
+    if isinstance(out, Failure):  # the step's own failure
+        assert failed is not None and out.action == ground.label(failed)
         return
     parts = [[int(o[1:]) for o in s.moved] for s in out]
     assert sorted(i for part in parts for i in part) == list(range(actions))
+    assert (len(parts) > 1) == (failed is not None)
+    assert alone <= set(parts[-1]) and parts[-1][0] not in latest
     for part in parts:
         assert not any(frozenset((i, j)) in meets for i in part for j in part if i < j)
-    assert (len(parts) > 1) == (lead is not None)
-    if lead is not None:
-        assert number[lead] in parts[-1] or reverse.repacked >= 1
-        for earlier, later in zip(parts, parts[1:]):
-            assert all(any(frozenset((i, j)) in meets for j in later) for i in earlier)
-    assert len(tried) <= 2 + actions * actions * (actions + 1) // 2
+    for earlier, later in zip(parts, parts[1:]):
+        assert all(any(frozenset((i, j)) in meets for j in later) for i in earlier)
 
 
 def test_a_pick_failing_on_what_never_moves_fails_every_skeleton_holding_it_at_once(pa3: Grounder) -> None:

@@ -13,7 +13,7 @@ from typing import Any, Iterable
 from mrgc.language.model import Fact, Problem
 
 #: the obstruction predicates: (M1, *what M1 obstructs)
-_OCCLUDES = ("occludes-pick", "occludes-goal-place", "occludes-handover")
+_OCCLUDES = ("occludes-pick", "occludes-goal-place", "occludes-handover", "occludes-relay")
 
 
 @dataclass(frozen=True)
@@ -38,6 +38,8 @@ class FactBase:
     occludes_place: dict[tuple[str, str, str, str], tuple[str, ...]] = field(default_factory=dict)  # (M2, Re, g, R)
     #: ``occludes-handover`` (beyond the paper): (M2, g1, g2, R1, R2) -> the M1s in the way of the exchange
     occludes_handover: dict[tuple[str, str, str, str, str], tuple[str, ...]] = field(default_factory=dict)
+    #: ``occludes-relay`` (beyond the paper): (M2, Re, g1, g2, R1, R2) -> the M1s in the way at the relay's spot
+    occludes_relay: dict[tuple[str, str, str, str, str, str], tuple[str, ...]] = field(default_factory=dict)
     #: handovers that can happen at once (the number of handover points); None: no limit (symbolic)
     handover_capacity: int | None = None
     #: robots that drive to their placements (planar bases): their place obstacles lie on the path and must
@@ -106,6 +108,7 @@ class FactBase:
             occludes_pick={k: tuple(sorted(v, key=rank)) for k, v in occ["occludes-pick"].items()},
             occludes_place={k: tuple(sorted(v, key=rank)) for k, v in occ["occludes-goal-place"].items()},
             occludes_handover={k: tuple(sorted(v, key=rank)) for k, v in occ["occludes-handover"].items()},
+            occludes_relay={k: tuple(sorted(v, key=rank)) for k, v in occ["occludes-relay"].items()},
             handover_capacity=handover_capacity,
             drivers=frozenset(drivers),
         )

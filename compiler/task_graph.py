@@ -7,11 +7,11 @@ handover's exchange, ``occludes-handover``, are block-pick edges of the handover
 before the object is picked).  Beyond the paper, a *relay* action sets a goal
 object down in another region (``via``) and picks it up there with another robot or grasp
 (``enable-relay``); like a handover it occupies both robots for its step, and has the same obstacles (the
-pick's and the goal placement's).  A goal object's target region is its goal region,
-any other object's its current region (it is only moved out of the way).  Handover actions exist only for
-goal objects.  Objects already moved (the grounded suffix during search) get no node: each object moves at
-most once, and an action obstructed by such an object is dropped, because that object is still in place
-when the action runs (the suffix runs later).
+pick's and the goal placement's) and those in the way at its spot (``occludes-relay``: block-pick edges).
+A goal object's target region is its goal region, any other object's its current region (it is only
+moved out of the way).  Handover actions exist only for goal objects.  Objects already moved (the grounded
+suffix during search) get no node: each object moves at most once, and an action obstructed by such an
+object is dropped, because that object is still in place when the action runs (the suffix runs later).
 """
 
 from __future__ import annotations
@@ -174,11 +174,16 @@ def build_task_graph(facts: FactBase, must_move: Iterable[str], moved: Iterable[
 
 def pick_obstacles(facts: FactBase, act: Action) -> tuple[str, ...]:
     """The objects that must be gone before ``act`` picks its object: its pick's ``occludes-pick`` obstacles,
-    and for a handover those in the way of the exchange (``occludes-handover``, beyond the paper)."""
+    for a handover those in the way of the exchange (``occludes-handover``, beyond the paper), and for a relay
+    those in the way at its spot (``occludes-relay``, beyond the paper: the relay sets the object down there in
+    the step it picks it)."""
     out = facts.occludes_pick.get((act.obj, act.pick_grasp, act.pick_robot), ())
     if act.handover:
         key = (act.obj, act.pick_grasp, act.place_grasp, act.pick_robot, act.place_robot)
         out += tuple(o for o in facts.occludes_handover.get(key, ()) if o not in out)
+    if act.via is not None:
+        spot = (act.obj, act.via, act.pick_grasp, act.place_grasp, act.pick_robot, act.place_robot)
+        out += tuple(o for o in facts.occludes_relay.get(spot, ()) if o not in out)
     return out
 
 

@@ -26,6 +26,10 @@ For every robot R (in parallel, one process per robot when there are cores to sp
 - ``enable-relay M Re g1 g2 R1 R2`` (beyond the paper; only for goal objects no single action takes to
   their goal): R1 sets M down with g1 at a placement in Re where R2 picks it up with g2
   (:mod:`mrgc.geometry.relays`);
+- ``occludes-relay M1 M Re g1 g2 R1 R2`` (beyond the paper): M1 is hit by R1's or R2's links along their
+  approaches to that relay's spot, or by M at the spot, for the spot that hits the fewest movable objects;
+  none when a spot hits none (a relay through a crowded start region needs room there: the objects at its
+  spot must move first);
 
 and ``in-region M Re`` from the initial poses.  Everything is deterministic for a seed.
 """
@@ -45,7 +49,7 @@ from mrgc.geometry.facts import FactsResult, HandoverConfig, RobotFacts
 from mrgc.geometry.grasps import finger_opening, fits, grasp_transform, pregrasp_transform
 from mrgc.geometry.ik import solve_ik_many
 from mrgc.geometry.kinds import approaches
-from mrgc.geometry.relays import Asks, Spots, relay_facts, spot_region, stranded
+from mrgc.geometry.relays import Asks, Spots, free_relays, relay_facts, spot_region, stranded
 from mrgc.geometry.relays import asks as relay_asks
 from mrgc.geometry.scene import Body, SceneSpec, floor_support, half_extents, inside
 from mrgc.geometry.transforms import translation
@@ -371,7 +375,9 @@ class RobotEvaluator:
     def spots(self, asks: Asks) -> Spots:
         """The relay spots this arm reaches (:mod:`mrgc.geometry.relays`): for each (object, grasp, region)
         asked, the indices of the region's placement lattice where the arm holds the object with the grasp,
-        grasp and pre-grasp free of the fixed objects (movable objects ignored)."""
+        grasp and pre-grasp free of the fixed objects, each with the movable objects the arm's links hit along
+        the approach or the object hits at the spot (its IK branches tried for one that hits none, as for a
+        pick)."""
         queries, keys = [], []
         for obj, grasp, region in asks:
             if not self.usable(obj, grasp):
@@ -380,7 +386,8 @@ class RobotEvaluator:
                 if self.arm.in_reach(pose[:3, 3], margin=0.3):
                     queries.append((obj, grasp, pose, True, "relay"))
                     keys.append((obj, grasp, region, k))
-        return {keys[i] for i in self._solve(queries, want_free=False)}
+        found = self._solve(queries, want_free=True)
+        return {keys[i]: frozenset(hits) - {keys[i][0]} for i, (_, hits) in found.items()}
 
     def _handover_configs(self) -> None:
         """Up to HANDOVER_CONFIGS distinct configurations per (goal object, handover point, grasp), from
@@ -475,14 +482,17 @@ def _spots_worker(args: tuple[SceneSpec, str, int, Asks]) -> tuple[Spots, int, i
 def _relays(
     scene: SceneSpec, facts: set[Fact], seed: int, n: int, deadline: float | None
 ) -> tuple[set[Fact], int, int] | None:
-    """``enable-relay`` facts for the goal objects that need them (:mod:`mrgc.geometry.relays`), with the
-    IK solves and collision checks they took; None when ``deadline`` passed first."""
+    """``enable-relay`` facts for the goal objects that need them (:mod:`mrgc.geometry.relays`), with their
+    ``occludes-relay`` facts and the IK solves and collision checks they took; None when ``deadline`` passed
+    first.  The fixed objects' tops are asked for the objects that got no relay through a region, and for those
+    whose every relay through a region has objects in the way at its spot (a crowded start region: a spot on
+    the table may be free)."""
     arms = {r.name for r in scene.robots if approaches(r.kind)}
     out: set[Fact] = set()
     ik = checks = 0
     stuck = stranded(scene, facts)
     for surfaces in (False, True):  # the regions first; fixed objects' tops for the objects still stuck
-        stuck = [o for o in stuck if not any(f.args[0] == o for f in out)]
+        stuck = [o for o in stuck if o not in free_relays(out)]
         asked = {r: a for r, a in relay_asks(scene, facts, stuck, surfaces).items() if r in arms} if stuck else {}
         if not asked:
             continue
@@ -566,6 +576,7 @@ def compute_facts(
         "enable-goal-handover": 5,
         "enable-relay": 6,
         "occludes-handover": 7,
+        "occludes-relay": 8,
     }
     stats = {
         "seconds": time.perf_counter() - t0,

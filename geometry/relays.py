@@ -44,8 +44,9 @@ PAIR = "@"
 
 #: what one robot is asked: (object, grasp, region) triples whose spots it should try
 Asks = list[tuple[str, str, str]]
-#: what one robot answers: (object, grasp, region, lattice index) of the spots it reaches
-Spots = set[tuple[str, str, str, int]]
+#: what one robot answers: (object, grasp, region, lattice index) of each spot it reaches -> the movable objects
+#: in the way there (its links along the approach, the object at the spot)
+Spots = dict[tuple[str, str, str, int], frozenset[str]]
 
 
 def stranded(scene: SceneSpec, facts: Iterable[Fact]) -> list[str]:
@@ -131,16 +132,20 @@ def spot_region(scene: SceneSpec, name: str, r1: str = "", r2: str = "") -> Body
 
 
 def relay_facts(scene: SceneSpec, facts: Iterable[Fact], spots: dict[str, Spots]) -> set[Fact]:
-    """``enable-relay`` facts from each robot's reached spots (see the module docstring)."""
+    """``enable-relay`` facts from each robot's reached spots (see the module docstring), and for each relay
+    the ``occludes-relay`` facts of its spot that has the fewest movable objects in the way of the two arms
+    (their links along the approaches, the object at the spot; the lowest lattice index among equals): none
+    when one is free."""
     facts = list(facts)
     pick = {f.args for f in facts if f.predicate == "reachable-pick"}
     place = {f.args for f in facts if f.predicate == "reachable-place"}
-    # robot -> (object, region, lattice index) -> the grasps it holds the object with there
-    grasps: dict[str, dict[tuple[str, str, int], set[str]]] = {}
+    # robot -> (object, region, lattice index) -> the grasps it holds the object with there -> what is in the way
+    grasps: dict[str, dict[tuple[str, str, int], dict[str, frozenset[str]]]] = {}
     for robot, reached in spots.items():
-        for obj, grasp, region, k in reached:
-            grasps.setdefault(robot, {}).setdefault((obj, region, k), set()).add(grasp)
-    out: set[Fact] = set()
+        for (obj, grasp, region, k), hits in reached.items():
+            grasps.setdefault(robot, {}).setdefault((obj, region, k), {})[grasp] = hits
+    # (M, Re, g1, g2, R1, R2) -> (objects in the way, lattice index, region asked) of its best spot
+    best: dict[tuple[str, str, str, str, str, str], tuple[int, int, str, frozenset[str]]] = {}
     for r1, mine in grasps.items():
         for r2, theirs in grasps.items():
             for (obj, region, k), g1s in mine.items():
@@ -148,8 +153,23 @@ def relay_facts(scene: SceneSpec, facts: Iterable[Fact], spots: dict[str, Spots]
                 where, *pair = region.split(PAIR)
                 if pair and sorted((r1, r2)) != pair:
                     continue  # a staging square is the one between r1 and r2
-                for g1 in g1s:
-                    for g2 in theirs.get((obj, region, k), ()):
+                for g1, in_way in g1s.items():
+                    for g2, also in theirs.get((obj, region, k), {}).items():
                         if (r1, g1) != (r2, g2) and (obj, g1, r1) in pick and (obj, goal, g2, r2) in place:
-                            out.add(Fact("enable-relay", (obj, where, g1, g2, r1, r2)))
+                            key = (obj, where, g1, g2, r1, r2)
+                            spot = (len(in_way | also), k, region, in_way | also)
+                            if key not in best or spot[:3] < best[key][:3]:
+                                best[key] = spot
+    out: set[Fact] = set()
+    for key, (_, _, _, occupied) in best.items():
+        out.add(Fact("enable-relay", key))
+        out.update(Fact("occludes-relay", (o, *key)) for o in sorted(occupied))
     return out
+
+
+def free_relays(facts: Iterable[Fact]) -> set[str]:
+    """The objects with a relay (``enable-relay``) that nothing is in the way of at its spot (no
+    ``occludes-relay`` fact names it)."""
+    facts = list(facts)
+    blocked = {f.args[1:] for f in facts if f.predicate == "occludes-relay"}
+    return {f.args[0] for f in facts if f.predicate == "enable-relay" and f.args not in blocked}

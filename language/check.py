@@ -474,7 +474,10 @@ def _self_referential(fact: Fact) -> tuple[str, str]:
     """What a fact wrongly relates to itself ("" if nothing), and a note: an object occluding itself, a
     handover to the same robot, a relay to the same robot with the same grasp."""
     a = fact.args
-    if fact.predicate in ("occludes-pick", "occludes-goal-place", "occludes-handover") and a[0] == a[1]:
+    if (
+        fact.predicate in ("occludes-pick", "occludes-goal-place", "occludes-handover", "occludes-relay")
+        and a[0] == a[1]
+    ):
         return f"object '{a[0]}'", ""
     if fact.predicate == "enable-goal-handover" and a[3] == a[4]:
         return f"robot '{a[3]}'", ""
@@ -500,6 +503,8 @@ def _grasp_uses(fact: Fact) -> list[tuple[str, str]]:
         return [(a[0], a[1]), (a[0], a[2])]
     if fact.predicate == "enable-relay":
         return [(a[0], a[2]), (a[0], a[3])]
+    if fact.predicate == "occludes-relay":
+        return [(a[1], a[3]), (a[1], a[4])]
     if fact.predicate == "occludes-handover":
         return [(a[1], a[2]), (a[1], a[3])]
     return []

@@ -201,7 +201,8 @@ HELP: dict[str, str] = {
     "E214": "A robot's `:kind` that the domain does not define with `(:robot-kind ...)`.",
     "E215": "A movable object's `:handover` list names a handover point the problem does not declare.",
     "E216": "A declared name used where another sort belongs, e.g. a robot in a movable object's place.",
-    "E220": "A predicate other than the seven of the language (docs/language.md): the paper's six and `enable-relay`.",
+    "E220": "A predicate other than the nine of the language (docs/language.md): the paper's six, `enable-relay`, "
+    "`occludes-handover` and `occludes-relay`.",
     "E221": "A predicate with too few or too many arguments; the message gives its signature.",
     "E222": "A goal asks to move a fixed object, which can never move.",
     "E223": "Goals are conjunctions of `(in-region OBJECT REGION)` literals only.",

@@ -17,8 +17,9 @@ from mrgc.language.ast import NOWHERE
 
 # The predicates: name -> sorts of the arguments, in order.  The paper's six, ``enable-relay`` (beyond
 # the paper: a goal object set down on its way and picked up again, in a region or on the top of a fixed
-# object, a "surface"; docs/language.md) and ``occludes-handover`` (beyond the paper: an object in the way
-# of the two arms at the exchange of a handover).
+# object, a "surface"; docs/language.md), ``occludes-handover`` (beyond the paper: an object in the way
+# of the two arms at the exchange of a handover) and ``occludes-relay`` (beyond the paper: an object in the
+# way at a relay's spot).
 PREDICATES: dict[str, tuple[str, ...]] = {
     "in-region": ("movable", "region"),
     "reachable-pick": ("movable", "grasp", "robot"),
@@ -28,6 +29,7 @@ PREDICATES: dict[str, tuple[str, ...]] = {
     "enable-goal-handover": ("movable", "grasp", "grasp", "robot", "robot"),
     "enable-relay": ("movable", "surface", "grasp", "grasp", "robot", "robot"),
     "occludes-handover": ("movable", "movable", "grasp", "grasp", "robot", "robot"),
+    "occludes-relay": ("movable", "movable", "surface", "grasp", "grasp", "robot", "robot"),
 }
 
 #: words users write for a predicate -> the predicates they mean (E220's "did you mean"; a word that is a
@@ -51,9 +53,12 @@ PREDICATE_WORDS: dict[str, tuple[str, ...]] = {
     "obstructs": ("occludes-pick", "occludes-goal-place"),
     "blocks-handover": ("occludes-handover",),
     "occludes-exchange": ("occludes-handover",),
+    "blocks-relay": ("occludes-relay",),
+    "occludes-spot": ("occludes-relay",),
     "blocks-pick": ("occludes-pick",),
     "blocks-place": ("occludes-goal-place",),
     "occludes-place": ("occludes-goal-place",),
+    "relay": ("enable-relay",),
     "regrasp": ("enable-relay",),
     "re-grasp": ("enable-relay",),
     "set-down": ("enable-relay",),

@@ -294,7 +294,8 @@ def reference_task_graph(
     ReachablePlace(target, g2, R2); relays (goal objects only, beyond the paper) need ReachablePick(g1, R1),
     EnableRelay(Re, g1, g2, R1, R2) with Re not the target and ReachablePlace(target, g2, R2).  Pick
     obstacles: OccludesPick(Mj, M, g_pick, R_pick), and for a handover OccludesHandover(Mj, M, g_pick, g_place,
-    R_pick, R_place); place obstacles (goal objects only):
+    R_pick, R_place), for a relay OccludesRelay(Mj, M, Re, g_pick, g_place, R_pick, R_place); place obstacles
+    (goal objects only):
     OccludesGoalPlace(Mj, M, target, g_place, R_place).  Obstacles join the graph recursively.  Edges and
     actions are compared as sets by the tests, so order is not meaningful here.
     """
@@ -306,6 +307,7 @@ def reference_task_graph(
     occ_pick = {f[1:] for f in facts if f[0] == "occludes-pick" and f[1] != f[2]}
     occ_place = {f[1:] for f in facts if f[0] == "occludes-goal-place" and f[1] != f[2]}
     occ_hand = {f[1:] for f in facts if f[0] == "occludes-handover" and f[1] != f[2]}
+    occ_relay = {f[1:] for f in facts if f[0] == "occludes-relay" and f[1] != f[2]}
     done = set(moved)
     must_move = [m for m in dict.fromkeys(must_move) if m not in done]
     movable = sorted({f[1] for f in facts if f[0] == "in-region"} | set(goal) | set(must_move) | done)
@@ -334,6 +336,10 @@ def reference_task_graph(
                 for mj in movable
                 if (mj, m, a.pick_grasp, a.pick_robot) in occ_pick
                 or (a.handover and (mj, m, a.pick_grasp, a.place_grasp, a.pick_robot, a.place_robot) in occ_hand)
+                or (
+                    a.via is not None
+                    and (mj, m, a.via, a.pick_grasp, a.place_grasp, a.pick_robot, a.place_robot) in occ_relay
+                )
             )
             q = tuple(mj for mj in movable if m in goal and (mj, m, target, a.place_grasp, a.place_robot) in occ_place)
             if done & set(p + q):

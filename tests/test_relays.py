@@ -11,11 +11,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from support import ROOT
 
 from mrgc import __version__
 from mrgc.compiler.facts import FactBase
-from mrgc.compiler.task_graph import Action, build_task_graph
+from mrgc.compiler.task_graph import Action, TaskGraph, build_task_graph
 from mrgc.geometry.relays import STAGING, staging, stranded
 from mrgc.geometry.scene import inside, scene_from_problem
 from mrgc.language.loader import parse_file, parse_string
@@ -24,6 +26,7 @@ from mrgc.planfile.format import file_sha256
 from mrgc.planner.outcome import PlanStatus
 from mrgc.planner.phase1 import compute_problem_facts
 from mrgc.planner.search import plan_problem
+from mrgc.planner.skeletons import compile_problem
 from mrgc.testing.oracle import graph_signature, reference_task_graph
 from mrgc.validator.validate import validate
 
@@ -43,8 +46,8 @@ def _plan(problem: Problem, path: Path, seed: int = 0):  # type: ignore[no-untyp
     return plan_problem(problem, str(path), file_sha256(str(path)), __version__, seed=seed, time_limit=120)
 
 
-def test_relay_actions_match_the_reference_graph() -> None:
-    problem = _problem(SYMBOLIC)
+def _graph(problem: Problem) -> TaskGraph:
+    """The compiler's task graph of ``problem``'s goals, after checking it against the reference oracle's."""
     facts = FactBase.from_problem(problem)
     graph = build_task_graph(facts, list(problem.goal_regions))
     reference = reference_task_graph(
@@ -56,12 +59,55 @@ def test_relay_actions_match_the_reference_graph() -> None:
         list(problem.goal_regions),
     )
     assert graph_signature(graph) == graph_signature(reference)
+    return graph
+
+
+def test_relay_actions_match_the_reference_graph() -> None:
+    graph = _graph(_problem(SYMBOLIC))
     relays = [a for a in graph.actions if a.via is not None]
     # (o1 mid top side r1 r2) has r2's goal placement with side; (o1 mid top side r1 r1) has no place by r1
     assert relays == [Action("o1", "goal", "r1", "r2", "top", "side", "mid")]
     (i,) = [graph.actions.index(a) for a in relays]
     assert graph.block_pick[i] == ("o2",) and graph.block_place[i] == ("o3",)
     assert not relays[0].handover and relays[0].robots == ("r1", "r2")
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.sets(st.sampled_from(["o2", "o3", "o4"])), st.booleans())
+def test_the_objects_in_the_way_at_a_relays_spot_are_its_pick_obstacles(in_way: set[str], other: bool) -> None:
+    """``occludes-relay`` (session 44): the objects in the way at a relay's spot are pick obstacles of that relay
+    and of no other action, as the reference graph says for any set of them; a fact naming a relay that is no
+    action (``other``: the regrasp r1 -> r1, which no goal placement by r1 follows) adds nothing."""
+    key = "o1 mid top side r1 r1" if other else "o1 mid top side r1 r2"
+    facts = " ".join(f"(occludes-relay {o} {key})" for o in sorted(in_way))
+    last = "(occludes-goal-place o4 o1 mid top r1))"
+    text = SYMBOLIC.read_text()
+    before, after = (
+        _graph(parse_string(text.replace(last, f"{last[:-1]} {extra})"), str(SYMBOLIC)).problems[0])
+        for extra in ("", facts)
+    )
+    assert before.actions == after.actions
+    for a, was, now in zip(after.actions, before.block_pick, after.block_pick):
+        assert set(now) == set(was) | (in_way if a.via is not None and not other else set())
+
+
+def test_a_skeleton_clears_a_relays_spot_before_the_relay(tmp_path: Path) -> None:
+    """With o4 in the way at the spot in mid (``occludes-relay``) and movable by r1, every skeleton moves o4
+    in a step before the relay of o1, and the plan (symbolic: the skeleton) still validates."""
+    last = "(occludes-goal-place o4 o1 mid top r1))"
+    extra = "(reachable-pick o4 top r1) (reachable-place o4 start top r1) (occludes-relay o4 o1 mid top side r1 r2)"
+    path = tmp_path / "relay-spot.mrg"
+    path.write_text(SYMBOLIC.read_text().replace(last, f"{last[:-1]} {extra})"))
+    problem = _problem(path)
+    result = compile_problem(problem, skeletons=3)
+    assert result.skeletons
+    for skel in result.skeletons:
+        when = {a.obj: t for t, step in enumerate(skel.steps) for a in step}
+        assert "o4" in when and when["o4"] < when["o1"], skel
+    plan = _plan(problem, path)
+    assert plan.status is PlanStatus.SOLVED
+    report = validate(problem, plan, str(path))
+    assert report.ok, [str(v) for v in report.violations]
 
 
 def test_a_symbolic_relay_is_two_moves_the_validator_accepts() -> None:
@@ -106,12 +152,16 @@ def test_a_generated_table_without_a_one_move_plan_is_planned_with_a_relay(seed:
 
 def test_a_relay_with_no_spot_left_in_its_region_sets_its_object_down_on_the_table() -> None:
     """tests/data/relay-crowded.mrg: relay-packaging with the part of start both arms reach filled.  Phase 1
-    relays o3 via start (it ignores movable objects); grounding finds no spot there and sets o3 down on the
-    table between r1 and r2 instead (session 42; before, the search first moved four of the fillers out of
-    the way: 7 objects moved in 8 moves, makespan 7).  The plan is valid."""
+    relays o3 via start with fillers in the way at its spot (``occludes-relay``, session 44), and so also via
+    the table between r1 and r2, where nothing is; the plan sets o3 down on the table (session 42: grounding
+    found no spot in start and fell back to the table; before, the search first moved four of the fillers
+    out of the way: 7 objects moved in 8 moves, makespan 7).  The plan is valid."""
     problem = _problem(CROWDED)
     facts = compute_problem_facts(problem, seed=0).facts
-    assert {f.args[1] for f in facts if f.predicate == "enable-relay" and f.args[0] == "o3"} == {"start"}
+    relays = {f.args[1:] for f in facts if f.predicate == "enable-relay" and f.args[0] == "o3"}
+    assert {r[0] for r in relays} == {"start", "table"}
+    in_way = {f.args[2:] for f in facts if f.predicate == "occludes-relay" and f.args[1] == "o3"}
+    assert {r[0] for r in in_way} == {"start"} and all(r in relays for r in in_way)
     plan = _plan(problem, CROWDED, 0)
     assert plan.status is PlanStatus.SOLVED, plan.summary()
     set_down = [a for step in plan.steps for a in step if a.relay]

@@ -485,6 +485,8 @@ def _self_referential(fact: Fact) -> tuple[str, str]:
         return f"robot '{a[4]}'", ""
     if fact.predicate == "enable-relay" and a[4] == a[5] and a[2] == a[3]:
         return f"robot '{a[4]}' with grasp '{a[2]}'", ": a relay back to the same robot must change the grasp"
+    if fact.predicate == "occludes-relay" and a[5] == a[6] and a[3] == a[4]:
+        return f"robot '{a[5]}' with grasp '{a[3]}'", ": a relay back to the same robot must change the grasp"
     return "", ""
 
 

@@ -204,6 +204,15 @@ def test_relay_facts_are_read_with_their_argument_sorts() -> None:
         ("(enable-relay o1 nowhere top side r1 r2)", "E212", 22, "undeclared region or fixed object 'nowhere'"),
         ("(enable-relay o1 mid top grip r1 r2)", "E213", 30, "undeclared grasp 'grip'"),
         ("(enable-relay o1 mid top side r1)", "E221", 5, "'enable-relay' takes 6 arguments"),
+        ("(occludes-relay o1 o1 mid top side r1 r2)", "E229", 5, "'occludes-relay' relates object 'o1' to itself"),
+        (
+            "(occludes-relay o2 o1 mid top top r2 r2)",
+            "E229",
+            5,
+            "'occludes-relay' relates robot 'r2' with grasp 'top' to itself: a relay back to the same robot",
+        ),
+        ("(occludes-relay o2 o1 mid top side r1)", "E221", 5, "'occludes-relay' takes 7 arguments"),
+        ("(occludes-relay r1 o1 mid top side r1 r2)", "E216", 21, "'r1' is a robot, but 'occludes-relay' expects"),
     ],
 )
 def test_relay_facts_are_checked_where_they_are_written(fact: str, code: str, column: int, message: str) -> None:

@@ -27,7 +27,7 @@ For every robot R (in parallel, one process per robot when there are cores to sp
   their goal): R1 sets M down with g1 at a placement in Re where R2 picks it up with g2
   (:mod:`mrgc.geometry.relays`);
 - ``occludes-relay M1 M Re g1 g2 R1 R2`` (beyond the paper): M1 is hit by R1's or R2's links along their
-  approaches to that relay's spot, or by M at the spot, for the spot that hits the fewest movable objects;
+  approaches to that relay's spot, or by M along them and at the spot, for the spot that hits the fewest;
   none when a spot hits none (a relay through a crowded start region needs room there: the objects at its
   spot must move first);
 

@@ -10,17 +10,23 @@ so no handover exists), picked by an arm that cannot reach its bin.
 The fact needs one placement of M in Re (a pose of :meth:`RobotEvaluator.placements
 <mrgc.geometry.predicates.RobotEvaluator.placements>`' lattice) that R1 reaches holding M with g1 and R2
 reaches with g2: grasp and pre-grasp by inverse kinematics, the arm, its fingers at the grasp's opening
-and M along the approach free of the fixed objects (movable objects ignored, as for ``reachable-place``:
-grounding looks for a free spot).  R1 must also pick M (``reachable-pick M g1 R1``) and R2 place it in its
-goal (``reachable-place M goal g2 R2``).  Relays are looked for only for the goal objects that need them,
-so a problem every goal of which has a pick-and-place or a handover gets the paper's facts unchanged.
+and M along the approach free of the fixed objects (movable objects do not decide whether the fact holds, as
+for ``reachable-place``: grounding looks for a free spot).  R1 must also pick M (``reachable-pick M g1 R1``)
+and R2 place it in its goal (``reachable-place M goal g2 R2``).  Relays are looked for only for the goal
+objects that need them, so a problem every goal of which has a pick-and-place or a handover gets the paper's
+facts unchanged.
 
-**Surfaces.**  When no region gives an object a relay (a table whose regions are each out of one arm's
-reach), the top of a fixed object may: ``enable-relay M table g1 g2 R1 R2`` sets M down on the table.
-Spots are looked for in a STAGING square of the top (:func:`mrgc.geometry.scene.surface`) centred between
-the two robots' bases (:func:`staging`), only for two different robots, and only for the objects the
-regions gave no relay (so problems whose regions serve get the same facts as before).  Grounding looks in
-the same square (:func:`spot_region`); the validator accepts any spot on the top.
+**In the way** (session 44).  The movable objects the two arms' approaches to a spot hit, or M on its way
+there and at the spot, are what is in the way of the relay there; of the spots that make the fact, the one
+with the fewest gives its ``occludes-relay M1 M Re g1 g2 R1 R2`` facts (none when one is free), and the
+compiler makes them pick obstacles of the relay: a skeleton clears the spot first.
+
+**Surfaces.**  When no region gives an object a relay with nothing in the way (a table whose regions are each
+out of one arm's reach, or a crowded start region), the top of a fixed object may: ``enable-relay M table g1
+g2 R1 R2`` sets M down on the table.  Spots are looked for in a STAGING square of the top
+(:func:`mrgc.geometry.scene.surface`) centred between the two robots' bases (:func:`staging`), only for two
+different robots, and only for those objects (so problems whose regions serve get the same facts as before).
+Grounding looks in the same square (:func:`spot_region`); the validator accepts any spot on the top.
 
 This module decides which spots to ask for and combines the answers; the per-robot inverse kinematics run
 in :mod:`mrgc.geometry.predicates` (one worker per robot, like the rest of phase 1).
